@@ -1,0 +1,20 @@
+#pragma once
+// The value each setting takes when the installation leaves it at zero or empty:
+// one place, read by apply_defaults and by the checks that relate two settings.
+
+#include <cstdint>
+
+namespace optique::config::defaults {
+
+inline constexpr double kFrameRate = 60.0;
+inline constexpr std::uint32_t kFrameTimeoutMs = 500;
+inline constexpr std::uint32_t kStartupTimeoutMs = 10000;
+inline constexpr std::uint32_t kHandshakeTimeoutMs = 2000;
+inline constexpr std::uint32_t kHeartbeatMs = 250;
+inline constexpr std::uint32_t kMinLivenessTimeoutMs = 3000;  // or 3 heartbeats, if longer
+inline constexpr std::uint32_t kPresentLeadUs = 2000;
+inline constexpr std::uint32_t kMaxMessageBytes = 16u << 20;
+inline constexpr double kEyeSeparation = 0.065;
+inline constexpr double kPixelsPerMetre = 200.0;
+
+}  // namespace optique::config::defaults

@@ -1,0 +1,90 @@
+#include "config/load.h"
+
+#include <google/protobuf/util/json_util.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "config/defaults.h"
+#include "config/validate.h"
+#include "util/sha256.h"
+
+namespace optique::config {
+
+Result<Installation> parse_installation(const std::string& json, const std::string& origin,
+                                        const std::string& directory) {
+  Installation installation;
+  google::protobuf::util::JsonParseOptions options;
+  options.ignore_unknown_fields = false;
+  const auto status = google::protobuf::util::JsonStringToMessage(json, &installation, options);
+  if (!status.ok()) {
+    return Error{origin + ": not a valid installation: " + std::string(status.message())};
+  }
+  const std::vector<Problem> problems = validate(installation, directory);
+  if (!problems.empty()) {
+    std::string message;
+    for (const Problem& p : problems) {
+      message += (message.empty() ? "" : "\n") + origin + ": " + p.path + ": " + p.message;
+    }
+    return Error{message};
+  }
+  apply_defaults(installation);
+  return installation;
+}
+
+Result<LoadedConfig> load_installation(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path + ": cannot open the config file"};
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) return Error{path + ": cannot read the config file"};
+
+  LoadedConfig loaded;
+  loaded.path = path;
+  loaded.directory = std::filesystem::path(path).parent_path().string();
+  if (loaded.directory.empty()) loaded.directory = ".";
+  auto installation = parse_installation(text.str(), path, loaded.directory);
+  if (!installation) return Error{installation.error()};
+  loaded.installation = std::move(installation).value();
+  loaded.sha256 = util::sha256_hex(text.str());
+  return loaded;
+}
+
+void apply_defaults(Installation& installation) {
+  MasterSettings& m = *installation.mutable_master();
+  if (m.listen().empty()) m.set_listen("0.0.0.0");
+  if (m.frame_rate() == 0.0) m.set_frame_rate(defaults::kFrameRate);
+  if (m.frame_timeout_ms() == 0) m.set_frame_timeout_ms(defaults::kFrameTimeoutMs);
+  if (m.startup_timeout_ms() == 0) m.set_startup_timeout_ms(defaults::kStartupTimeoutMs);
+  if (m.handshake_timeout_ms() == 0) m.set_handshake_timeout_ms(defaults::kHandshakeTimeoutMs);
+  if (m.heartbeat_ms() == 0) m.set_heartbeat_ms(defaults::kHeartbeatMs);
+  if (m.liveness_timeout_ms() == 0)
+    m.set_liveness_timeout_ms(std::max(defaults::kMinLivenessTimeoutMs, 3 * m.heartbeat_ms()));
+  if (m.present_lead_us() == 0) m.set_present_lead_us(defaults::kPresentLeadUs);
+  if (m.max_message_bytes() == 0) m.set_max_message_bytes(defaults::kMaxMessageBytes);
+
+  Viewer& v = *installation.mutable_viewer();
+  if (v.eye_separation() == 0.0) v.set_eye_separation(defaults::kEyeSeparation);
+
+  for (Screen& s : *installation.mutable_screens()) {
+    if (s.pixels_per_metre() == 0.0) s.set_pixels_per_metre(defaults::kPixelsPerMetre);
+  }
+  for (Projector& p : *installation.mutable_projectors()) {
+    if (p.host().empty()) p.set_host("localhost");
+    if (p.output().kind().empty()) p.mutable_output()->set_kind("headless");
+    if (p.eye().empty()) p.set_eye("mono");
+    if (!p.has_region()) {
+      for (const Screen& s : installation.screens()) {
+        if (s.id() != p.screen()) continue;
+        Region& r = *p.mutable_region();
+        r.set_x(0.0);
+        r.set_y(0.0);
+        r.set_width(s.width());
+        r.set_height(s.height());
+      }
+    }
+  }
+}
+
+}  // namespace optique::config

@@ -1,0 +1,245 @@
+#include "config/validate.h"
+
+#include <arpa/inet.h>
+
+#include <cmath>
+#include <filesystem>
+#include <set>
+#include <sstream>
+
+#include "config/defaults.h"
+#include "scene/builtin.h"
+
+namespace optique::config {
+namespace {
+
+std::string number(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
+}
+
+class Checker {
+ public:
+  explicit Checker(std::vector<Problem>& problems) : problems_(problems) {}
+
+  void fail(const std::string& path, const std::string& message) { problems_.push_back({path, message}); }
+
+  bool finite(const std::string& path, double v) {
+    if (std::isfinite(v)) return true;
+    fail(path, "must be a finite number (got " + number(v) + ")");
+    return false;
+  }
+
+  void positive(const std::string& path, double v) {
+    if (finite(path, v) && v <= 0.0) fail(path, "must be > 0 (got " + number(v) + ")");
+  }
+
+  void non_negative(const std::string& path, double v) {
+    if (finite(path, v) && v < 0.0) fail(path, "must be >= 0 (got " + number(v) + ")");
+  }
+
+  // A 3-vector of finite numbers; returns whether it is one.
+  bool vec3(const std::string& path, const google::protobuf::RepeatedField<double>& v) {
+    if (v.size() != 3) {
+      fail(path, "must be [x, y, z] (got " + std::to_string(v.size()) + " numbers)");
+      return false;
+    }
+    bool ok = true;
+    for (int i = 0; i < 3; ++i) ok = finite(path + "[" + std::to_string(i) + "]", v[i]) && ok;
+    return ok;
+  }
+
+  void one_of(const std::string& path, const std::string& value, std::initializer_list<const char*> allowed) {
+    if (value.empty()) return;  // the default applies
+    std::string list;
+    for (const char* a : allowed) {
+      if (value == a) return;
+      list += list.empty() ? "" : ", ";
+      list += a;
+    }
+    fail(path, "unknown value '" + value + "' (expected one of: " + list + ")");
+  }
+
+ private:
+  std::vector<Problem>& problems_;
+};
+
+bool usable_as_file_name(const std::string& id) {
+  if (id.empty() || id == "." || id == "..") return false;
+  for (char c : id) {
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+    if (!ok) return false;
+  }
+  return true;
+}
+
+void check_id(Checker& check, const std::string& path, const std::string& id, std::set<std::string>& seen,
+              const char* what) {
+  if (id.empty()) {
+    check.fail(path, std::string("every ") + what + " needs an id");
+  } else if (!usable_as_file_name(id)) {
+    check.fail(path, "id '" + id + "' may only use letters, digits, '-', '_' and '.' (it names output folders)");
+  } else if (!seen.insert(id).second) {
+    check.fail(path, std::string("duplicate ") + what + " id '" + id + "'");
+  }
+}
+
+double dot(const google::protobuf::RepeatedField<double>& a, const google::protobuf::RepeatedField<double>& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+void check_screens(Checker& check, const Installation& inst, std::set<std::string>& ids) {
+  if (inst.screens().empty()) check.fail("screens", "at least one screen is needed");
+  for (int i = 0; i < inst.screens_size(); ++i) {
+    const Screen& s = inst.screens(i);
+    const std::string at = "screens[" + std::to_string(i) + "]";
+    check_id(check, at + ".id", s.id(), ids, "screen");
+    check.vec3(at + ".origin", s.origin());
+    const bool right_ok = check.vec3(at + ".right", s.right());
+    const bool up_ok = check.vec3(at + ".up", s.up());
+    constexpr double kTolerance = 1e-3;
+    if (right_ok && std::abs(std::sqrt(dot(s.right(), s.right())) - 1.0) > kTolerance) {
+      check.fail(at + ".right", "must be a unit vector (length " + number(std::sqrt(dot(s.right(), s.right()))) + ")");
+    }
+    if (up_ok && std::abs(std::sqrt(dot(s.up(), s.up())) - 1.0) > kTolerance) {
+      check.fail(at + ".up", "must be a unit vector (length " + number(std::sqrt(dot(s.up(), s.up()))) + ")");
+    }
+    if (right_ok && up_ok && std::abs(dot(s.right(), s.up())) > kTolerance) {
+      check.fail(at + ".up", "must be perpendicular to right (dot product " + number(dot(s.right(), s.up())) + ")");
+    }
+    check.positive(at + ".width", s.width());
+    check.positive(at + ".height", s.height());
+    check.non_negative(at + ".pixels_per_metre", s.pixels_per_metre());
+  }
+}
+
+void check_region(Checker& check, const std::string& at, const Region& r, const Screen* screen) {
+  check.non_negative(at + ".x", r.x());
+  check.non_negative(at + ".y", r.y());
+  check.positive(at + ".width", r.width());
+  check.positive(at + ".height", r.height());
+  if (screen == nullptr) return;
+  constexpr double kSlack = 1e-9;
+  if (std::isfinite(r.x() + r.width()) && r.x() + r.width() > screen->width() + kSlack) {
+    check.fail(at, "extends past the right edge of screen '" + screen->id() +
+                       "' (x + width = " + number(r.x() + r.width()) + " m > " + number(screen->width()) + " m)");
+  }
+  if (std::isfinite(r.y() + r.height()) && r.y() + r.height() > screen->height() + kSlack) {
+    check.fail(at, "extends past the top edge of screen '" + screen->id() +
+                       "' (y + height = " + number(r.y() + r.height()) + " m > " + number(screen->height()) + " m)");
+  }
+}
+
+void check_projectors(Checker& check, const Installation& inst) {
+  if (inst.projectors().empty()) check.fail("projectors", "at least one projector is needed");
+  std::set<std::string> ids;
+  constexpr std::uint32_t kMaxPixels = 16384;
+  for (int i = 0; i < inst.projectors_size(); ++i) {
+    const Projector& p = inst.projectors(i);
+    const std::string at = "projectors[" + std::to_string(i) + "]";
+    check_id(check, at + ".id", p.id(), ids, "projector");
+    if (p.width() == 0 || p.width() > kMaxPixels) {
+      check.fail(at + ".width",
+                 "must be 1.." + std::to_string(kMaxPixels) + " pixels (got " + std::to_string(p.width()) + ")");
+    }
+    if (p.height() == 0 || p.height() > kMaxPixels) {
+      check.fail(at + ".height",
+                 "must be 1.." + std::to_string(kMaxPixels) + " pixels (got " + std::to_string(p.height()) + ")");
+    }
+    const Screen* screen = nullptr;
+    for (const Screen& s : inst.screens()) {
+      if (s.id() == p.screen()) screen = &s;
+    }
+    if (p.screen().empty()) {
+      check.fail(at + ".screen", "must name the screen this projector lights");
+    } else if (screen == nullptr) {
+      std::string known;
+      for (const Screen& s : inst.screens()) known += (known.empty() ? "" : ", ") + s.id();
+      check.fail(at + ".screen", "unknown screen '" + p.screen() + "' (screens are: " + known + ")");
+    }
+    if (p.has_region()) check_region(check, at + ".region", p.region(), screen);
+    check.one_of(at + ".output.kind", p.output().kind(), {"headless", "window"});
+    check.one_of(at + ".eye", p.eye(), {"mono", "left", "right"});
+  }
+}
+
+void check_viewer(Checker& check, const Viewer& v) {
+  const bool has_eye = !v.eye().empty();
+  const bool has_path = !v.path().empty();
+  if (has_eye == has_path) {
+    check.fail("viewer",
+               has_eye ? "give either eye or path, not both" : "give the eye position: eye [x, y, z] or a path");
+  }
+  if (has_eye) check.vec3("viewer.eye", v.eye());
+  for (int i = 0; i < v.path_size(); ++i) {
+    const std::string at = "viewer.path[" + std::to_string(i) + "]";
+    check.non_negative(at + ".time", v.path(i).time());
+    check.vec3(at + ".position", v.path(i).position());
+    if (i > 0 && !(v.path(i).time() > v.path(i - 1).time())) {
+      check.fail(at + ".time",
+                 "times must increase (" + number(v.path(i).time()) + " after " + number(v.path(i - 1).time()) + ")");
+    }
+  }
+  check.non_negative("viewer.eye_separation", v.eye_separation());
+  if (v.eye_separation() > 1.0)
+    check.fail("viewer.eye_separation", "is in metres; " + number(v.eye_separation()) + " m is not an eye separation");
+}
+
+void check_master(Checker& check, const MasterSettings& m) {
+  if (!m.listen().empty()) {
+    in6_addr buffer{};
+    if (inet_pton(AF_INET, m.listen().c_str(), &buffer) != 1 && inet_pton(AF_INET6, m.listen().c_str(), &buffer) != 1) {
+      check.fail("master.listen", "'" + m.listen() + "' is not an IPv4 or IPv6 address");
+    }
+  }
+  if (m.port() > 65535) check.fail("master.port", "must be 0..65535 (got " + std::to_string(m.port()) + ")");
+  if (check.finite("master.frame_rate", m.frame_rate()) && (m.frame_rate() < 0.0 || m.frame_rate() > 1000.0)) {
+    check.fail("master.frame_rate",
+               "must be in (0, 1000] Hz, or 0 for the default (got " + number(m.frame_rate()) + ")");
+  }
+  if (m.max_message_bytes() != 0 && m.max_message_bytes() < 1024) {
+    check.fail("master.max_message_bytes", "must be at least 1024 (got " + std::to_string(m.max_message_bytes()) + ")");
+  }
+  const std::uint32_t heartbeat = m.heartbeat_ms() != 0 ? m.heartbeat_ms() : defaults::kHeartbeatMs;
+  if (m.liveness_timeout_ms() != 0 && m.liveness_timeout_ms() <= 2 * heartbeat) {
+    check.fail("master.liveness_timeout_ms", "must be more than twice heartbeat_ms (" + std::to_string(heartbeat) +
+                                                 " ms), or peers are dropped between heartbeats");
+  }
+}
+
+void check_scene(Checker& check, const Scene& s, const std::string& config_dir) {
+  const bool builtin = !s.builtin().empty();
+  const bool gltf = !s.gltf().empty();
+  if (builtin == gltf) {
+    check.fail("scene", builtin ? "give either builtin or gltf, not both" : "name a builtin scene or a gltf file");
+    return;
+  }
+  if (builtin && !scene::is_builtin_scene(s.builtin())) {
+    std::string known;
+    for (const auto& name : scene::builtin_scene_names()) known += (known.empty() ? "" : ", ") + std::string(name);
+    check.fail("scene.builtin", "unknown scene '" + s.builtin() + "' (built-in scenes are: " + known + ")");
+  }
+  if (gltf) {
+    const std::filesystem::path file = std::filesystem::path(config_dir) / s.gltf();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) check.fail("scene.gltf", "no such file: " + file.string());
+  }
+}
+
+}  // namespace
+
+std::vector<Problem> validate(const Installation& installation, const std::string& config_dir) {
+  std::vector<Problem> problems;
+  Checker check(problems);
+  std::set<std::string> screen_ids;
+  check_screens(check, installation, screen_ids);
+  check_projectors(check, installation);
+  check_viewer(check, installation.viewer());
+  check_master(check, installation.master());
+  check_scene(check, installation.scene(), config_dir);
+  return problems;
+}
+
+}  // namespace optique::config

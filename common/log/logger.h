@@ -1,0 +1,16 @@
+#pragma once
+// One logger per process, made in main and handed to whoever logs: no global.
+
+#include <spdlog/logger.h>
+
+#include <memory>
+#include <string>
+
+namespace optique::log {
+
+// Logs to stderr, and also to `file` when it is not empty. `level` is one of
+// spdlog's names: trace, debug, info, warn, error.
+[[nodiscard]] std::shared_ptr<spdlog::logger> make_logger(const std::string& name, const std::string& level,
+                                                          const std::string& file = {});
+
+}  // namespace optique::log

@@ -1,0 +1,165 @@
+#include "net/connection.h"
+
+#include <boost/asio/write.hpp>
+
+#include "net/envelope.h"
+
+namespace optique::net {
+
+std::shared_ptr<Connection> Connection::create(asio::ip::tcp::socket socket, std::uint32_t max_payload_bytes) {
+  return std::shared_ptr<Connection>(new Connection(std::move(socket), max_payload_bytes));
+}
+
+Connection::Connection(asio::ip::tcp::socket socket, std::uint32_t max_payload_bytes)
+    : socket_(std::move(socket)),
+      liveness_timer_(socket_.get_executor()),
+      deadline_timer_(socket_.get_executor()),
+      reader_(max_payload_bytes),
+      last_receive_(std::chrono::steady_clock::now()) {
+  boost::system::error_code ec;
+  socket_.set_option(asio::ip::tcp::no_delay(true), ec);
+  const auto endpoint = socket_.remote_endpoint(ec);
+  peer_ = ec ? std::string("unknown peer") : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
+}
+
+Connection::~Connection() = default;
+
+void Connection::start(Handlers handlers) {
+  handlers_ = std::move(handlers);
+  read_more();
+}
+
+void Connection::send(wire::Envelope& message) {
+  if (!open_ || closing_) return;
+  message.set_protocol_version(message.protocol_version() != 0 ? message.protocol_version() : kProtocolVersion);
+  message.set_sequence(next_send_sequence_++);
+  append_envelope(outbox_, message);
+  if (queued_bytes() > kMaxQueuedBytes) {
+    close("peer is not reading its messages (" + std::to_string(queued_bytes() >> 20) + " MiB queued)");
+    return;
+  }
+  if (in_flight_.empty()) write_more();
+}
+
+void Connection::write_more() {
+  if (outbox_.empty() || !open_) return;
+  in_flight_.swap(outbox_);
+  asio::async_write(socket_, asio::buffer(in_flight_),
+                    [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
+                      self->in_flight_.clear();
+                      if (ec) {
+                        if (ec != asio::error::operation_aborted) self->finish("write failed: " + ec.message());
+                        return;
+                      }
+                      if (!self->outbox_.empty()) {
+                        self->write_more();
+                      } else if (self->closing_) {
+                        self->finish(self->closing_reason_);
+                      }
+                    });
+}
+
+void Connection::read_more() {
+  socket_.async_read_some(asio::buffer(read_buffer_),
+                          [self = shared_from_this()](const boost::system::error_code& ec, std::size_t count) {
+                            if (ec) {
+                              if (ec == asio::error::eof) {
+                                self->finish("peer closed the connection");
+                              } else if (ec != asio::error::operation_aborted) {
+                                self->finish("read failed: " + ec.message());
+                              }
+                              return;
+                            }
+                            self->handle_bytes(count);
+                            if (self->open_) self->read_more();
+                          });
+}
+
+void Connection::handle_bytes(std::size_t count) {
+  last_receive_ = std::chrono::steady_clock::now();
+  if (closing_) return;  // draining: what the peer says no longer matters
+  reader_.append({read_buffer_.data(), count});
+  while (open_ && !closing_) {
+    const DecodedFrame frame = reader_.next();
+    if (frame.status == DecodeStatus::need_more) return;
+    if (frame.status == DecodeStatus::bad) {
+      close("bad frame: " + frame.error);
+      return;
+    }
+    auto message = parse_envelope(frame.payload);
+    if (!message) {
+      close("bad message: " + message.error());
+      return;
+    }
+    if (message.value().sequence() != next_receive_sequence_) {
+      close("message out of sequence (got " + std::to_string(message.value().sequence()) + ", expected " +
+            std::to_string(next_receive_sequence_) + ")");
+      return;
+    }
+    ++next_receive_sequence_;
+    if (handlers_.on_message) handlers_.on_message(message.value());
+  }
+}
+
+void Connection::close(const std::string& reason) { finish(reason); }
+
+void Connection::close_after_sending(const std::string& reason) {
+  if (!open_ || closing_) return;
+  closing_ = true;
+  closing_reason_ = reason;
+  if (in_flight_.empty() && outbox_.empty()) {
+    finish(reason);
+  } else if (in_flight_.empty()) {
+    write_more();
+  }
+}
+
+void Connection::set_liveness_timeout(std::chrono::milliseconds timeout, std::string reason) {
+  liveness_timeout_ = timeout;
+  liveness_reason_ = std::move(reason);
+  if (timeout.count() > 0) {
+    arm_liveness();
+  } else {
+    liveness_timer_.cancel();
+  }
+}
+
+// One timer for the whole connection rather than one reset per message: when it
+// fires early (traffic came in meanwhile) it re-arms for the remaining time.
+void Connection::arm_liveness() {
+  liveness_timer_.expires_at(last_receive_ + liveness_timeout_);
+  liveness_timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+    if (ec || !self->open_ || self->liveness_timeout_.count() == 0) return;
+    if (std::chrono::steady_clock::now() >= self->last_receive_ + self->liveness_timeout_) {
+      self->finish(self->liveness_reason_);
+    } else {
+      self->arm_liveness();
+    }
+  });
+}
+
+void Connection::set_deadline(std::chrono::milliseconds timeout, std::string reason) {
+  deadline_timer_.expires_after(timeout);
+  deadline_timer_.async_wait(
+      [self = shared_from_this(), reason = std::move(reason)](const boost::system::error_code& ec) {
+        if (!ec && self->open_) self->finish(reason);
+      });
+}
+
+void Connection::cancel_deadline() { deadline_timer_.cancel(); }
+
+void Connection::finish(const std::string& reason) {
+  if (!open_) return;
+  open_ = false;
+  boost::system::error_code ignored;
+  socket_.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+  socket_.close(ignored);
+  liveness_timer_.cancel();
+  deadline_timer_.cancel();
+  // Handlers usually capture their owner; drop them so nothing keeps a cycle alive.
+  Handlers handlers = std::move(handlers_);
+  handlers_ = {};
+  if (handlers.on_closed) handlers.on_closed(reason);
+}
+
+}  // namespace optique::net

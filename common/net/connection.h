@@ -1,0 +1,90 @@
+#pragma once
+// One TCP connection carrying Envelopes: asynchronous reads through a FrameReader,
+// coalesced asynchronous writes, and deadlines owned by the session (a liveness
+// timeout and an optional one-shot deadline). Never a blocking read. Used on one
+// io_context thread; not thread-safe.
+
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include <array>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "net/framing.h"
+#include "optique/wire.pb.h"
+
+namespace optique::net {
+
+namespace asio = boost::asio;
+
+class Connection : public std::enable_shared_from_this<Connection> {
+ public:
+  struct Handlers {
+    std::function<void(wire::Envelope& message)> on_message;
+    // Called once, when the connection is gone for any reason.
+    std::function<void(const std::string& reason)> on_closed;
+  };
+
+  static std::shared_ptr<Connection> create(asio::ip::tcp::socket socket, std::uint32_t max_payload_bytes);
+
+  Connection(const Connection&) = delete;
+  Connection& operator=(const Connection&) = delete;
+  ~Connection();
+
+  void start(Handlers handlers);
+
+  // Stamps protocol version and sequence number and queues the message.
+  void send(wire::Envelope& message);
+
+  // Closes now; queued messages are dropped.
+  void close(const std::string& reason);
+  // Sends what is queued, then closes (a Refuse or a Goodbye must arrive).
+  void close_after_sending(const std::string& reason);
+
+  // Closes with `reason` when nothing arrives for `timeout` (0 turns it off).
+  void set_liveness_timeout(std::chrono::milliseconds timeout, std::string reason);
+  // Closes with `reason` at `timeout` from now unless cancel_deadline() is called.
+  void set_deadline(std::chrono::milliseconds timeout, std::string reason);
+  void cancel_deadline();
+
+  [[nodiscard]] bool is_open() const { return open_; }
+  [[nodiscard]] const std::string& peer() const { return peer_; }
+  [[nodiscard]] std::size_t queued_bytes() const { return outbox_.size() + in_flight_.size(); }
+
+  // A peer that does not read its messages is dropped past this much backlog.
+  static constexpr std::size_t kMaxQueuedBytes = 64u << 20;
+
+ private:
+  Connection(asio::ip::tcp::socket socket, std::uint32_t max_payload_bytes);
+
+  void read_more();
+  void handle_bytes(std::size_t count);
+  void write_more();
+  void arm_liveness();
+  void finish(const std::string& reason);
+
+  asio::ip::tcp::socket socket_;
+  asio::steady_timer liveness_timer_;
+  asio::steady_timer deadline_timer_;
+  FrameReader reader_;
+  Handlers handlers_;
+  std::string peer_;
+  std::array<std::uint8_t, 64 * 1024> read_buffer_{};
+  std::vector<std::uint8_t> outbox_;
+  std::vector<std::uint8_t> in_flight_;
+  std::uint64_t next_send_sequence_ = 1;
+  std::uint64_t next_receive_sequence_ = 1;
+  std::chrono::milliseconds liveness_timeout_{0};
+  std::string liveness_reason_;
+  std::chrono::steady_clock::time_point last_receive_;
+  std::string closing_reason_;
+  bool open_ = true;
+  bool closing_ = false;
+};
+
+}  // namespace optique::net

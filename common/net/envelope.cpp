@@ -1,0 +1,37 @@
+#include "net/envelope.h"
+
+#include "net/framing.h"
+
+namespace optique::net {
+
+void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envelope) {
+  const std::size_t size = envelope.ByteSizeLong();
+  const std::size_t start = out.size();
+  out.resize(start + kFrameHeaderBytes + size);
+  const auto length = static_cast<std::uint32_t>(size);
+  out[start + 0] = static_cast<std::uint8_t>(length >> 24);
+  out[start + 1] = static_cast<std::uint8_t>(length >> 16);
+  out[start + 2] = static_cast<std::uint8_t>(length >> 8);
+  out[start + 3] = static_cast<std::uint8_t>(length);
+  const bool serialized = envelope.SerializeWithCachedSizesToArray(out.data() + start + kFrameHeaderBytes) != nullptr;
+  assert(serialized);
+  (void)serialized;
+}
+
+Result<wire::Envelope> parse_envelope(std::span<const std::uint8_t> payload) {
+  wire::Envelope envelope;
+  if (!envelope.ParseFromArray(payload.data(), static_cast<int>(payload.size()))) {
+    return Error{"undecodable message (" + std::to_string(payload.size()) + " bytes are not an Envelope)"};
+  }
+  if (envelope.body_case() == wire::Envelope::BODY_NOT_SET) {
+    return Error{"message without a body (unknown type, or a newer protocol)"};
+  }
+  return envelope;
+}
+
+const char* body_name(const wire::Envelope& envelope) {
+  const auto* field = wire::Envelope::descriptor()->FindFieldByNumber(envelope.body_case());
+  return field != nullptr ? field->name().c_str() : "none";
+}
+
+}  // namespace optique::net

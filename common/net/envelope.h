@@ -1,0 +1,26 @@
+#pragma once
+// One Envelope per frame: serialization and parsing, still free of sockets.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "optique/wire.pb.h"
+#include "util/result.h"
+
+namespace optique::net {
+
+// Bumped whenever a message changes meaning; master and node must agree exactly.
+inline constexpr std::uint32_t kProtocolVersion = 1;
+
+// Serializes `envelope` and appends it as one frame to `out`.
+void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envelope);
+
+// Parses one frame's payload. Fails on bytes that are not an Envelope or an
+// Envelope without a body; the protocol version is left for the handshake to judge.
+[[nodiscard]] Result<wire::Envelope> parse_envelope(std::span<const std::uint8_t> payload);
+
+// "frame_begin", "hello", ...: for log lines.
+[[nodiscard]] const char* body_name(const wire::Envelope& envelope);
+
+}  // namespace optique::net

@@ -1,0 +1,69 @@
+#include "net/framing.h"
+
+#include <algorithm>
+
+namespace optique::net {
+
+DecodedFrame decode_frame(std::span<const std::uint8_t> bytes, std::uint32_t max_payload_bytes) {
+  DecodedFrame frame;
+  if (bytes.size() < kFrameHeaderBytes) return frame;
+  const std::uint32_t length = (std::uint32_t{bytes[0]} << 24) | (std::uint32_t{bytes[1]} << 16) |
+                               (std::uint32_t{bytes[2]} << 8) | std::uint32_t{bytes[3]};
+  if (length == 0) {
+    frame.status = DecodeStatus::bad;
+    frame.error = "empty frame (length 0)";
+    return frame;
+  }
+  if (length > max_payload_bytes) {
+    frame.status = DecodeStatus::bad;
+    frame.error =
+        "frame of " + std::to_string(length) + " bytes exceeds the maximum of " + std::to_string(max_payload_bytes);
+    return frame;
+  }
+  if (bytes.size() - kFrameHeaderBytes < length) return frame;
+  frame.status = DecodeStatus::good;
+  frame.payload = bytes.subspan(kFrameHeaderBytes, length);
+  frame.consumed = kFrameHeaderBytes + length;
+  return frame;
+}
+
+void append_frame(std::vector<std::uint8_t>& out, std::span<const std::uint8_t> payload) {
+  const auto length = static_cast<std::uint32_t>(payload.size());
+  out.push_back(static_cast<std::uint8_t>(length >> 24));
+  out.push_back(static_cast<std::uint8_t>(length >> 16));
+  out.push_back(static_cast<std::uint8_t>(length >> 8));
+  out.push_back(static_cast<std::uint8_t>(length));
+  out.insert(out.end(), payload.begin(), payload.end());
+}
+
+void FrameReader::append(std::span<const std::uint8_t> bytes) {
+  if (!failure_.empty()) return;
+  // Drop what was already handed out before growing, so the buffer stays bounded
+  // by one frame plus one read.
+  if (read_pos_ > 0) {
+    buffer_.erase(buffer_.begin(), buffer_.begin() + static_cast<std::ptrdiff_t>(read_pos_));
+    read_pos_ = 0;
+  }
+  buffer_.insert(buffer_.end(), bytes.begin(), bytes.end());
+}
+
+DecodedFrame FrameReader::next() {
+  if (!failure_.empty()) {
+    DecodedFrame bad;
+    bad.status = DecodeStatus::bad;
+    bad.error = failure_;
+    return bad;
+  }
+  const std::span<const std::uint8_t> pending(buffer_.data() + read_pos_, buffer_.size() - read_pos_);
+  DecodedFrame frame = decode_frame(pending, max_payload_bytes_);
+  if (frame.status == DecodeStatus::good) {
+    read_pos_ += frame.consumed;
+  } else if (frame.status == DecodeStatus::bad) {
+    failure_ = frame.error;
+    buffer_.clear();
+    read_pos_ = 0;
+  }
+  return frame;
+}
+
+}  // namespace optique::net

@@ -1,0 +1,217 @@
+#include "scene/state.h"
+
+#include <bit>
+#include <cmath>
+#include <string>
+
+namespace optique::scene {
+namespace {
+
+class Fnv1a {
+ public:
+  void add(std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) {
+      hash_ ^= (v >> (8 * i)) & 0xFFu;
+      hash_ *= 0x100000001b3ull;
+    }
+  }
+  void add(double v) { add(std::bit_cast<std::uint64_t>(v)); }
+  void add(const glm::dvec3& v) {
+    add(v.x);
+    add(v.y);
+    add(v.z);
+  }
+  void add(const Pose& p) {
+    add(p.position);
+    add(p.rotation.w);
+    add(p.rotation.x);
+    add(p.rotation.y);
+    add(p.rotation.z);
+    add(p.scale);
+  }
+  [[nodiscard]] std::uint64_t value() const { return hash_; }
+
+ private:
+  std::uint64_t hash_ = 0xcbf29ce484222325ull;
+};
+
+// Equality as the hash sees it: bit for bit (0.0 and -0.0 differ), so a change
+// the hash notices is never left out of a delta.
+bool same_bits(double a, double b) { return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b); }
+
+bool identical(const glm::dvec3& a, const glm::dvec3& b) {
+  return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z);
+}
+
+bool identical(const Pose& a, const Pose& b) {
+  return identical(a.position, b.position) && same_bits(a.rotation.w, b.rotation.w) &&
+         same_bits(a.rotation.x, b.rotation.x) && same_bits(a.rotation.y, b.rotation.y) &&
+         same_bits(a.rotation.z, b.rotation.z) && identical(a.scale, b.scale);
+}
+
+bool identical(const ObjectState& a, const ObjectState& b) {
+  return identical(a.now, b.now) && identical(a.next, b.next);
+}
+
+void to_wire(const glm::dvec3& v, wire::Vec3& out) {
+  out.set_x(v.x);
+  out.set_y(v.y);
+  out.set_z(v.z);
+}
+
+void to_wire(const Pose& p, wire::Pose& out) {
+  to_wire(p.position, *out.mutable_position());
+  auto& q = *out.mutable_rotation();
+  q.set_w(p.rotation.w);
+  q.set_x(p.rotation.x);
+  q.set_y(p.rotation.y);
+  q.set_z(p.rotation.z);
+  to_wire(p.scale, *out.mutable_scale());
+}
+
+void to_wire(std::uint32_t id, const ObjectState& o, wire::ObjectState& out) {
+  out.set_id(id);
+  to_wire(o.now, *out.mutable_now());
+  to_wire(o.next, *out.mutable_next());
+}
+
+void to_wire(const SceneState& s, wire::ViewerState& out) {
+  to_wire(s.eye_now, *out.mutable_eye_now());
+  to_wire(s.eye_next, *out.mutable_eye_next());
+}
+
+// Reading from the wire checks every number: NaN or Inf never reaches a matrix.
+Result<glm::dvec3> from_wire(const wire::Vec3& v, const std::string& what) {
+  if (!std::isfinite(v.x()) || !std::isfinite(v.y()) || !std::isfinite(v.z())) {
+    return Error{what + " has a non-finite coordinate"};
+  }
+  return glm::dvec3(v.x(), v.y(), v.z());
+}
+
+Result<Pose> from_wire(const wire::Pose& p, const std::string& what) {
+  Pose pose;
+  auto position = from_wire(p.position(), what + " position");
+  if (!position) return Error{position.error()};
+  pose.position = position.value();
+  // A missing scale means unit scale; a missing rotation means identity.
+  if (p.has_scale()) {
+    auto scale = from_wire(p.scale(), what + " scale");
+    if (!scale) return Error{scale.error()};
+    pose.scale = scale.value();
+  }
+  if (p.has_rotation()) {
+    const auto& q = p.rotation();
+    const glm::dquat rotation(q.w(), q.x(), q.y(), q.z());
+    const double norm = std::sqrt(rotation.w * rotation.w + rotation.x * rotation.x + rotation.y * rotation.y +
+                                  rotation.z * rotation.z);
+    if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-6) {
+      return Error{what + " rotation is not a unit quaternion (norm " + std::to_string(norm) + ")"};
+    }
+    pose.rotation = rotation;
+  }
+  return pose;
+}
+
+Result<ObjectState> from_wire(const wire::ObjectState& o) {
+  const std::string what = "object " + std::to_string(o.id());
+  auto now = from_wire(o.now(), what + " (now)");
+  if (!now) return Error{now.error()};
+  auto next = from_wire(o.next(), what + " (next)");
+  if (!next) return Error{next.error()};
+  return ObjectState{now.value(), next.value()};
+}
+
+struct EyePair {
+  glm::dvec3 now;
+  glm::dvec3 next;
+};
+
+Result<EyePair> viewer_from_wire(const wire::ViewerState& v) {
+  auto now = from_wire(v.eye_now(), "viewer eye (now)");
+  if (!now) return Error{now.error()};
+  auto next = from_wire(v.eye_next(), "viewer eye (next)");
+  if (!next) return Error{next.error()};
+  return EyePair{now.value(), next.value()};
+}
+
+}  // namespace
+
+std::uint64_t state_hash(const SceneState& state) {
+  Fnv1a h;
+  h.add(static_cast<std::uint64_t>(state.objects.size()));
+  for (const auto& [id, object] : state.objects) {
+    h.add(static_cast<std::uint64_t>(id));
+    h.add(object.now);
+    h.add(object.next);
+  }
+  h.add(state.eye_now);
+  h.add(state.eye_next);
+  return h.value();
+}
+
+wire::Snapshot to_snapshot(const SceneState& state) {
+  wire::Snapshot snapshot;
+  for (const auto& [id, object] : state.objects) to_wire(id, object, *snapshot.add_objects());
+  to_wire(state, *snapshot.mutable_viewer());
+  return snapshot;
+}
+
+Result<SceneState> from_snapshot(const wire::Snapshot& snapshot) {
+  SceneState state;
+  for (const auto& o : snapshot.objects()) {
+    auto object = from_wire(o);
+    if (!object) return Error{object.error()};
+    if (!state.objects.emplace(o.id(), object.value()).second) {
+      return Error{"snapshot lists object " + std::to_string(o.id()) + " twice"};
+    }
+  }
+  auto eye = viewer_from_wire(snapshot.viewer());
+  if (!eye) return Error{eye.error()};
+  state.eye_now = eye.value().now;
+  state.eye_next = eye.value().next;
+  return state;
+}
+
+wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
+  wire::StateDelta delta;
+  for (const auto& [id, object] : after.objects) {
+    const auto old = before.objects.find(id);
+    if (old == before.objects.end() || !identical(old->second, object)) to_wire(id, object, *delta.add_changed());
+  }
+  for (const auto& [id, object] : before.objects) {
+    if (!after.objects.contains(id)) delta.add_removed(id);
+  }
+  if (!identical(before.eye_now, after.eye_now) || !identical(before.eye_next, after.eye_next)) {
+    to_wire(after, *delta.mutable_viewer());
+  }
+  return delta;
+}
+
+Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
+  // Check everything first so a bad delta leaves the state as it was.
+  std::vector<std::pair<std::uint32_t, ObjectState>> changed;
+  changed.reserve(static_cast<std::size_t>(delta.changed_size()));
+  for (const auto& o : delta.changed()) {
+    auto object = from_wire(o);
+    if (!object) return Error{"delta: " + object.error()};
+    changed.emplace_back(o.id(), object.value());
+  }
+  for (std::uint32_t id : delta.removed()) {
+    if (!state.objects.contains(id))
+      return Error{"delta removes object " + std::to_string(id) + ", which does not exist"};
+  }
+  EyePair eye{state.eye_now, state.eye_next};
+  if (delta.has_viewer()) {
+    auto moved = viewer_from_wire(delta.viewer());
+    if (!moved) return Error{"delta: " + moved.error()};
+    eye = moved.value();
+  }
+
+  for (auto& [id, object] : changed) state.objects.insert_or_assign(id, object);
+  for (std::uint32_t id : delta.removed()) state.objects.erase(id);
+  state.eye_now = eye.now;
+  state.eye_next = eye.next;
+  return {};
+}
+
+}  // namespace optique::scene

@@ -1,0 +1,54 @@
+#pragma once
+// The scene state every node must agree on: dynamic objects, each with its pose at
+// the frame time and at the next frame time, and the viewer's eye at both times.
+// A snapshot on join, then per frame only what changed; a hash both sides compare.
+
+#include <cstdint>
+#include <map>
+
+#include <glm/gtc/quaternion.hpp>
+#include <glm/vec3.hpp>
+
+#include "optique/wire.pb.h"
+#include "util/result.h"
+
+namespace optique::scene {
+
+struct Pose {
+  glm::dvec3 position{0.0};
+  glm::dquat rotation{1.0, 0.0, 0.0, 0.0};
+  glm::dvec3 scale{1.0};
+
+  bool operator==(const Pose&) const = default;
+};
+
+struct ObjectState {
+  Pose now;
+  Pose next;
+
+  bool operator==(const ObjectState&) const = default;
+};
+
+struct SceneState {
+  std::map<std::uint32_t, ObjectState> objects;
+  glm::dvec3 eye_now{0.0};
+  glm::dvec3 eye_next{0.0};
+
+  bool operator==(const SceneState&) const = default;
+};
+
+// FNV-1a over a canonical encoding (ids in order, the bits of every double), so
+// equal states hash equally on every machine.
+[[nodiscard]] std::uint64_t state_hash(const SceneState& state);
+
+[[nodiscard]] wire::Snapshot to_snapshot(const SceneState& state);
+[[nodiscard]] Result<SceneState> from_snapshot(const wire::Snapshot& snapshot);
+
+// What changed from `before` to `after`.
+[[nodiscard]] wire::StateDelta make_delta(const SceneState& before, const SceneState& after);
+
+// Applies `delta` to `state`, or leaves it untouched and says what is wrong
+// (non-finite numbers, removing an object that does not exist).
+[[nodiscard]] Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta);
+
+}  // namespace optique::scene

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs everything optique needs to build and test, from Debian 12 packages.
+# Idempotent: when every package is already installed it changes nothing and
+# does not touch the network.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libboost-dev                       # Asio (header-only)
+  libprotobuf-dev protobuf-compiler  # wire format and config schema
+  libspdlog-dev libcli11-dev         # logging, command lines
+  libglfw3-dev libglm-dev            # windows on projectors, render math
+  libopenimageio-dev                 # image files and image operations
+  libgtest-dev libgmock-dev          # tests
+  libssl-dev                         # SHA-256 of configs, HMAC (libcrypto)
+  python3                            # bench plots and helper scripts
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+if [ "$(id -u)" -ne 0 ]; then
+  echo "install-deps: missing packages: ${missing[*]}" >&2
+  echo "install-deps: run this script as root (or with sudo) to install them" >&2
+  exit 1
+fi
+
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq --no-install-recommends "${missing[@]}"
