@@ -1,0 +1,637 @@
+#include "master.h"
+
+#include <google/protobuf/util/json_util.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "net/envelope.h"
+#include "scene/builtin.h"
+
+namespace optique::master {
+namespace {
+
+using std::chrono::milliseconds;
+
+std::string random_nonce() {
+  std::random_device device;
+  std::string nonce(16, '\0');
+  for (char& c : nonce) c = static_cast<char>(device() & 0xFF);
+  return nonce;
+}
+
+std::string format_us(double us) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.0f µs", us);
+  return buffer;
+}
+
+}  // namespace
+
+Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
+    : io_(io),
+      options_(std::move(options)),
+      log_(log),
+      settings_(options_.config.installation.master()),
+      acceptor_(io),
+      signals_(io, SIGINT, SIGTERM),
+      frame_timer_(io),
+      barrier_timer_(io),
+      phase_timer_(io),
+      housekeeping_timer_(io),
+      heartbeat_timer_(io),
+      status_(options_.status_line) {
+  for (const auto& projector : options_.config.installation.projectors()) slots_.push_back({&projector, nullptr});
+  frame_period_ = static_cast<clock::Nanos>(1e9 / settings_.frame_rate());
+}
+
+Master::~Master() = default;
+
+Result<void> Master::start() {
+  const auto& installation = options_.config.installation;
+  if (!installation.scene().gltf().empty()) {
+    return Error{
+        options_.config.path +
+        ": scene.gltf: glTF scenes need the GL renderer, which this build does not have yet; use a builtin scene"};
+  }
+  auto script = scene::builtin_scene(installation.scene().builtin());
+  if (!script) return Error{options_.config.path + ": scene.builtin: " + script.error()};
+  authority_.emplace(std::move(script).value(), installation.viewer(), frame_period_);
+  current_state_ = authority_->state_at_frame(0);
+  current_hash_ = scene::state_hash(current_state_);
+
+  std::vector<std::string> ids;
+  for (const Slot& s : slots_) ids.push_back(s.projector->id());
+  if (!options_.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(std::filesystem::path(options_.out_dir) / "logs", ec);
+    if (ec) return Error{"cannot create the output folder '" + options_.out_dir + "': " + ec.message()};
+    const auto csv_path = std::filesystem::path(options_.out_dir) / "frames.csv";
+    csv_.open(csv_path);
+    if (!csv_) return Error{"cannot write " + csv_path.string()};
+  }
+  recorder_.emplace(ids, csv_.is_open() ? &csv_ : nullptr);
+
+  // Listen.
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(settings_.listen(), ec);
+  if (ec) return Error{"master.listen: '" + settings_.listen() + "' is not an address"};
+  const asio::ip::tcp::endpoint endpoint(address, static_cast<std::uint16_t>(settings_.port()));
+  acceptor_.open(endpoint.protocol(), ec);
+  if (!ec) acceptor_.set_option(asio::ip::tcp::acceptor::reuse_address(true), ec);
+  if (!ec) acceptor_.bind(endpoint, ec);
+  if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec) {
+    return Error{"cannot listen on " + settings_.listen() + ":" + std::to_string(settings_.port()) + ": " +
+                 ec.message()};
+  }
+  port_ = acceptor_.local_endpoint().port();
+  if (!options_.port_file.empty()) {
+    const std::string temp = options_.port_file + ".tmp";
+    std::ofstream(temp) << port_ << "\n";
+    std::error_code renamed;
+    std::filesystem::rename(temp, options_.port_file, renamed);
+    if (renamed) return Error{"cannot write the port file '" + options_.port_file + "': " + renamed.message()};
+  }
+  std::string id_list;
+  for (const auto& id : ids) id_list += (id_list.empty() ? "" : ", ") + id;
+  log_.info("listening on {}:{}; waiting for {} node(s): {}", settings_.listen(), port_, slots_.size(), id_list);
+
+  if (options_.local) {
+    launcher_.emplace(options_.node_binary);
+    for (const Slot& s : slots_) {
+      std::vector<std::string> args{"--master",    "127.0.0.1:" + std::to_string(port_),
+                                    "--id",        s.projector->id(),
+                                    "--log-level", options_.node_log_level};
+      args.insert(args.end(), options_.node_args.begin(), options_.node_args.end());
+      const std::string log_file =
+          options_.out_dir.empty()
+              ? std::string()
+              : (std::filesystem::path(options_.out_dir) / "logs" / (s.projector->id() + ".log")).string();
+      auto pid = launcher_->spawn(s.projector->id(), args, log_file);
+      if (!pid) return Error{"cannot start the node for projector '" + s.projector->id() + "': " + pid.error()};
+      log_.debug("started node '{}' as pid {}", s.projector->id(), pid.value());
+    }
+  }
+
+  signals_.async_wait([this](const boost::system::error_code& error, int signal) {
+    if (!error) on_signal(signal);
+  });
+  accept_next();
+  housekeeping();
+  send_heartbeats();
+  phase_timer_.expires_after(milliseconds(settings_.startup_timeout_ms()));
+  phase_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (error || state_ != RunState::starting) return;
+    if (nodes_up() == 0) {
+      fail("no node connected within " + std::to_string(settings_.startup_timeout_ms()) + " ms");
+      return;
+    }
+    std::string missing;
+    for (const Slot& s : slots_) {
+      if (!s.session) missing += (missing.empty() ? "" : ", ") + s.projector->id();
+    }
+    log_.warn("starting without {} (not connected after {} ms); they join when they come", missing,
+              settings_.startup_timeout_ms());
+    start_frames();
+  });
+  return {};
+}
+
+// ---------------------------------------------------------------- connections
+
+void Master::accept_next() {
+  acceptor_.async_accept([this](const boost::system::error_code& error, asio::ip::tcp::socket socket) {
+    if (error) {
+      if (error != asio::error::operation_aborted) log_.warn("accept failed: {}", error.message());
+      if (acceptor_.is_open() && state_ != RunState::done) accept_next();
+      return;
+    }
+    if (state_ == RunState::starting || state_ == RunState::running) on_connection(std::move(socket));
+    accept_next();
+  });
+}
+
+void Master::on_connection(asio::ip::tcp::socket socket) {
+  auto session = std::make_shared<Session>();
+  session->connection = net::Connection::create(std::move(socket), settings_.max_message_bytes());
+  sessions_.push_back(session);
+  std::weak_ptr<Session> weak = session;
+  session->connection->start({
+      [this, weak](wire::Envelope& message) {
+        if (auto s = weak.lock()) on_message(s, message);
+      },
+      [this, weak](const std::string& reason) {
+        if (auto s = weak.lock()) on_closed(s, reason);
+      },
+  });
+  session->connection->set_deadline(
+      milliseconds(settings_.handshake_timeout_ms()),
+      "no valid hello within " + std::to_string(settings_.handshake_timeout_ms()) + " ms");
+  wire::Envelope challenge;
+  challenge.mutable_challenge()->set_nonce(random_nonce());
+  session->connection->send(challenge);
+  log_.debug("connection from {}", session->connection->peer());
+}
+
+void Master::on_message(const std::shared_ptr<Session>& session, wire::Envelope& message) {
+  const clock::Nanos received = clock::monotonic_now();
+  if (session->phase == Phase::handshake) {
+    handle_hello(session, message);
+    return;
+  }
+  if (message.protocol_version() != net::kProtocolVersion) {
+    session->connection->close("protocol version changed mid-connection");
+    return;
+  }
+  switch (message.body_case()) {
+    case wire::Envelope::kPing: {
+      wire::Envelope pong;
+      auto& p = *pong.mutable_pong();
+      p.set_t1(message.ping().t1());
+      p.set_t2(received);
+      p.set_t3(clock::monotonic_now());
+      session->connection->send(pong);
+      break;
+    }
+    case wire::Envelope::kHeartbeat:
+      break;
+    case wire::Envelope::kFrameReady:
+      handle_ready(*session, message.frame_ready(), received);
+      break;
+    case wire::Envelope::kPresented:
+      handle_presented(*session, message.presented());
+      break;
+    case wire::Envelope::kGoodbye:
+      session->connection->close("node said goodbye (" + message.goodbye().reason() + ")");
+      break;
+    default:
+      session->connection->close(std::string("unexpected ") + net::body_name(message) + " from a node");
+      break;
+  }
+}
+
+void Master::refuse(Session& session, const std::string& node_id, const std::string& reason, bool retriable) {
+  log_.warn("refused node '{}' from {}: {}", node_id, session.connection->peer(), reason);
+  wire::Envelope envelope;
+  envelope.set_protocol_version(net::kProtocolVersion);
+  envelope.mutable_refuse()->set_reason(reason);
+  envelope.mutable_refuse()->set_retriable(retriable);
+  session.connection->send(envelope);
+  session.connection->close_after_sending("refused: " + reason);
+}
+
+void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelope& message) {
+  if (message.body_case() != wire::Envelope::kHello) {
+    refuse(*session, "?", std::string("expected hello, got ") + net::body_name(message), false);
+    return;
+  }
+  const wire::Hello& hello = message.hello();
+  if (message.protocol_version() != net::kProtocolVersion) {
+    refuse(*session, hello.node_id(),
+           "protocol version mismatch: node speaks v" + std::to_string(message.protocol_version()) +
+               ", master speaks v" + std::to_string(net::kProtocolVersion) +
+               "; run the same optique version on master and nodes",
+           false);
+    return;
+  }
+  std::optional<std::size_t> slot;
+  std::string known;
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    if (slots_[i].projector->id() == hello.node_id()) slot = i;
+    known += (known.empty() ? "" : ", ") + slots_[i].projector->id();
+  }
+  if (!slot) {
+    refuse(*session, hello.node_id(),
+           "unknown projector id '" + hello.node_id() + "' (this installation has: " + known + ")", false);
+    return;
+  }
+  Slot& target = slots_[*slot];
+  if (target.session) {
+    refuse(*session, hello.node_id(),
+           "projector '" + hello.node_id() + "' is already driven by the node at " + target.session->connection->peer(),
+           true);
+    return;
+  }
+
+  target.session = session;
+  session->slot = slot;
+  session->phase = Phase::joined;
+  session->connection->cancel_deadline();
+  session->connection->set_liveness_timeout(
+      milliseconds(settings_.liveness_timeout_ms()),
+      "node silent for " + std::to_string(settings_.liveness_timeout_ms()) + " ms");
+
+  const auto& installation = options_.config.installation;
+  wire::Envelope envelope;
+  auto& welcome = *envelope.mutable_welcome();
+  *welcome.mutable_projector() = *target.projector;
+  for (const auto& screen : installation.screens()) {
+    if (screen.id() == target.projector->screen()) *welcome.mutable_screen() = screen;
+  }
+  *welcome.mutable_viewer() = installation.viewer();
+  *welcome.mutable_scene() = installation.scene();
+  *welcome.mutable_snapshot() = scene::to_snapshot(current_state_);
+  welcome.set_next_frame_id(next_frame_);
+  welcome.set_frame_period_ns(frame_period_);
+  welcome.set_heartbeat_ms(settings_.heartbeat_ms());
+  welcome.set_liveness_timeout_ms(settings_.liveness_timeout_ms());
+  welcome.set_state_hash(current_hash_);
+  session->connection->send(envelope);
+  recorder_->node_joined(*slot);
+  log_.info("node '{}' joined from {} ({}/{} up)", hello.node_id(), session->connection->peer(), nodes_up(),
+            slots_.size());
+
+  if (state_ == RunState::starting && nodes_up() == slots_.size()) start_frames();
+}
+
+void Master::on_closed(const std::shared_ptr<Session>& session, const std::string& reason) {
+  std::erase(sessions_, session);
+  if (!session->slot) {
+    if (state_ == RunState::starting || state_ == RunState::running) {
+      log_.info("connection from {} closed before joining: {}", session->connection->peer(), reason);
+    }
+  } else {
+    const std::size_t slot = *session->slot;
+    slots_[slot].session.reset();
+    if (state_ == RunState::starting || state_ == RunState::running) {
+      log_.warn("node '{}' left: {} ({}/{} up)", slot_id(slot), reason, nodes_up(), slots_.size());
+    } else {
+      log_.debug("node '{}' closed: {}", slot_id(slot), reason);
+    }
+    if (barrier_.active()) {
+      barrier_.leave(slot);
+      if (barrier_.complete()) swap();
+    }
+  }
+  if (state_ == RunState::closing && sessions_.empty() && (!launcher_ || launcher_->running() == 0)) finish();
+}
+
+// ---------------------------------------------------------------- frames
+
+void Master::start_frames() {
+  if (state_ != RunState::starting) return;
+  state_ = RunState::running;
+  phase_timer_.cancel();
+  log_.info("starting frames at {} Hz with {}/{} node(s){}", settings_.frame_rate(), nodes_up(), slots_.size(),
+            options_.frames ? " for " + std::to_string(options_.frames) + " frames" : std::string());
+  schedule_origin_ = clock::monotonic_now();
+  schedule_origin_frame_ = next_frame_;
+  begin_frame();
+}
+
+void Master::begin_frame() {
+  if (state_ != RunState::running) return;
+  const std::uint64_t frame = next_frame_;
+  if (options_.frames != 0 && frame >= options_.frames) {
+    drain("ran " + std::to_string(options_.frames) + " frames");
+    return;
+  }
+  scene::SceneState state = authority_->state_at_frame(frame);
+  wire::Envelope envelope;
+  auto& begin = *envelope.mutable_frame_begin();
+  begin.set_frame_id(frame);
+  begin.set_simulation_time_ns(authority_->simulation_time(frame));
+  *begin.mutable_delta() = scene::make_delta(current_state_, state);
+  current_state_ = std::move(state);
+  current_hash_ = scene::state_hash(current_state_);
+  begin.set_state_hash(current_hash_);
+  begin.set_present_time_ns(schedule_origin_ +
+                            static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_);
+
+  std::vector<std::size_t> sent;
+  std::vector<std::size_t> waited;
+  const clock::Nanos begin_sent = clock::monotonic_now();
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    Session* session = slots_[i].session.get();
+    if (session == nullptr || session->phase == Phase::handshake) continue;
+    if (session->phase == Phase::joined) session->phase = Phase::in_barrier;
+    session->connection->send(envelope);
+    sent.push_back(i);
+    if (session->phase == Phase::in_barrier) waited.push_back(i);
+  }
+  recorder_->frame_begun(frame, begin_sent, sent);
+  if (frame > 0) recorder_->finalize_before(frame - 1);  // the previous frame may still get Presented
+  next_frame_ = frame + 1;
+  ready_for_swap_.clear();
+  barrier_.begin(frame, std::move(waited));
+  if (barrier_.complete()) {
+    swap();
+    return;
+  }
+  barrier_timer_.expires_after(milliseconds(settings_.frame_timeout_ms()));
+  barrier_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (!error) on_barrier_timeout();
+  });
+}
+
+void Master::handle_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received) {
+  const std::size_t slot = *session.slot;
+  if (!barrier_.active() || ready.frame_id() != barrier_.frame()) {
+    log_.debug("late ready from '{}' for frame {}", slot_id(slot), ready.frame_id());
+    return;
+  }
+  recorder_->ready(ready.frame_id(), slot, received, ready.render_ns());
+  if (ready.state_hash() != current_hash_) {
+    recorder_->hash_mismatch(slot);
+    log_.warn("node '{}' reports state hash {:016x} for frame {}, master has {:016x}", slot_id(slot),
+              ready.state_hash(), ready.frame_id(), current_hash_);
+  }
+  if (session.phase == Phase::out_of_barrier) {
+    session.phase = Phase::in_barrier;
+    ready_for_swap_.push_back(slot);
+    log_.info("node '{}' is in time again and back in the barrier from frame {}", slot_id(slot), ready.frame_id());
+  } else if (barrier_.ready(slot)) {
+    ready_for_swap_.push_back(slot);
+  }
+  if (barrier_.complete()) swap();
+}
+
+void Master::on_barrier_timeout() {
+  if (!barrier_.active()) return;
+  for (std::size_t slot : barrier_.waiting_for()) {
+    recorder_->node_missed_barrier(slot);
+    if (Session* session = slots_[slot].session.get()) session->phase = Phase::out_of_barrier;
+    log_.warn("node '{}' was not ready for frame {} within {} ms: taken out of the barrier, the others go on",
+              slot_id(slot), barrier_.frame(), settings_.frame_timeout_ms());
+  }
+  swap();
+}
+
+void Master::swap() {
+  barrier_timer_.cancel();
+  const std::uint64_t frame = barrier_.frame();
+  barrier_.end();
+  wire::Envelope envelope;
+  auto& swap = *envelope.mutable_swap();
+  swap.set_frame_id(frame);
+  const clock::Nanos sent = clock::monotonic_now();
+  swap.set_present_deadline_ns(sent + static_cast<clock::Nanos>(settings_.present_lead_us()) * clock::kNanosPerMicro);
+  for (std::size_t slot : ready_for_swap_) {
+    if (Session* session = slots_[slot].session.get()) session->connection->send(envelope);
+  }
+  recorder_->swapped(frame, sent, ready_for_swap_);
+  ready_for_swap_.clear();
+  update_status();
+  schedule_next_frame(sent);
+}
+
+void Master::schedule_next_frame(clock::Nanos now) {
+  clock::Nanos due = schedule_origin_ + static_cast<clock::Nanos>(next_frame_ - schedule_origin_frame_) * frame_period_;
+  if (due < now) {
+    // Behind schedule: start again from now instead of rushing frames to catch up.
+    schedule_origin_ = now;
+    schedule_origin_frame_ = next_frame_;
+    due = now;
+  }
+  frame_timer_.expires_after(std::chrono::nanoseconds(due - clock::monotonic_now()));
+  frame_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (!error) begin_frame();
+  });
+}
+
+void Master::handle_presented(Session& session, const wire::Presented& presented) {
+  recorder_->presented(presented.frame_id(), *session.slot, presented.presented_ns());
+}
+
+// ---------------------------------------------------------------- stopping
+
+void Master::drain(const std::string& reason) {
+  if (state_ != RunState::starting && state_ != RunState::running) return;
+  stopped_because_ = reason;
+  const bool frames_ran = state_ == RunState::running;
+  state_ = RunState::draining;
+  frame_timer_.cancel();
+  if (barrier_.active()) swap();
+  frame_timer_.cancel();
+  log_.info("stopping: {}", reason);
+  // The last swap's Presented arrive after its present deadline.
+  const auto wait = frames_ran ? milliseconds(settings_.present_lead_us() / 1000 + 250) : milliseconds(0);
+  phase_timer_.cancel();
+  phase_timer_.expires_after(wait);
+  phase_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (!error) say_goodbye();
+  });
+}
+
+void Master::say_goodbye() {
+  state_ = RunState::closing;
+  acceptor_.close();
+  wire::Envelope envelope;
+  envelope.mutable_goodbye()->set_reason(stopped_because_);
+  for (const auto& session : std::vector(sessions_)) {
+    session->connection->send(envelope);
+    session->connection->close_after_sending("goodbye");
+  }
+  // Nodes exit on goodbye; whatever is still there after this is stopped harder.
+  phase_timer_.expires_after(std::chrono::seconds(3));
+  phase_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (error || state_ != RunState::closing) return;
+    if (launcher_ && launcher_->running() > 0) {
+      log_.warn("{} local node(s) still running 3 s after goodbye; terminating them", launcher_->running());
+      launcher_->signal_all(SIGTERM);
+      phase_timer_.expires_after(std::chrono::seconds(2));
+      phase_timer_.async_wait([this](const boost::system::error_code& e) {
+        if (!e && state_ == RunState::closing) {
+          launcher_->signal_all(SIGKILL);
+          finish();
+        }
+      });
+      return;
+    }
+    finish();
+  });
+  if (sessions_.empty() && (!launcher_ || launcher_->running() == 0)) finish();
+}
+
+void Master::fail(const std::string& reason) {
+  log_.error("{}", reason);
+  exit_code_ = kExitFailed;
+  stopped_because_ = reason;
+  say_goodbye();
+}
+
+void Master::finish() {
+  if (state_ == RunState::done) return;
+  state_ = RunState::done;
+  status_.clear();
+  frame_timer_.cancel();
+  barrier_timer_.cancel();
+  phase_timer_.cancel();
+  housekeeping_timer_.cancel();
+  heartbeat_timer_.cancel();
+  signals_.cancel();
+  if (launcher_) {
+    for (const ChildExit& exit : launcher_->reap()) {
+      log_.debug("node '{}' (pid {}) {}", exit.id, exit.pid, exit.describe());
+    }
+  }
+  recorder_->finalize_all();
+  write_outputs();
+  io_.stop();
+}
+
+void Master::write_outputs() {
+  report::RunReport report = recorder_->report();
+  report.set_config_file(options_.config.path);
+  report.set_config_sha256(options_.config.sha256);
+  report.set_frame_rate(settings_.frame_rate());
+  report.set_stopped_because(stopped_because_);
+  const auto& sync = report.sync();
+  log_.info("{} frames; barrier round median {} p99 {}; present skew median {} p99 {}; {} frame(s) with a node missing",
+            report.frames(), format_us(sync.barrier_round_us().median()), format_us(sync.barrier_round_us().p99()),
+            format_us(sync.present_skew_us().median()), format_us(sync.present_skew_us().p99()),
+            sync.frames_with_missing_node());
+  if (options_.out_dir.empty()) return;
+  std::string json;
+  google::protobuf::util::JsonPrintOptions print;
+  print.add_whitespace = true;
+  print.always_print_primitive_fields = true;
+  print.preserve_proto_field_names = true;
+  const auto status = google::protobuf::util::MessageToJsonString(report, &json, print);
+  assert(status.ok());
+  (void)status;
+  const auto path = std::filesystem::path(options_.out_dir) / "run.json";
+  std::ofstream out(path);
+  out << json;
+  if (!out) {
+    log_.error("cannot write {}", path.string());
+    exit_code_ = kExitFailed;
+    return;
+  }
+  log_.info("wrote {} and {}", path.string(), (std::filesystem::path(options_.out_dir) / "frames.csv").string());
+}
+
+// ---------------------------------------------------------------- periodic
+
+void Master::housekeeping() {
+  if (launcher_) {
+    for (const ChildExit& exit : launcher_->reap()) {
+      const std::string log_hint =
+          options_.out_dir.empty()
+              ? std::string()
+              : "; its log: " + (std::filesystem::path(options_.out_dir) / "logs" / (exit.id + ".log")).string();
+      if (state_ == RunState::closing && exit.clean()) {
+        log_.debug("node '{}' (pid {}) {}", exit.id, exit.pid, exit.describe());
+      } else {
+        log_.warn("node '{}' (pid {}) {}{}", exit.id, exit.pid, exit.describe(), log_hint);
+      }
+      if (state_ == RunState::starting && !exit.clean()) {
+        fail("node '" + exit.id + "' stopped before the cluster started" + log_hint);
+        return;
+      }
+    }
+    if (state_ == RunState::closing && sessions_.empty() && launcher_->running() == 0) {
+      finish();
+      return;
+    }
+  }
+  if (state_ == RunState::done) return;
+  update_status();
+  housekeeping_timer_.expires_after(milliseconds(100));
+  housekeeping_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (!error) housekeeping();
+  });
+}
+
+void Master::send_heartbeats() {
+  wire::Envelope envelope;
+  envelope.mutable_heartbeat()->set_sent_ns(clock::monotonic_now());
+  for (const Slot& slot : slots_) {
+    if (slot.session && slot.session->phase != Phase::handshake) slot.session->connection->send(envelope);
+  }
+  heartbeat_timer_.expires_after(milliseconds(settings_.heartbeat_ms()));
+  heartbeat_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (!error) send_heartbeats();
+  });
+}
+
+void Master::on_signal(int signal) {
+  ++interrupts_;
+  if (interrupts_ == 1) {
+    status_.clear();
+    log_.info("{}: finishing the current frame and shutting down (again to stop at once)", strsignal(signal));
+    if (state_ == RunState::starting || state_ == RunState::running) {
+      drain(std::string("interrupted (") + strsignal(signal) + ")");
+    }
+  } else {
+    log_.warn("{} again: stopping now", strsignal(signal));
+    if (launcher_) launcher_->signal_all(SIGKILL);
+    stopped_because_ = std::string("interrupted twice (") + strsignal(signal) + ")";
+    finish();
+    return;
+  }
+  signals_.async_wait([this](const boost::system::error_code& error, int next) {
+    if (!error) on_signal(next);
+  });
+}
+
+void Master::update_status() {
+  if (!status_.enabled()) return;
+  const clock::Nanos now = clock::monotonic_now();
+  if (now - last_status_ < 250 * clock::kNanosPerMilli) return;
+  const double rate = last_status_ == 0 ? 0.0
+                                        : static_cast<double>(next_frame_ - status_frame_) * 1e9 /
+                                              static_cast<double>(now - last_status_);
+  last_status_ = now;
+  status_frame_ = next_frame_;
+  const std::string total = options_.frames ? std::to_string(options_.frames) : std::string("-");
+  char line[200];
+  std::snprintf(line, sizeof line, "frame %llu/%s  %.1f Hz  nodes %zu/%zu  skew %.0f us  missing %llu",
+                static_cast<unsigned long long>(next_frame_), total.c_str(), rate, nodes_up(), slots_.size(),
+                recorder_->last_present_skew_us(),
+                static_cast<unsigned long long>(recorder_->frames_with_missing_node()));
+  status_.show(line);
+}
+
+std::size_t Master::nodes_up() const {
+  std::size_t up = 0;
+  for (const Slot& s : slots_) up += s.session ? 1 : 0;
+  return up;
+}
+
+std::string Master::slot_id(std::size_t slot) const { return slots_[slot].projector->id(); }
+
+}  // namespace optique::master

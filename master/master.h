@@ -1,0 +1,142 @@
+#pragma once
+// The master: owns the scene and the clock, accepts nodes, and steps them through
+// frames in lock-step (FrameBegin → FrameReady from every live node → Swap with a
+// present deadline → Presented). One io_context thread; every wait is a timer.
+
+#include <spdlog/logger.h>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "barrier.h"
+#include "config/load.h"
+#include "local_launcher.h"
+#include "net/connection.h"
+#include "run_recorder.h"
+#include "scene_authority.h"
+#include "status_line.h"
+#include "util/result.h"
+
+namespace optique::master {
+
+namespace asio = boost::asio;
+
+struct MasterOptions {
+  config::LoadedConfig config;
+  std::uint64_t frames = 0;  // 0: until interrupted
+  std::string out_dir;       // empty: write no files
+  bool local = false;        // start one node process per projector here
+  std::string node_binary;
+  std::vector<std::string> node_args;  // extra arguments for local nodes
+  std::string port_file;               // write the bound port here once listening
+  std::string node_log_level = "info";
+  bool status_line = false;
+};
+
+// Process exit statuses, shared by main and the tests.
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitUsage = 2;   // bad config or command line: nothing started
+inline constexpr int kExitFailed = 3;  // could not run: no nodes, cannot listen, ...
+
+class Master {
+ public:
+  Master(asio::io_context& io, MasterOptions options, spdlog::logger& log);
+  ~Master();
+  Master(const Master&) = delete;
+  Master& operator=(const Master&) = delete;
+
+  // Listens, starts local nodes, and schedules everything; then run the io_context.
+  [[nodiscard]] Result<void> start();
+  [[nodiscard]] int exit_code() const { return exit_code_; }
+
+ private:
+  enum class Phase { handshake, joined, in_barrier, out_of_barrier };
+  enum class RunState { starting, running, draining, closing, done };
+
+  struct Session {
+    std::shared_ptr<net::Connection> connection;
+    std::optional<std::size_t> slot;
+    Phase phase = Phase::handshake;
+  };
+
+  struct Slot {
+    const config::Projector* projector = nullptr;
+    std::shared_ptr<Session> session;
+  };
+
+  void accept_next();
+  void on_connection(asio::ip::tcp::socket socket);
+  void on_message(const std::shared_ptr<Session>& session, wire::Envelope& message);
+  void on_closed(const std::shared_ptr<Session>& session, const std::string& reason);
+  void handle_hello(const std::shared_ptr<Session>& session, wire::Envelope& message);
+  void refuse(Session& session, const std::string& node_id, const std::string& reason, bool retriable);
+  void handle_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received);
+  void handle_presented(Session& session, const wire::Presented& presented);
+
+  void start_frames();
+  void begin_frame();
+  void swap();
+  void on_barrier_timeout();
+  void schedule_next_frame(clock::Nanos now);
+
+  void drain(const std::string& reason);
+  void say_goodbye();
+  void finish();
+  void fail(const std::string& reason);
+
+  void housekeeping();
+  void send_heartbeats();
+  void on_signal(int signal);
+  void update_status();
+  void write_outputs();
+
+  [[nodiscard]] std::size_t nodes_up() const;
+  [[nodiscard]] std::string slot_id(std::size_t slot) const;
+
+  asio::io_context& io_;
+  MasterOptions options_;
+  spdlog::logger& log_;
+  const config::MasterSettings& settings_;
+
+  asio::ip::tcp::acceptor acceptor_;
+  asio::signal_set signals_;
+  asio::steady_timer frame_timer_;
+  asio::steady_timer barrier_timer_;
+  asio::steady_timer phase_timer_;  // startup wait, drain, goodbye: one at a time
+  asio::steady_timer housekeeping_timer_;
+  asio::steady_timer heartbeat_timer_;
+
+  std::vector<Slot> slots_;
+  std::vector<std::shared_ptr<Session>> sessions_;
+  std::optional<SceneAuthority> authority_;
+  scene::SceneState current_state_;
+  std::uint64_t current_hash_ = 0;
+  Barrier barrier_;
+  std::vector<std::size_t> ready_for_swap_;
+
+  std::uint64_t next_frame_ = 0;
+  clock::Nanos frame_period_ = 0;
+  clock::Nanos schedule_origin_ = 0;
+  std::uint64_t schedule_origin_frame_ = 0;
+
+  std::ofstream csv_;
+  std::optional<RunRecorder> recorder_;
+  std::optional<LocalLauncher> launcher_;
+  StatusLine status_;
+  clock::Nanos last_status_ = 0;
+  std::uint64_t status_frame_ = 0;
+  RunState state_ = RunState::starting;
+  std::string stopped_because_;
+  std::uint16_t port_ = 0;
+  int exit_code_ = kExitOk;
+  int interrupts_ = 0;
+};
+
+}  // namespace optique::master

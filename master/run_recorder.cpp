@@ -1,0 +1,134 @@
+#include "run_recorder.h"
+
+#include <algorithm>
+
+#include "metrics/distribution.h"
+
+namespace optique::master {
+
+RunRecorder::RunRecorder(std::vector<std::string> node_ids, std::ostream* csv)
+    : ids_(std::move(node_ids)), csv_(csv), totals_(ids_.size()) {
+  if (csv_ != nullptr) *csv_ << "frame_id,node,begin_sent_ns,ready_received_ns,swap_sent_ns,presented_ns\n";
+}
+
+RunRecorder::FrameRecord* RunRecorder::find(std::uint64_t frame) {
+  for (auto& record : open_) {
+    if (record.id == frame) return &record;
+  }
+  return nullptr;
+}
+
+void RunRecorder::frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes) {
+  FrameRecord record;
+  record.id = frame;
+  record.begin_sent = sent;
+  record.nodes.resize(ids_.size());
+  for (std::size_t n : nodes) record.nodes[n].begun = true;
+  open_.push_back(std::move(record));
+  if (first_begin_ == 0) first_begin_ = sent;
+  last_begin_ = sent;
+}
+
+void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time) {
+  FrameRecord* record = find(frame);
+  if (record == nullptr || record->nodes[node].ready != 0) return;
+  record->nodes[node].ready = received;
+  totals_[node].rendered += 1;
+  totals_[node].render_us.push_back(static_cast<double>(render_time) / 1e3);
+}
+
+void RunRecorder::swapped(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes) {
+  FrameRecord* record = find(frame);
+  if (record == nullptr) return;
+  record->swap_sent = sent;
+  for (std::size_t n : nodes) record->nodes[n].swapped = true;
+  barrier_round_us_.push_back(static_cast<double>(sent - record->begin_sent) / 1e3);
+}
+
+void RunRecorder::presented(std::uint64_t frame, std::size_t node, clock::Nanos at) {
+  FrameRecord* record = find(frame);
+  if (record == nullptr || !record->nodes[node].swapped || record->nodes[node].presented != 0) return;
+  record->nodes[node].presented = at;
+  totals_[node].presented += 1;
+}
+
+void RunRecorder::node_joined(std::size_t node) { totals_[node].joins += 1; }
+void RunRecorder::node_missed_barrier(std::size_t node) { totals_[node].misses += 1; }
+void RunRecorder::hash_mismatch(std::size_t node) { totals_[node].mismatches += 1; }
+
+void RunRecorder::finalize(const FrameRecord& record) {
+  clock::Nanos earliest = 0;
+  clock::Nanos latest = 0;
+  std::size_t presented = 0;
+  bool incoherent = false;
+  for (std::size_t n = 0; n < record.nodes.size(); ++n) {
+    const NodeFrame& f = record.nodes[n];
+    if (f.presented != 0) {
+      earliest = presented == 0 ? f.presented : std::min(earliest, f.presented);
+      latest = presented == 0 ? f.presented : std::max(latest, f.presented);
+      ++presented;
+    } else if (f.swapped) {
+      incoherent = true;  // told to show this frame, never said it did
+    }
+    if (csv_ != nullptr && f.begun) {
+      *csv_ << record.id << ',' << ids_[n] << ',' << record.begin_sent << ',';
+      if (f.ready != 0) *csv_ << f.ready;
+      *csv_ << ',';
+      if (f.swapped) *csv_ << record.swap_sent;
+      *csv_ << ',';
+      if (f.presented != 0) *csv_ << f.presented;
+      *csv_ << '\n';
+    }
+  }
+  if (presented > 0) {
+    last_skew_us_ = static_cast<double>(latest - earliest) / 1e3;
+    present_skew_us_.push_back(last_skew_us_);
+  }
+  if (presented < record.nodes.size()) ++frames_missing_;
+  if (incoherent) ++frames_incoherent_;
+  ++frames_finalized_;
+}
+
+void RunRecorder::finalize_before(std::uint64_t frame) {
+  while (!open_.empty() && open_.front().id < frame) {
+    finalize(open_.front());
+    open_.pop_front();
+  }
+}
+
+void RunRecorder::finalize_all() {
+  while (!open_.empty()) {
+    finalize(open_.front());
+    open_.pop_front();
+  }
+  if (csv_ != nullptr) csv_->flush();
+}
+
+report::RunReport RunRecorder::report() const {
+  report::RunReport r;
+  r.set_frames(frames_finalized_);
+  r.set_nodes_configured(static_cast<std::uint32_t>(ids_.size()));
+  for (std::size_t n = 0; n < ids_.size(); ++n) {
+    const NodeTotals& t = totals_[n];
+    auto& node = *r.add_nodes();
+    node.set_id(ids_[n]);
+    node.set_frames_rendered(t.rendered);
+    node.set_frames_presented(t.presented);
+    *node.mutable_render_us() = metrics::summarize(t.render_us);
+    node.set_barrier_misses(t.misses);
+    node.set_hash_mismatches(t.mismatches);
+    node.set_joins(t.joins);
+  }
+  auto& sync = *r.mutable_sync();
+  *sync.mutable_barrier_round_us() = metrics::summarize(barrier_round_us_);
+  *sync.mutable_present_skew_us() = metrics::summarize(present_skew_us_);
+  sync.set_frames_with_missing_node(frames_missing_);
+  sync.set_frames_incoherent(frames_incoherent_);
+  if (frames_finalized_ > 1 && last_begin_ > first_begin_) {
+    sync.set_achieved_frame_rate(static_cast<double>(frames_finalized_ - 1) * 1e9 /
+                                 static_cast<double>(last_begin_ - first_begin_));
+  }
+  return r;
+}
+
+}  // namespace optique::master

@@ -1,0 +1,83 @@
+#pragma once
+// What happened to every frame on every node, in master-clock nanoseconds: streamed
+// to frames.csv as frames complete, and folded into the run.json summary.
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <ostream>
+#include <string>
+#include <vector>
+
+#include "clock/clock.h"
+#include "optique/report.pb.h"
+
+namespace optique::master {
+
+class RunRecorder {
+ public:
+  // `csv` may be null (no --out); otherwise it receives the header now and a row
+  // per (frame, node) as frames are finalized.
+  RunRecorder(std::vector<std::string> node_ids, std::ostream* csv);
+
+  void frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
+  void ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time);
+  void swapped(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
+  void presented(std::uint64_t frame, std::size_t node, clock::Nanos at);
+
+  void node_joined(std::size_t node);
+  void node_missed_barrier(std::size_t node);
+  void hash_mismatch(std::size_t node);
+
+  // Frames older than `frame` can no longer change: write and summarize them.
+  void finalize_before(std::uint64_t frame);
+  void finalize_all();
+
+  // Summary of the finalized frames.
+  [[nodiscard]] report::RunReport report() const;
+
+  [[nodiscard]] std::uint64_t frames_finalized() const { return frames_finalized_; }
+  // Present skew of the most recently finalized frame that has one, for the status line.
+  [[nodiscard]] double last_present_skew_us() const { return last_skew_us_; }
+  [[nodiscard]] std::uint64_t frames_with_missing_node() const { return frames_missing_; }
+
+ private:
+  struct NodeFrame {
+    bool begun = false;
+    bool swapped = false;
+    clock::Nanos ready = 0;
+    clock::Nanos presented = 0;
+  };
+  struct FrameRecord {
+    std::uint64_t id = 0;
+    clock::Nanos begin_sent = 0;
+    clock::Nanos swap_sent = 0;
+    std::vector<NodeFrame> nodes;
+  };
+  struct NodeTotals {
+    std::uint64_t rendered = 0;
+    std::uint64_t presented = 0;
+    std::uint64_t misses = 0;
+    std::uint64_t mismatches = 0;
+    std::uint64_t joins = 0;
+    std::vector<double> render_us;
+  };
+
+  FrameRecord* find(std::uint64_t frame);
+  void finalize(const FrameRecord& record);
+
+  std::vector<std::string> ids_;
+  std::ostream* csv_;
+  std::deque<FrameRecord> open_;
+  std::vector<NodeTotals> totals_;
+  std::vector<double> barrier_round_us_;
+  std::vector<double> present_skew_us_;
+  std::uint64_t frames_finalized_ = 0;
+  std::uint64_t frames_missing_ = 0;
+  std::uint64_t frames_incoherent_ = 0;
+  clock::Nanos first_begin_ = 0;
+  clock::Nanos last_begin_ = 0;
+  double last_skew_us_ = 0.0;
+};
+
+}  // namespace optique::master

@@ -1,0 +1,28 @@
+#pragma once
+// The master owns the scene: frame k happens at simulation time k·T, and every
+// dynamic object and the eye are evaluated at that time and at the next frame's.
+
+#include <cstdint>
+
+#include "clock/clock.h"
+#include "optique/config.pb.h"
+#include "scene/builtin.h"
+#include "scene/state.h"
+
+namespace optique::master {
+
+class SceneAuthority {
+ public:
+  SceneAuthority(scene::SceneScript script, config::Viewer viewer, clock::Nanos frame_period);
+
+  [[nodiscard]] scene::SceneState state_at_frame(std::uint64_t frame) const;
+  [[nodiscard]] clock::Nanos simulation_time(std::uint64_t frame) const;
+  [[nodiscard]] clock::Nanos frame_period() const { return period_; }
+
+ private:
+  scene::SceneScript script_;
+  config::Viewer viewer_;
+  clock::Nanos period_;
+};
+
+}  // namespace optique::master

@@ -1,0 +1,60 @@
+#include "cli.h"
+
+#include <CLI/CLI.hpp>
+#include <boost/asio/io_context.hpp>
+#include <iostream>
+
+#include "log/logger.h"
+#include "node.h"
+#include "null_renderer.h"
+
+namespace optique::node {
+
+int run_cli(int argc, char** argv) {
+  CLI::App app{"optique-node: renders one projector's share of the picture in sync with the master"};
+  NodeOptions options;
+  std::string master = "127.0.0.1:7400";
+  std::string log_level = "info";
+  std::int64_t give_up_ms = 10000;
+  std::int64_t clock_offset_ns = 0;
+  double clock_drift_ppm = 0.0;
+  app.add_option("-m,--master", master, "the master's HOST:PORT")->required();
+  app.add_option("-i,--id", options.id, "the projector this node drives (its id in the installation)")->required();
+  app.add_option("--give-up-after-ms", give_up_ms, "exit when the master is unreachable this long")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{86'400'000}));
+  app.add_option("--log-level", log_level, "trace, debug, info, warn or error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  // Test hooks, hidden from --help.
+  app.add_option("--protocol-version", options.protocol_version, "speak this protocol version")->group("");
+  app.add_option("--clock-offset-ns", clock_offset_ns, "skew this node's clock")->group("");
+  app.add_option("--clock-drift-ppm", clock_drift_ppm, "make this node's clock drift")->group("");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int status = app.exit(e);
+    return status == 0 ? kExitOk : kExitRefused;
+  }
+  const auto colon = master.rfind(':');
+  if (colon == std::string::npos || colon == 0 || colon + 1 == master.size()) {
+    std::cerr << "optique-node: --master must be HOST:PORT (got '" << master << "')\n";
+    return kExitRefused;
+  }
+  options.master_host = master.substr(0, colon);
+  options.master_port = master.substr(colon + 1);
+  if (options.master_host.front() == '[' && options.master_host.back() == ']') {
+    options.master_host = options.master_host.substr(1, options.master_host.size() - 2);  // [::1]:7400
+  }
+  options.give_up_after = std::chrono::milliseconds(give_up_ms);
+  options.clock = clock::LocalClock(clock_offset_ns, clock_drift_ppm);
+
+  auto logger = log::make_logger("node " + options.id, log_level);
+  boost::asio::io_context io;
+  NullRenderer renderer;
+  Node node(io, std::move(options), renderer, *logger);
+  node.start();
+  io.run();
+  return node.exit_code();
+}
+
+}  // namespace optique::node

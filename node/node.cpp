@@ -1,0 +1,305 @@
+#include "node.h"
+
+#include <boost/asio/connect.hpp>
+
+#include <csignal>
+#include <cstring>
+
+namespace optique::node {
+
+using std::chrono::milliseconds;
+
+namespace {
+constexpr milliseconds kMaxBackoff{2000};
+constexpr milliseconds kHandshakeTimeout{5000};
+constexpr int kPingBurst = 8;
+}  // namespace
+
+Node::Node(asio::io_context& io, NodeOptions options, Renderer& renderer, spdlog::logger& log)
+    : io_(io),
+      options_(std::move(options)),
+      renderer_(renderer),
+      log_(log),
+      resolver_(io),
+      retry_timer_(io),
+      ping_timer_(io),
+      signals_(io, SIGINT, SIGTERM) {}
+
+void Node::start() {
+  signals_.async_wait([this](const boost::system::error_code& error, int signal) {
+    if (!error) on_signal(signal);
+  });
+  connect();
+}
+
+void Node::connect() {
+  if (phase_ == Phase::stopped) return;
+  ++attempts_;
+  resolver_.async_resolve(
+      options_.master_host, options_.master_port,
+      [this](const boost::system::error_code& error, const asio::ip::tcp::resolver::results_type& endpoints) {
+        if (phase_ == Phase::stopped) return;
+        if (error) {
+          retry_later("cannot resolve " + options_.master_host + ": " + error.message());
+          return;
+        }
+        auto socket = std::make_shared<asio::ip::tcp::socket>(io_);
+        asio::async_connect(*socket, endpoints,
+                            [this, socket](const boost::system::error_code& e, const asio::ip::tcp::endpoint&) {
+                              if (phase_ == Phase::stopped) return;
+                              if (e) {
+                                retry_later(e.message());
+                                return;
+                              }
+                              on_connected(std::move(*socket));
+                            });
+      });
+}
+
+void Node::retry_later(const std::string& reason) {
+  const auto now = std::chrono::steady_clock::now();
+  if (!unreachable_) {
+    unreachable_ = true;
+    unreachable_since_ = now;
+  }
+  const auto waited = std::chrono::duration_cast<milliseconds>(now - unreachable_since_);
+  if (waited >= options_.give_up_after) {
+    stop(kExitNoMaster, "gave up: the master at " + options_.master_host + ":" + options_.master_port +
+                            " was not reachable for " + std::to_string(waited.count()) + " ms (" + reason + ")");
+    return;
+  }
+  // One line at the first failure and then about every few seconds, not one per try.
+  if (attempts_ == 1 || attempts_ % 5 == 0) {
+    log_.info("master at {}:{} not reachable ({}); retrying every {} ms, giving up after {} ms", options_.master_host,
+              options_.master_port, reason, backoff_.count(), options_.give_up_after.count());
+  }
+  retry_timer_.expires_after(backoff_);
+  backoff_ = std::min(backoff_ * 2, kMaxBackoff);
+  retry_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (!error) connect();
+  });
+}
+
+void Node::on_connected(asio::ip::tcp::socket socket) {
+  connection_ = net::Connection::create(std::move(socket), net::kDefaultMaxPayloadBytes);
+  phase_ = Phase::awaiting_challenge;
+  connection_->start({
+      [this](wire::Envelope& message) { on_message(message); },
+      [this](const std::string& reason) { on_closed(reason); },
+  });
+  connection_->set_deadline(kHandshakeTimeout, "no welcome from the master within 5 s");
+  log_.debug("connected to the master at {}", connection_->peer());
+}
+
+void Node::on_message(wire::Envelope& message) {
+  switch (message.body_case()) {
+    case wire::Envelope::kChallenge:
+      handle_challenge(message);
+      return;
+    case wire::Envelope::kRefuse:
+      if (message.refuse().retriable()) {
+        log_.warn("the master refused this node for now: {}", message.refuse().reason());
+        connection_->close("refused (will retry)");
+      } else {
+        stop(kExitRefused, "the master refused this node: " + message.refuse().reason());
+      }
+      return;
+    case wire::Envelope::kGoodbye:
+      stop(kExitOk, "the master said goodbye (" + message.goodbye().reason() + ")");
+      return;
+    default:
+      break;
+  }
+  if (message.protocol_version() != net::kProtocolVersion) {
+    stop(kExitRefused, "the master speaks protocol v" + std::to_string(message.protocol_version()) + ", this node v" +
+                           std::to_string(net::kProtocolVersion));
+    return;
+  }
+  if (phase_ == Phase::awaiting_welcome && message.body_case() == wire::Envelope::kWelcome) {
+    handle_welcome(message.welcome());
+    return;
+  }
+  if (phase_ != Phase::joined) {
+    connection_->close(std::string("unexpected ") + net::body_name(message) + " before the welcome");
+    return;
+  }
+  switch (message.body_case()) {
+    case wire::Envelope::kFrameBegin:
+      handle_frame_begin(message.frame_begin());
+      break;
+    case wire::Envelope::kSwap:
+      handle_swap(message.swap());
+      break;
+    case wire::Envelope::kPong:
+      handle_pong(message.pong());
+      break;
+    case wire::Envelope::kHeartbeat:
+      break;
+    default:
+      connection_->close(std::string("unexpected ") + net::body_name(message) + " from the master");
+      break;
+  }
+}
+
+void Node::handle_challenge(wire::Envelope&) {
+  if (phase_ != Phase::awaiting_challenge) {
+    connection_->close("a second challenge from the master");
+    return;
+  }
+  wire::Envelope hello;
+  hello.set_protocol_version(options_.protocol_version);
+  hello.mutable_hello()->set_node_id(options_.id);
+  hello.mutable_hello()->add_capabilities("null-renderer");
+  connection_->send(hello);
+  phase_ = Phase::awaiting_welcome;
+}
+
+void Node::handle_welcome(const wire::Welcome& welcome) {
+  auto state = scene::from_snapshot(welcome.snapshot());
+  if (!state) {
+    connection_->close("bad snapshot in the welcome: " + state.error());
+    return;
+  }
+  if (scene::state_hash(state.value()) != welcome.state_hash()) {
+    connection_->close("the welcome's snapshot does not match its hash");
+    return;
+  }
+  if (auto configured = renderer_.configure(welcome); !configured) {
+    stop(kExitRefused, "cannot drive projector '" + options_.id + "': " + configured.error());
+    return;
+  }
+  state_ = std::move(state).value();
+  next_frame_ = welcome.next_frame_id();
+  rendered_any_ = false;
+  frame_period_ = welcome.frame_period_ns();
+  heartbeat_ = milliseconds(std::max<std::uint32_t>(welcome.heartbeat_ms(), 10));
+  phase_ = Phase::joined;
+  unreachable_ = false;
+  attempts_ = 0;
+  backoff_ = milliseconds(100);
+  connection_->cancel_deadline();
+  connection_->set_liveness_timeout(milliseconds(welcome.liveness_timeout_ms()),
+                                    "master silent for " + std::to_string(welcome.liveness_timeout_ms()) + " ms");
+  const auto& p = welcome.projector();
+  log_.info("joined as '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms, next frame {}", p.id(), p.width(),
+            p.height(), p.screen(), p.eye(), static_cast<double>(frame_period_) / 1e6, next_frame_);
+  // A quick burst of pings to get a clock offset before the first swap.
+  pings_in_burst_ = kPingBurst;
+  send_ping();
+}
+
+void Node::handle_frame_begin(const wire::FrameBegin& begin) {
+  if (begin.frame_id() != next_frame_) {
+    log_.warn("frame ids jumped from {} to {}", next_frame_, begin.frame_id());
+  }
+  next_frame_ = begin.frame_id() + 1;
+  if (auto applied = scene::apply_delta(state_, begin.delta()); !applied) {
+    connection_->close("cannot apply frame " + std::to_string(begin.frame_id()) + ": " + applied.error());
+    return;
+  }
+  const std::uint64_t hash = scene::state_hash(state_);
+  if (hash != begin.state_hash()) {
+    log_.warn("state hash {:016x} differs from the master's {:016x} at frame {}", hash, begin.state_hash(),
+              begin.frame_id());
+  }
+  const clock::Nanos started = clock::monotonic_now();
+  renderer_.render({begin.frame_id(), begin.simulation_time_ns(), begin.present_time_ns(), frame_period_, &state_});
+  const clock::Nanos render_time = clock::monotonic_now() - started;
+  last_rendered_ = begin.frame_id();
+  rendered_any_ = true;
+
+  wire::Envelope envelope;
+  auto& ready = *envelope.mutable_frame_ready();
+  ready.set_frame_id(begin.frame_id());
+  ready.set_render_ns(render_time);
+  ready.set_state_hash(hash);
+  connection_->send(envelope);
+}
+
+void Node::handle_swap(const wire::FrameSwap& swap) {
+  if (!rendered_any_ || swap.frame_id() != last_rendered_) {
+    log_.warn("swap for frame {} but the last rendered frame is {}; not presenting", swap.frame_id(), last_rendered_);
+    return;
+  }
+  const clock::Nanos to_master = offset();
+  const clock::Nanos local_deadline = swap.present_deadline_ns() - to_master;
+  clock::sleep_until_monotonic(options_.clock.to_monotonic(local_deadline));
+  renderer_.present();
+  const clock::Nanos presented = options_.clock.now() + to_master;
+
+  wire::Envelope envelope;
+  auto& report = *envelope.mutable_presented();
+  report.set_frame_id(swap.frame_id());
+  report.set_presented_ns(presented);
+  report.set_clock_offset_ns(to_master);
+  if (const auto best = estimator_.best()) report.set_clock_rtt_ns(best->round_trip);
+  connection_->send(envelope);
+  log_.debug("presented frame {} at master time {} ns ({:+.1f} µs from the deadline)", swap.frame_id(), presented,
+             static_cast<double>(presented - swap.present_deadline_ns()) / 1e3);
+}
+
+void Node::send_ping() {
+  if (phase_ != Phase::joined || !connection_) return;
+  wire::Envelope envelope;
+  envelope.mutable_ping()->set_t1(options_.clock.now());
+  connection_->send(envelope);
+  if (pings_in_burst_ > 0) --pings_in_burst_;
+  schedule_pings(pings_in_burst_ > 0 ? milliseconds(5) : heartbeat_);
+}
+
+void Node::schedule_pings(milliseconds interval) {
+  ping_timer_.expires_after(interval);
+  ping_timer_.async_wait([this](const boost::system::error_code& error) {
+    if (!error) send_ping();
+  });
+}
+
+void Node::handle_pong(const wire::Pong& pong) {
+  const clock::PingSample sample{pong.t1(), pong.t2(), pong.t3(), options_.clock.now()};
+  if (!estimator_.add(sample)) log_.debug("dropped an impossible clock sample");
+}
+
+clock::Nanos Node::offset() const {
+  const auto best = estimator_.best();
+  return best ? best->offset : 0;
+}
+
+void Node::on_closed(const std::string& reason) {
+  ping_timer_.cancel();
+  if (phase_ == Phase::stopped) return;
+  const bool was_joined = phase_ == Phase::joined;
+  phase_ = Phase::disconnected;
+  if (was_joined) {
+    log_.warn("lost the master: {}; reconnecting", reason);
+  } else {
+    log_.info("connection to the master closed during the handshake: {}", reason);
+  }
+  retry_later(reason);
+}
+
+void Node::on_signal(int signal) {
+  if (connection_ && connection_->is_open()) {
+    wire::Envelope goodbye;
+    goodbye.mutable_goodbye()->set_reason(std::string("node ") + strsignal(signal));
+    connection_->send(goodbye);
+  }
+  stop(kExitOk, std::string("stopping on ") + strsignal(signal));
+}
+
+void Node::stop(int exit_code, const std::string& reason) {
+  if (phase_ == Phase::stopped) return;
+  phase_ = Phase::stopped;
+  exit_code_ = exit_code;
+  if (exit_code == kExitOk) {
+    log_.info("{}", reason);
+  } else {
+    log_.error("{}", reason);
+  }
+  retry_timer_.cancel();
+  ping_timer_.cancel();
+  signals_.cancel();
+  resolver_.cancel();
+  if (connection_) connection_->close_after_sending(reason);
+}
+
+}  // namespace optique::node

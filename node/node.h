@@ -1,0 +1,97 @@
+#pragma once
+// A render node: connects to the master (retrying with backoff while it is not
+// up), handshakes, applies the snapshot and per-frame deltas, renders, reports
+// ready, and presents at the master's deadline converted to its own clock.
+
+#include <spdlog/logger.h>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include <chrono>
+#include <memory>
+#include <string>
+
+#include "clock/clock.h"
+#include "clock/offset_estimator.h"
+#include "net/connection.h"
+#include "net/envelope.h"
+#include "renderer.h"
+#include "scene/state.h"
+
+namespace optique::node {
+
+namespace asio = boost::asio;
+
+struct NodeOptions {
+  std::string master_host = "127.0.0.1";
+  std::string master_port;
+  std::string id;
+  std::chrono::milliseconds give_up_after{10000};          // master unreachable this long: exit
+  std::uint32_t protocol_version = net::kProtocolVersion;  // test hook: speak another version
+  clock::LocalClock clock;                                 // test hook: a skewed clock
+};
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitRefused = 2;   // refused by the master, or bad command line
+inline constexpr int kExitNoMaster = 3;  // gave up reaching the master
+
+class Node {
+ public:
+  Node(asio::io_context& io, NodeOptions options, Renderer& renderer, spdlog::logger& log);
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+
+  void start();
+  [[nodiscard]] int exit_code() const { return exit_code_; }
+
+ private:
+  enum class Phase { disconnected, awaiting_challenge, awaiting_welcome, joined, stopped };
+
+  void connect();
+  void on_connected(asio::ip::tcp::socket socket);
+  void retry_later(const std::string& reason);
+  void on_message(wire::Envelope& message);
+  void on_closed(const std::string& reason);
+  void handle_challenge(wire::Envelope& message);
+  void handle_welcome(const wire::Welcome& welcome);
+  void handle_frame_begin(const wire::FrameBegin& begin);
+  void handle_swap(const wire::FrameSwap& swap);
+  void handle_pong(const wire::Pong& pong);
+  void send_ping();
+  void schedule_pings(std::chrono::milliseconds interval);
+  void on_signal(int signal);
+  void stop(int exit_code, const std::string& reason);
+
+  [[nodiscard]] clock::Nanos offset() const;
+
+  asio::io_context& io_;
+  NodeOptions options_;
+  Renderer& renderer_;
+  spdlog::logger& log_;
+
+  asio::ip::tcp::resolver resolver_;
+  asio::steady_timer retry_timer_;
+  asio::steady_timer ping_timer_;
+  asio::signal_set signals_;
+  std::shared_ptr<net::Connection> connection_;
+
+  Phase phase_ = Phase::disconnected;
+  scene::SceneState state_;
+  clock::OffsetEstimator estimator_;
+  std::uint64_t next_frame_ = 0;
+  std::uint64_t last_rendered_ = 0;
+  bool rendered_any_ = false;
+  clock::Nanos frame_period_ = 0;
+  std::chrono::milliseconds heartbeat_{250};
+  int pings_in_burst_ = 0;
+
+  std::chrono::milliseconds backoff_{100};
+  std::chrono::steady_clock::time_point unreachable_since_;
+  bool unreachable_ = false;
+  int attempts_ = 0;
+  int exit_code_ = kExitOk;
+};
+
+}  // namespace optique::node

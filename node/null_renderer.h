@@ -1,0 +1,23 @@
+#pragma once
+// Draws nothing: for runs that measure the cluster's own costs (barrier, clock,
+// network) without any rendering in the way.
+
+#include "renderer.h"
+
+namespace optique::node {
+
+class NullRenderer final : public Renderer {
+ public:
+  [[nodiscard]] Result<void> configure(const wire::Welcome& welcome) override;
+  void render(const FrameInput& frame) override;
+  void present() override;
+
+  [[nodiscard]] std::uint64_t frames_rendered() const { return rendered_; }
+  [[nodiscard]] std::uint64_t frames_presented() const { return presented_; }
+
+ private:
+  std::uint64_t rendered_ = 0;
+  std::uint64_t presented_ = 0;
+};
+
+}  // namespace optique::node

@@ -1,0 +1,33 @@
+#pragma once
+// What a node does with a frame. The null renderer implements it now; the GL
+// renderer (windowed or headless) implements the same interface.
+
+#include <cstdint>
+
+#include "clock/clock.h"
+#include "optique/wire.pb.h"
+#include "scene/state.h"
+#include "util/result.h"
+
+namespace optique::node {
+
+struct FrameInput {
+  std::uint64_t frame_id = 0;
+  clock::Nanos simulation_time = 0;
+  clock::Nanos present_time = 0;  // predicted, master clock
+  clock::Nanos frame_period = 0;
+  const scene::SceneState* state = nullptr;
+};
+
+class Renderer {
+ public:
+  virtual ~Renderer() = default;
+  // The projector, its screen, the viewer and the scene, from the master's welcome.
+  [[nodiscard]] virtual Result<void> configure(const wire::Welcome& welcome) = 0;
+  // Draws the frame into the back buffer; returns when it is ready to show.
+  virtual void render(const FrameInput& frame) = 0;
+  // Shows the last rendered frame (swap buffers).
+  virtual void present() = 0;
+};
+
+}  // namespace optique::node
