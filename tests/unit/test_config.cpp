@@ -1,0 +1,432 @@
+// Installation files: common/config/load.h and common/config/validate.h.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "config/load.h"
+#include "config/validate.h"
+
+namespace optique::config {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A small valid installation: two screens, two projectors (one with a region).
+// Every test below changes one thing in it by exact text replacement.
+const char* const kValid = R"json({
+  "name": "unit test",
+  "screens": [
+    {"id": "front", "origin": [-2.0, 0.0, 0.0], "right": [1, 0, 0], "up": [0, 1, 0], "width": 4.0, "height": 2.0},
+    {"id": "floor", "origin": [-2.0, 0.0, 2.0], "right": [1, 0, 0], "up": [0, 0, -1], "width": 4.0, "height": 2.0}
+  ],
+  "projectors": [
+    {"id": "p-front", "width": 640, "height": 320, "screen": "front"},
+    {"id": "p-floor", "width": 800, "height": 400, "screen": "floor",
+     "region": {"x": 1.0, "y": 0.5, "width": 2.0, "height": 1.0}}
+  ],
+  "viewer": {"eye": [0.0, 1.6, 2.0]},
+  "master": {"port": 7400},
+  "scene": {"builtin": "cubes"}
+})json";
+
+constexpr const char* kOrigin = "test.json";
+
+// `json` with the single occurrence of `from` replaced by `to`.
+std::string replaced(const std::string& json, const std::string& from, const std::string& to) {
+  const auto at = json.find(from);
+  EXPECT_NE(at, std::string::npos) << "test setup: '" << from << "' not in the JSON";
+  EXPECT_EQ(json.find(from, at + 1), std::string::npos) << "test setup: '" << from << "' is not unique";
+  if (at == std::string::npos) return json;
+  std::string out = json;
+  out.replace(at, from.size(), to);
+  return out;
+}
+
+std::string with(const std::string& from, const std::string& to) { return replaced(kValid, from, to); }
+
+std::string test_dir() { return ::testing::TempDir(); }
+
+Result<Installation> parse(const std::string& json) { return parse_installation(json, kOrigin, test_dir()); }
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// The result failed, and one line of its message reads "test.json: <path>: ..." and
+// mentions every fragment.
+void expect_problem(const Result<Installation>& result, const std::string& path,
+                    const std::vector<std::string>& fragments) {
+  ASSERT_FALSE(result.ok()) << "expected a problem at " << path;
+  const std::string prefix = std::string(kOrigin) + ": " + path + ": ";
+  for (const std::string& line : lines_of(result.error())) {
+    if (line.rfind(prefix, 0) != 0) continue;
+    bool all = true;
+    for (const auto& f : fragments) all = all && line.find(f) != std::string::npos;
+    if (all) return;
+  }
+  std::string wanted;
+  for (const auto& f : fragments) wanted += " '" + f + "'";
+  ADD_FAILURE() << "no line starting with '" << prefix << "' and containing" << wanted << " in:\n" << result.error();
+}
+
+// --- shipped configs -------------------------------------------------------------
+
+TEST(ShippedConfigs, EveryConfigLoadsAndHasAProjector) {
+  const fs::path dir = fs::path(OPTIQUE_SOURCE_DIR) / "configs";
+  ASSERT_TRUE(fs::is_directory(dir)) << dir;
+  std::size_t count = 0;
+  for (const auto& entry : fs::directory_iterator(dir)) {
+    if (!entry.is_regular_file() || entry.path().extension() != ".json") continue;
+    ++count;
+    SCOPED_TRACE(entry.path().string());
+    auto loaded = load_installation(entry.path().string());
+    ASSERT_TRUE(loaded.ok()) << loaded.error();
+    const LoadedConfig& c = loaded.value();
+    EXPECT_GE(c.installation.projectors_size(), 1);
+    EXPECT_GE(c.installation.screens_size(), 1);
+    EXPECT_EQ(c.path, entry.path().string());
+    EXPECT_EQ(fs::path(c.directory), dir);
+    ASSERT_EQ(c.sha256.size(), 64u);
+    EXPECT_EQ(c.sha256.find_first_not_of("0123456789abcdef"), std::string::npos) << c.sha256;
+    // Defaults were applied.
+    EXPECT_GT(c.installation.master().frame_rate(), 0.0);
+    for (const auto& p : c.installation.projectors()) EXPECT_TRUE(p.has_region()) << p.id();
+  }
+  EXPECT_GE(count, 1u) << "no *.json in " << dir;
+}
+
+TEST(LoadInstallation, MissingFileNamesThePath) {
+  const std::string path = (fs::path(test_dir()) / "no-such-dir" / "missing-config.json").string();
+  auto loaded = load_installation(path);
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.error().find(path), std::string::npos) << loaded.error();
+  EXPECT_NE(loaded.error().find("cannot open"), std::string::npos) << loaded.error();
+}
+
+TEST(LoadInstallation, ProblemsNameTheFilePath) {
+  const fs::path file = fs::path(test_dir()) / "optique-test-config-bad-width.json";
+  {
+    std::ofstream out(file);
+    out << with(R"("width": 640)", R"("width": 0)");
+  }
+  auto loaded = load_installation(file.string());
+  fs::remove(file);
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_NE(loaded.error().find(file.string() + ": projectors[0].width: "), std::string::npos) << loaded.error();
+}
+
+TEST(LoadInstallation, HashIsOfTheFileBytes) {
+  const fs::path file = fs::path(test_dir()) / "optique-test-config-valid.json";
+  {
+    std::ofstream out(file);
+    out << kValid;
+  }
+  auto first = load_installation(file.string());
+  {
+    std::ofstream out(file, std::ios::app);
+    out << "\n";  // whitespace only: same installation, different bytes
+  }
+  auto second = load_installation(file.string());
+  fs::remove(file);
+  ASSERT_TRUE(first.ok()) << first.error();
+  ASSERT_TRUE(second.ok()) << second.error();
+  EXPECT_NE(first.value().sha256, second.value().sha256);
+}
+
+// --- the base case ------------------------------------------------------------------
+
+TEST(ParseInstallation, ValidBaseParses) {
+  auto parsed = parse(kValid);
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().name(), "unit test");
+  EXPECT_EQ(parsed.value().projectors_size(), 2);
+  EXPECT_TRUE(validate(parsed.value(), test_dir()).empty());
+}
+
+// --- one test per kind of problem ------------------------------------------------
+
+TEST(ParseInstallation, JsonSyntaxError) {
+  auto parsed = parse(with(R"("port": 7400)", R"("port" 7400)"));  // no colon
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_EQ(parsed.error().rfind(std::string(kOrigin) + ": not a valid installation: ", 0), 0u) << parsed.error();
+}
+
+TEST(ParseInstallation, UnknownField) {
+  auto parsed = parse(with(R"("id": "front",)", R"("id": "front", "colour": "red",)"));
+  ASSERT_FALSE(parsed.ok());
+  EXPECT_EQ(parsed.error().rfind(std::string(kOrigin) + ": not a valid installation: ", 0), 0u) << parsed.error();
+  EXPECT_NE(parsed.error().find("colour"), std::string::npos) << parsed.error();
+  EXPECT_NE(parsed.error().find("screens[0]"), std::string::npos) << parsed.error();  // where it is
+}
+
+TEST(ParseInstallation, DuplicateProjectorId) {
+  expect_problem(parse(with(R"("id": "p-floor")", R"("id": "p-front")")), "projectors[1].id",
+                 {"duplicate projector id 'p-front'"});
+}
+
+TEST(ParseInstallation, DuplicateScreenId) {
+  const std::string json =
+      replaced(with(R"("id": "floor")", R"("id": "front")"), R"("screen": "floor")", R"("screen": "front")");
+  expect_problem(parse(json), "screens[1].id", {"duplicate screen id 'front'"});
+}
+
+TEST(ParseInstallation, ProjectorOnUnknownScreenListsKnownScreens) {
+  expect_problem(parse(with(R"("screen": "floor")", R"("screen": "ceiling")")), "projectors[1].screen",
+                 {"unknown screen 'ceiling'", "front, floor"});
+}
+
+TEST(ParseInstallation, ZeroWidth) {
+  expect_problem(parse(with(R"("width": 640)", R"("width": 0)")), "projectors[0].width",
+                 {"must be 1..16384 pixels", "got 0"});
+}
+
+TEST(ParseInstallation, RegionPastTheScreen) {
+  // x + width = 3 + 2 = 5 m on a 4 m screen.
+  expect_problem(parse(with(R"("x": 1.0)", R"("x": 3.0)")), "projectors[1].region",
+                 {"extends past the right edge of screen 'floor'", "5 m > 4 m"});
+}
+
+TEST(ParseInstallation, RegionPastTheTop) {
+  expect_problem(parse(with(R"("y": 0.5)", R"("y": 1.5)")), "projectors[1].region",
+                 {"extends past the top edge of screen 'floor'", "2.5 m > 2 m"});
+}
+
+TEST(Validate, ShrunkScreenAfterDefaultsCatchesTheDefaultedRegion) {
+  // apply_defaults gave p-front the whole 4 m x 2 m screen; shrinking the screen
+  // afterwards leaves that region hanging over the top.
+  auto parsed = parse(kValid);
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  Installation inst = parsed.value();
+  inst.mutable_screens(0)->set_height(1.0);
+  const auto problems = validate(inst, test_dir());
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].path, "projectors[0].region");
+  EXPECT_NE(problems[0].message.find("top edge of screen 'front'"), std::string::npos) << problems[0].message;
+}
+
+TEST(ParseInstallation, RegionExactlyToTheEdgeIsFine) {
+  auto parsed = parse(with(R"("x": 1.0)", R"("x": 2.0)"));  // 2 + 2 = 4 m
+  EXPECT_TRUE(parsed.ok()) << parsed.error();
+}
+
+TEST(ParseInstallation, NonUnitRightVector) {
+  expect_problem(parse(with(R"("origin": [-2.0, 0.0, 0.0], "right": [1, 0, 0])",
+                            R"("origin": [-2.0, 0.0, 0.0], "right": [2, 0, 0])")),
+                 "screens[0].right", {"must be a unit vector", "length 2"});
+}
+
+TEST(ParseInstallation, UpNotPerpendicularToRight) {
+  expect_problem(parse(with(R"("up": [0, 1, 0])", R"("up": [0.6, 0.8, 0])")), "screens[0].up",
+                 {"must be perpendicular to right", "0.6"});
+}
+
+TEST(ParseInstallation, NaNInADoubleField) {
+  expect_problem(parse(with(R"("width": 4.0, "height": 2.0},
+    {"id": "floor")",
+                            R"("width": "NaN", "height": 2.0},
+    {"id": "floor")")),
+                 "screens[0].width", {"must be a finite number", "nan"});
+}
+
+TEST(ParseInstallation, InfinityInAVector) {
+  expect_problem(parse(with(R"("origin": [-2.0, 0.0, 0.0])", R"("origin": [-2.0, "Infinity", 0.0])")),
+                 "screens[0].origin[1]", {"must be a finite number", "inf"});
+}
+
+TEST(ParseInstallation, ViewerWithNeitherEyeNorPath) {
+  expect_problem(parse(with(R"("viewer": {"eye": [0.0, 1.6, 2.0]})", R"("viewer": {"eye_separation": 0.06})")),
+                 "viewer", {"give the eye position"});
+}
+
+TEST(ParseInstallation, ViewerWithBothEyeAndPath) {
+  expect_problem(parse(with(R"("viewer": {"eye": [0.0, 1.6, 2.0]})",
+                            R"("viewer": {"eye": [0.0, 1.6, 2.0], "path": [{"time": 0, "position": [0, 1, 2]}]})")),
+                 "viewer", {"not both"});
+}
+
+TEST(ParseInstallation, ViewerPathTimesMustIncrease) {
+  const std::string path = R"("viewer": {"path": [
+      {"time": 0.0, "position": [0, 1.6, 2]},
+      {"time": 1.5, "position": [1, 1.6, 2]},
+      {"time": 1.5, "position": [0, 1.6, 2]}]})";
+  expect_problem(parse(with(R"("viewer": {"eye": [0.0, 1.6, 2.0]})", path)), "viewer.path[2].time",
+                 {"times must increase", "1.5 after 1.5"});
+}
+
+TEST(ParseInstallation, ViewerPathThatIncreasesIsFine) {
+  const std::string path = R"("viewer": {"path": [
+      {"time": 0.0, "position": [0, 1.6, 2]},
+      {"time": 1.5, "position": [1, 1.6, 2]}]})";
+  auto parsed = parse(with(R"("viewer": {"eye": [0.0, 1.6, 2.0]})", path));
+  EXPECT_TRUE(parsed.ok()) << parsed.error();
+}
+
+TEST(ParseInstallation, UnknownBuiltinSceneListsKnownOnes) {
+  expect_problem(parse(with(R"("builtin": "cubes")", R"("builtin": "spheres")")), "scene.builtin",
+                 {"unknown scene 'spheres'", "cubes", "many-lights", "depth-stack", "moving-square"});
+}
+
+TEST(ParseInstallation, GltfFileMissing) {
+  const std::string expected_path = (fs::path(test_dir()) / "models/missing-room.glb").string();
+  expect_problem(parse(with(R"("builtin": "cubes")", R"("gltf": "models/missing-room.glb")")), "scene.gltf",
+                 {"no such file", expected_path});
+}
+
+TEST(ParseInstallation, GltfFilePresentRelativeToConfigDir) {
+  const fs::path file = fs::path(test_dir()) / "optique-test-room.glb";
+  { std::ofstream(file) << "glTF"; }
+  auto parsed = parse(with(R"("builtin": "cubes")", R"("gltf": "optique-test-room.glb")"));
+  fs::remove(file);
+  EXPECT_TRUE(parsed.ok()) << parsed.error();
+}
+
+TEST(ParseInstallation, FrameRateTooHigh) {
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "frame_rate": 1500)")), "master.frame_rate",
+                 {"must be in (0, 1000]", "1500"});
+}
+
+TEST(ParseInstallation, FrameRateNegative) {
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "frame_rate": -30)")), "master.frame_rate",
+                 {"must be in (0, 1000]", "-30"});
+}
+
+TEST(ParseInstallation, FrameRateAtTheLimitIsFine) {
+  auto parsed = parse(with(R"("port": 7400)", R"("port": 7400, "frame_rate": 1000)"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_DOUBLE_EQ(parsed.value().master().frame_rate(), 1000.0);
+}
+
+TEST(ParseInstallation, UnknownOutputKind) {
+  expect_problem(parse(with(R"("screen": "front"})", R"("screen": "front", "output": {"kind": "hologram"}})")),
+                 "projectors[0].output.kind", {"unknown value 'hologram'", "headless, window"});
+}
+
+TEST(ParseInstallation, UnknownEye) {
+  expect_problem(parse(with(R"("screen": "front"})", R"("screen": "front", "eye": "centre"})")), "projectors[0].eye",
+                 {"unknown value 'centre'", "mono, left, right"});
+}
+
+TEST(ParseInstallation, BadListenAddress) {
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "listen": "300.1.2.3")")), "master.listen",
+                 {"'300.1.2.3' is not an IPv4 or IPv6 address"});
+}
+
+TEST(ParseInstallation, IPv4AndIPv6ListenAddressesAreFine) {
+  for (const char* address : {"127.0.0.1", "::1", "0.0.0.0"}) {
+    auto parsed = parse(with(R"("port": 7400)", std::string(R"("port": 7400, "listen": ")") + address + "\""));
+    EXPECT_TRUE(parsed.ok()) << address << ": " << parsed.error();
+  }
+}
+
+TEST(ParseInstallation, SeveralProblemsReportedAtOnce) {
+  std::string json = with(R"("width": 640)", R"("width": 0)");
+  json = replaced(json, R"("builtin": "cubes")", R"("builtin": "nope")");
+  json = replaced(json, R"("port": 7400)", R"("port": 7400, "listen": "somewhere")");
+  auto parsed = parse(json);
+  ASSERT_FALSE(parsed.ok());
+  const auto lines = lines_of(parsed.error());
+  EXPECT_EQ(lines.size(), 3u) << parsed.error();
+  for (const auto& line : lines) EXPECT_EQ(line.rfind(std::string(kOrigin) + ": ", 0), 0u) << line;
+  expect_problem(parsed, "projectors[0].width", {"got 0"});
+  expect_problem(parsed, "scene.builtin", {"'nope'"});
+  expect_problem(parsed, "master.listen", {"'somewhere'"});
+}
+
+TEST(Validate, ReturnsEveryProblemWithItsPath) {
+  auto parsed = parse(kValid);
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  Installation inst = parsed.value();
+  inst.mutable_projectors(1)->set_height(20000);
+  inst.mutable_screens(0)->set_pixels_per_metre(-1.0);
+  const auto problems = validate(inst, test_dir());
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_EQ(problems[0].path, "screens[0].pixels_per_metre");
+  EXPECT_NE(problems[0].message.find("must be >= 0 (got -1)"), std::string::npos) << problems[0].message;
+  EXPECT_EQ(problems[1].path, "projectors[1].height");
+  EXPECT_NE(problems[1].message.find("got 20000"), std::string::npos) << problems[1].message;
+}
+
+// The rule relates two settings, so it must hold with the default heartbeat too
+// (a 400 ms liveness timeout would drop peers between 250 ms heartbeats).
+TEST(ParseInstallation, LivenessTimeoutCheckedAgainstDefaultHeartbeat) {
+  auto parsed = parse(with(R"("port": 7400)", R"("port": 7400, "liveness_timeout_ms": 400)"));
+  if (parsed.ok()) {
+    const MasterSettings& m = parsed.value().master();
+    EXPECT_GT(m.liveness_timeout_ms(), 2 * m.heartbeat_ms())
+        << "accepted liveness_timeout_ms " << m.liveness_timeout_ms() << " with heartbeat_ms " << m.heartbeat_ms();
+  } else {
+    expect_problem(parsed, "master.liveness_timeout_ms", {"twice heartbeat_ms"});
+  }
+}
+
+TEST(ParseInstallation, LivenessTimeoutCheckedAgainstExplicitHeartbeat) {
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "heartbeat_ms": 300, "liveness_timeout_ms": 600)")),
+                 "master.liveness_timeout_ms", {"twice heartbeat_ms"});
+}
+
+// --- defaults -----------------------------------------------------------------------
+
+TEST(ApplyDefaults, FillsFrameRateAndWholeScreenRegion) {
+  auto parsed = parse(kValid);
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  const Installation& inst = parsed.value();
+  EXPECT_DOUBLE_EQ(inst.master().frame_rate(), 60.0);
+  EXPECT_EQ(inst.master().listen(), "0.0.0.0");
+  EXPECT_EQ(inst.master().port(), 7400u);  // given values stay
+
+  // p-front gave no region: the whole of "front" (4 m x 2 m).
+  const Projector& front = inst.projectors(0);
+  ASSERT_TRUE(front.has_region());
+  EXPECT_DOUBLE_EQ(front.region().x(), 0.0);
+  EXPECT_DOUBLE_EQ(front.region().y(), 0.0);
+  EXPECT_DOUBLE_EQ(front.region().width(), 4.0);
+  EXPECT_DOUBLE_EQ(front.region().height(), 2.0);
+  EXPECT_EQ(front.eye(), "mono");
+  EXPECT_EQ(front.output().kind(), "headless");
+  EXPECT_EQ(front.host(), "localhost");
+
+  // p-floor gave one: kept.
+  const Projector& floor = inst.projectors(1);
+  EXPECT_DOUBLE_EQ(floor.region().x(), 1.0);
+  EXPECT_DOUBLE_EQ(floor.region().y(), 0.5);
+  EXPECT_DOUBLE_EQ(floor.region().width(), 2.0);
+  EXPECT_DOUBLE_EQ(floor.region().height(), 1.0);
+}
+
+TEST(ApplyDefaults, KeepsGivenValuesAndFillsTheRest) {
+  Installation inst;
+  auto& screen = *inst.add_screens();
+  screen.set_id("s");
+  screen.set_width(3.0);
+  screen.set_height(1.5);
+  auto& p = *inst.add_projectors();
+  p.set_id("p");
+  p.set_screen("s");
+  p.set_eye("left");
+  inst.mutable_master()->set_frame_rate(30.0);
+  inst.mutable_master()->set_heartbeat_ms(2000);
+
+  apply_defaults(inst);
+  EXPECT_DOUBLE_EQ(inst.master().frame_rate(), 30.0);
+  EXPECT_EQ(inst.master().heartbeat_ms(), 2000u);
+  EXPECT_EQ(inst.master().liveness_timeout_ms(), 6000u);  // 3 heartbeats, above the 3000 floor
+  EXPECT_EQ(inst.master().max_message_bytes(), 16u << 20);
+  EXPECT_NEAR(inst.viewer().eye_separation(), 0.065, 1e-12);
+  EXPECT_DOUBLE_EQ(inst.screens(0).pixels_per_metre(), 200.0);
+  EXPECT_EQ(inst.projectors(0).eye(), "left");
+  ASSERT_TRUE(inst.projectors(0).has_region());
+  EXPECT_DOUBLE_EQ(inst.projectors(0).region().width(), 3.0);
+  EXPECT_DOUBLE_EQ(inst.projectors(0).region().height(), 1.5);
+}
+
+}  // namespace
+}  // namespace optique::config

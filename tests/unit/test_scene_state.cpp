@@ -1,0 +1,402 @@
+// Scene state, deltas, snapshots and hashes (common/scene/state.h), and the
+// built-in scenes (common/scene/builtin.h).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "scene/builtin.h"
+#include "scene/state.h"
+
+namespace optique::scene {
+namespace {
+
+Pose pose(double x, double y, double z, double angle = 0.0, double s = 1.0) {
+  Pose p;
+  p.position = {x, y, z};
+  p.rotation = glm::angleAxis(angle, glm::normalize(glm::dvec3(0.3, 1.0, -0.2)));
+  p.scale = {s, s * 0.5, s * 2.0};
+  return p;
+}
+
+SceneState before_state() {
+  SceneState s;
+  s.objects[1] = {pose(0.0, 1.0, -0.5, 0.1), pose(0.0, 1.0, -0.5, 0.2)};
+  s.objects[2] = {pose(1.0, 1.2, -0.7, 0.0, 0.25), pose(1.0, 1.2, -0.7, 0.0, 0.25)};
+  s.objects[5] = {pose(-1.0, 0.3, 0.1), pose(-1.1, 0.3, 0.1)};
+  s.objects[9] = {pose(3.0, 3.0, 3.0), pose(3.0, 3.0, 3.0)};
+  s.eye_now = {0.0, 1.6, 2.0};
+  s.eye_next = {0.0, 1.6, 2.0};
+  return s;
+}
+
+SceneState after_state() {
+  SceneState s = before_state();
+  s.objects[1] = {pose(0.0, 1.0, -0.5, 0.2), pose(0.0, 1.0, -0.5, 0.3)};  // moved
+  s.objects.erase(5);                                                     // removed
+  s.objects[7] = {pose(2.0, 0.0, 0.0), pose(2.0, 0.1, 0.0)};              // added
+  s.eye_now = {0.0, 1.6, 2.0};
+  s.eye_next = {0.01, 1.6, 2.0};  // the eye moved
+  return s;
+}
+
+TEST(SceneDelta, ApplyReproducesTargetExactly) {
+  const SceneState before = before_state();
+  const SceneState after = after_state();
+  const wire::StateDelta delta = make_delta(before, after);
+
+  ASSERT_EQ(delta.changed_size(), 2);  // 1 moved, 7 added; 2 and 9 unchanged
+  EXPECT_EQ(delta.changed(0).id(), 1u);
+  EXPECT_EQ(delta.changed(1).id(), 7u);
+  ASSERT_EQ(delta.removed_size(), 1);
+  EXPECT_EQ(delta.removed(0), 5u);
+  EXPECT_TRUE(delta.has_viewer());
+
+  SceneState state = before;
+  auto applied = apply_delta(state, delta);
+  ASSERT_TRUE(applied.ok()) << applied.error();
+  EXPECT_EQ(state, after);
+  EXPECT_EQ(state_hash(state), state_hash(after));
+  EXPECT_NE(state_hash(before), state_hash(after));
+}
+
+TEST(SceneDelta, SurvivesWireSerialization) {
+  const SceneState before = before_state();
+  const SceneState after = after_state();
+  wire::StateDelta delta;
+  ASSERT_TRUE(delta.ParseFromString(make_delta(before, after).SerializeAsString()));
+  SceneState state = before;
+  ASSERT_TRUE(apply_delta(state, delta).ok());
+  EXPECT_EQ(state, after);
+  EXPECT_EQ(state_hash(state), state_hash(after));
+}
+
+TEST(SceneDelta, IdenticalStatesGiveEmptyDelta) {
+  const SceneState s = before_state();
+  const wire::StateDelta delta = make_delta(s, s);
+  EXPECT_EQ(delta.changed_size(), 0);
+  EXPECT_EQ(delta.removed_size(), 0);
+  EXPECT_FALSE(delta.has_viewer());
+
+  SceneState copy = s;
+  ASSERT_TRUE(apply_delta(copy, delta).ok());
+  EXPECT_EQ(copy, s);
+}
+
+TEST(SceneDelta, EyeOnlyMoveCarriesViewerOnly) {
+  const SceneState before = before_state();
+  SceneState after = before;
+  after.eye_now.z = 1.9;
+  const wire::StateDelta delta = make_delta(before, after);
+  EXPECT_EQ(delta.changed_size(), 0);
+  EXPECT_EQ(delta.removed_size(), 0);
+  ASSERT_TRUE(delta.has_viewer());
+  EXPECT_DOUBLE_EQ(delta.viewer().eye_now().z(), 1.9);
+  SceneState state = before;
+  ASSERT_TRUE(apply_delta(state, delta).ok());
+  EXPECT_EQ(state, after);
+}
+
+TEST(SceneDelta, RemovingEveryObject) {
+  const SceneState before = before_state();
+  SceneState after = before;
+  after.objects.clear();
+  const wire::StateDelta delta = make_delta(before, after);
+  EXPECT_EQ(delta.changed_size(), 0);
+  EXPECT_EQ(delta.removed_size(), 4);
+  SceneState state = before;
+  ASSERT_TRUE(apply_delta(state, delta).ok());
+  EXPECT_TRUE(state.objects.empty());
+  EXPECT_EQ(state, after);
+  EXPECT_EQ(state_hash(state), state_hash(after));
+}
+
+TEST(SceneSnapshot, RoundTrip) {
+  const SceneState s = after_state();
+  wire::Snapshot wire_snapshot;
+  ASSERT_TRUE(wire_snapshot.ParseFromString(to_snapshot(s).SerializeAsString()));
+  EXPECT_EQ(wire_snapshot.objects_size(), static_cast<int>(s.objects.size()));
+  auto back = from_snapshot(wire_snapshot);
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back.value(), s);
+  EXPECT_EQ(state_hash(back.value()), state_hash(s));
+}
+
+TEST(SceneSnapshot, EmptyStateRoundTrip) {
+  const SceneState empty;
+  auto back = from_snapshot(to_snapshot(empty));
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back.value(), empty);
+}
+
+TEST(SceneSnapshot, DuplicateObjectRejected) {
+  wire::Snapshot snapshot = to_snapshot(before_state());
+  *snapshot.add_objects() = snapshot.objects(0);
+  auto back = from_snapshot(snapshot);
+  ASSERT_FALSE(back.ok());
+  EXPECT_NE(back.error().find("twice"), std::string::npos) << back.error();
+}
+
+TEST(SceneSnapshot, MissingRotationAndScaleMeanIdentity) {
+  wire::Snapshot snapshot;
+  auto& o = *snapshot.add_objects();
+  o.set_id(4);
+  o.mutable_now()->mutable_position()->set_x(1.5);
+  o.mutable_next()->mutable_position()->set_y(-2.0);
+  auto back = from_snapshot(snapshot);
+  ASSERT_TRUE(back.ok()) << back.error();
+  const ObjectState& state = back.value().objects.at(4);
+  EXPECT_EQ(state.now.rotation, glm::dquat(1.0, 0.0, 0.0, 0.0));
+  EXPECT_EQ(state.now.scale, glm::dvec3(1.0));
+  EXPECT_EQ(state.now.position, glm::dvec3(1.5, 0.0, 0.0));
+  EXPECT_EQ(state.next.position, glm::dvec3(0.0, -2.0, 0.0));
+}
+
+// Every double of the state feeds the hash: bumping any one by one ulp changes it.
+TEST(SceneHash, ChangesWhenAnySingleDoubleChanges) {
+  const SceneState base = before_state();
+  const std::uint64_t base_hash = state_hash(base);
+  auto bump = [](double& v) { v = std::nextafter(v, std::numeric_limits<double>::infinity()); };
+
+  int variants = 0;
+  auto check = [&](const char* what, auto&& mutate) {
+    SceneState s = base;
+    mutate(s);
+    ASSERT_NE(s, base) << what;
+    EXPECT_NE(state_hash(s), base_hash) << what;
+    ++variants;
+  };
+  check("scale.z", [&](SceneState& s) { bump(s.objects[2].now.scale.z); });
+  check("next.scale.z", [&](SceneState& s) { bump(s.objects[9].next.scale.z); });
+  check("position.x", [&](SceneState& s) { bump(s.objects[1].now.position.x); });
+  check("position.y", [&](SceneState& s) { bump(s.objects[5].next.position.y); });
+  check("rotation.w", [&](SceneState& s) { bump(s.objects[1].now.rotation.w); });
+  check("rotation.x", [&](SceneState& s) { bump(s.objects[1].next.rotation.x); });
+  check("rotation.y", [&](SceneState& s) { bump(s.objects[5].now.rotation.y); });
+  check("rotation.z", [&](SceneState& s) { bump(s.objects[9].now.rotation.z); });
+  check("eye_now.y", [&](SceneState& s) { bump(s.eye_now.y); });
+  check("eye_next.z", [&](SceneState& s) { bump(s.eye_next.z); });
+  EXPECT_EQ(variants, 10);
+}
+
+TEST(SceneHash, DependsOnIdsAndNowNextOrder) {
+  const SceneState base = before_state();
+  SceneState renumbered = base;
+  auto node = renumbered.objects.extract(9);
+  node.key() = 10;
+  renumbered.objects.insert(std::move(node));
+  EXPECT_NE(state_hash(renumbered), state_hash(base));
+
+  SceneState swapped = base;
+  std::swap(swapped.objects[1].now, swapped.objects[1].next);
+  EXPECT_NE(state_hash(swapped), state_hash(base));
+
+  SceneState eyes = base;
+  eyes.eye_now = {1.0, 2.0, 3.0};
+  eyes.eye_next = {3.0, 2.0, 1.0};
+  SceneState eyes_swapped = eyes;
+  std::swap(eyes_swapped.eye_now, eyes_swapped.eye_next);
+  EXPECT_NE(state_hash(eyes), state_hash(eyes_swapped));
+}
+
+TEST(SceneHash, EqualStatesHashEqually) {
+  EXPECT_EQ(state_hash(before_state()), state_hash(before_state()));
+  EXPECT_EQ(state_hash(SceneState{}), state_hash(SceneState{}));
+}
+
+// 0.0 == -0.0 but their bits (which the hash reads) differ: a sign-of-zero change
+// must still reach the node, or its hash drifts from the master's.
+TEST(SceneDelta, SignOfZeroChangeKeepsHashesInStep) {
+  SceneState before = before_state();
+  before.objects[2].now.position.x = 0.0;
+  SceneState after = before;
+  after.objects[2].now.position.x = -0.0;
+
+  SceneState node = before;
+  ASSERT_TRUE(apply_delta(node, make_delta(before, after)).ok());
+  EXPECT_EQ(state_hash(node), state_hash(after))
+      << "node hash after applying the master's delta differs from the master's hash";
+}
+
+TEST(ApplyDelta, NaNPositionFailsAndLeavesStateUnchanged) {
+  const SceneState before = before_state();
+  // A good change and a removal first, then the bad object: nothing may be applied.
+  wire::StateDelta delta = make_delta(before, after_state());
+  auto& bad = *delta.add_changed();
+  bad.set_id(42);
+  bad.mutable_now()->mutable_position()->set_y(std::numeric_limits<double>::quiet_NaN());
+  bad.mutable_now()->mutable_rotation()->set_w(1.0);
+
+  SceneState state = before;
+  auto applied = apply_delta(state, delta);
+  ASSERT_FALSE(applied.ok());
+  EXPECT_NE(applied.error().find("object 42"), std::string::npos) << applied.error();
+  EXPECT_NE(applied.error().find("non-finite"), std::string::npos) << applied.error();
+  EXPECT_EQ(state, before);
+  EXPECT_EQ(state_hash(state), state_hash(before));
+}
+
+TEST(ApplyDelta, InfiniteViewerFailsAndLeavesStateUnchanged) {
+  const SceneState before = before_state();
+  wire::StateDelta delta = make_delta(before, after_state());
+  delta.mutable_viewer()->mutable_eye_next()->set_x(std::numeric_limits<double>::infinity());
+  SceneState state = before;
+  auto applied = apply_delta(state, delta);
+  ASSERT_FALSE(applied.ok());
+  EXPECT_NE(applied.error().find("viewer"), std::string::npos) << applied.error();
+  EXPECT_EQ(state, before);
+}
+
+TEST(ApplyDelta, RemovingUnknownIdFailsAndLeavesStateUnchanged) {
+  const SceneState before = before_state();
+  wire::StateDelta delta = make_delta(before, after_state());
+  delta.add_removed(1234);
+  SceneState state = before;
+  auto applied = apply_delta(state, delta);
+  ASSERT_FALSE(applied.ok());
+  EXPECT_NE(applied.error().find("1234"), std::string::npos) << applied.error();
+  EXPECT_EQ(state, before);
+}
+
+TEST(ApplyDelta, NonUnitQuaternionRejected) {
+  const SceneState before = before_state();
+  wire::StateDelta delta;
+  auto& o = *delta.add_changed();
+  o.set_id(1);
+  auto& q = *o.mutable_next()->mutable_rotation();
+  q.set_w(1.0);
+  q.set_x(0.01);  // norm 1.00005: off by more than 1e-6
+  SceneState state = before;
+  auto applied = apply_delta(state, delta);
+  ASSERT_FALSE(applied.ok());
+  EXPECT_NE(applied.error().find("unit quaternion"), std::string::npos) << applied.error();
+  EXPECT_EQ(state, before);
+
+  // A zero quaternion (all fields left at 0 but present) is no rotation either.
+  wire::StateDelta zero;
+  auto& z = *zero.add_changed();
+  z.set_id(1);
+  z.mutable_now()->mutable_rotation();
+  EXPECT_FALSE(apply_delta(state, zero).ok());
+  EXPECT_EQ(state, before);
+}
+
+TEST(ApplyDelta, NearlyUnitQuaternionAccepted) {
+  SceneState state = before_state();
+  wire::StateDelta delta;
+  auto& o = *delta.add_changed();
+  o.set_id(1);
+  auto& q = *o.mutable_now()->mutable_rotation();
+  q.set_w(1.0 + 1e-9);
+  auto applied = apply_delta(state, delta);
+  ASSERT_TRUE(applied.ok()) << applied.error();
+  EXPECT_DOUBLE_EQ(state.objects.at(1).now.rotation.w, 1.0 + 1e-9);
+}
+
+// --- built-in scenes ---------------------------------------------------------------
+
+bool finite(const Pose& p) {
+  return std::isfinite(p.position.x) && std::isfinite(p.position.y) && std::isfinite(p.position.z) &&
+         std::isfinite(p.rotation.w) && std::isfinite(p.rotation.x) && std::isfinite(p.rotation.y) &&
+         std::isfinite(p.rotation.z) && std::isfinite(p.scale.x) && std::isfinite(p.scale.y) &&
+         std::isfinite(p.scale.z);
+}
+
+TEST(BuiltinScene, CubesPosesAreFiniteUnitAndDeterministic) {
+  auto first = builtin_scene("cubes");
+  auto second = builtin_scene("cubes");
+  ASSERT_TRUE(first.ok()) << first.error();
+  ASSERT_TRUE(second.ok()) << second.error();
+  const SceneScript& a = first.value();
+  const SceneScript& b = second.value();
+  EXPECT_EQ(a.name, "cubes");
+  ASSERT_EQ(a.objects.size(), 5u);
+  ASSERT_EQ(b.objects.size(), a.objects.size());
+  for (std::size_t i = 0; i < a.objects.size(); ++i) {
+    EXPECT_EQ(a.objects[i].id, i + 1);
+    for (double t : {0.0, 1.0 / 60.0, 0.5, 3.25, 1000.0}) {
+      const Pose p = a.objects[i].pose_at(t);
+      EXPECT_TRUE(finite(p)) << "cube " << i << " t=" << t;
+      EXPECT_NEAR(glm::length(p.rotation), 1.0, 1e-9) << "cube " << i << " t=" << t;
+      EXPECT_EQ(p, a.objects[i].pose_at(t)) << "same script, same t";
+      EXPECT_EQ(p, b.objects[i].pose_at(t)) << "another instance, same t";
+    }
+    // They do turn.
+    EXPECT_NE(a.objects[i].pose_at(0.0).rotation, a.objects[i].pose_at(0.5).rotation) << "cube " << i;
+  }
+}
+
+const std::vector<std::string> kBuiltinNames{"cubes", "many-lights", "depth-stack", "moving-square"};
+
+TEST(BuiltinScene, NamesAreTheFourKnownScenes) {
+  const auto names = builtin_scene_names();
+  ASSERT_EQ(names.size(), kBuiltinNames.size());
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    EXPECT_EQ(names[i], kBuiltinNames[i]);
+    EXPECT_TRUE(is_builtin_scene(names[i]));
+  }
+}
+
+class BuiltinSceneByName : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(BuiltinSceneByName, BuildsFinitePosesDeterministically) {
+  auto first = builtin_scene(GetParam());
+  auto second = builtin_scene(GetParam());
+  ASSERT_TRUE(first.ok()) << first.error();
+  ASSERT_TRUE(second.ok()) << second.error();
+  EXPECT_EQ(first.value().name, GetParam());
+  ASSERT_FALSE(first.value().objects.empty());
+  ASSERT_EQ(first.value().objects.size(), second.value().objects.size());
+  for (std::size_t i = 0; i < first.value().objects.size(); ++i) {
+    const AnimatedObject& o = first.value().objects[i];
+    for (double t : {0.0, 0.75, 2.0 + 1.0 / 60.0}) {
+      EXPECT_TRUE(finite(o.pose_at(t))) << o.name << " t=" << t;
+      EXPECT_EQ(o.pose_at(t), second.value().objects[i].pose_at(t)) << o.name << " t=" << t;
+    }
+  }
+}
+
+// Every built-in scene must produce poses a node accepts (a braced {} quaternion is
+// all zeros, which nodes rightly reject).
+TEST_P(BuiltinSceneByName, PosesAreUnitRotationsAcceptedByANode) {
+  auto script = builtin_scene(GetParam());
+  ASSERT_TRUE(script.ok()) << script.error();
+  SceneState state;
+  for (const auto& o : script.value().objects) {
+    state.objects[o.id] = {o.pose_at(2.0), o.pose_at(2.0 + 1.0 / 60.0)};
+    EXPECT_NEAR(glm::length(state.objects[o.id].now.rotation), 1.0, 1e-9) << o.name;
+    EXPECT_NEAR(glm::length(state.objects[o.id].next.rotation), 1.0, 1e-9) << o.name;
+  }
+  // What the master builds, a node can read back: as a snapshot ...
+  auto back = from_snapshot(to_snapshot(state));
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back.value(), state);
+  // ... and as a delta.
+  SceneState node;
+  auto applied = apply_delta(node, make_delta(SceneState{}, state));
+  ASSERT_TRUE(applied.ok()) << applied.error();
+  EXPECT_EQ(state_hash(node), state_hash(state));
+}
+
+INSTANTIATE_TEST_SUITE_P(All, BuiltinSceneByName, ::testing::ValuesIn(kBuiltinNames),
+                         [](const ::testing::TestParamInfo<std::string>& param_info) {
+                           std::string name = param_info.param;
+                           for (char& c : name) c = c == '-' ? '_' : c;
+                           return name;
+                         });
+
+TEST(BuiltinScene, UnknownNameFails) {
+  EXPECT_FALSE(is_builtin_scene("spheres"));
+  EXPECT_FALSE(is_builtin_scene(""));
+  EXPECT_FALSE(is_builtin_scene("Cubes"));
+  auto script = builtin_scene("spheres");
+  ASSERT_FALSE(script.ok());
+  EXPECT_NE(script.error().find("spheres"), std::string::npos) << script.error();
+}
+
+}  // namespace
+}  // namespace optique::scene
