@@ -1,0 +1,44 @@
+#pragma once
+// A child process for integration tests: started with its output in files, waited
+// for with a deadline (never forever), killed if the test ends first.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace optique::testing {
+
+class Process {
+ public:
+  // Starts `argv[0]` with `argv`; stdout and stderr go to `log_path`.
+  Process(std::vector<std::string> argv, std::string log_path);
+  Process(const Process&) = delete;
+  Process& operator=(const Process&) = delete;
+  ~Process();  // SIGKILL if still running
+
+  // Exit code, or 128 + signal; nullopt if still running after `timeout`.
+  [[nodiscard]] std::optional<int> wait(std::chrono::milliseconds timeout);
+  void signal(int signal) const;
+  [[nodiscard]] bool running();
+  [[nodiscard]] pid_t pid() const { return pid_; }
+  [[nodiscard]] std::string output() const;  // everything it wrote so far
+  [[nodiscard]] const std::string& log_path() const { return log_path_; }
+
+ private:
+  pid_t pid_ = -1;
+  std::string log_path_;
+  std::optional<int> status_;
+};
+
+// A fresh empty folder under the system temp dir.
+[[nodiscard]] std::string make_temp_dir(const std::string& prefix);
+[[nodiscard]] std::string read_file(const std::string& path);
+// Polls until `path` exists and is non-empty, or the timeout passes.
+[[nodiscard]] bool wait_for_file(const std::string& path, std::chrono::milliseconds timeout);
+// Processes whose command line contains `needle` (from /proc), excluding this one.
+[[nodiscard]] std::vector<pid_t> processes_matching(const std::string& needle);
+
+}  // namespace optique::testing

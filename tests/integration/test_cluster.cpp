@@ -1,0 +1,286 @@
+// Real master and node processes on 127.0.0.1, as a user would run them.
+
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "cluster_run.h"
+#include "config/load.h"
+#include "process.h"
+
+namespace optique::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+const std::string kMaster = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
+const std::string kNode = std::string(OPTIQUE_BIN_DIR) + "/optique-node";
+const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
+
+std::vector<std::string> projector_ids(const std::string& config) {
+  auto loaded = config::load_installation(config);
+  EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error());
+  std::vector<std::string> ids;
+  if (loaded.ok()) {
+    for (const auto& p : loaded.value().installation.projectors()) ids.push_back(p.id());
+  }
+  return ids;
+}
+
+// A master on 127.0.0.1 with an ephemeral port that the test reads back.
+struct ExternalMaster {
+  std::string dir = make_temp_dir("optique-it");
+  std::unique_ptr<Process> process;
+  std::string port;
+
+  ExternalMaster(const std::string& config, std::vector<std::string> extra) {
+    std::vector<std::string> argv{kMaster, "--config",    config,        "--listen", "127.0.0.1",  "--port",
+                                  "0",     "--port-file", dir + "/port", "--out",    dir + "/out", "--no-status"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    process = std::make_unique<Process>(argv, dir + "/master.log");
+    if (wait_for_file(dir + "/port", 10s)) {
+      port = read_file(dir + "/port");
+      while (!port.empty() && port.back() == '\n') port.pop_back();
+    }
+  }
+
+  std::unique_ptr<Process> node(const std::string& id, std::vector<std::string> extra = {}) const {
+    std::vector<std::string> argv{kNode, "--master", "127.0.0.1:" + port, "--id", id};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    return std::make_unique<Process>(argv, dir + "/node-" + id + ".log");
+  }
+};
+
+// A port nothing listens on (bound, then released).
+std::string free_port() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = 0;
+  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
+  socklen_t length = sizeof address;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
+  close(fd);
+  return std::to_string(ntohs(address.sin_port));
+}
+
+// ------------------------------------------------------------- every shipped config
+
+class ShippedConfig : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(ShippedConfig, RunsSixtyFramesInSyncWithLocalNodes) {
+  const std::string config = kConfigs + "/" + GetParam();
+  const std::string dir = make_temp_dir("optique-it");
+  Process master({kMaster, "--config", config, "--local", "--frames", "60", "--out", dir + "/out", "--no-status"},
+                 dir + "/master.log");
+  const auto status = master.wait(60s);
+  ASSERT_TRUE(status.has_value()) << "master still running after 60 s:\n" << master.output();
+  ASSERT_EQ(*status, 0) << master.output();
+
+  const ClusterRun run = read_cluster_run(dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  const auto ids = projector_ids(config);
+  EXPECT_EQ(run.report.frames(), 60u);
+  EXPECT_EQ(run.report.nodes_configured(), ids.size());
+  for (const auto& id : ids) {
+    const auto* node = find_node(run.report, id);
+    ASSERT_NE(node, nullptr) << id;
+    EXPECT_EQ(node->frames_rendered(), 60u) << id;
+    EXPECT_EQ(node->frames_presented(), 60u) << id;
+    EXPECT_EQ(node->hash_mismatches(), 0u) << id;
+    EXPECT_EQ(node->barrier_misses(), 0u) << id;
+  }
+  EXPECT_EQ(run.report.sync().frames_with_missing_node(), 0u);
+  EXPECT_EQ(run.report.sync().frames_incoherent(), 0u);
+  EXPECT_EQ(run.rows.size(), 60u * ids.size());
+  const auto problems = sync_problems(run, ids, 60);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  // Every local node exited after the master's goodbye.
+  for (const auto& id : ids) {
+    const std::string log = read_file(dir + "/out/logs/" + id + ".log");
+    EXPECT_NE(log.find("the master said goodbye"), std::string::npos) << id << ":\n" << log;
+  }
+}
+
+std::vector<std::string> shipped_configs() {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(kConfigs)) {
+    if (entry.path().extension() == ".json") names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+INSTANTIATE_TEST_SUITE_P(Configs, ShippedConfig, ::testing::ValuesIn(shipped_configs()), [](const auto& param_info) {
+  std::string name = param_info.param.substr(0, param_info.param.size() - 5);
+  for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
+  return name;
+});
+
+// ------------------------------------------------------------- failures
+
+TEST(Cluster, KilledNodeLeavesTheBarrierAndTheOthersFinish) {
+  const std::string config = kConfigs + "/powerwall-2x2.json";
+  ExternalMaster master(config, {"--frames", "120"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  std::vector<std::unique_ptr<Process>> nodes;
+  for (const auto& id : projector_ids(config)) nodes.push_back(master.node(id));
+  std::this_thread::sleep_for(700ms);  // about 40 frames in
+  nodes.back()->signal(SIGKILL);
+
+  const auto status = master.process->wait(30s);
+  ASSERT_TRUE(status.has_value()) << master.process->output();
+  EXPECT_EQ(*status, 0) << master.process->output();
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  EXPECT_EQ(run.report.frames(), 120u);
+  const auto ids = projector_ids(config);
+  const auto* killed = find_node(run.report, ids.back());
+  ASSERT_NE(killed, nullptr);
+  EXPECT_GT(killed->frames_presented(), 0u);
+  EXPECT_LT(killed->frames_presented(), 120u);
+  const std::vector<std::string> survivors(ids.begin(), ids.end() - 1);
+  for (const auto& id : survivors) EXPECT_EQ(find_node(run.report, id)->frames_presented(), 120u) << id;
+  const auto problems = sync_problems(run, survivors, 120);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  EXPECT_GT(run.report.sync().frames_with_missing_node(), 0u);
+  EXPECT_NE(master.process->output().find("node '" + ids.back() + "' left"), std::string::npos)
+      << master.process->output();
+  for (std::size_t i = 0; i + 1 < nodes.size(); ++i) EXPECT_EQ(nodes[i]->wait(5s), 0) << nodes[i]->output();
+}
+
+TEST(Cluster, HungNodeIsTakenOutOfTheBarrierAfterTheTimeout) {
+  const std::string config = kConfigs + "/powerwall-2x2.json";
+  ExternalMaster master(config, {"--frames", "90"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  std::vector<std::unique_ptr<Process>> nodes;
+  for (const auto& id : projector_ids(config)) nodes.push_back(master.node(id));
+  std::this_thread::sleep_for(500ms);
+  nodes.front()->signal(SIGSTOP);
+
+  const auto status = master.process->wait(30s);
+  nodes.front()->signal(SIGCONT);
+  ASSERT_TRUE(status.has_value()) << master.process->output();
+  EXPECT_EQ(*status, 0) << master.process->output();
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  const auto ids = projector_ids(config);
+  const auto* hung = find_node(run.report, ids.front());
+  EXPECT_GE(hung->barrier_misses(), 1u);
+  EXPECT_LT(hung->frames_presented(), 90u);
+  const std::vector<std::string> others(ids.begin() + 1, ids.end());
+  for (const auto& id : others) EXPECT_EQ(find_node(run.report, id)->frames_presented(), 90u) << id;
+  EXPECT_TRUE(sync_problems(run, others, 90).empty());
+  EXPECT_NE(master.process->output().find("taken out of the barrier"), std::string::npos);
+}
+
+TEST(Cluster, UnknownNodeIdIsRefusedOnBothSides) {
+  ExternalMaster master(kConfigs + "/single-wall.json", {});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  auto stranger = master.node("no-such-projector");
+  const auto status = stranger->wait(10s);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(*status, 2);
+  EXPECT_NE(stranger->output().find("unknown projector id 'no-such-projector'"), std::string::npos)
+      << stranger->output();
+  EXPECT_NE(stranger->output().find("wall"), std::string::npos) << "the refusal lists the known ids";
+  EXPECT_NE(master.process->output().find("refused node 'no-such-projector'"), std::string::npos)
+      << master.process->output();
+  master.process->signal(SIGINT);
+  EXPECT_EQ(master.process->wait(10s), 0) << master.process->output();
+}
+
+TEST(Cluster, ProtocolVersionMismatchIsRefusedOnBothSides) {
+  ExternalMaster master(kConfigs + "/single-wall.json", {});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  auto old_node = master.node("wall", {"--protocol-version", "99"});
+  const auto status = old_node->wait(10s);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(*status, 2);
+  EXPECT_NE(old_node->output().find("protocol version mismatch: node speaks v99"), std::string::npos)
+      << old_node->output();
+  EXPECT_NE(master.process->output().find("protocol version mismatch"), std::string::npos) << master.process->output();
+  master.process->signal(SIGINT);
+  EXPECT_EQ(master.process->wait(10s), 0) << master.process->output();
+}
+
+TEST(Cluster, ConfigErrorStartsNothing) {
+  const std::string dir = make_temp_dir("optique-it");
+  const std::string config = dir + "/broken.json";
+  std::ofstream(config) << R"({
+    "screens": [{"id": "front", "origin": [0, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0], "width": 2, "height": 1}],
+    "projectors": [{"id": "p", "width": 320, "height": 180, "screen": "wall"}],
+    "viewer": {"eye": [0, 1, 2]},
+    "scene": {"builtin": "cubes"}
+  })";
+  // A stand-in node binary that leaves a mark if anything starts it.
+  const std::string fake_node = dir + "/fake-node";
+  std::ofstream(fake_node) << "#!/bin/sh\ntouch " << dir << "/node-started\n";
+  std::filesystem::permissions(fake_node, std::filesystem::perms::owner_all);
+
+  Process master(
+      {kMaster, "--config", config, "--local", "--node-binary", fake_node, "--out", dir + "/out", "--no-status"},
+      dir + "/master.log");
+  const auto status = master.wait(10s);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(*status, 2);
+  const std::string output = master.output();
+  EXPECT_NE(output.find(config + ": projectors[0].screen: unknown screen 'wall'"), std::string::npos) << output;
+  std::this_thread::sleep_for(200ms);
+  EXPECT_FALSE(std::filesystem::exists(dir + "/node-started"));
+  EXPECT_FALSE(std::filesystem::exists(dir + "/out/run.json"));
+}
+
+TEST(Cluster, NodeWaitsForALateMasterThenJoins) {
+  const std::string dir = make_temp_dir("optique-it");
+  const std::string port = free_port();
+  Process node({kNode, "--master", "127.0.0.1:" + port, "--id", "wall"}, dir + "/node.log");
+  std::this_thread::sleep_for(600ms);
+  EXPECT_NE(node.output().find("not reachable"), std::string::npos) << node.output();
+  Process master({kMaster, "--config", kConfigs + "/single-wall.json", "--listen", "127.0.0.1", "--port", port,
+                  "--frames", "30", "--out", dir + "/out", "--no-status"},
+                 dir + "/master.log");
+  ASSERT_EQ(master.wait(30s), 0) << master.output();
+  EXPECT_EQ(node.wait(10s), 0) << node.output();
+  const ClusterRun run = read_cluster_run(dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  EXPECT_EQ(find_node(run.report, "wall")->frames_presented(), 30u);
+}
+
+TEST(Cluster, NodeGivesUpWhenNoMasterComes) {
+  const std::string dir = make_temp_dir("optique-it");
+  Process node({kNode, "--master", "127.0.0.1:" + free_port(), "--id", "wall", "--give-up-after-ms", "500"},
+               dir + "/node.log");
+  const auto status = node.wait(10s);
+  ASSERT_TRUE(status.has_value());
+  EXPECT_EQ(*status, 3);
+  EXPECT_NE(node.output().find("gave up"), std::string::npos) << node.output();
+}
+
+TEST(Cluster, InterruptStopsTheLocalClusterCleanly) {
+  const std::string dir = make_temp_dir("optique-it");
+  Process master({kMaster, "--config", kConfigs + "/powerwall-2x2.json", "--local", "--port-file", dir + "/port",
+                  "--out", dir + "/out", "--no-status"},
+                 dir + "/master.log");
+  ASSERT_TRUE(wait_for_file(dir + "/port", 10s));
+  std::string port = read_file(dir + "/port");
+  port.pop_back();
+  std::this_thread::sleep_for(800ms);
+  master.signal(SIGINT);
+  ASSERT_EQ(master.wait(10s), 0) << master.output();
+  const ClusterRun run = read_cluster_run(dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  EXPECT_NE(run.report.stopped_because().find("interrupted"), std::string::npos);
+  EXPECT_GT(run.report.frames(), 10u);
+  EXPECT_TRUE(processes_matching("127.0.0.1:" + port).empty()) << "local nodes outlived the master";
+}
+
+}  // namespace
+}  // namespace optique::testing
