@@ -9,6 +9,7 @@ packages=(
   libboost-dev                       # Asio (header-only)
   libprotobuf-dev protobuf-compiler  # wire format and config schema
   libspdlog-dev libcli11-dev         # logging, command lines
+  nlohmann-json3-dev                 # JSON syntax errors with line and column
   libglfw3-dev libglm-dev            # windows on projectors, render math
   libopenimageio-dev                 # image files and image operations
   libgtest-dev libgmock-dev          # tests

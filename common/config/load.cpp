@@ -2,6 +2,8 @@
 
 #include <google/protobuf/util/json_util.h>
 
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -14,6 +16,26 @@ namespace optique::config {
 
 Result<Installation> parse_installation(const std::string& json, const std::string& origin,
                                         const std::string& directory) {
+  // Protobuf's parser says what is wrong with JSON syntax but not where; a user
+  // with a missing comma in a long file needs the line and column.
+  try {
+    [[maybe_unused]] const auto document = nlohmann::json::parse(json);
+  } catch (const nlohmann::json::parse_error& e) {
+    std::string what = e.what();
+    const auto detail = what.find(": ");
+    if (detail != std::string::npos) what = what.substr(detail + 2);
+    std::size_t line = 1;
+    std::size_t column = 1;
+    for (std::size_t i = 0; i + 1 < e.byte && i < json.size(); ++i) {
+      if (json[i] == '\n') {
+        ++line;
+        column = 1;
+      } else {
+        ++column;
+      }
+    }
+    return Error{origin + ":" + std::to_string(line) + ":" + std::to_string(column) + ": not valid JSON: " + what};
+  }
   Installation installation;
   google::protobuf::util::JsonParseOptions options;
   options.ignore_unknown_fields = false;

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -154,10 +156,23 @@ TEST(ParseInstallation, ValidBaseParses) {
 
 // --- one test per kind of problem ------------------------------------------------
 
-TEST(ParseInstallation, JsonSyntaxError) {
-  auto parsed = parse(with(R"("port": 7400)", R"("port" 7400)"));  // no colon
+// Syntax errors say where: the line of the mistake and a column on it.
+void expect_syntax_error_on_line_of(const std::string& text, const std::string& mistake) {
+  const auto at = text.find(mistake);
+  ASSERT_NE(at, std::string::npos);
+  const auto line = 1 + std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+  auto parsed = parse(text);
   ASSERT_FALSE(parsed.ok());
-  EXPECT_EQ(parsed.error().rfind(std::string(kOrigin) + ": not a valid installation: ", 0), 0u) << parsed.error();
+  EXPECT_EQ(parsed.error().rfind(std::string(kOrigin) + ":" + std::to_string(line) + ":", 0), 0u) << parsed.error();
+  EXPECT_NE(parsed.error().find("not valid JSON"), std::string::npos) << parsed.error();
+}
+
+TEST(ParseInstallation, JsonSyntaxErrorNamesLineAndColumn) {
+  expect_syntax_error_on_line_of(with(R"("port": 7400)", R"("port" 7400)"), R"("port" 7400)");  // no colon
+}
+
+TEST(ParseInstallation, TrailingCommaIsASyntaxError) {
+  expect_syntax_error_on_line_of(with(R"("port": 7400})", R"("port": 7400,})"), R"("port": 7400,})");
 }
 
 TEST(ParseInstallation, UnknownField) {
