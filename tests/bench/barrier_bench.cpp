@@ -1,0 +1,146 @@
+// Barrier benchmark: optique's frame barrier (null renderer, real master and node
+// processes on loopback) for 1, 2, 4, 8, 16 nodes, side by side in one run with a
+// plain ready/go barrier at the same pacing. Writes a Markdown table and a CSV.
+//
+//   optique-bench-barrier [--out DIR] [--frames N] [--rate HZ] [--repeats R] [--nodes 1,2,4]
+
+#include <CLI/CLI.hpp>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "../integration/cluster_run.h"
+#include "../integration/process.h"
+#include "metrics/distribution.h"
+#include "ready_go_baseline.h"
+
+namespace {
+
+using namespace optique;
+
+std::string installation_json(std::size_t nodes, double rate) {
+  // One wall cut into vertical strips, one small projector each.
+  std::ostringstream json;
+  const double width = 4.0;
+  json << R"({"screens": [{"id": "wall", "origin": [-2, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0], "width": )" << width
+       << R"(, "height": 2.25}], "projectors": [)";
+  for (std::size_t i = 0; i < nodes; ++i) {
+    json << (i ? "," : "") << R"({"id": "n)" << i
+         << R"(", "width": 160, "height": 90, "screen": "wall", "region": {"x": )"
+         << width * static_cast<double>(i) / static_cast<double>(nodes) << R"(, "y": 0, "width": )"
+         << width / static_cast<double>(nodes) << R"(, "height": 2.25}})";
+  }
+  json << R"(], "viewer": {"eye": [0, 1.6, 2]}, "master": {"frame_rate": )" << rate
+       << R"(}, "scene": {"builtin": "cubes"}})";
+  return json.str();
+}
+
+struct Sample {
+  double barrier_median = 0, barrier_p99 = 0, skew_median = 0, skew_p99 = 0;
+  double baseline_median = 0, baseline_p99 = 0;
+  std::uint64_t missing = 0;
+};
+
+Sample run_once(const std::string& master_bin, const std::string& work, std::size_t nodes, std::size_t frames,
+                double rate) {
+  const std::string config = work + "/bench-" + std::to_string(nodes) + ".json";
+  std::ofstream(config) << installation_json(nodes, rate);
+  const std::string out = work + "/run-" + std::to_string(nodes);
+  std::filesystem::remove_all(out);
+  testing::Process master({master_bin, "--config", config, "--local", "--frames", std::to_string(frames), "--out", out,
+                           "--no-status", "--log-level", "warn"},
+                          work + "/master.log");
+  const auto status = master.wait(std::chrono::seconds(120));
+  if (status != 0) throw std::runtime_error("master failed:\n" + master.output());
+  const auto run = testing::read_cluster_run(out);
+  if (!run.error.empty()) throw std::runtime_error(run.error);
+  Sample s;
+  const auto& sync = run.report.sync();
+  s.barrier_median = sync.barrier_round_us().median();
+  s.barrier_p99 = sync.barrier_round_us().p99();
+  s.skew_median = sync.present_skew_us().median();
+  s.skew_p99 = sync.present_skew_us().p99();
+  s.missing = sync.frames_with_missing_node();
+  auto baseline = bench::ready_go_rounds(nodes, frames, rate);
+  const auto summary = metrics::summarize(std::move(baseline));
+  s.baseline_median = summary.median();
+  s.baseline_p99 = summary.p99();
+  return s;
+}
+
+// Median over repeats, and the spread (min..max) as the error.
+struct Spread {
+  double median, low, high;
+};
+Spread spread(std::vector<double> v) {
+  std::vector<double> copy = v;
+  const double mid = metrics::percentile(copy, 50.0);
+  return {mid, *std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end())};
+}
+
+std::string cell(const Spread& s) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.0f (%.0f–%.0f)", s.median, s.low, s.high);
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"optique barrier benchmark"};
+  std::string out = "docs/bench";
+  std::size_t frames = 300;
+  double rate = 60.0;
+  std::size_t repeats = 3;
+  std::vector<std::size_t> node_counts{1, 2, 4, 8, 16};
+  std::string master_bin = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
+  app.add_option("--out", out, "folder for barrier.md and barrier.csv");
+  app.add_option("--frames", frames, "frames (and baseline rounds) per run");
+  app.add_option("--rate", rate, "frame rate in Hz (both barriers are paced at it)");
+  app.add_option("--repeats", repeats, "runs per node count; the table shows the median and the min–max");
+  app.add_option("--nodes", node_counts, "node counts")->delimiter(',');
+  app.add_option("--master", master_bin, "optique-master binary");
+  CLI11_PARSE(app, argc, argv);
+
+  const std::string work = testing::make_temp_dir("optique-bench");
+  std::filesystem::create_directories(out);
+  std::ofstream csv(out + "/barrier.csv");
+  csv << "nodes,repeat,frames,rate_hz,barrier_median_us,barrier_p99_us,present_skew_median_us,present_skew_p99_us,"
+         "ready_go_median_us,ready_go_p99_us,frames_with_missing_node\n";
+  std::ostringstream table;
+  table << "| nodes | optique barrier round median µs | p99 µs | present skew median µs | p99 µs | "
+           "ready/go baseline median µs | p99 µs | optique / baseline (median) |\n"
+        << "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  for (std::size_t nodes : node_counts) {
+    std::vector<double> bm, bp, sm, sp, gm, gp, ratio;
+    for (std::size_t r = 0; r < repeats; ++r) {
+      const Sample s = run_once(master_bin, work, nodes, frames, rate);
+      csv << nodes << ',' << r << ',' << frames << ',' << rate << ',' << s.barrier_median << ',' << s.barrier_p99 << ','
+          << s.skew_median << ',' << s.skew_p99 << ',' << s.baseline_median << ',' << s.baseline_p99 << ',' << s.missing
+          << '\n';
+      bm.push_back(s.barrier_median);
+      bp.push_back(s.barrier_p99);
+      sm.push_back(s.skew_median);
+      sp.push_back(s.skew_p99);
+      gm.push_back(s.baseline_median);
+      gp.push_back(s.baseline_p99);
+      ratio.push_back(s.barrier_median / s.baseline_median);
+      std::cerr << "nodes " << nodes << " repeat " << r << ": barrier " << s.barrier_median << " µs, skew "
+                << s.skew_median << " µs, ready/go " << s.baseline_median << " µs\n";
+    }
+    const Spread q = spread(ratio);
+    char ratio_text[64];
+    std::snprintf(ratio_text, sizeof ratio_text, "%.2f (%.2f–%.2f)", q.median, q.low, q.high);
+    table << "| " << nodes << " | " << cell(spread(bm)) << " | " << cell(spread(bp)) << " | " << cell(spread(sm))
+          << " | " << cell(spread(sp)) << " | " << cell(spread(gm)) << " | " << cell(spread(gp)) << " | " << ratio_text
+          << " |\n";
+  }
+  std::ofstream md(out + "/barrier.md");
+  md << "Barrier benchmark: " << frames << " frames at " << rate << " Hz, " << repeats
+     << " runs per row; each cell is the median over runs with the min–max in brackets.\n\n"
+     << table.str();
+  std::cout << table.str();
+  std::filesystem::remove_all(work);
+  return 0;
+}
