@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The main job: installs, builds, and runs a local cluster on loopback (one master,
+# one node process per projector) with a default installation, writing its
+# outputs to a folder it names.
+#   scripts/run-local.sh [CONFIG] [FRAMES] [OUT]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+config="${1:-configs/powerwall-2x2.json}"
+frames="${2:-300}"
+out="${3:-out/$(basename "$config" .json)}"
+bash scripts/install-deps.sh
+bash scripts/build.sh
+build_dir="${OPTIQUE_BUILD_DIR:-build}"
+"$build_dir/bin/optique-master" --config "$config" --local --frames "$frames" --out "$out"
+echo
+echo "outputs in $out/: run.json (sync summary), frames.csv (per frame and node), logs/"
