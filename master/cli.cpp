@@ -8,6 +8,8 @@
 #include <iostream>
 
 #include "check_config.h"
+#include <spdlog/sinks/sink.h>
+
 #include "log/logger.h"
 #include "master.h"
 
@@ -103,7 +105,8 @@ int run_cli(int argc, char** argv) {
   options.out_dir = out_dir;
   options.status_line = !no_status && isatty(STDERR_FILENO) == 1;
   auto logger = log::make_logger("master", log_level, log_file);
-  if (options.status_line) logger->set_pattern("\r\033[K%H:%M:%S.%e %^%-5l%$ [%n] %v");
+  // On a terminal, each log line first clears the status line (stderr only, not the log file).
+  if (options.status_line) logger->sinks().front()->set_pattern("\r\033[K%H:%M:%S.%e %^%-5l%$ [%n] %v");
 
   boost::asio::io_context io;
   Master master(io, std::move(options), *logger);

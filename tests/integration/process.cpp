@@ -64,6 +64,15 @@ bool Process::running() { return !wait(std::chrono::milliseconds(0)).has_value()
 
 std::string Process::output() const { return read_file(log_path_); }
 
+bool Process::wait_for_output(const std::string& needle, std::chrono::milliseconds timeout) const {
+  const auto deadline = std::chrono::steady_clock::now() + timeout;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (output().find(needle) != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return false;
+}
+
 std::string make_temp_dir(const std::string& prefix) {
   std::random_device device;
   const auto dir = std::filesystem::temp_directory_path() /

@@ -25,6 +25,8 @@ class Process {
   [[nodiscard]] bool running();
   [[nodiscard]] pid_t pid() const { return pid_; }
   [[nodiscard]] std::string output() const;  // everything it wrote so far
+  // Polls the output until it contains `needle`, or the timeout passes.
+  [[nodiscard]] bool wait_for_output(const std::string& needle, std::chrono::milliseconds timeout) const;
   [[nodiscard]] const std::string& log_path() const { return log_path_; }
 
  private:

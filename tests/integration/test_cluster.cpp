@@ -132,7 +132,8 @@ TEST(Cluster, KilledNodeLeavesTheBarrierAndTheOthersFinish) {
   ASSERT_FALSE(master.port.empty()) << master.process->output();
   std::vector<std::unique_ptr<Process>> nodes;
   for (const auto& id : projector_ids(config)) nodes.push_back(master.node(id));
-  std::this_thread::sleep_for(700ms);  // about 40 frames in
+  ASSERT_TRUE(master.process->wait_for_output("starting frames", 15s)) << master.process->output();
+  std::this_thread::sleep_for(500ms);  // about 30 of 120 frames in
   nodes.back()->signal(SIGKILL);
 
   const auto status = master.process->wait(30s);
@@ -162,7 +163,8 @@ TEST(Cluster, HungNodeIsTakenOutOfTheBarrierAfterTheTimeout) {
   ASSERT_FALSE(master.port.empty()) << master.process->output();
   std::vector<std::unique_ptr<Process>> nodes;
   for (const auto& id : projector_ids(config)) nodes.push_back(master.node(id));
-  std::this_thread::sleep_for(500ms);
+  ASSERT_TRUE(master.process->wait_for_output("starting frames", 15s)) << master.process->output();
+  std::this_thread::sleep_for(300ms);  // about 18 of 90 frames in
   nodes.front()->signal(SIGSTOP);
 
   const auto status = master.process->wait(30s);
@@ -272,7 +274,8 @@ TEST(Cluster, InterruptStopsTheLocalClusterCleanly) {
   ASSERT_TRUE(wait_for_file(dir + "/port", 10s));
   std::string port = read_file(dir + "/port");
   port.pop_back();
-  std::this_thread::sleep_for(800ms);
+  ASSERT_TRUE(master.wait_for_output("starting frames", 15s)) << master.output();
+  std::this_thread::sleep_for(500ms);
   master.signal(SIGINT);
   ASSERT_EQ(master.wait(10s), 0) << master.output();
   const ClusterRun run = read_cluster_run(dir + "/out");
