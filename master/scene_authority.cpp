@@ -4,7 +4,7 @@
 
 namespace optique::master {
 
-SceneAuthority::SceneAuthority(scene::SceneScript script, config::Viewer viewer, clock::Nanos frame_period)
+SceneAuthority::SceneAuthority(scene::SceneDefinition script, config::Viewer viewer, clock::Nanos frame_period)
     : script_(std::move(script)), viewer_(std::move(viewer)), period_(frame_period) {}
 
 clock::Nanos SceneAuthority::simulation_time(std::uint64_t frame) const {

@@ -13,14 +13,14 @@ namespace optique::master {
 
 class SceneAuthority {
  public:
-  SceneAuthority(scene::SceneScript script, config::Viewer viewer, clock::Nanos frame_period);
+  SceneAuthority(scene::SceneDefinition script, config::Viewer viewer, clock::Nanos frame_period);
 
   [[nodiscard]] scene::SceneState state_at_frame(std::uint64_t frame) const;
   [[nodiscard]] clock::Nanos simulation_time(std::uint64_t frame) const;
   [[nodiscard]] clock::Nanos frame_period() const { return period_; }
 
  private:
-  scene::SceneScript script_;
+  scene::SceneDefinition script_;
   config::Viewer viewer_;
   clock::Nanos period_;
 };

@@ -311,8 +311,8 @@ TEST(BuiltinScene, CubesPosesAreFiniteUnitAndDeterministic) {
   auto second = builtin_scene("cubes");
   ASSERT_TRUE(first.ok()) << first.error();
   ASSERT_TRUE(second.ok()) << second.error();
-  const SceneScript& a = first.value();
-  const SceneScript& b = second.value();
+  const SceneDefinition& a = first.value();
+  const SceneDefinition& b = second.value();
   EXPECT_EQ(a.name, "cubes");
   ASSERT_EQ(a.objects.size(), 5u);
   ASSERT_EQ(b.objects.size(), a.objects.size());
