@@ -34,7 +34,7 @@ void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos rece
   if (record == nullptr || record->nodes[node].ready != 0) return;
   record->nodes[node].ready = received;
   totals_[node].rendered += 1;
-  totals_[node].render_us.push_back(static_cast<double>(render_time) / 1e3);
+  totals_[node].render_us.add(static_cast<double>(render_time) / 1e3);
 }
 
 void RunRecorder::swapped(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes) {
@@ -42,7 +42,7 @@ void RunRecorder::swapped(std::uint64_t frame, clock::Nanos sent, const std::vec
   if (record == nullptr) return;
   record->swap_sent = sent;
   for (std::size_t n : nodes) record->nodes[n].swapped = true;
-  barrier_round_us_.push_back(static_cast<double>(sent - record->begin_sent) / 1e3);
+  barrier_round_us_.add(static_cast<double>(sent - record->begin_sent) / 1e3);
 }
 
 void RunRecorder::presented(std::uint64_t frame, std::size_t node, clock::Nanos at) {
@@ -80,9 +80,10 @@ void RunRecorder::finalize(const FrameRecord& record) {
       *csv_ << '\n';
     }
   }
-  if (presented > 0) {
-    last_skew_us_ = static_cast<double>(latest - earliest) / 1e3;
-    present_skew_us_.push_back(last_skew_us_);
+  if (presented >= 2) {  // skew is between nodes: one node alone has none
+    // In double: present times come from the network and may be anything.
+    last_skew_us_ = (static_cast<double>(latest) - static_cast<double>(earliest)) / 1e3;
+    present_skew_us_.add(last_skew_us_);
   }
   if (presented < record.nodes.size()) ++frames_missing_;
   if (incoherent) ++frames_incoherent_;
@@ -114,14 +115,14 @@ report::RunReport RunRecorder::report() const {
     node.set_id(ids_[n]);
     node.set_frames_rendered(t.rendered);
     node.set_frames_presented(t.presented);
-    *node.mutable_render_us() = metrics::summarize(t.render_us);
+    *node.mutable_render_us() = t.render_us.summary();
     node.set_barrier_misses(t.misses);
     node.set_hash_mismatches(t.mismatches);
     node.set_joins(t.joins);
   }
   auto& sync = *r.mutable_sync();
-  *sync.mutable_barrier_round_us() = metrics::summarize(barrier_round_us_);
-  *sync.mutable_present_skew_us() = metrics::summarize(present_skew_us_);
+  *sync.mutable_barrier_round_us() = barrier_round_us_.summary();
+  *sync.mutable_present_skew_us() = present_skew_us_.summary();
   sync.set_frames_with_missing_node(frames_missing_);
   sync.set_frames_incoherent(frames_incoherent_);
   if (frames_finalized_ > 1 && last_begin_ > first_begin_) {

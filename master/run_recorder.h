@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "clock/clock.h"
+#include "metrics/distribution.h"
 #include "optique/report.pb.h"
 
 namespace optique::master {
@@ -37,7 +38,8 @@ class RunRecorder {
   [[nodiscard]] report::RunReport report() const;
 
   [[nodiscard]] std::uint64_t frames_finalized() const { return frames_finalized_; }
-  // Present skew of the most recently finalized frame that has one, for the status line.
+  // Present skew of the most recently finalized frame that two or more nodes
+  // presented, for the status line.
   [[nodiscard]] double last_present_skew_us() const { return last_skew_us_; }
   [[nodiscard]] std::uint64_t frames_with_missing_node() const { return frames_missing_; }
 
@@ -60,7 +62,7 @@ class RunRecorder {
     std::uint64_t misses = 0;
     std::uint64_t mismatches = 0;
     std::uint64_t joins = 0;
-    std::vector<double> render_us;
+    metrics::Reservoir render_us;
   };
 
   FrameRecord* find(std::uint64_t frame);
@@ -70,8 +72,8 @@ class RunRecorder {
   std::ostream* csv_;
   std::deque<FrameRecord> open_;
   std::vector<NodeTotals> totals_;
-  std::vector<double> barrier_round_us_;
-  std::vector<double> present_skew_us_;
+  metrics::Reservoir barrier_round_us_;
+  metrics::Reservoir present_skew_us_;
   std::uint64_t frames_finalized_ = 0;
   std::uint64_t frames_missing_ = 0;
   std::uint64_t frames_incoherent_ = 0;

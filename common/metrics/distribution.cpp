@@ -26,4 +26,27 @@ report::Distribution summarize(std::vector<double> values) {
   return d;
 }
 
+void Reservoir::add(double value) {
+  max_ = count_ == 0 ? value : std::max(max_, value);
+  ++count_;
+  if (sample_.size() < capacity_) {
+    sample_.push_back(value);
+    return;
+  }
+  // splitmix64: deterministic, so the same run summarizes the same way.
+  std::uint64_t z = (random_state_ += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  z ^= z >> 31;
+  const std::uint64_t slot = z % count_;
+  if (slot < capacity_) sample_[slot] = value;
+}
+
+report::Distribution Reservoir::summary() const {
+  report::Distribution d = summarize(sample_);
+  d.set_count(count_);
+  d.set_max(max_);
+  return d;
+}
+
 }  // namespace optique::metrics

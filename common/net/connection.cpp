@@ -1,5 +1,6 @@
 #include "net/connection.h"
 
+#include <boost/asio/post.hpp>
 #include <boost/asio/write.hpp>
 
 #include "net/envelope.h"
@@ -35,7 +36,15 @@ void Connection::send(wire::Envelope& message) {
   message.set_sequence(next_send_sequence_++);
   append_envelope(outbox_, message);
   if (queued_bytes() > kMaxQueuedBytes) {
-    close("peer is not reading its messages (" + std::to_string(queued_bytes() >> 20) + " MiB queued)");
+    // Closed from the event loop, not from inside send(): the caller may be
+    // iterating over sessions, and on_closed may drop the last reference to one.
+    closing_ = true;
+    outbox_.clear();
+    asio::post(socket_.get_executor(),
+               [self = shared_from_this(), reason = "peer is not reading its messages (more than " +
+                                                    std::to_string(kMaxQueuedBytes >> 20) + " MiB queued)"] {
+                 self->finish(reason);
+               });
     return;
   }
   if (in_flight_.empty()) write_more();
@@ -138,15 +147,23 @@ void Connection::arm_liveness() {
   });
 }
 
+// A generation number, not only cancel(): a timer that already fired has its
+// handler queued, and cancel() no longer reaches it.
 void Connection::set_deadline(std::chrono::milliseconds timeout, std::string reason) {
+  const std::uint64_t generation = ++deadline_generation_;
   deadline_timer_.expires_after(timeout);
   deadline_timer_.async_wait(
-      [self = shared_from_this(), reason = std::move(reason)](const boost::system::error_code& ec) {
-        if (!ec && self->open_) self->finish(reason);
+      [self = shared_from_this(), generation, reason = std::move(reason)](const boost::system::error_code& ec) {
+        if (!ec && self->open_ && generation == self->deadline_generation_) self->finish(reason);
       });
 }
 
-void Connection::cancel_deadline() { deadline_timer_.cancel(); }
+void Connection::cancel_deadline() {
+  ++deadline_generation_;
+  deadline_timer_.cancel();
+}
+
+void Connection::set_max_payload_bytes(std::uint32_t max_payload_bytes) { reader_.set_max_payload_bytes(max_payload_bytes); }
 
 void Connection::finish(const std::string& reason) {
   if (!open_) return;

@@ -51,6 +51,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   // Closes with `reason` at `timeout` from now unless cancel_deadline() is called.
   void set_deadline(std::chrono::milliseconds timeout, std::string reason);
   void cancel_deadline();
+  // The largest frame accepted from now on (small before a peer has identified itself).
+  void set_max_payload_bytes(std::uint32_t max_payload_bytes);
 
   [[nodiscard]] bool is_open() const { return open_; }
   [[nodiscard]] const std::string& peer() const { return peer_; }
@@ -79,6 +81,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::vector<std::uint8_t> in_flight_;
   std::uint64_t next_send_sequence_ = 1;
   std::uint64_t next_receive_sequence_ = 1;
+  std::uint64_t deadline_generation_ = 0;
   std::chrono::milliseconds liveness_timeout_{0};
   std::string liveness_reason_;
   std::chrono::steady_clock::time_point last_receive_;

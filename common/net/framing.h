@@ -44,6 +44,7 @@ class FrameReader {
   [[nodiscard]] DecodedFrame next();
 
   [[nodiscard]] std::size_t buffered_bytes() const { return buffer_.size() - read_pos_; }
+  void set_max_payload_bytes(std::uint32_t max_payload_bytes) { max_payload_bytes_ = max_payload_bytes; }
 
  private:
   std::uint32_t max_payload_bytes_;

@@ -332,10 +332,10 @@ TEST(BuiltinScene, CubesPosesAreFiniteUnitAndDeterministic) {
 
 const std::vector<std::string> kBuiltinNames{"cubes", "many-lights", "depth-stack", "moving-square"};
 
-TEST(BuiltinScene, NamesAreTheFourKnownScenes) {
+TEST(BuiltinScene, TheFirstFourAreTheKnownScenes) {
   const auto names = builtin_scene_names();
-  ASSERT_EQ(names.size(), kBuiltinNames.size());
-  for (std::size_t i = 0; i < names.size(); ++i) {
+  ASSERT_GE(names.size(), kBuiltinNames.size());
+  for (std::size_t i = 0; i < kBuiltinNames.size(); ++i) {
     EXPECT_EQ(names[i], kBuiltinNames[i]);
     EXPECT_TRUE(is_builtin_scene(names[i]));
   }
