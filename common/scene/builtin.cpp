@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <numbers>
+#include <string>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "scene/meshes.h"
 
@@ -114,17 +118,164 @@ SceneDefinition moving_square() {
   return scene;
 }
 
+// The seed-001 set: the test scenes of the frame-rate up-conversion paper. One
+// object each (the falling ring has a static plinth too), turning or moving at a
+// known rate, under one or two point lights.
+
+constexpr double kTau = 2.0 * std::numbers::pi;
+constexpr double kFastTurnsPerSecond = 2.0;
+constexpr double kSlowTurnsPerSecond = 0.25;
+// "Zoom in/out": z swings kZoomSwing either side of kZoomCentre (−1.2 to −0.2),
+// once per kZoomPeriod, starting far away: in front of the 3 m CAVE's back wall
+// (z = −1.5) and of its viewer (z = 0).
+constexpr double kZoomCentre = -0.7;
+constexpr double kZoomSwing = 0.5;
+constexpr double kZoomPeriod = 4.0;  // s
+
+// Two white lights, a key light up and to the left and a dimmer fill to the right,
+// both in front of the stage.
+void add_key_and_fill(SceneDefinition& scene) {
+  scene.lights = {{{-0.9, 2.3, 1.0}, {1.0f, 0.96f, 0.9f}, 2.5f}, {{1.1, 1.4, 0.7}, {0.85f, 0.9f, 1.0f}, 1.0f}};
+}
+
+// A tilt that shows three sides of an object turning about the vertical.
+glm::dquat three_quarter_tilt() { return spin({1.0, 0.0, 0.2}, 0.45); }
+
+// About the vertical through the stage, after a fixed tilt, at `turns_per_second`.
+std::function<Pose(double)> turning_about_vertical(double turns_per_second, glm::dquat tilt, double size) {
+  return [turns_per_second, tilt, size](double t) {
+    return Pose{kStage, glm::normalize(spin({0.0, 1.0, 0.0}, kTau * turns_per_second * t) * tilt),
+                glm::dvec3(size)};
+  };
+}
+
+// Where a zooming object is at `t`: far at t = 0, nearest at half a period.
+glm::dvec3 zoom_position(double t) {
+  return {kStage.x, kStage.y, kZoomCentre - kZoomSwing * std::cos(kTau * t / kZoomPeriod)};
+}
+
+SceneDefinition rotating_cube(std::string name, double turns_per_second) {
+  SceneDefinition scene;
+  scene.name = std::move(name);
+  const auto cube = add_mesh(scene, make_box(glm::vec3(1.0f)));
+  const auto orange = add_material(scene, {glm::vec3(0.85f, 0.45f, 0.15f), 0.0f, 0.45f, {}});
+  add_animated(scene, cube, orange, "cube", turning_about_vertical(turns_per_second, three_quarter_tilt(), 0.4));
+  add_key_and_fill(scene);
+  return scene;
+}
+
+SceneDefinition cube_fast_rotation() { return rotating_cube("cube-fast-rotation", kFastTurnsPerSecond); }
+SceneDefinition cube_slow_rotation() { return rotating_cube("cube-slow-rotation", kSlowTurnsPerSecond); }
+
+SceneDefinition cube_zoom() {
+  // A cube, tilted to show three faces, moving towards the viewer and away again.
+  SceneDefinition scene;
+  scene.name = "cube-zoom";
+  const auto cube = add_mesh(scene, make_box(glm::vec3(1.0f)));
+  const auto teal = add_material(scene, {glm::vec3(0.15f, 0.6f, 0.65f), 0.0f, 0.4f, {}});
+  const glm::dquat tilt = glm::normalize(spin({0.0, 1.0, 0.0}, 0.6) * three_quarter_tilt());
+  add_animated(scene, cube, teal, "cube", [tilt](double t) { return Pose{zoom_position(t), tilt, glm::dvec3(0.35)}; });
+  add_key_and_fill(scene);
+  return scene;
+}
+
+SceneDefinition rotating_pyramid(std::string name, double turns_per_second) {
+  SceneDefinition scene;
+  scene.name = std::move(name);
+  const auto pyramid = add_mesh(scene, make_pyramid(1.0f, 1.0f));
+  const auto yellow = add_material(scene, {glm::vec3(0.9f, 0.75f, 0.2f), 0.0f, 0.5f, {}});
+  // Tipped a little towards the viewer so the apex and the base's edges both show.
+  add_animated(scene, pyramid, yellow, "pyramid",
+               turning_about_vertical(turns_per_second, spin({1.0, 0.0, 0.0}, 0.25), 0.5));
+  add_key_and_fill(scene);
+  return scene;
+}
+
+SceneDefinition pyramid_fast_rotation() { return rotating_pyramid("pyramid-fast-rotation", kFastTurnsPerSecond); }
+SceneDefinition pyramid_slow_rotation() { return rotating_pyramid("pyramid-slow-rotation", kSlowTurnsPerSecond); }
+
+// An eight-spoked wheel, 0.9 m across, facing the viewer (axle along z) and turned
+// a little about the vertical so the rim shows depth; it turns once a second.
+constexpr double kWheelTurnsPerSecond = 1.0;
+const glm::dquat kWheelYaw{spin({0.0, 1.0, 0.0}, 0.3)};
+
+glm::dquat wheel_rotation_at(double t) {
+  return glm::normalize(kWheelYaw * spin({0.0, 0.0, 1.0}, -kTau * kWheelTurnsPerSecond * t));  // clockwise as seen
+}
+
+SceneDefinition wheel_scene(std::string name, std::function<Pose(double)> pose_at) {
+  SceneDefinition scene;
+  scene.name = std::move(name);
+  const auto wheel = add_mesh(scene, make_wheel(0.45f, 0.06f, 8));
+  const auto steel = add_material(scene, {glm::vec3(0.75f, 0.75f, 0.8f), 0.6f, 0.35f, {}});
+  add_animated(scene, wheel, steel, "wheel", std::move(pose_at));
+  add_key_and_fill(scene);
+  return scene;
+}
+
+SceneDefinition wheel_rotation() {
+  return wheel_scene("wheel-rotation", [](double t) { return Pose{kStage, wheel_rotation_at(t), glm::dvec3(1.0)}; });
+}
+
+SceneDefinition wheel_in_out() {
+  return wheel_scene("wheel-in-out",
+                     [](double t) { return Pose{zoom_position(t), wheel_rotation_at(t), glm::dvec3(1.0)}; });
+}
+
+SceneDefinition falling_ring() {
+  // A ring dropped onto a plinth, bouncing without loss (so its motion repeats with
+  // a fixed period), tilted so its hole shows and turning slowly about the vertical.
+  SceneDefinition scene;
+  scene.name = "falling-ring";
+  constexpr double kGravity = 9.81;               // m/s²
+  constexpr double kMajor = 0.25, kMinor = 0.06;  // m
+  constexpr double kTilt = 0.35;                  // rad from lying flat
+  constexpr double kPlinthTop = 0.55;             // m above the floor
+  const double top = kStage.y + 0.6;              // the ring's centre at the top
+  // The ring's centre when its lowest point touches the plinth.
+  const double contact = kPlinthTop + kMajor * std::sin(kTilt) + kMinor;
+  const double drop = top - contact;
+  const double period = 2.0 * std::sqrt(2.0 * drop / kGravity);  // top → plinth → top
+
+  const auto plinth = add_mesh(scene, make_box(glm::vec3(1.0f, 0.1f, 0.8f)));
+  const auto grey = add_material(scene, {glm::vec3(0.5f, 0.5f, 0.52f), 0.0f, 0.8f, {}});
+  scene.instances.push_back(
+      {plinth, grey, std::nullopt, glm::translate(glm::dmat4(1.0), glm::dvec3(kStage.x, kPlinthTop - 0.05, kStage.z))});
+
+  const auto ring = add_mesh(scene, make_torus(static_cast<float>(kMajor), static_cast<float>(kMinor), 48, 16));
+  const auto red = add_material(scene, {glm::vec3(0.8f, 0.15f, 0.12f), 0.0f, 0.35f, {}});
+  // The torus lies in the xy plane: a quarter turn about x lays it flat, less the tilt.
+  const glm::dquat lay = spin({1.0, 0.0, 0.0}, std::numbers::pi / 2.0 - kTilt);
+  add_animated(scene, ring, red, "ring", [period, top, lay](double t) {
+    const double phase = t - period * std::floor(t / period);  // in [0, period)
+    const double fall = period / 2.0 - std::abs(phase - period / 2.0);  // time from the nearest top
+    const double y = top - 0.5 * kGravity * fall * fall;
+    return Pose{{kStage.x, y, kStage.z}, glm::normalize(spin({0.0, 1.0, 0.0}, 0.8 * t) * lay), glm::dvec3(1.0)};
+  });
+  add_key_and_fill(scene);
+  return scene;
+}
+
 struct Entry {
   std::string_view name;
   SceneDefinition (*make)();
 };
 
-constexpr std::array<Entry, 4> kScenes{{
-    {"cubes", cubes},
-    {"many-lights", many_lights},
-    {"depth-stack", depth_stack},
-    {"moving-square", moving_square},
-}};
+constexpr std::array kScenes{
+    Entry{"cubes", cubes},
+    Entry{"many-lights", many_lights},
+    Entry{"depth-stack", depth_stack},
+    Entry{"moving-square", moving_square},
+    // seed-001
+    Entry{"cube-fast-rotation", cube_fast_rotation},
+    Entry{"cube-slow-rotation", cube_slow_rotation},
+    Entry{"cube-zoom", cube_zoom},
+    Entry{"pyramid-fast-rotation", pyramid_fast_rotation},
+    Entry{"pyramid-slow-rotation", pyramid_slow_rotation},
+    Entry{"wheel-rotation", wheel_rotation},
+    Entry{"wheel-in-out", wheel_in_out},
+    Entry{"falling-ring", falling_ring},
+};
 
 constexpr std::array<std::string_view, kScenes.size()> kNames = [] {
   std::array<std::string_view, kScenes.size()> names{};
