@@ -7,11 +7,12 @@
 #include <filesystem>
 #include <iostream>
 
-#include "check_config.h"
 #include <spdlog/sinks/sink.h>
+#include "check_config.h"
 
 #include "log/logger.h"
 #include "master.h"
+#include "render_reference.h"
 
 namespace optique::master {
 namespace {
@@ -59,10 +60,21 @@ int run_cli(int argc, char** argv) {
   app.add_option("--node-log-level", options.node_log_level, "log level for local nodes")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_flag("--no-status", no_status, "no live status line, even on a terminal");
+  app.add_option("--capture-every", options.capture_every,
+                 "nodes write every K-th frame (frame 0, K, 2K, ...); with --local into OUT/nodes/<projector-id>/");
 
   std::vector<std::string> check_files;
   auto* check = app.add_subcommand("check-config", "validate installation files and print a summary of each");
   check->add_option("files", check_files, "installation files")->required();
+
+  std::string reference_config;
+  std::uint64_t reference_frame = 0;
+  std::string reference_out;
+  auto* reference = app.add_subcommand("render-reference", "draw what a viewer should see on each screen at one frame");
+  reference->add_option("--config", reference_config, "installation file")->required();
+  reference->add_option("--frame", reference_frame, "frame number (simulation time = frame / frame rate)");
+  reference->add_option("--out", reference_out, "writes OUT/reference/<screen-id>/frame-NNNNNN.exr and .png")
+      ->required();
 
   try {
     app.parse(argc, argv);
@@ -72,6 +84,19 @@ int run_cli(int argc, char** argv) {
   }
 
   if (check->parsed()) return check_config(check_files);
+  if (reference->parsed()) {
+    auto loaded = config::load_installation(reference_config);
+    if (!loaded) {
+      std::cerr << loaded.error() << "\n";
+      return kExitUsage;
+    }
+    auto logger = log::make_logger("master", log_level);
+    if (auto done = render_reference(loaded.value(), reference_frame, reference_out, *logger); !done) {
+      logger->error("{}", done.error());
+      return kExitFailed;
+    }
+    return kExitOk;
+  }
 
   if (config_path.empty()) {
     std::cerr << "optique-master: --config FILE is required (see --help)\n";
@@ -101,6 +126,10 @@ int run_cli(int argc, char** argv) {
       return kExitUsage;
     }
     log_file = (std::filesystem::path(out_dir) / "master.log").string();
+  }
+  if (options.local && options.capture_every != 0 && out_dir.empty()) {
+    std::cerr << "optique-master: --capture-every with --local needs --out DIR (captures go to DIR/nodes/)\n";
+    return kExitUsage;
   }
   options.out_dir = out_dir;
   options.status_line = !no_status && isatty(STDERR_FILENO) == 1;

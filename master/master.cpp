@@ -36,6 +36,7 @@ Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
       log_(log),
       settings_(options_.config.installation.master()),
       acceptor_(io),
+      accept_retry_timer_(io),
       signals_(io, SIGINT, SIGTERM),
       frame_timer_(io),
       barrier_timer_(io),
@@ -105,6 +106,10 @@ Result<void> Master::start() {
       std::vector<std::string> args{"--master",    "127.0.0.1:" + std::to_string(port_),
                                     "--id",        s.projector->id(),
                                     "--log-level", options_.node_log_level};
+      if (!options_.out_dir.empty()) {
+        args.push_back("--capture-dir");
+        args.push_back((std::filesystem::path(options_.out_dir) / "nodes" / s.projector->id()).string());
+      }
       args.insert(args.end(), options_.node_args.begin(), options_.node_args.end());
       const std::string log_file =
           options_.out_dir.empty()
@@ -145,10 +150,19 @@ Result<void> Master::start() {
 void Master::accept_next() {
   acceptor_.async_accept([this](const boost::system::error_code& error, asio::ip::tcp::socket socket) {
     if (error) {
-      if (error != asio::error::operation_aborted) log_.warn("accept failed: {}", error.message());
-      if (acceptor_.is_open() && state_ != RunState::done) accept_next();
+      if (error == asio::error::operation_aborted || !acceptor_.is_open() || state_ == RunState::done) return;
+      // Out of file descriptors and the like: try again shortly, and say so once
+      // per failure streak rather than thousands of times a second.
+      if (!accept_failing_) log_.warn("accept failed: {}; retrying every 100 ms", error.message());
+      accept_failing_ = true;
+      accept_retry_timer_.expires_after(milliseconds(100));
+      accept_retry_timer_.async_wait([this](const boost::system::error_code& e) {
+        if (!e) accept_next();
+      });
       return;
     }
+    if (accept_failing_) log_.info("accepting connections again");
+    accept_failing_ = false;
     if (state_ == RunState::starting || state_ == RunState::running) on_connection(std::move(socket));
     accept_next();
   });
@@ -156,7 +170,9 @@ void Master::accept_next() {
 
 void Master::on_connection(asio::ip::tcp::socket socket) {
   auto session = std::make_shared<Session>();
-  session->connection = net::Connection::create(std::move(socket), settings_.max_message_bytes());
+  // Until a peer has said who it is, only a hello-sized frame is accepted: nobody
+  // makes the master parse megabytes before authenticating.
+  session->connection = net::Connection::create(std::move(socket), kMaxHelloBytes);
   sessions_.push_back(session);
   std::weak_ptr<Session> weak = session;
   session->connection->start({
@@ -197,6 +213,13 @@ void Master::on_message(const std::shared_ptr<Session>& session, wire::Envelope&
       break;
     }
     case wire::Envelope::kHeartbeat:
+      break;
+    case wire::Envelope::kConfigured:
+      if (session->phase != Phase::configuring) {
+        session->connection->close("configured twice");
+        break;
+      }
+      handle_configured(*session, message.configured());
       break;
     case wire::Envelope::kFrameReady:
       handle_ready(*session, message.frame_ready(), received);
@@ -258,11 +281,12 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
 
   target.session = session;
   session->slot = slot;
-  session->phase = Phase::joined;
-  session->connection->cancel_deadline();
-  session->connection->set_liveness_timeout(
-      milliseconds(settings_.liveness_timeout_ms()),
-      "node silent for " + std::to_string(settings_.liveness_timeout_ms()) + " ms");
+  session->phase = Phase::configuring;
+  session->connection->set_max_payload_bytes(settings_.max_message_bytes());
+  // Setting up a GL context and compiling shaders can take seconds on a loaded
+  // machine; the node is silent meanwhile.
+  session->connection->set_deadline(
+      kConfigureTimeout, "node did not finish configuring within " + std::to_string(kConfigureTimeout.count()) + " s");
 
   const auto& installation = options_.config.installation;
   wire::Envelope envelope;
@@ -273,18 +297,34 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
   }
   *welcome.mutable_viewer() = installation.viewer();
   *welcome.mutable_scene() = installation.scene();
-  *welcome.mutable_snapshot() = scene::to_snapshot(current_state_);
-  welcome.set_next_frame_id(next_frame_);
   welcome.set_frame_period_ns(frame_period_);
   welcome.set_heartbeat_ms(settings_.heartbeat_ms());
   welcome.set_liveness_timeout_ms(settings_.liveness_timeout_ms());
-  welcome.set_state_hash(current_hash_);
   session->connection->send(envelope);
-  recorder_->node_joined(*slot);
-  log_.info("node '{}' joined from {} ({}/{} up)", hello.node_id(), session->connection->peer(), nodes_up(),
-            slots_.size());
+  log_.debug("node '{}' from {} is configuring", hello.node_id(), session->connection->peer());
+}
 
+void Master::handle_configured(Session& session, const wire::Configured& configured) {
+  session.connection->cancel_deadline();
+  session.connection->set_liveness_timeout(
+      milliseconds(settings_.liveness_timeout_ms()),
+      "node silent for " + std::to_string(settings_.liveness_timeout_ms()) + " ms");
+  send_resync(session);
+  session.phase = Phase::joined;
+  recorder_->node_joined(*session.slot);
+  log_.info("node '{}' joined from {} with {} ({}/{} up)", slot_id(*session.slot), session.connection->peer(),
+            configured.renderer(), nodes_up(), slots_.size());
   if (state_ == RunState::starting && nodes_up() == slots_.size()) start_frames();
+}
+
+// The state as of the last frame begun; the next FrameBegin's delta applies to it.
+void Master::send_resync(Session& session) {
+  wire::Envelope envelope;
+  auto& resync = *envelope.mutable_resync();
+  *resync.mutable_snapshot() = scene::to_snapshot(current_state_);
+  resync.set_next_frame_id(next_frame_);
+  resync.set_state_hash(current_hash_);
+  session.connection->send(envelope);
 }
 
 void Master::on_closed(const std::shared_ptr<Session>& session, const std::string& reason) {
@@ -301,6 +341,7 @@ void Master::on_closed(const std::shared_ptr<Session>& session, const std::strin
     } else {
       log_.debug("node '{}' closed: {}", slot_id(slot), reason);
     }
+    std::erase(ready_for_swap_, slot);  // a node that is gone is not told to swap
     if (barrier_.active()) {
       barrier_.leave(slot);
       if (barrier_.complete()) swap();
@@ -338,6 +379,7 @@ void Master::begin_frame() {
   current_state_ = std::move(state);
   current_hash_ = scene::state_hash(current_state_);
   begin.set_state_hash(current_hash_);
+  begin.set_capture(options_.capture_every != 0 && frame % options_.capture_every == 0);
   begin.set_present_time_ns(schedule_origin_ +
                             static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_);
 
@@ -345,8 +387,8 @@ void Master::begin_frame() {
   std::vector<std::size_t> waited;
   const clock::Nanos begin_sent = clock::monotonic_now();
   for (std::size_t i = 0; i < slots_.size(); ++i) {
-    Session* session = slots_[i].session.get();
-    if (session == nullptr || session->phase == Phase::handshake) continue;
+    const std::shared_ptr<Session> session = slots_[i].session;
+    if (!session || session->phase == Phase::handshake || session->phase == Phase::configuring) continue;
     if (session->phase == Phase::joined) session->phase = Phase::in_barrier;
     session->connection->send(envelope);
     sent.push_back(i);
@@ -369,23 +411,24 @@ void Master::begin_frame() {
 
 void Master::handle_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received) {
   const std::size_t slot = *session.slot;
-  if (!barrier_.active() || ready.frame_id() != barrier_.frame()) {
-    log_.debug("late ready from '{}' for frame {}", slot_id(slot), ready.frame_id());
-    return;
-  }
   recorder_->ready(ready.frame_id(), slot, received, ready.render_ns());
-  if (ready.state_hash() != current_hash_) {
+  if (ready.frame_id() + 1 == next_frame_ && ready.state_hash() != current_hash_) {
     recorder_->hash_mismatch(slot);
     log_.warn("node '{}' reports state hash {:016x} for frame {}, master has {:016x}", slot_id(slot),
               ready.state_hash(), ready.frame_id(), current_hash_);
   }
+  const bool current = barrier_.active() && ready.frame_id() == barrier_.frame();
   if (session.phase == Phase::out_of_barrier) {
-    session.phase = Phase::in_barrier;
-    ready_for_swap_.push_back(slot);
-    log_.info("node '{}' is in time again and back in the barrier from frame {}", slot_id(slot), ready.frame_id());
-  } else if (barrier_.ready(slot)) {
+    // It answers again: wait for it from the next frame on, and if this answer is
+    // for the frame being decided, it swaps with the others.
+    session.phase = Phase::joined;
+    log_.info("node '{}' answers again (frame {}); back in the barrier from the next frame", slot_id(slot),
+              ready.frame_id());
+    if (current) ready_for_swap_.push_back(slot);
+  } else if (current && barrier_.ready(slot)) {
     ready_for_swap_.push_back(slot);
   }
+  if (!current) log_.debug("late ready from '{}' for frame {}", slot_id(slot), ready.frame_id());
   if (barrier_.complete()) swap();
 }
 
@@ -415,6 +458,10 @@ void Master::swap() {
   recorder_->swapped(frame, sent, ready_for_swap_);
   ready_for_swap_.clear();
   update_status();
+  if (state_ == RunState::draining) {
+    wait_for_last_presents(true);
+    return;
+  }
   schedule_next_frame(sent);
 }
 
@@ -444,12 +491,15 @@ void Master::drain(const std::string& reason) {
   const bool frames_ran = state_ == RunState::running;
   state_ = RunState::draining;
   frame_timer_.cancel();
-  if (barrier_.active()) swap();
-  frame_timer_.cancel();
+  phase_timer_.cancel();
   log_.info("stopping: {}", reason);
+  // A frame in its barrier finishes first (swap() then comes back here).
+  if (!barrier_.active()) wait_for_last_presents(frames_ran);
+}
+
+void Master::wait_for_last_presents(bool frames_ran) {
   // The last swap's Presented arrive after its present deadline.
   const auto wait = frames_ran ? milliseconds(settings_.present_lead_us() / 1000 + 250) : milliseconds(0);
-  phase_timer_.cancel();
   phase_timer_.expires_after(wait);
   phase_timer_.async_wait([this](const boost::system::error_code& error) {
     if (!error) say_goodbye();
@@ -502,6 +552,7 @@ void Master::finish() {
   phase_timer_.cancel();
   housekeeping_timer_.cancel();
   heartbeat_timer_.cancel();
+  accept_retry_timer_.cancel();
   signals_.cancel();
   if (launcher_) {
     for (const ChildExit& exit : launcher_->reap()) {
@@ -580,7 +631,9 @@ void Master::send_heartbeats() {
   wire::Envelope envelope;
   envelope.mutable_heartbeat()->set_sent_ns(clock::monotonic_now());
   for (const Slot& slot : slots_) {
-    if (slot.session && slot.session->phase != Phase::handshake) slot.session->connection->send(envelope);
+    if (slot.session && slot.session->phase != Phase::handshake && slot.session->phase != Phase::configuring) {
+      slot.session->connection->send(envelope);
+    }
   }
   heartbeat_timer_.expires_after(milliseconds(settings_.heartbeat_ms()));
   heartbeat_timer_.async_wait([this](const boost::system::error_code& error) {
@@ -628,7 +681,7 @@ void Master::update_status() {
 
 std::size_t Master::nodes_up() const {
   std::size_t up = 0;
-  for (const Slot& s : slots_) up += s.session ? 1 : 0;
+  for (const Slot& s : slots_) up += s.session && s.session->phase != Phase::configuring ? 1 : 0;
   return up;
 }
 

@@ -37,6 +37,7 @@ struct MasterOptions {
   std::vector<std::string> node_args;  // extra arguments for local nodes
   std::string port_file;               // write the bound port here once listening
   std::string node_log_level = "info";
+  std::uint64_t capture_every = 0;  // ask nodes to capture every K-th frame (0: never)
   bool status_line = false;
 };
 
@@ -44,6 +45,11 @@ struct MasterOptions {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitUsage = 2;   // bad config or command line: nothing started
 inline constexpr int kExitFailed = 3;  // could not run: no nodes, cannot listen, ...
+
+// The largest frame a peer may send before its hello is accepted.
+inline constexpr std::uint32_t kMaxHelloBytes = 4096;
+// How long a node may take to set itself up (GL context, scene) after the welcome.
+inline constexpr std::chrono::seconds kConfigureTimeout{30};
 
 class Master {
  public:
@@ -57,7 +63,7 @@ class Master {
   [[nodiscard]] int exit_code() const { return exit_code_; }
 
  private:
-  enum class Phase { handshake, joined, in_barrier, out_of_barrier };
+  enum class Phase { handshake, configuring, joined, in_barrier, out_of_barrier };
   enum class RunState { starting, running, draining, closing, done };
 
   struct Session {
@@ -76,6 +82,8 @@ class Master {
   void on_message(const std::shared_ptr<Session>& session, wire::Envelope& message);
   void on_closed(const std::shared_ptr<Session>& session, const std::string& reason);
   void handle_hello(const std::shared_ptr<Session>& session, wire::Envelope& message);
+  void handle_configured(Session& session, const wire::Configured& configured);
+  void send_resync(Session& session);
   void refuse(Session& session, const std::string& node_id, const std::string& reason, bool retriable);
   void handle_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received);
   void handle_presented(Session& session, const wire::Presented& presented);
@@ -87,6 +95,7 @@ class Master {
   void schedule_next_frame(clock::Nanos now);
 
   void drain(const std::string& reason);
+  void wait_for_last_presents(bool frames_ran);
   void say_goodbye();
   void finish();
   void fail(const std::string& reason);
@@ -106,6 +115,8 @@ class Master {
   const config::MasterSettings& settings_;
 
   asio::ip::tcp::acceptor acceptor_;
+  asio::steady_timer accept_retry_timer_;
+  bool accept_failing_ = false;
   asio::signal_set signals_;
   asio::steady_timer frame_timer_;
   asio::steady_timer barrier_timer_;

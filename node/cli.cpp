@@ -4,6 +4,7 @@
 #include <boost/asio/io_context.hpp>
 #include <iostream>
 
+#include "gl_renderer.h"
 #include "log/logger.h"
 #include "node.h"
 #include "null_renderer.h"
@@ -22,6 +23,13 @@ int run_cli(int argc, char** argv) {
   app.add_option("-i,--id", options.id, "the projector this node drives (its id in the installation)")->required();
   app.add_option("--give-up-after-ms", give_up_ms, "exit when the master is unreachable this long")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{86'400'000}));
+  std::string renderer_kind = "gl";
+  std::string capture_dir;
+  app.add_option("--renderer", renderer_kind,
+                 "gl: draw the scene (headless or in a window, as the config says); "
+                 "null: draw nothing (to measure the cluster alone)")
+      ->check(CLI::IsMember({"gl", "null"}));
+  app.add_option("--capture-dir", capture_dir, "where captured frames go (default: captures/<id>)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn or error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   // Test hooks, hidden from --help.
@@ -50,8 +58,14 @@ int run_cli(int argc, char** argv) {
 
   auto logger = log::make_logger("node " + options.id, log_level);
   boost::asio::io_context io;
-  NullRenderer renderer;
-  Node node(io, std::move(options), renderer, *logger);
+  if (capture_dir.empty()) capture_dir = "captures/" + options.id;
+  std::unique_ptr<Renderer> renderer;
+  if (renderer_kind == "null") {
+    renderer = std::make_unique<NullRenderer>();
+  } else {
+    renderer = std::make_unique<GlRenderer>(*logger, capture_dir);
+  }
+  Node node(io, std::move(options), *renderer, *logger);
   node.start();
   io.run();
   return node.exit_code();

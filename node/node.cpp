@@ -12,6 +12,7 @@ using std::chrono::milliseconds;
 namespace {
 constexpr milliseconds kMaxBackoff{2000};
 constexpr milliseconds kHandshakeTimeout{5000};
+constexpr milliseconds kConnectTimeout{3000};
 constexpr int kPingBurst = 8;
 }  // namespace
 
@@ -23,6 +24,7 @@ Node::Node(asio::io_context& io, NodeOptions options, Renderer& renderer, spdlog
       resolver_(io),
       retry_timer_(io),
       ping_timer_(io),
+      connect_timer_(io),
       signals_(io, SIGINT, SIGTERM) {}
 
 void Node::start() {
@@ -44,15 +46,27 @@ void Node::connect() {
           return;
         }
         auto socket = std::make_shared<asio::ip::tcp::socket>(io_);
-        asio::async_connect(*socket, endpoints,
-                            [this, socket](const boost::system::error_code& e, const asio::ip::tcp::endpoint&) {
-                              if (phase_ == Phase::stopped) return;
-                              if (e) {
-                                retry_later(e.message());
-                                return;
-                              }
-                              on_connected(std::move(*socket));
-                            });
+        connecting_ = socket;
+        // A master host that drops connection attempts silently would keep a
+        // connect pending for minutes of kernel retries: bound it.
+        connect_timer_.expires_after(kConnectTimeout);
+        connect_timer_.async_wait([socket](const boost::system::error_code& e) {
+          if (!e) {
+            boost::system::error_code ignored;
+            socket->close(ignored);
+          }
+        });
+        asio::async_connect(
+            *socket, endpoints, [this, socket](const boost::system::error_code& e, const asio::ip::tcp::endpoint&) {
+              connect_timer_.cancel();
+              connecting_.reset();
+              if (phase_ == Phase::stopped) return;
+              if (e) {
+                retry_later(e == asio::error::operation_aborted ? "no answer to the connection attempt" : e.message());
+                return;
+              }
+              on_connected(std::move(*socket));
+            });
       });
 }
 
@@ -119,6 +133,10 @@ void Node::on_message(wire::Envelope& message) {
     handle_welcome(message.welcome());
     return;
   }
+  if ((phase_ == Phase::awaiting_state || phase_ == Phase::joined) && message.body_case() == wire::Envelope::kResync) {
+    handle_resync(message.resync());
+    return;
+  }
   if (phase_ != Phase::joined) {
     connection_->close(std::string("unexpected ") + net::body_name(message) + " before the welcome");
     return;
@@ -149,40 +167,55 @@ void Node::handle_challenge(wire::Envelope&) {
   wire::Envelope hello;
   hello.set_protocol_version(options_.protocol_version);
   hello.mutable_hello()->set_node_id(options_.id);
-  hello.mutable_hello()->add_capabilities("null-renderer");
+  hello.mutable_hello()->add_capabilities("render");
   connection_->send(hello);
   phase_ = Phase::awaiting_welcome;
 }
 
 void Node::handle_welcome(const wire::Welcome& welcome) {
-  auto state = scene::from_snapshot(welcome.snapshot());
-  if (!state) {
-    connection_->close("bad snapshot in the welcome: " + state.error());
-    return;
-  }
-  if (scene::state_hash(state.value()) != welcome.state_hash()) {
-    connection_->close("the welcome's snapshot does not match its hash");
-    return;
-  }
   if (auto configured = renderer_.configure(welcome); !configured) {
     stop(kExitRefused, "cannot drive projector '" + options_.id + "': " + configured.error());
     return;
   }
-  state_ = std::move(state).value();
-  next_frame_ = welcome.next_frame_id();
-  rendered_any_ = false;
   frame_period_ = welcome.frame_period_ns();
   heartbeat_ = milliseconds(std::max<std::uint32_t>(welcome.heartbeat_ms(), 10));
+  liveness_timeout_ = milliseconds(welcome.liveness_timeout_ms());
+  wire::Envelope envelope;
+  envelope.mutable_configured()->set_renderer(renderer_.description());
+  connection_->send(envelope);
+  phase_ = Phase::awaiting_state;
+  connection_->set_deadline(kHandshakeTimeout, "no state from the master within 5 s of being configured");
+  const auto& p = welcome.projector();
+  log_.info("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}", p.id(), p.width(), p.height(),
+            p.screen(), p.eye(), static_cast<double>(frame_period_) / 1e6, renderer_.description());
+}
+
+void Node::handle_resync(const wire::Resync& resync) {
+  auto state = scene::from_snapshot(resync.snapshot());
+  if (!state) {
+    connection_->close("bad snapshot from the master: " + state.error());
+    return;
+  }
+  if (scene::state_hash(state.value()) != resync.state_hash()) {
+    connection_->close("the master's snapshot does not match its hash");
+    return;
+  }
+  state_ = std::move(state).value();
+  next_frame_ = resync.next_frame_id();
+  rendered_any_ = false;
+  if (phase_ == Phase::joined) {
+    log_.info("state resynchronized at frame {}", next_frame_);
+    return;
+  }
   phase_ = Phase::joined;
+  estimator_ = clock::OffsetEstimator{};  // samples from an earlier connection may be from another master
   unreachable_ = false;
   attempts_ = 0;
   backoff_ = milliseconds(100);
   connection_->cancel_deadline();
-  connection_->set_liveness_timeout(milliseconds(welcome.liveness_timeout_ms()),
-                                    "master silent for " + std::to_string(welcome.liveness_timeout_ms()) + " ms");
-  const auto& p = welcome.projector();
-  log_.info("joined as '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms, next frame {}", p.id(), p.width(),
-            p.height(), p.screen(), p.eye(), static_cast<double>(frame_period_) / 1e6, next_frame_);
+  connection_->set_liveness_timeout(liveness_timeout_,
+                                    "master silent for " + std::to_string(liveness_timeout_.count()) + " ms");
+  log_.info("joined at frame {}", next_frame_);
   // A quick burst of pings to get a clock offset before the first swap.
   pings_in_burst_ = kPingBurst;
   send_ping();
@@ -203,7 +236,8 @@ void Node::handle_frame_begin(const wire::FrameBegin& begin) {
               begin.frame_id());
   }
   const clock::Nanos started = clock::monotonic_now();
-  renderer_.render({begin.frame_id(), begin.simulation_time_ns(), begin.present_time_ns(), frame_period_, &state_});
+  renderer_.render(
+      {begin.frame_id(), begin.simulation_time_ns(), begin.present_time_ns(), frame_period_, &state_, begin.capture()});
   const clock::Nanos render_time = clock::monotonic_now() - started;
   last_rendered_ = begin.frame_id();
   rendered_any_ = true;
@@ -223,7 +257,17 @@ void Node::handle_swap(const wire::FrameSwap& swap) {
   }
   const clock::Nanos to_master = offset();
   const clock::Nanos local_deadline = swap.present_deadline_ns() - to_master;
-  clock::sleep_until_monotonic(options_.clock.to_monotonic(local_deadline));
+  // Never wait on a deadline from a broken or hostile master for longer than a few
+  // frames: this wait holds the event loop.
+  const clock::Nanos now = clock::monotonic_now();
+  const clock::Nanos longest = std::max<clock::Nanos>(4 * frame_period_, 100 * clock::kNanosPerMilli);
+  clock::Nanos deadline = options_.clock.to_monotonic(local_deadline);
+  if (deadline > now + longest) {
+    log_.warn("swap for frame {} asks to present {:.1f} ms from now; presenting in {:.1f} ms", swap.frame_id(),
+              static_cast<double>(deadline - now) / 1e6, static_cast<double>(longest) / 1e6);
+    deadline = now + longest;
+  }
+  clock::sleep_until_monotonic(deadline);
   renderer_.present();
   const clock::Nanos presented = options_.clock.now() + to_master;
 
@@ -297,8 +341,13 @@ void Node::stop(int exit_code, const std::string& reason) {
   }
   retry_timer_.cancel();
   ping_timer_.cancel();
+  connect_timer_.cancel();
   signals_.cancel();
   resolver_.cancel();
+  if (connecting_) {
+    boost::system::error_code ignored;
+    connecting_->close(ignored);
+  }
   if (connection_) connection_->close_after_sending(reason);
 }
 

@@ -47,7 +47,7 @@ class Node {
   [[nodiscard]] int exit_code() const { return exit_code_; }
 
  private:
-  enum class Phase { disconnected, awaiting_challenge, awaiting_welcome, joined, stopped };
+  enum class Phase { disconnected, awaiting_challenge, awaiting_welcome, awaiting_state, joined, stopped };
 
   void connect();
   void on_connected(asio::ip::tcp::socket socket);
@@ -56,6 +56,7 @@ class Node {
   void on_closed(const std::string& reason);
   void handle_challenge(wire::Envelope& message);
   void handle_welcome(const wire::Welcome& welcome);
+  void handle_resync(const wire::Resync& resync);
   void handle_frame_begin(const wire::FrameBegin& begin);
   void handle_swap(const wire::FrameSwap& swap);
   void handle_pong(const wire::Pong& pong);
@@ -74,6 +75,8 @@ class Node {
   asio::ip::tcp::resolver resolver_;
   asio::steady_timer retry_timer_;
   asio::steady_timer ping_timer_;
+  asio::steady_timer connect_timer_;
+  std::shared_ptr<asio::ip::tcp::socket> connecting_;
   asio::signal_set signals_;
   std::shared_ptr<net::Connection> connection_;
 
@@ -85,6 +88,7 @@ class Node {
   bool rendered_any_ = false;
   clock::Nanos frame_period_ = 0;
   std::chrono::milliseconds heartbeat_{250};
+  std::chrono::milliseconds liveness_timeout_{3000};
   int pings_in_burst_ = 0;
 
   std::chrono::milliseconds backoff_{100};

@@ -17,6 +17,7 @@ struct FrameInput {
   clock::Nanos present_time = 0;  // predicted, master clock
   clock::Nanos frame_period = 0;
   const scene::SceneState* state = nullptr;
+  bool capture = false;  // also write this frame to the capture folder
 };
 
 class Renderer {
@@ -24,6 +25,8 @@ class Renderer {
   virtual ~Renderer() = default;
   // The projector, its screen, the viewer and the scene, from the master's welcome.
   [[nodiscard]] virtual Result<void> configure(const wire::Welcome& welcome) = 0;
+  // What draws, for the master's log ("llvmpipe (...), headless").
+  [[nodiscard]] virtual std::string description() const = 0;
   // Draws the frame into the back buffer; returns when it is ready to show.
   virtual void render(const FrameInput& frame) = 0;
   // Shows the last rendered frame (swap buffers).

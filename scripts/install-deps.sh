@@ -11,7 +11,9 @@ packages=(
   libspdlog-dev libcli11-dev         # logging, command lines
   nlohmann-json3-dev                 # JSON syntax errors with line and column
   libglfw3-dev libglm-dev            # windows on projectors, render math
-  libopenimageio-dev                 # image files and image operations
+  libopenimageio-dev openimageio-tools  # image files and operations; oiiotool to inspect them
+  libepoxy-dev libegl-dev            # GL/EGL function loading, headless contexts
+  libegl-mesa0 libgl1-mesa-dri       # Mesa's EGL and llvmpipe: GL without a GPU
   libgtest-dev libgmock-dev          # tests
   libssl-dev                         # SHA-256 of configs, HMAC (libcrypto)
   python3                            # bench plots and helper scripts

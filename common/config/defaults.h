@@ -15,6 +15,8 @@ inline constexpr std::uint32_t kMinLivenessTimeoutMs = 3000;  // or 3 heartbeats
 inline constexpr std::uint32_t kPresentLeadUs = 2000;
 inline constexpr std::uint32_t kMaxMessageBytes = 16u << 20;
 inline constexpr double kEyeSeparation = 0.065;
+inline constexpr double kNear = 0.05;
+inline constexpr double kFar = 100.0;
 inline constexpr double kPixelsPerMetre = 200.0;
 
 }  // namespace optique::config::defaults

@@ -88,6 +88,13 @@ void apply_defaults(Installation& installation) {
 
   Viewer& v = *installation.mutable_viewer();
   if (v.eye_separation() == 0.0) v.set_eye_separation(defaults::kEyeSeparation);
+  if (v.near() == 0.0) v.set_near(defaults::kNear);
+  if (v.far() == 0.0) v.set_far(defaults::kFar);
+  if (v.head_right().empty()) {
+    v.add_head_right(1.0);
+    v.add_head_right(0.0);
+    v.add_head_right(0.0);
+  }
 
   for (Screen& s : *installation.mutable_screens()) {
     if (s.pixels_per_metre() == 0.0) s.set_pixels_per_metre(defaults::kPixelsPerMetre);

@@ -183,6 +183,18 @@ void check_viewer(Checker& check, const Viewer& v) {
     }
   }
   check.non_negative("viewer.eye_separation", v.eye_separation());
+  check.non_negative("viewer.near", v.near());
+  check.non_negative("viewer.far", v.far());
+  const double near = v.near() != 0.0 ? v.near() : defaults::kNear;
+  const double far = v.far() != 0.0 ? v.far() : defaults::kFar;
+  if (std::isfinite(near) && std::isfinite(far) && near >= 0.0 && far >= 0.0 && !(far > near)) {
+    check.fail("viewer.far", "must be greater than near (" + number(far) + " m <= " + number(near) + " m)");
+  }
+  if (!v.head_right().empty() && check.vec3("viewer.head_right", v.head_right()) &&
+      std::abs(std::sqrt(dot(v.head_right(), v.head_right())) - 1.0) > 1e-3) {
+    check.fail("viewer.head_right",
+               "must be a unit vector (length " + number(std::sqrt(dot(v.head_right(), v.head_right()))) + ")");
+  }
   if (v.eye_separation() > 1.0)
     check.fail("viewer.eye_separation", "is in metres; " + number(v.eye_separation()) + " m is not an eye separation");
 }

@@ -49,7 +49,7 @@ Sample run_once(const std::string& master_bin, const std::string& work, std::siz
   const std::string out = work + "/run-" + std::to_string(nodes);
   std::filesystem::remove_all(out);
   testing::Process master({master_bin, "--config", config, "--local", "--frames", std::to_string(frames), "--out", out,
-                           "--no-status", "--log-level", "warn"},
+                           "--no-status", "--log-level", "warn", "--node-arg=--renderer=null"},
                           work + "/master.log");
   const auto status = master.wait(std::chrono::seconds(120));
   if (status != 0) throw std::runtime_error("master failed:\n" + master.output());

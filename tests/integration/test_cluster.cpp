@@ -183,6 +183,31 @@ TEST(Cluster, HungNodeIsTakenOutOfTheBarrierAfterTheTimeout) {
   EXPECT_NE(master.process->output().find("taken out of the barrier"), std::string::npos);
 }
 
+TEST(Cluster, AStoppedNodeAloneComesBackAfterSigcont) {
+  const std::string config = kConfigs + "/single-wall.json";
+  ExternalMaster master(config, {"--frames", "240"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  auto node = master.node("wall");
+  ASSERT_TRUE(master.process->wait_for_output("starting frames", 15s)) << master.process->output();
+  std::this_thread::sleep_for(500ms);
+  node->signal(SIGSTOP);
+  std::this_thread::sleep_for(1000ms);  // twice the frame timeout, less than the liveness timeout
+  node->signal(SIGCONT);
+
+  ASSERT_EQ(master.process->wait(30s), 0) << master.process->output();
+  EXPECT_EQ(node->wait(10s), 0) << node->output();
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  const auto* wall = find_node(run.report, "wall");
+  EXPECT_GE(wall->barrier_misses(), 1u);
+  EXPECT_NE(master.process->output().find("answers again"), std::string::npos) << master.process->output();
+  // Back in the barrier: it presents the last frame, and most of the run.
+  bool presented_last = false;
+  for (const auto& row : run.rows) presented_last |= row.frame == 239 && row.presented != 0;
+  EXPECT_TRUE(presented_last);
+  EXPECT_GE(wall->frames_presented(), 150u);
+}
+
 TEST(Cluster, UnknownNodeIdIsRefusedOnBothSides) {
   ExternalMaster master(kConfigs + "/single-wall.json", {});
   ASSERT_FALSE(master.port.empty()) << master.process->output();

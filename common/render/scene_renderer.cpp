@@ -1,0 +1,358 @@
+#include "render/scene_renderer.h"
+
+#include <epoxy/gl.h>
+
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/mat3x3.hpp>
+
+namespace optique::render {
+namespace {
+
+constexpr const char* kSceneVertex = R"(#version 450 core
+layout(location = 0) in vec3 position;
+layout(location = 1) in vec3 normal;
+uniform mat4 model_view_projection;
+uniform mat4 model;
+uniform mat3 normal_matrix;
+out vec3 world_position;
+out vec3 world_normal;
+void main() {
+  world_position = (model * vec4(position, 1.0)).xyz;
+  world_normal = normal_matrix * normal;
+  gl_Position = model_view_projection * vec4(position, 1.0);
+}
+)";
+
+// Blinn-Phong with a roughness-derived exponent and a normalized specular lobe,
+// Fresnel F0 from metallic: a cheap stand-in for metallic/roughness. All linear.
+constexpr const char* kSceneFragment = R"(#version 450 core
+in vec3 world_position;
+in vec3 world_normal;
+uniform vec3 eye;
+uniform vec3 base_colour;
+uniform float metallic;
+uniform float roughness;
+uniform vec3 emissive;
+uniform vec3 ambient;
+uniform int light_count;
+layout(std430, binding = 0) readonly buffer Lights { vec4 lights[]; };  // position, radiance
+out vec4 colour;
+const float kPi = 3.14159265358979;
+void main() {
+  vec3 n = normalize(world_normal);
+  if (!gl_FrontFacing) n = -n;
+  vec3 v = normalize(eye - world_position);
+  vec3 diffuse = base_colour * (1.0 - metallic) / kPi;
+  vec3 f0 = mix(vec3(0.04), base_colour, metallic);
+  float alpha = max(roughness * roughness, 0.02);
+  float shininess = 2.0 / (alpha * alpha) - 2.0;
+  float normalization = (shininess + 8.0) / (8.0 * kPi);
+  vec3 result = ambient * base_colour + emissive;
+  for (int i = 0; i < light_count; ++i) {
+    vec3 to_light = lights[2 * i].xyz - world_position;
+    float r2 = max(dot(to_light, to_light), 1e-8);
+    vec3 l = to_light * inversesqrt(r2);
+    float n_dot_l = dot(n, l);
+    if (n_dot_l <= 0.0) continue;
+    vec3 h = normalize(l + v);
+    vec3 specular = f0 * normalization * pow(max(dot(n, h), 0.0), shininess);
+    result += (diffuse + specular) * lights[2 * i + 1].rgb * (n_dot_l / r2);
+  }
+  colour = vec4(result, 1.0);
+}
+)";
+
+constexpr const char* kFullscreenVertex = R"(#version 450 core
+out vec2 uv;
+void main() {
+  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+  uv = p;
+  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+// The projector's response, applied last: the sRGB transfer function for now.
+constexpr const char* kEncodeFragment = R"(#version 450 core
+in vec2 uv;
+uniform sampler2D linear_image;
+out vec4 colour;
+vec3 encode(vec3 c) {
+  c = clamp(c, 0.0, 1.0);
+  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+}
+void main() {
+  vec4 linear = texelFetch(linear_image, ivec2(gl_FragCoord.xy), 0);
+  colour = vec4(encode(linear.rgb), 1.0);
+}
+)";
+
+Result<GLuint> compile(GLenum type, const char* source) {
+  const GLuint shader = glCreateShader(type);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = GL_FALSE;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (ok == GL_TRUE) return shader;
+  char log[2048] = {};
+  glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+  glDeleteShader(shader);
+  return Error{std::string("shader does not compile: ") + log};
+}
+
+Result<GLuint> link(const char* vertex_source, const char* fragment_source) {
+  auto vertex = compile(GL_VERTEX_SHADER, vertex_source);
+  if (!vertex) return Error{vertex.error()};
+  auto fragment = compile(GL_FRAGMENT_SHADER, fragment_source);
+  if (!fragment) {
+    glDeleteShader(vertex.value());
+    return Error{fragment.error()};
+  }
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, vertex.value());
+  glAttachShader(program, fragment.value());
+  glLinkProgram(program);
+  glDeleteShader(vertex.value());
+  glDeleteShader(fragment.value());
+  GLint ok = GL_FALSE;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (ok == GL_TRUE) return program;
+  char log[2048] = {};
+  glGetProgramInfoLog(program, sizeof log, nullptr, log);
+  glDeleteProgram(program);
+  return Error{std::string("shader program does not link: ") + log};
+}
+
+struct MeshRange {
+  GLsizei count = 0;
+  std::size_t first_index = 0;
+  GLint base_vertex = 0;
+};
+
+}  // namespace
+
+struct SceneRenderer::Gl {
+  int width = 0;
+  int height = 0;
+  GLuint scene_program = 0;
+  GLuint encode_program = 0;
+  GLuint vertex_array = 0;
+  GLuint vertex_buffer = 0;
+  GLuint index_buffer = 0;
+  GLuint light_buffer = 0;
+  GLuint empty_vertex_array = 0;
+  GLuint linear_framebuffer = 0;
+  GLuint linear_colour = 0;
+  GLuint depth = 0;
+  GLuint encoded_framebuffer = 0;
+  GLuint encoded_colour = 0;
+  std::vector<MeshRange> meshes;
+  std::vector<scene::Material> materials;
+  std::vector<scene::Instance> instances;
+  glm::vec3 ambient{0.0f};
+  glm::vec3 background{0.0f};
+  int light_count = 0;
+  struct {
+    GLint model_view_projection, model, normal_matrix, eye, base_colour, metallic, roughness, emissive, ambient,
+        light_count;
+  } uniforms{};
+
+  ~Gl() {
+    glDeleteProgram(scene_program);
+    glDeleteProgram(encode_program);
+    const GLuint arrays[] = {vertex_array, empty_vertex_array};
+    glDeleteVertexArrays(2, arrays);
+    const GLuint buffers[] = {vertex_buffer, index_buffer, light_buffer};
+    glDeleteBuffers(3, buffers);
+    const GLuint framebuffers[] = {linear_framebuffer, encoded_framebuffer};
+    glDeleteFramebuffers(2, framebuffers);
+    const GLuint textures[] = {linear_colour, depth, encoded_colour};
+    glDeleteTextures(3, textures);
+  }
+};
+
+SceneRenderer::SceneRenderer(std::unique_ptr<Gl> gl) : gl_(std::move(gl)) {}
+SceneRenderer::~SceneRenderer() = default;
+
+Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneDefinition& scene, int width,
+                                                             int height) {
+  if (width <= 0 || height <= 0) return Error{"the image size must be positive"};
+  auto gl = std::make_unique<Gl>();
+  gl->width = width;
+  gl->height = height;
+  auto scene_program = link(kSceneVertex, kSceneFragment);
+  if (!scene_program) return Error{scene_program.error()};
+  gl->scene_program = scene_program.value();
+  auto encode_program = link(kFullscreenVertex, kEncodeFragment);
+  if (!encode_program) return Error{encode_program.error()};
+  gl->encode_program = encode_program.value();
+  const GLuint p = gl->scene_program;
+  gl->uniforms = {glGetUniformLocation(p, "model_view_projection"),
+                  glGetUniformLocation(p, "model"),
+                  glGetUniformLocation(p, "normal_matrix"),
+                  glGetUniformLocation(p, "eye"),
+                  glGetUniformLocation(p, "base_colour"),
+                  glGetUniformLocation(p, "metallic"),
+                  glGetUniformLocation(p, "roughness"),
+                  glGetUniformLocation(p, "emissive"),
+                  glGetUniformLocation(p, "ambient"),
+                  glGetUniformLocation(p, "light_count")};
+
+  // All meshes in one vertex and one index buffer.
+  std::vector<scene::Vertex> vertices;
+  std::vector<std::uint32_t> indices;
+  for (const auto& mesh : scene.meshes) {
+    gl->meshes.push_back(
+        {static_cast<GLsizei>(mesh.indices.size()), indices.size(), static_cast<GLint>(vertices.size())});
+    vertices.insert(vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
+    indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
+  }
+  glCreateVertexArrays(1, &gl->vertex_array);
+  glCreateVertexArrays(1, &gl->empty_vertex_array);
+  glCreateBuffers(1, &gl->vertex_buffer);
+  glCreateBuffers(1, &gl->index_buffer);
+  glNamedBufferStorage(gl->vertex_buffer,
+                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, vertices.size()) * sizeof(scene::Vertex)),
+                       vertices.empty() ? nullptr : vertices.data(), 0);
+  glNamedBufferStorage(gl->index_buffer,
+                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, indices.size()) * sizeof(std::uint32_t)),
+                       indices.empty() ? nullptr : indices.data(), 0);
+  glVertexArrayVertexBuffer(gl->vertex_array, 0, gl->vertex_buffer, 0, sizeof(scene::Vertex));
+  glVertexArrayElementBuffer(gl->vertex_array, gl->index_buffer);
+  glEnableVertexArrayAttrib(gl->vertex_array, 0);
+  glVertexArrayAttribFormat(gl->vertex_array, 0, 3, GL_FLOAT, GL_FALSE, offsetof(scene::Vertex, position));
+  glVertexArrayAttribBinding(gl->vertex_array, 0, 0);
+  glEnableVertexArrayAttrib(gl->vertex_array, 1);
+  glVertexArrayAttribFormat(gl->vertex_array, 1, 3, GL_FLOAT, GL_FALSE, offsetof(scene::Vertex, normal));
+  glVertexArrayAttribBinding(gl->vertex_array, 1, 0);
+
+  std::vector<glm::vec4> lights;
+  for (const auto& light : scene.lights) {
+    lights.emplace_back(glm::vec3(light.position), 1.0f);
+    lights.emplace_back(light.colour * light.intensity, 0.0f);
+  }
+  gl->light_count = static_cast<int>(scene.lights.size());
+  glCreateBuffers(1, &gl->light_buffer);
+  glNamedBufferStorage(gl->light_buffer,
+                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, lights.size()) * sizeof(glm::vec4)),
+                       lights.empty() ? nullptr : lights.data(), 0);
+
+  gl->materials = scene.materials;
+  gl->instances = scene.instances;
+  gl->ambient = scene.ambient;
+  gl->background = scene.background;
+
+  // Linear light in half floats, depth in 32-bit float.
+  glCreateTextures(GL_TEXTURE_2D, 1, &gl->linear_colour);
+  glTextureStorage2D(gl->linear_colour, 1, GL_RGBA16F, width, height);
+  glCreateTextures(GL_TEXTURE_2D, 1, &gl->depth);
+  glTextureStorage2D(gl->depth, 1, GL_DEPTH_COMPONENT32F, width, height);
+  glCreateFramebuffers(1, &gl->linear_framebuffer);
+  glNamedFramebufferTexture(gl->linear_framebuffer, GL_COLOR_ATTACHMENT0, gl->linear_colour, 0);
+  glNamedFramebufferTexture(gl->linear_framebuffer, GL_DEPTH_ATTACHMENT, gl->depth, 0);
+  glCreateTextures(GL_TEXTURE_2D, 1, &gl->encoded_colour);
+  glTextureStorage2D(gl->encoded_colour, 1, GL_RGBA8, width, height);
+  glCreateFramebuffers(1, &gl->encoded_framebuffer);
+  glNamedFramebufferTexture(gl->encoded_framebuffer, GL_COLOR_ATTACHMENT0, gl->encoded_colour, 0);
+  for (GLuint fb : {gl->linear_framebuffer, gl->encoded_framebuffer}) {
+    const GLenum status = glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER);
+    if (status != GL_FRAMEBUFFER_COMPLETE) {
+      return Error{"framebuffer incomplete (status " + std::to_string(status) + ")"};
+    }
+  }
+  return std::unique_ptr<SceneRenderer>(new SceneRenderer(std::move(gl)));
+}
+
+void SceneRenderer::draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye, const Frustum& frustum,
+                         const LightTerms& terms) {
+  Gl& gl = *gl_;
+  glBindFramebuffer(GL_FRAMEBUFFER, gl.linear_framebuffer);
+  glViewport(0, 0, gl.width, gl.height);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);  // thin objects (quads) are seen from both sides
+  glClearColor(gl.background.r, gl.background.g, gl.background.b, 1.0f);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+
+  glUseProgram(gl.scene_program);
+  glBindVertexArray(gl.vertex_array);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl.light_buffer);
+  const auto& u = gl.uniforms;
+  glUniform3f(u.eye, static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z));
+  const glm::vec3 ambient = terms.ambient ? gl.ambient : glm::vec3(0.0f);
+  glUniform3fv(u.ambient, 1, glm::value_ptr(ambient));
+  glUniform1i(u.light_count, gl.light_count);
+  const glm::dmat4 view_projection = frustum.projection * frustum.view;
+
+  for (const auto& instance : gl.instances) {
+    glm::dmat4 model = instance.transform;
+    if (instance.object) {
+      const auto found = state.objects.find(*instance.object);
+      if (found == state.objects.end()) continue;  // not in the state (yet): nothing to place
+      model = scene::model_matrix(scene::interpolate(found->second, fraction)) * instance.transform;
+    }
+    // Products in double, then to float: keeps precision for large worlds.
+    const glm::mat4 mvp(view_projection * model);
+    const glm::mat4 model_f(model);
+    const glm::mat3 normal_matrix(glm::transpose(glm::inverse(glm::dmat3(model))));
+    glUniformMatrix4fv(u.model_view_projection, 1, GL_FALSE, glm::value_ptr(mvp));
+    glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(model_f));
+    glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+    const scene::Material& m = gl.materials[instance.material];
+    glUniform3fv(u.base_colour, 1, glm::value_ptr(m.base_colour));
+    glUniform1f(u.metallic, m.metallic);
+    glUniform1f(u.roughness, m.roughness);
+    const glm::vec3 emissive = terms.emissive ? m.emissive : glm::vec3(0.0f);
+    glUniform3fv(u.emissive, 1, glm::value_ptr(emissive));
+    const MeshRange& mesh = gl.meshes[instance.mesh];
+    glDrawElementsBaseVertex(GL_TRIANGLES, mesh.count, GL_UNSIGNED_INT,
+                             reinterpret_cast<const void*>(mesh.first_index * sizeof(std::uint32_t)), mesh.base_vertex);
+  }
+
+  encode();
+}
+
+void SceneRenderer::draw_black() {
+  glBindFramebuffer(GL_FRAMEBUFFER, gl_->linear_framebuffer);
+  glViewport(0, 0, gl_->width, gl_->height);
+  glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  encode();
+}
+
+// The projector's response, last: linear light → what is sent to it.
+void SceneRenderer::encode() {
+  Gl& gl = *gl_;
+  glBindFramebuffer(GL_FRAMEBUFFER, gl.encoded_framebuffer);
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(gl.encode_program);
+  glBindTextureUnit(0, gl.linear_colour);
+  glBindVertexArray(gl.empty_vertex_array);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glFinish();
+}
+
+image::FloatImage SceneRenderer::read_linear() const {
+  image::FloatImage image(gl_->width, gl_->height, 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->linear_framebuffer);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, gl_->width, gl_->height, GL_RGBA, GL_FLOAT, image.pixels.data());
+  image::flip_rows(image);
+  return image;
+}
+
+image::ByteImage SceneRenderer::read_encoded() const {
+  image::ByteImage image(gl_->width, gl_->height, 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->encoded_framebuffer);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, gl_->width, gl_->height, GL_RGBA, GL_UNSIGNED_BYTE, image.pixels.data());
+  image::flip_rows(image);
+  return image;
+}
+
+unsigned SceneRenderer::output_framebuffer() const { return gl_->encoded_framebuffer; }
+int SceneRenderer::width() const { return gl_->width; }
+int SceneRenderer::height() const { return gl_->height; }
+
+}  // namespace optique::render

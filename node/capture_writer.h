@@ -1,0 +1,48 @@
+#pragma once
+// Writes captured frames on a worker thread, so encoding and disk I/O do not stall
+// the frame loop. The read-back from the GPU happens before (it must); if the
+// writer falls more than a few frames behind, submit() waits rather than drop a
+// capture.
+
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include <spdlog/logger.h>
+
+#include "image/image.h"
+
+namespace optique::node {
+
+class CaptureWriter {
+ public:
+  CaptureWriter(std::string folder, spdlog::logger& log, std::size_t max_queued = 4);
+  ~CaptureWriter();  // writes what is queued, then stops
+  CaptureWriter(const CaptureWriter&) = delete;
+  CaptureWriter& operator=(const CaptureWriter&) = delete;
+
+  void submit(std::uint64_t frame, image::FloatImage linear, image::ByteImage encoded);
+  [[nodiscard]] const std::string& folder() const { return folder_; }
+
+ private:
+  struct Job {
+    std::uint64_t frame;
+    image::FloatImage linear;
+    image::ByteImage encoded;
+  };
+  void run();
+
+  std::string folder_;
+  spdlog::logger& log_;
+  std::size_t max_queued_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::deque<Job> jobs_;
+  bool stopping_ = false;
+  std::thread worker_;
+};
+
+}  // namespace optique::node

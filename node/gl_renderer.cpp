@@ -1,0 +1,84 @@
+#include "gl_renderer.h"
+
+#include "scene/builtin.h"
+
+namespace optique::node {
+
+GlRenderer::GlRenderer(spdlog::logger& log, std::string capture_folder)
+    : log_(log), capture_folder_(std::move(capture_folder)) {}
+
+GlRenderer::~GlRenderer() {
+  captures_.reset();  // finish writing before the GL objects go
+  renderer_.reset();
+  context_.reset();
+}
+
+Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
+  const auto& projector = welcome.projector();
+  const std::string key = projector.SerializeAsString() + welcome.screen().SerializeAsString() +
+                          welcome.scene().SerializeAsString() + welcome.viewer().SerializeAsString();
+  if (key == configured_for_ && renderer_) return {};  // a rejoin: same job, keep everything
+
+  if (!welcome.scene().gltf().empty()) return Error{"glTF scenes are not supported yet"};
+  auto definition = scene::builtin_scene(welcome.scene().builtin());
+  if (!definition) return Error{definition.error()};
+
+  renderer_.reset();
+  context_.reset();
+  const int width = static_cast<int>(projector.width());
+  const int height = static_cast<int>(projector.height());
+  auto context =
+      projector.output().kind() == "window"
+          ? render::make_window_context("optique " + projector.id(), width, height,
+                                        static_cast<int>(projector.output().monitor()), projector.output().fullscreen())
+          : render::make_headless_context();
+  if (!context) return Error{context.error()};
+  context_ = std::move(context).value();
+  auto renderer = render::SceneRenderer::create(definition.value(), width, height);
+  if (!renderer) return Error{renderer.error()};
+  renderer_ = std::move(renderer).value();
+
+  rect_ = render::screen_region(welcome.screen(), projector.region());
+  eye_ = render::parse_eye(projector.eye());
+  const auto& viewer = welcome.viewer();
+  head_right_ = glm::dvec3(viewer.head_right(0), viewer.head_right(1), viewer.head_right(2));
+  eye_separation_ = viewer.eye_separation();
+  near_ = viewer.near();
+  far_ = viewer.far();
+  // One draw now, seen from a metre in front of the region: drivers compile
+  // shaders lazily, and the first frame should not pay for it.
+  const glm::dvec3 warm_eye = rect_.at(0.5, 0.5) + rect_.normal();
+  if (auto frustum = render::off_axis_frustum(rect_, warm_eye, near_, far_)) {
+    renderer_->draw(scene::SceneState{}, 0.0, warm_eye, frustum.value());
+  }
+  if (!captures_) captures_.emplace(capture_folder_, log_);
+  configured_for_ = key;
+  log_.info("rendering '{}' with {} ({}), {}×{} px", definition.value().name, context_->renderer_name(),
+            context_->has_window() ? "window" : "headless", width, height);
+  return {};
+}
+
+std::string GlRenderer::description() const {
+  if (!context_) return "OpenGL (not configured)";
+  return context_->renderer_name() + (context_->has_window() ? ", window" : ", headless");
+}
+
+void GlRenderer::render(const FrameInput& frame) {
+  const glm::dvec3 eye = render::eye_position(frame.state->eye_now, head_right_, eye_separation_, eye_);
+  auto frustum = render::off_axis_frustum(rect_, eye, near_, far_);
+  if (!frustum) {
+    // The eye left the space in front of this screen: nothing of the scene can be
+    // seen through it, so the projector shows black rather than a wrong picture.
+    log_.debug("frame {}: {}", frame.frame_id, frustum.error());
+    renderer_->draw_black();
+  } else {
+    renderer_->draw(*frame.state, 0.0, eye, frustum.value());
+  }
+  if (frame.capture) captures_->submit(frame.frame_id, renderer_->read_linear(), renderer_->read_encoded());
+}
+
+void GlRenderer::present() {
+  context_->present(renderer_->output_framebuffer(), renderer_->width(), renderer_->height());
+}
+
+}  // namespace optique::node

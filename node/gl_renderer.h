@@ -1,0 +1,47 @@
+#pragma once
+// The node's real renderer: an OpenGL context (headless or a window, from the
+// projector's output), the scene drawn through the projector's part of its screen
+// from the viewer's eye (or one eye), shown on present(), and captured on request.
+
+#include <memory>
+#include <optional>
+#include <string>
+
+#include <spdlog/logger.h>
+
+#include "capture_writer.h"
+#include "render/gl_context.h"
+#include "render/projection.h"
+#include "render/scene_renderer.h"
+#include "renderer.h"
+#include "scene/definition.h"
+
+namespace optique::node {
+
+class GlRenderer final : public Renderer {
+ public:
+  // Captures go to `capture_folder`/frame-NNNNNN.{exr,png}.
+  GlRenderer(spdlog::logger& log, std::string capture_folder);
+  ~GlRenderer() override;
+
+  [[nodiscard]] Result<void> configure(const wire::Welcome& welcome) override;
+  [[nodiscard]] std::string description() const override;
+  void render(const FrameInput& frame) override;
+  void present() override;
+
+ private:
+  spdlog::logger& log_;
+  std::string capture_folder_;
+  std::string configured_for_;  // the welcome's projector and scene, to skip rebuilding on a rejoin
+  std::unique_ptr<render::GlContext> context_;
+  std::unique_ptr<render::SceneRenderer> renderer_;
+  std::optional<CaptureWriter> captures_;
+  render::WorldRect rect_;
+  render::Eye eye_ = render::Eye::mono;
+  glm::dvec3 head_right_{1.0, 0.0, 0.0};
+  double eye_separation_ = 0.0;
+  double near_ = 0.05;
+  double far_ = 100.0;
+};
+
+}  // namespace optique::node
