@@ -56,8 +56,9 @@ SceneDefinition cubes() {
     const float hue = static_cast<float>(i) / kCount;
     const auto material = add_material(
         scene, {glm::vec3(0.25f + 0.6f * hue, 0.7f - 0.5f * hue, 0.3f + 0.4f * std::abs(0.5f - hue)), 0.0f, 0.4f, {}});
-    add_animated(scene, cube, material, "cube-" + std::to_string(i + 1),
-                 [where, axis, rate](double t) { return Pose{where, spin(axis, rate * t), glm::dvec3(0.25)}; });
+    add_animated(scene, cube, material, "cube-" + std::to_string(i + 1), [where, axis, rate](double t) {
+      return Pose{where, spin(axis, rate * t), glm::dvec3(0.25)};
+    });
   }
   scene.lights = {{{-1.0, 2.2, 1.0}, {1.0f, 0.95f, 0.9f}, 2.0f},
                   {{1.2, 1.6, 0.8}, {0.9f, 0.95f, 1.0f}, 1.5f},
@@ -71,8 +72,9 @@ SceneDefinition many_lights() {
   scene.name = "many-lights";
   const auto box = add_mesh(scene, make_box(glm::vec3(1.0f)));
   const auto material = add_material(scene, {glm::vec3(0.8f), 0.0f, 0.25f, {}});
-  add_animated(scene, box, material, "statue",
-               [](double t) { return Pose{kStage, spin({0, 1, 0}, 0.3 * t), glm::dvec3(0.6)}; });
+  add_animated(scene, box, material, "statue", [](double t) {
+    return Pose{kStage, spin({0, 1, 0}, 0.3 * t), glm::dvec3(0.6)};
+  });
   constexpr int kLights = 24;
   for (int i = 0; i < kLights; ++i) {
     const double angle = 2.0 * std::numbers::pi * i / kLights;
@@ -80,7 +82,8 @@ SceneDefinition many_lights() {
     const glm::vec3 colour(0.5f + 0.5f * std::cos(6.2832f * h), 0.5f + 0.5f * std::cos(6.2832f * (h - 0.333f)),
                            0.5f + 0.5f * std::cos(6.2832f * (h - 0.667f)));
     scene.lights.push_back(
-        {kStage + glm::dvec3(1.1 * std::cos(angle), 0.5 * std::sin(3.0 * angle), 1.1 * std::sin(angle)), colour, 0.12f});
+        {kStage + glm::dvec3(1.1 * std::cos(angle), 0.5 * std::sin(3.0 * angle), 1.1 * std::sin(angle)), colour,
+         0.12f});
   }
   return scene;
 }
@@ -95,8 +98,9 @@ SceneDefinition depth_stack() {
     const glm::dvec3 where(-1.0 + 0.5 * static_cast<double>(i), 1.2, depths[i]);
     const float shade = 0.3f + 0.15f * static_cast<float>(i);
     const auto material = add_material(scene, {glm::vec3(shade, 0.8f - shade * 0.5f, 0.5f), 0.0f, 0.6f, {}});
-    add_animated(scene, slab, material, "slab-" + std::to_string(i + 1),
-                 [where](double) { return Pose{where, kUpright, glm::dvec3(0.3)}; });
+    add_animated(scene, slab, material, "slab-" + std::to_string(i + 1), [where](double) {
+      return Pose{where, kUpright, glm::dvec3(0.3)};
+    });
   }
   scene.lights = {{{0.0, 2.5, 2.0}, {1.0f, 1.0f, 1.0f}, 4.0f}};
   scene.ambient = glm::vec3(0.05f);
@@ -144,8 +148,7 @@ glm::dquat three_quarter_tilt() { return spin({1.0, 0.0, 0.2}, 0.45); }
 // About the vertical through the stage, after a fixed tilt, at `turns_per_second`.
 std::function<Pose(double)> turning_about_vertical(double turns_per_second, glm::dquat tilt, double size) {
   return [turns_per_second, tilt, size](double t) {
-    return Pose{kStage, glm::normalize(spin({0.0, 1.0, 0.0}, kTau * turns_per_second * t) * tilt),
-                glm::dvec3(size)};
+    return Pose{kStage, glm::normalize(spin({0.0, 1.0, 0.0}, kTau * turns_per_second * t) * tilt), glm::dvec3(size)};
   };
 }
 
@@ -218,8 +221,9 @@ SceneDefinition wheel_rotation() {
 }
 
 SceneDefinition wheel_in_out() {
-  return wheel_scene("wheel-in-out",
-                     [](double t) { return Pose{zoom_position(t), wheel_rotation_at(t), glm::dvec3(1.0)}; });
+  return wheel_scene("wheel-in-out", [](double t) {
+    return Pose{zoom_position(t), wheel_rotation_at(t), glm::dvec3(1.0)};
+  });
 }
 
 SceneDefinition falling_ring() {
@@ -247,12 +251,47 @@ SceneDefinition falling_ring() {
   // The torus lies in the xy plane: a quarter turn about x lays it flat, less the tilt.
   const glm::dquat lay = spin({1.0, 0.0, 0.0}, std::numbers::pi / 2.0 - kTilt);
   add_animated(scene, ring, red, "ring", [period, top, lay](double t) {
-    const double phase = t - period * std::floor(t / period);  // in [0, period)
+    const double phase = t - period * std::floor(t / period);           // in [0, period)
     const double fall = period / 2.0 - std::abs(phase - period / 2.0);  // time from the nearest top
     const double y = top - 0.5 * kGravity * fall * fall;
     return Pose{{kStage.x, y, kStage.z}, glm::normalize(spin({0.0, 1.0, 0.0}, 0.8 * t) * lay), glm::dvec3(1.0)};
   });
   add_key_and_fill(scene);
+  return scene;
+}
+
+// Probes for tests: self-lit shapes on black at known places, so an image
+// measurement has nothing else to separate them from.
+SceneDefinition probe(std::string name) {
+  SceneDefinition scene;
+  scene.name = std::move(name);
+  scene.ambient = glm::vec3(0.0f);
+  scene.materials.push_back({glm::vec3(0.0f), 0.0f, 1.0f, glm::vec3(1.0f)});
+  return scene;
+}
+
+glm::dmat4 placed(const glm::dvec3& position, const glm::dvec3& size, double roll = 0.0) {
+  return glm::translate(glm::dmat4(1.0), position) * glm::rotate(glm::dmat4(1.0), roll, glm::dvec3(0, 0, 1)) *
+         glm::scale(glm::dmat4(1.0), size);
+}
+
+SceneDefinition stereo_probe() {
+  // A 10 cm square 1 m behind a wall at z = 0, at eye height: its two eyes' images
+  // are apart by the parallax of that depth.
+  SceneDefinition scene = probe("stereo-probe");
+  scene.meshes.push_back(make_quad(1.0f, 1.0f));
+  scene.instances.push_back({0, 0, std::nullopt, placed({0.0, 1.6, -1.0}, {0.1, 0.1, 1.0})});
+  return scene;
+}
+
+SceneDefinition corner_probe() {
+  // Two long bars, one level and one tilted, in front of a CAVE's front wall and
+  // long enough to be seen through the side walls too: at a wall corner, each bar
+  // must continue from one wall's image into the other's.
+  SceneDefinition scene = probe("corner-probe");
+  scene.meshes.push_back(make_box(glm::vec3(1.0f)));
+  scene.instances.push_back({0, 0, std::nullopt, placed({0.0, 1.2, -1.0}, {4.8, 0.08, 0.02})});
+  scene.instances.push_back({0, 0, std::nullopt, placed({0.0, 1.9, -1.2}, {4.8, 0.05, 0.02}, 0.2)});
   return scene;
 }
 
@@ -275,6 +314,9 @@ constexpr std::array kScenes{
     Entry{"wheel-rotation", wheel_rotation},
     Entry{"wheel-in-out", wheel_in_out},
     Entry{"falling-ring", falling_ring},
+    // test probes
+    Entry{"stereo-probe", stereo_probe},
+    Entry{"corner-probe", corner_probe},
 };
 
 constexpr std::array<std::string_view, kScenes.size()> kNames = [] {

@@ -68,7 +68,10 @@ TEST_P(EveryBuiltinScene, BuildsUnderItsName) {
   EXPECT_FALSE(scene.meshes.empty());
   EXPECT_FALSE(scene.materials.empty());
   EXPECT_FALSE(scene.instances.empty());
-  EXPECT_FALSE(scene.objects.empty());
+  // A scene may be all static (the test probes); otherwise something moves.
+  const bool any_animated = std::any_of(scene.instances.begin(), scene.instances.end(),
+                                        [](const Instance& i) { return i.object.has_value(); });
+  EXPECT_EQ(any_animated, !scene.objects.empty());
 }
 
 TEST_P(EveryBuiltinScene, InstancesReferToWhatExists) {

@@ -1,0 +1,31 @@
+#pragma once
+// Comparing two images of the same size: PSNR per channel, of luma, and the
+// seed-001 weighting (PSNR_Y = 0.299·PSNR_R + 0.587·PSNR_G + 0.114·PSNR_B), the
+// largest absolute difference, and a difference image to look at.
+
+#include <limits>
+
+#include "image/image.h"
+#include "util/result.h"
+
+namespace optique::image {
+
+struct Comparison {
+  double psnr_r = 0.0;  // dB; +infinity when identical
+  double psnr_g = 0.0;
+  double psnr_b = 0.0;
+  double psnr_luma = 0.0;        // of Rec. 601 luma, 0.299 R + 0.587 G + 0.114 B
+  double psnr_y_weighted = 0.0;  // the seed's weighted sum of channel PSNRs
+  double max_abs_error = 0.0;
+};
+
+// RGB of both images (alpha ignored); `peak` is the largest possible value.
+[[nodiscard]] Result<Comparison> compare(const FloatImage& a, const FloatImage& b, double peak = 1.0);
+
+// |a − b| per RGB channel, scaled by `gain`, alpha 1. Sizes must match.
+[[nodiscard]] FloatImage difference(const FloatImage& a, const FloatImage& b, float gain = 1.0f);
+
+// Copies `source` into `target` with its top-left corner at (x, y).
+void paste(FloatImage& target, const FloatImage& source, int x, int y);
+
+}  // namespace optique::image

@@ -1,0 +1,183 @@
+// Real nodes rendering with GL (headless, llvmpipe in CI): captured images must fit
+// together as the installation says. Label `gpu`.
+
+#include <google/protobuf/util/json_util.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "config/load.h"
+#include "image/compare.h"
+#include "image/frame_files.h"
+#include "image/image_io.h"
+#include "process.h"
+
+namespace optique::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+const std::string kMaster = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
+const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
+
+// Runs a local cluster for `frames` frames, capturing every `capture_every`-th;
+// returns its output folder.
+std::string run_and_capture(const std::string& config, int frames, int capture_every) {
+  const std::string dir = make_temp_dir("optique-gl");
+  Process master({kMaster, "--config", config, "--local", "--frames", std::to_string(frames), "--capture-every",
+                  std::to_string(capture_every), "--out", dir + "/out", "--no-status"},
+                 dir + "/master.log");
+  const auto status = master.wait(120s);
+  EXPECT_TRUE(status.has_value()) << "master still running:\n" << master.output();
+  EXPECT_EQ(status.value_or(-1), 0) << master.output();
+  return dir + "/out";
+}
+
+image::FloatImage capture(const std::string& out, const std::string& projector, std::uint64_t frame) {
+  auto loaded = image::read_image(image::frame_path(out + "/nodes/" + projector, frame, "png"));
+  EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error());
+  return loaded.ok() ? std::move(loaded).value() : image::FloatImage();
+}
+
+// A shipped config with another scene and a fixed eye, written to a temp file.
+std::string variant(const std::string& shipped, const std::function<void(config::Installation&)>& change) {
+  auto loaded = config::load_installation(kConfigs + "/" + shipped);
+  EXPECT_TRUE(loaded.ok());
+  config::Installation installation = loaded.value().installation;
+  change(installation);
+  std::string json;
+  EXPECT_TRUE(google::protobuf::util::MessageToJsonString(installation, &json).ok());
+  const std::string path = make_temp_dir("optique-gl") + "/" + shipped;
+  std::ofstream(path) << json;
+  return path;
+}
+
+// Where the image is lit (above `threshold` in green): runs of rows in one column.
+std::vector<std::pair<int, int>> lit_runs_in_column(const image::FloatImage& image, int column,
+                                                    float threshold = 0.5f) {
+  std::vector<std::pair<int, int>> runs;
+  int start = -1;
+  for (int y = 0; y <= image.height; ++y) {
+    const bool lit = y < image.height && image.at(column, y, 1) > threshold;
+    if (lit && start < 0) start = y;
+    if (!lit && start >= 0) {
+      runs.emplace_back(start, y - 1);
+      start = -1;
+    }
+  }
+  return runs;
+}
+
+TEST(Rendering, TheFourTilesOfThePowerWallEqualTheSingleWall) {
+  const std::string tiles = run_and_capture(kConfigs + "/powerwall-2x2.json", 31, 30);
+  const std::string whole = run_and_capture(kConfigs + "/single-wall.json", 31, 30);
+  const image::FloatImage reference = capture(whole, "wall", 30);
+  ASSERT_EQ(reference.width, 640);
+  ASSERT_EQ(reference.height, 360);
+  // Screen y is up, image rows go down: the top tiles are the upper half.
+  image::FloatImage stitched(640, 360, reference.channels);
+  image::paste(stitched, capture(tiles, "top-left", 30), 0, 0);
+  image::paste(stitched, capture(tiles, "top-right", 30), 320, 0);
+  image::paste(stitched, capture(tiles, "bottom-left", 30), 0, 180);
+  image::paste(stitched, capture(tiles, "bottom-right", 30), 320, 180);
+
+  auto comparison = image::compare(stitched, reference);
+  ASSERT_TRUE(comparison.ok()) << comparison.error();
+  const auto& c = comparison.value();
+  const double worst = std::min({c.psnr_r, c.psnr_g, c.psnr_b});
+  std::printf("stitched tiles vs single wall: PSNR R/G/B %.1f/%.1f/%.1f dB, max abs error %.4f\n", c.psnr_r, c.psnr_g,
+              c.psnr_b, c.max_abs_error);
+  if (worst < 40.0) {
+    const std::string dir = make_temp_dir("optique-gl-failure");
+    (void)image::write_exr(dir + "/stitched.exr", stitched);
+    (void)image::write_exr(dir + "/reference.exr", reference);
+    (void)image::write_exr(dir + "/difference.exr", image::difference(stitched, reference, 10.0f));
+    ADD_FAILURE() << "stitched tiles vs single wall: PSNR R/G/B " << c.psnr_r << "/" << c.psnr_g << "/" << c.psnr_b
+                  << " dB; images and the difference (×10) in " << dir;
+  }
+  // Something was drawn: not two black images.
+  double lit = 0.0;
+  for (float v : reference.pixels) lit += v;
+  EXPECT_GT(lit, 100.0);
+}
+
+TEST(Rendering, GeometryCrossingACaveCornerLinesUpOnBothWalls) {
+  const std::string config = variant("cave-4wall.json", [](config::Installation& inst) {
+    inst.mutable_scene()->set_builtin("corner-probe");
+    inst.mutable_viewer()->clear_path();
+    for (double v : {0.1, 1.6, 0.2}) inst.mutable_viewer()->add_eye(v);  // off centre: walls see it differently
+  });
+  const std::string out = run_and_capture(config, 1, 1);
+  const image::FloatImage front = capture(out, "front", 0);
+  const image::FloatImage left = capture(out, "left", 0);
+  const image::FloatImage right = capture(out, "right", 0);
+  ASSERT_FALSE(front.empty());
+  // front's left edge meets left's right edge; front's right edge meets right's left edge.
+  const struct {
+    const image::FloatImage& a;
+    int column_a;
+    const image::FloatImage& b;
+    int column_b;
+    const char* corner;
+  } corners[] = {{front, 0, left, left.width - 1, "front/left"}, {front, front.width - 1, right, 0, "front/right"}};
+  for (const auto& corner : corners) {
+    const auto runs_a = lit_runs_in_column(corner.a, corner.column_a);
+    const auto runs_b = lit_runs_in_column(corner.b, corner.column_b);
+    ASSERT_EQ(runs_a.size(), 2u) << corner.corner << ": both bars cross the corner";
+    ASSERT_EQ(runs_b.size(), 2u) << corner.corner;
+    for (std::size_t i = 0; i < runs_a.size(); ++i) {
+      EXPECT_LE(std::abs(runs_a[i].first - runs_b[i].first), 1) << corner.corner << " bar " << i << " top edge";
+      EXPECT_LE(std::abs(runs_a[i].second - runs_b[i].second), 1) << corner.corner << " bar " << i << " bottom edge";
+    }
+  }
+}
+
+// Intensity-weighted centre of the lit pixels, in pixels.
+double centroid_x(const image::FloatImage& image) {
+  double sum = 0.0;
+  double weighted = 0.0;
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const double v = image.at(x, y, 1);
+      sum += v;
+      weighted += v * (x + 0.5);
+    }
+  }
+  return sum > 0.0 ? weighted / sum : -1.0;
+}
+
+TEST(Rendering, LeftAndRightEyesDifferByTheParallaxOfTheDepth) {
+  const std::string config = variant("single-wall.json", [](config::Installation& inst) {
+    inst.mutable_scene()->set_builtin("stereo-probe");  // a square 1 m behind the wall, at eye height
+    config::Projector left = inst.projectors(0);
+    left.set_width(2560);  // 640 px/m: pixel edges quantize the measurement less
+    left.set_height(1440);
+    left.set_id("left-eye");
+    left.set_eye("left");
+    config::Projector right = left;
+    right.set_id("right-eye");
+    right.set_eye("right");
+    inst.clear_projectors();
+    *inst.add_projectors() = left;
+    *inst.add_projectors() = right;
+  });
+  const std::string out = run_and_capture(config, 1, 1);
+  const double left_x = centroid_x(capture(out, "left-eye", 0));
+  const double right_x = centroid_x(capture(out, "right-eye", 0));
+  ASSERT_GT(left_x, 0.0);
+  ASSERT_GT(right_x, 0.0);
+  // Eye 2 m in front of the wall, the square 1 m behind it: on the wall the two
+  // images are sep · d / (D + d) apart, right eye's to the right (uncrossed).
+  // Each centroid is within half a pixel of exact (edges snap to pixels).
+  const double separation = 0.065;
+  const double pixels_per_metre = 2560.0 / 4.0;
+  const double on_wall = separation / 2.0 * (1.0 - 2.0 / 3.0);  // each eye's image from the centre, metres
+  EXPECT_NEAR(left_x, (2.0 - on_wall) * pixels_per_metre, 0.5);
+  EXPECT_NEAR(right_x, (2.0 + on_wall) * pixels_per_metre, 0.5);
+  EXPECT_NEAR(right_x - left_x, separation * 1.0 / (2.0 + 1.0) * pixels_per_metre, 0.5);
+}
+
+}  // namespace
+}  // namespace optique::testing
