@@ -17,16 +17,26 @@
 namespace optique::master {
 namespace {
 
+// The config and the scene it names: both must load before anything starts.
+Result<std::pair<config::LoadedConfig, scene::LoadedScene>> load_config_and_scene(const std::string& path) {
+  auto loaded = config::load_installation(path);
+  if (!loaded) return Error{loaded.error()};
+  auto scene = scene::load_scene(loaded.value().installation.scene(), loaded.value().directory);
+  if (!scene) return Error{path + ": scene: " + scene.error()};
+  return std::pair{std::move(loaded).value(), std::move(scene).value()};
+}
+
 int check_config(const std::vector<std::string>& files) {
   int status = kExitOk;
   for (const auto& file : files) {
-    auto loaded = config::load_installation(file);
+    auto loaded = load_config_and_scene(file);
     if (!loaded) {
       std::cerr << loaded.error() << "\n";
       status = kExitUsage;
       continue;
     }
-    std::cout << summarize(loaded.value());
+    std::cout << summarize(loaded.value().first);
+    for (const auto& warning : loaded.value().second.warnings) std::cout << "  scene warning: " << warning << "\n";
   }
   return status;
 }
@@ -85,13 +95,15 @@ int run_cli(int argc, char** argv) {
 
   if (check->parsed()) return check_config(check_files);
   if (reference->parsed()) {
-    auto loaded = config::load_installation(reference_config);
+    auto loaded = load_config_and_scene(reference_config);
     if (!loaded) {
       std::cerr << loaded.error() << "\n";
       return kExitUsage;
     }
     auto logger = log::make_logger("master", log_level);
-    if (auto done = render_reference(loaded.value(), reference_frame, reference_out, *logger); !done) {
+    if (auto done =
+            render_reference(loaded.value().first, loaded.value().second, reference_frame, reference_out, *logger);
+        !done) {
       logger->error("{}", done.error());
       return kExitFailed;
     }
@@ -102,12 +114,13 @@ int run_cli(int argc, char** argv) {
     std::cerr << "optique-master: --config FILE is required (see --help)\n";
     return kExitUsage;
   }
-  auto loaded = config::load_installation(config_path);
+  auto loaded = load_config_and_scene(config_path);
   if (!loaded) {
     std::cerr << loaded.error() << "\n";
     return kExitUsage;
   }
-  options.config = std::move(loaded).value();
+  options.config = std::move(loaded.value().first);
+  options.scene = std::move(loaded.value().second);
   auto& settings = *options.config.installation.mutable_master();
   if (options.local) {
     settings.set_listen("127.0.0.1");

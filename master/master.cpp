@@ -8,7 +8,6 @@
 #include <random>
 
 #include "net/envelope.h"
-#include "scene/builtin.h"
 
 namespace optique::master {
 namespace {
@@ -52,14 +51,7 @@ Master::~Master() = default;
 
 Result<void> Master::start() {
   const auto& installation = options_.config.installation;
-  if (!installation.scene().gltf().empty()) {
-    return Error{
-        options_.config.path +
-        ": scene.gltf: glTF scenes need the GL renderer, which this build does not have yet; use a builtin scene"};
-  }
-  auto script = scene::builtin_scene(installation.scene().builtin());
-  if (!script) return Error{options_.config.path + ": scene.builtin: " + script.error()};
-  authority_.emplace(std::move(script).value(), installation.viewer(), frame_period_);
+  authority_.emplace(options_.scene.definition, installation.viewer(), frame_period_);
   current_state_ = authority_->state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
 
@@ -297,6 +289,11 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
   }
   *welcome.mutable_viewer() = installation.viewer();
   *welcome.mutable_scene() = installation.scene();
+  if (!installation.scene().gltf().empty()) {
+    // The node loads the same file, at the path the master resolved.
+    welcome.mutable_scene()->set_gltf(options_.scene.source);
+    welcome.set_scene_sha256(options_.scene.content_sha256);
+  }
   welcome.set_frame_period_ns(frame_period_);
   welcome.set_heartbeat_ms(settings_.heartbeat_ms());
   welcome.set_liveness_timeout_ms(settings_.liveness_timeout_ms());

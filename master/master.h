@@ -20,6 +20,7 @@
 #include "local_launcher.h"
 #include "net/connection.h"
 #include "run_recorder.h"
+#include "scene/load_scene.h"
 #include "scene_authority.h"
 #include "status_line.h"
 #include "util/result.h"
@@ -30,6 +31,7 @@ namespace asio = boost::asio;
 
 struct MasterOptions {
   config::LoadedConfig config;
+  scene::LoadedScene scene;  // loaded before anything starts, so a bad scene starts nothing
   std::uint64_t frames = 0;  // 0: until interrupted
   std::string out_dir;       // empty: write no files
   bool local = false;        // start one node process per projector here

@@ -7,21 +7,15 @@
 #include "render/gl_context.h"
 #include "render/projection.h"
 #include "render/scene_renderer.h"
-#include "scene/builtin.h"
 #include "scene_authority.h"
 
 namespace optique::master {
 
-Result<void> render_reference(const config::LoadedConfig& config, std::uint64_t frame, const std::string& out_dir,
-                              spdlog::logger& log) {
+Result<void> render_reference(const config::LoadedConfig& config, const scene::LoadedScene& scene, std::uint64_t frame,
+                              const std::string& out_dir, spdlog::logger& log) {
   const auto& installation = config.installation;
-  if (!installation.scene().gltf().empty()) {
-    return Error{config.path + ": scene.gltf: glTF scenes are not supported yet; use a builtin scene"};
-  }
-  auto definition = scene::builtin_scene(installation.scene().builtin());
-  if (!definition) return Error{config.path + ": scene.builtin: " + definition.error()};
   const auto period = static_cast<clock::Nanos>(1e9 / installation.master().frame_rate());
-  const SceneAuthority authority(definition.value(), installation.viewer(), period);
+  const SceneAuthority authority(scene.definition, installation.viewer(), period);
   const scene::SceneState state = authority.state_at_frame(frame);
 
   auto context = render::make_headless_context();
@@ -30,7 +24,7 @@ Result<void> render_reference(const config::LoadedConfig& config, std::uint64_t 
   for (const auto& screen : installation.screens()) {
     const int width = static_cast<int>(std::lround(screen.width() * screen.pixels_per_metre()));
     const int height = static_cast<int>(std::lround(screen.height() * screen.pixels_per_metre()));
-    auto renderer = render::SceneRenderer::create(definition.value(), width, height);
+    auto renderer = render::SceneRenderer::create(scene.definition, width, height);
     if (!renderer) return Error{"screen '" + screen.id() + "': " + renderer.error()};
     auto frustum = render::off_axis_frustum(render::whole_screen(screen), state.eye_now, viewer.near(), viewer.far());
     if (!frustum)

@@ -10,12 +10,13 @@
 #include <spdlog/logger.h>
 
 #include "config/load.h"
+#include "scene/load_scene.h"
 #include "util/result.h"
 
 namespace optique::master {
 
 // Writes OUT/reference/<screen-id>/frame-NNNNNN.exr and .png for every screen.
-[[nodiscard]] Result<void> render_reference(const config::LoadedConfig& config, std::uint64_t frame,
-                                            const std::string& out_dir, spdlog::logger& log);
+[[nodiscard]] Result<void> render_reference(const config::LoadedConfig& config, const scene::LoadedScene& scene,
+                                            std::uint64_t frame, const std::string& out_dir, spdlog::logger& log);
 
 }  // namespace optique::master

@@ -1,6 +1,6 @@
 #include "gl_renderer.h"
 
-#include "scene/builtin.h"
+#include "scene/load_scene.h"
 
 namespace optique::node {
 
@@ -19,9 +19,17 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
                           welcome.scene().SerializeAsString() + welcome.viewer().SerializeAsString();
   if (key == configured_for_ && renderer_) return {};  // a rejoin: same job, keep everything
 
-  if (!welcome.scene().gltf().empty()) return Error{"glTF scenes are not supported yet"};
-  auto definition = scene::builtin_scene(welcome.scene().builtin());
-  if (!definition) return Error{definition.error()};
+  auto definition = scene::load_scene(welcome.scene(), ".");
+  if (!definition) {
+    return Error{"cannot load the scene: " + definition.error() +
+                 (welcome.scene().gltf().empty() ? "" : " (a node needs the master's scene file at the same path)")};
+  }
+  if (definition.value().content_sha256 != welcome.scene_sha256()) {
+    return Error{"the scene file " + definition.value().source + " differs from the master's (sha256 " +
+                 definition.value().content_sha256.substr(0, 12) + "… here, " + welcome.scene_sha256().substr(0, 12) +
+                 "… on the master)"};
+  }
+  for (const auto& warning : definition.value().warnings) log_.warn("scene: {}", warning);
 
   renderer_.reset();
   context_.reset();
@@ -34,7 +42,7 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
           : render::make_headless_context();
   if (!context) return Error{context.error()};
   context_ = std::move(context).value();
-  auto renderer = render::SceneRenderer::create(definition.value(), width, height);
+  auto renderer = render::SceneRenderer::create(definition.value().definition, width, height);
   if (!renderer) return Error{renderer.error()};
   renderer_ = std::move(renderer).value();
 
@@ -53,7 +61,7 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
   }
   if (!captures_) captures_.emplace(capture_folder_, log_);
   configured_for_ = key;
-  log_.info("rendering '{}' with {} ({}), {}×{} px", definition.value().name, context_->renderer_name(),
+  log_.info("rendering {} with {} ({}), {}×{} px", definition.value().source, context_->renderer_name(),
             context_->has_window() ? "window" : "headless", width, height);
   return {};
 }

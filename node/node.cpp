@@ -348,7 +348,15 @@ void Node::stop(int exit_code, const std::string& reason) {
     boost::system::error_code ignored;
     connecting_->close(ignored);
   }
-  if (connection_) connection_->close_after_sending(reason);
+  if (connection_ && connection_->is_open()) {
+    // The master logs why a node leaves: a node that cannot render says so there too.
+    if (exit_code != kExitOk) {
+      wire::Envelope goodbye;
+      goodbye.mutable_goodbye()->set_reason(reason);
+      connection_->send(goodbye);
+    }
+    connection_->close_after_sending(reason);
+  }
 }
 
 }  // namespace optique::node

@@ -10,6 +10,7 @@ packages=(
   libprotobuf-dev protobuf-compiler  # wire format and config schema
   libspdlog-dev libcli11-dev         # logging, command lines
   nlohmann-json3-dev                 # JSON syntax errors with line and column
+  libtinygltf-dev                    # glTF 2.0 scene files
   libglfw3-dev libglm-dev            # windows on projectors, render math
   libopenimageio-dev openimageio-tools  # image files and operations; oiiotool to inspect them
   libepoxy-dev libegl-dev            # GL/EGL function loading, headless contexts

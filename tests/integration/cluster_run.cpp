@@ -3,10 +3,14 @@
 #include <google/protobuf/util/json_util.h>
 
 #include <algorithm>
+#include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
+
+#include "process.h"
 
 namespace optique::testing {
 namespace {
@@ -86,6 +90,22 @@ const report::NodeReport* find_node(const report::RunReport& report, const std::
     if (node.id() == id) return &node;
   }
   return nullptr;
+}
+
+StandInStart start_with_stand_in_nodes(const std::string& master_binary, const std::string& config) {
+  const std::string dir = make_temp_dir("optique-it");
+  const std::string stand_in = dir + "/stand-in-node";
+  std::ofstream(stand_in) << "#!/bin/sh\ntouch " << dir << "/node-started\n";
+  std::filesystem::permissions(stand_in, std::filesystem::perms::owner_all);
+  StandInStart result;
+  result.out_dir = dir + "/out";
+  Process master(
+      {master_binary, "--config", config, "--local", "--node-binary", stand_in, "--out", result.out_dir, "--no-status"},
+      dir + "/master.log");
+  result.status = master.wait(std::chrono::seconds(30)).value_or(-1);
+  result.output = master.output();
+  result.node_started = std::filesystem::exists(dir + "/node-started");
+  return result;
 }
 
 }  // namespace optique::testing

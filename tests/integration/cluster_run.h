@@ -36,4 +36,14 @@ struct ClusterRun {
 
 [[nodiscard]] const report::NodeReport* find_node(const report::RunReport& report, const std::string& id);
 
+// A master started with `config` and --local, whose node binary is a stand-in
+// that only leaves a mark: did the master start anything, and what did it say?
+struct StandInStart {
+  int status = -1;  // exit status, -1 if it was still running after 30 s
+  std::string output;
+  std::string out_dir;
+  bool node_started = false;
+};
+[[nodiscard]] StandInStart start_with_stand_in_nodes(const std::string& master_binary, const std::string& config);
+
 }  // namespace optique::testing

@@ -247,22 +247,12 @@ TEST(Cluster, ConfigErrorStartsNothing) {
     "viewer": {"eye": [0, 1, 2]},
     "scene": {"builtin": "cubes"}
   })";
-  // A stand-in node binary that leaves a mark if anything starts it.
-  const std::string fake_node = dir + "/fake-node";
-  std::ofstream(fake_node) << "#!/bin/sh\ntouch " << dir << "/node-started\n";
-  std::filesystem::permissions(fake_node, std::filesystem::perms::owner_all);
-
-  Process master(
-      {kMaster, "--config", config, "--local", "--node-binary", fake_node, "--out", dir + "/out", "--no-status"},
-      dir + "/master.log");
-  const auto status = master.wait(10s);
-  ASSERT_TRUE(status.has_value());
-  EXPECT_EQ(*status, 2);
-  const std::string output = master.output();
-  EXPECT_NE(output.find(config + ": projectors[0].screen: unknown screen 'wall'"), std::string::npos) << output;
-  std::this_thread::sleep_for(200ms);
-  EXPECT_FALSE(std::filesystem::exists(dir + "/node-started"));
-  EXPECT_FALSE(std::filesystem::exists(dir + "/out/run.json"));
+  const StandInStart start = start_with_stand_in_nodes(kMaster, config);
+  EXPECT_EQ(start.status, 2);
+  EXPECT_NE(start.output.find(config + ": projectors[0].screen: unknown screen 'wall'"), std::string::npos)
+      << start.output;
+  EXPECT_FALSE(start.node_started);
+  EXPECT_FALSE(std::filesystem::exists(start.out_dir + "/run.json"));
 }
 
 TEST(Cluster, NodeWaitsForALateMasterThenJoins) {

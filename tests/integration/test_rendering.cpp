@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 
+#include "cluster_run.h"
 #include "config/load.h"
 #include "image/compare.h"
 #include "image/frame_files.h"
@@ -177,6 +179,97 @@ TEST(Rendering, LeftAndRightEyesDifferByTheParallaxOfTheDepth) {
   EXPECT_NEAR(left_x, (2.0 - on_wall) * pixels_per_metre, 0.5);
   EXPECT_NEAR(right_x, (2.0 + on_wall) * pixels_per_metre, 0.5);
   EXPECT_NEAR(right_x - left_x, separation * 1.0 / (2.0 + 1.0) * pixels_per_metre, 0.5);
+}
+
+// ------------------------------------------------------------- glTF scenes
+
+const std::string kAnimatedCubes = kConfigs + "/assets/animated-cubes.gltf";
+
+double largest_difference(const image::FloatImage& a, const image::FloatImage& b) {
+  auto comparison = image::compare(a, b);
+  EXPECT_TRUE(comparison.ok()) << (comparison.ok() ? "" : comparison.error());
+  return comparison.ok() ? comparison.value().max_abs_error : 1.0;
+}
+
+TEST(Rendering, AnAnimatedGltfRendersTheSameOnStackedNodes) {
+  const std::string config = variant("single-wall.json", [](config::Installation& inst) {
+    inst.mutable_scene()->clear_builtin();
+    inst.mutable_scene()->set_gltf(kAnimatedCubes);
+    config::Projector a = inst.projectors(0);
+    a.set_id("stack-a");
+    config::Projector b = a;
+    b.set_id("stack-b");
+    inst.clear_projectors();
+    *inst.add_projectors() = a;
+    *inst.add_projectors() = b;
+  });
+  const std::string out = run_and_capture(config, 31, 30);
+  for (std::uint64_t frame : {0u, 30u}) {
+    EXPECT_EQ(largest_difference(capture(out, "stack-a", frame), capture(out, "stack-b", frame)), 0.0)
+        << "stacked duplicates differ at frame " << frame;
+  }
+  EXPECT_GT(largest_difference(capture(out, "stack-a", 0), capture(out, "stack-a", 30)), 0.1)
+      << "the animation moved nothing between frames 0 and 30";
+  const std::string report = read_file(out + "/run.json");
+  EXPECT_EQ(report.find("\"hash_mismatches\": \"1"), std::string::npos) << report;
+  EXPECT_NE(report.find("\"hash_mismatches\": \"0\""), std::string::npos) << report;
+}
+
+std::string with_gltf(const std::string& gltf) {
+  return variant("single-wall.json", [&gltf](config::Installation& inst) {
+    inst.mutable_scene()->clear_builtin();
+    inst.mutable_scene()->set_gltf(gltf);
+  });
+}
+
+TEST(Rendering, BadGltfInputStartsNothingAndSaysWhy) {
+  const std::string dir = make_temp_dir("optique-gl");
+  const std::string malformed = dir + "/malformed.gltf";
+  std::ofstream(malformed) << "{ \"asset\": { \"version\": \"2.0\" }, \"nodes\": [ ";
+  // The shipped asset with a skin added: a feature we cannot draw.
+  std::string skinned_text = read_file(kAnimatedCubes);
+  const auto brace = skinned_text.rfind('}');
+  ASSERT_NE(brace, std::string::npos);
+  skinned_text.insert(brace, ", \"skins\": [ { \"joints\": [ 0 ] } ]");
+  const std::string skinned = dir + "/skinned.gltf";
+  std::ofstream(skinned) << skinned_text;
+
+  const struct {
+    std::string gltf;
+    std::string expected;
+  } cases[] = {
+      {dir + "/missing.gltf", "missing.gltf"},
+      {malformed, "malformed.gltf"},
+      {skinned, "skin"},
+  };
+  for (const auto& c : cases) {
+    const StandInStart start = start_with_stand_in_nodes(kMaster, with_gltf(c.gltf));
+    EXPECT_EQ(start.status, 2) << c.gltf << ":\n" << start.output;
+    EXPECT_NE(start.output.find(c.expected), std::string::npos) << start.output;
+    EXPECT_FALSE(start.node_started) << c.gltf;
+  }
+}
+
+TEST(Rendering, ANodeWhoseSceneFileDiffersIsRefusedWithAMessage) {
+  const std::string dir = make_temp_dir("optique-gl");
+  const std::string asset = dir + "/scene.gltf";
+  std::filesystem::copy_file(kAnimatedCubes, asset);
+  const std::string config = with_gltf(asset);
+  Process master({kMaster, "--config", config, "--listen", "127.0.0.1", "--port", "0", "--port-file", dir + "/port",
+                  "--no-status"},
+                 dir + "/master.log");
+  ASSERT_TRUE(wait_for_file(dir + "/port", 10s)) << master.output();
+  std::string port = read_file(dir + "/port");
+  port.pop_back();
+  // The master has loaded the file; now the copy the node will load changes.
+  std::ofstream(asset, std::ios::app) << "\n";
+  Process node({std::string(OPTIQUE_BIN_DIR) + "/optique-node", "--master", "127.0.0.1:" + port, "--id", "wall"},
+               dir + "/node.log");
+  EXPECT_EQ(node.wait(30s), 2) << node.output();
+  EXPECT_NE(node.output().find("differs from the master's"), std::string::npos) << node.output();
+  EXPECT_TRUE(master.wait_for_output("differs from the master's", 10s)) << master.output();
+  master.signal(SIGINT);
+  EXPECT_EQ(master.wait(10s), 0) << master.output();
 }
 
 }  // namespace

@@ -1,0 +1,35 @@
+#include "scene/load_scene.h"
+
+#include <filesystem>
+
+#include "scene/builtin.h"
+#include "scene/gltf.h"
+
+namespace optique::scene {
+
+std::string resolve_asset(const std::string& path, const std::string& config_dir) {
+  const std::filesystem::path asset(path);
+  if (asset.is_absolute()) return asset.lexically_normal().string();
+  return std::filesystem::absolute(std::filesystem::path(config_dir) / asset).lexically_normal().string();
+}
+
+Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& config_dir) {
+  LoadedScene loaded;
+  if (!scene.builtin().empty()) {
+    auto definition = builtin_scene(scene.builtin());
+    if (!definition) return Error{definition.error()};
+    loaded.definition = std::move(definition).value();
+    loaded.source = "builtin " + scene.builtin();
+    return loaded;
+  }
+  const std::string path = resolve_asset(scene.gltf(), config_dir);
+  auto gltf = load_gltf(path);
+  if (!gltf) return Error{gltf.error()};
+  loaded.definition = std::move(gltf.value().scene);
+  loaded.content_sha256 = gltf.value().content_sha256;
+  loaded.warnings = std::move(gltf.value().warnings);
+  loaded.source = path;
+  return loaded;
+}
+
+}  // namespace optique::scene

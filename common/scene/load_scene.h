@@ -1,0 +1,27 @@
+#pragma once
+// The scene an installation names, built in or from a glTF file, loaded the same
+// way by the master (to animate it) and by every node (to draw it).
+
+#include <string>
+#include <vector>
+
+#include "optique/config.pb.h"
+#include "scene/definition.h"
+#include "util/result.h"
+
+namespace optique::scene {
+
+struct LoadedScene {
+  SceneDefinition definition;
+  std::string source;          // "builtin cubes" or the glTF file's path
+  std::string content_sha256;  // of the glTF content; empty for built-in scenes
+  std::vector<std::string> warnings;
+};
+
+// A glTF path relative to `config_dir` becomes absolute, so nodes started
+// elsewhere load the same file.
+[[nodiscard]] std::string resolve_asset(const std::string& path, const std::string& config_dir);
+
+[[nodiscard]] Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& config_dir);
+
+}  // namespace optique::scene

@@ -1,0 +1,489 @@
+// glTF scenes (common/scene/gltf.h): the shipped animated-cubes asset loads into
+// the meshes, instances, lights and animated objects it describes, with poses that
+// match hand-computed values, loop, and are pure functions of time; the content
+// hash covers the file and its side buffers; what we cannot draw fails with a
+// message that starts with the path and names the feature.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <initializer_list>
+#include <iterator>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+
+#include "scene/gltf.h"
+#include "util/sha256.h"
+
+namespace optique::scene {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kTolerance = 1e-9;
+const std::string kCubes = OPTIQUE_SOURCE_DIR "/configs/assets/animated-cubes.gltf";
+const std::string kData = OPTIQUE_SOURCE_DIR "/tests/data/gltf/";
+
+// A fresh directory under the system's temporary one, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    std::string pattern = (fs::temp_directory_path() / "optique-gltf-XXXXXX").string();
+    const char* made = mkdtemp(pattern.data());
+    EXPECT_NE(made, nullptr);
+    path_ = pattern;
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+
+  [[nodiscard]] std::string file(const std::string& name) const { return (path_ / name).string(); }
+
+ private:
+  fs::path path_;
+};
+
+std::string read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_bytes(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out << bytes;
+}
+
+json read_json(const std::string& path) { return json::parse(read_bytes(path)); }
+
+void write_json(const std::string& path, const json& doc) { write_bytes(path, doc.dump(1)); }
+
+LoadedGltf load_ok(const std::string& path) {
+  auto loaded = load_gltf(path);
+  EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error());
+  if (!loaded.ok()) return {};
+  return std::move(loaded).value();
+}
+
+// Loads `path`, expecting an error that starts with the path and contains every
+// one of `words`.
+void expect_error(const std::string& path, std::initializer_list<std::string> words) {
+  const auto loaded = load_gltf(path);
+  ASSERT_FALSE(loaded.ok()) << path << " loaded";
+  const std::string& message = loaded.error();
+  EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;
+  for (const auto& word : words) EXPECT_NE(message.find(word), std::string::npos) << message;
+}
+
+// The animated-cubes document with `change` applied, written to `dir`.
+std::string cubes_variant(const TempDir& dir, const std::function<void(json&)>& change) {
+  json doc = read_json(kCubes);
+  change(doc);
+  const std::string path = dir.file("variant.gltf");
+  write_json(path, doc);
+  return path;
+}
+
+bool contains(const std::vector<std::string>& warnings, const std::string& word) {
+  for (const auto& warning : warnings) {
+    if (warning.find(word) != std::string::npos) return true;
+  }
+  return false;
+}
+
+void expect_near(const glm::dvec3& actual, const glm::dvec3& expected, double tolerance = kTolerance) {
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(actual[i], expected[i], tolerance) << "component " << i;
+}
+
+// Equal as rotations: q and −q are the same.
+void expect_rotation(const glm::dquat& actual, glm::dquat expected) {
+  if (glm::dot(actual, expected) < 0.0) expected = -expected;
+  EXPECT_NEAR(actual.w, expected.w, kTolerance);
+  EXPECT_NEAR(actual.x, expected.x, kTolerance);
+  EXPECT_NEAR(actual.y, expected.y, kTolerance);
+  EXPECT_NEAR(actual.z, expected.z, kTolerance);
+}
+
+glm::dquat about(const glm::dvec3& axis, double degrees) { return glm::angleAxis(degrees * kPi / 180.0, axis); }
+
+const AnimatedObject& object_named(const SceneDefinition& scene, const std::string& name) {
+  for (const auto& object : scene.objects) {
+    if (object.name == name) return object;
+  }
+  ADD_FAILURE() << "no object " << name;
+  return scene.objects.front();
+}
+
+// --- the shipped asset
+
+TEST(Gltf, AnimatedCubesHasItsContent) {
+  const auto loaded = load_ok(kCubes);
+  const auto& scene = loaded.scene;
+  EXPECT_EQ(scene.name, "animated-cubes");
+  EXPECT_TRUE(loaded.warnings.empty()) << loaded.warnings.front();
+  ASSERT_EQ(scene.meshes.size(), 3u);
+  for (const auto& mesh : scene.meshes) {
+    EXPECT_EQ(mesh.vertices.size(), 24u);
+    EXPECT_EQ(mesh.indices.size(), 36u);
+  }
+  ASSERT_EQ(scene.materials.size(), 3u);
+  ASSERT_EQ(scene.instances.size(), 3u);
+  ASSERT_EQ(scene.objects.size(), 2u);
+  EXPECT_EQ(scene.objects[0].id, 1u);
+  EXPECT_EQ(scene.objects[1].id, 2u);
+  EXPECT_EQ(scene.objects[0].name, "green-box");
+  EXPECT_EQ(scene.objects[1].name, "blue-box");
+
+  // The red box is static: translate · rotate · scale from its node.
+  const auto& red = scene.instances[0];
+  EXPECT_FALSE(red.object.has_value());
+  const glm::dmat4 expected = glm::translate(glm::dmat4(1.0), glm::dvec3(-0.45, 1.2, -0.5)) *
+                              glm::mat4_cast(about({0, 1, 0}, 30.0)) * glm::scale(glm::dmat4(1.0), glm::dvec3(0.3));
+  for (int c = 0; c < 4; ++c) {
+    for (int r = 0; r < 4; ++r) EXPECT_NEAR(red.transform[c][r], expected[c][r], 1e-12);
+  }
+  const auto& red_material = scene.materials[red.material];
+  EXPECT_FLOAT_EQ(red_material.base_colour.r, 0.8f);
+  EXPECT_FLOAT_EQ(red_material.base_colour.g, 0.15f);
+  EXPECT_FLOAT_EQ(red_material.roughness, 0.4f);
+  EXPECT_FLOAT_EQ(red_material.metallic, 0.0f);
+
+  // The others ride on their objects.
+  EXPECT_EQ(scene.instances[1].object, std::optional<std::uint32_t>(1));
+  EXPECT_EQ(scene.instances[2].object, std::optional<std::uint32_t>(2));
+  EXPECT_EQ(scene.instances[1].transform, glm::dmat4(1.0));
+  const auto& blue_material = scene.materials[scene.instances[2].material];
+  EXPECT_FLOAT_EQ(blue_material.metallic, 0.3f);
+  EXPECT_FLOAT_EQ(blue_material.emissive.b, 0.05f);
+
+  // Two point lights; glTF candela / 100.
+  ASSERT_EQ(scene.lights.size(), 2u);
+  expect_near(scene.lights[0].position, {-0.9, 2.3, 1.0});
+  EXPECT_FLOAT_EQ(scene.lights[0].colour.g, 0.96f);
+  EXPECT_FLOAT_EQ(scene.lights[0].intensity, 2.5f);
+  expect_near(scene.lights[1].position, {1.1, 1.4, 0.7});
+  EXPECT_FLOAT_EQ(scene.lights[1].intensity, 1.0f);
+}
+
+TEST(Gltf, GreenBoxPoseMatchesHandComputedValues) {
+  const auto loaded = load_ok(kCubes);
+  const auto& green = object_named(loaded.scene, "green-box");
+  // Rotation keys every second, 0°, 90°, … 360° about y; translation keys at 0, 2,
+  // 4 s with y = 1, 1.5, 1.
+  const Pose early = green.pose_at(0.5);
+  expect_near(early.position, {0.0, 1.125, -0.5});
+  expect_rotation(early.rotation, about({0, 1, 0}, 45.0));
+  expect_near(early.scale, glm::dvec3(0.3));
+
+  const Pose late = green.pose_at(2.5);
+  expect_near(late.position, {0.0, 1.375, -0.5});
+  expect_rotation(late.rotation, about({0, 1, 0}, 225.0));
+  expect_near(late.scale, glm::dvec3(0.3));
+}
+
+TEST(Gltf, ChildOfAnimatedPivotRidesOnItsWorldTransform) {
+  const auto loaded = load_ok(kCubes);
+  const auto& blue = object_named(loaded.scene, "blue-box");
+  // The pivot at (0.45, 1.2, −0.5) turns about z 0° → 90° → 0° over 0, 1.5, 3 s;
+  // the box sits 0.2 m above it.
+  const double s60 = std::sin(kPi / 3.0);
+  const Pose at_one = blue.pose_at(1.0);  // 60°
+  expect_near(at_one.position, {0.45 - 0.2 * s60, 1.2 + 0.2 * 0.5, -0.5});
+  expect_rotation(at_one.rotation, about({0, 0, 1}, 60.0));
+  expect_near(at_one.scale, glm::dvec3(0.3));
+
+  const Pose falling_back = blue.pose_at(2.25);  // 45°, on the way back
+  expect_rotation(falling_back.rotation, about({0, 0, 1}, 45.0));
+
+  // The swing ends at 3 s, the longest animation at 4 s: it holds its last key.
+  const Pose after = blue.pose_at(3.5);
+  expect_near(after.position, {0.45, 1.4, -0.5});
+  expect_rotation(after.rotation, glm::dquat(1.0, 0.0, 0.0, 0.0));
+}
+
+TEST(Gltf, PosesLoopOverTheLongestAnimation) {
+  const auto loaded = load_ok(kCubes);
+  for (const auto& object : loaded.scene.objects) {
+    EXPECT_EQ(object.pose_at(4.0), object.pose_at(0.0)) << object.name;
+    EXPECT_EQ(object.pose_at(8.0), object.pose_at(0.0)) << object.name;
+    EXPECT_EQ(object.pose_at(4.5), object.pose_at(0.5)) << object.name;
+    EXPECT_EQ(object.pose_at(-3.5), object.pose_at(0.5)) << object.name;
+    const Pose a = object.pose_at(401.3);
+    const Pose b = object.pose_at(1.3);
+    expect_near(a.position, b.position, 1e-9);
+    expect_rotation(a.rotation, b.rotation);
+  }
+}
+
+TEST(Gltf, PosesArePureDeterministicAndUnit) {
+  const auto first = load_ok(kCubes);
+  const auto second = load_ok(kCubes);
+  ASSERT_EQ(first.scene.objects.size(), second.scene.objects.size());
+  for (std::size_t i = 0; i < first.scene.objects.size(); ++i) {
+    const auto& a = first.scene.objects[i];
+    const auto& b = second.scene.objects[i];
+    for (double t = -1.0; t < 9.0; t += 0.0625) {
+      const Pose pose = a.pose_at(t);
+      EXPECT_EQ(pose, a.pose_at(t));
+      EXPECT_EQ(pose, b.pose_at(t));
+      EXPECT_NEAR(glm::length(pose.rotation), 1.0, 1e-12);
+      EXPECT_TRUE(std::isfinite(pose.position.x) && std::isfinite(pose.position.y) && std::isfinite(pose.position.z));
+      EXPECT_TRUE(std::isfinite(pose.scale.x) && std::isfinite(pose.scale.y) && std::isfinite(pose.scale.z));
+    }
+    // Not a number in, a pose out all the same.
+    EXPECT_EQ(a.pose_at(std::nan("")), a.pose_at(0.0));
+  }
+}
+
+TEST(Gltf, ScaleAnimatedToZeroOnOneAxis) {
+  TempDir dir;
+  // The green box's translation keys, (0, 1 … 1.5, −0.5), as its scale too: x
+  // collapses to 0 and z is negative; the pose must still give the world matrix.
+  const auto path = cubes_variant(dir, [](json& doc) {
+    doc["animations"][0]["channels"].push_back({{"sampler", 1}, {"target", {{"node", 1}, {"path", "scale"}}}});
+  });
+  const auto loaded = load_ok(path);
+  const auto& green = object_named(loaded.scene, "green-box");
+  for (double t : {0.0, 0.5, 1.7, 2.5}) {
+    const Pose pose = green.pose_at(t);
+    const double y = t < 2.0 ? 1.0 + 0.25 * t : 1.5 - 0.25 * (t - 2.0);
+    const glm::dmat4 expected = glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, y, -0.5)) *
+                                glm::mat4_cast(about({0, 1, 0}, 90.0 * t)) *
+                                glm::scale(glm::dmat4(1.0), glm::dvec3(0.0, y, -0.5));
+    const glm::dmat4 actual = model_matrix(pose);
+    for (int c = 0; c < 4; ++c) {
+      for (int r = 0; r < 4; ++r) EXPECT_NEAR(actual[c][r], expected[c][r], 1e-9) << "t " << t;
+    }
+    EXPECT_NEAR(glm::length(pose.rotation), 1.0, 1e-12);
+  }
+}
+
+// --- the content hash
+
+TEST(Gltf, HashIsStableAndFollowsTheBytes) {
+  const auto first = load_ok(kCubes);
+  const auto second = load_ok(kCubes);
+  EXPECT_EQ(first.content_sha256.size(), 64u);
+  EXPECT_EQ(first.content_sha256, second.content_sha256);
+  EXPECT_EQ(first.content_sha256, util::sha256_hex(read_bytes(kCubes)));
+
+  TempDir dir;
+  std::string bytes = read_bytes(kCubes);
+  const auto where = bytes.find("\"roughnessFactor\": 0.4");
+  ASSERT_NE(where, std::string::npos);
+  bytes[where + std::string("\"roughnessFactor\": 0.").size()] = '3';
+  const std::string changed = dir.file("changed.gltf");
+  write_bytes(changed, bytes);
+  const auto modified = load_ok(changed);
+  EXPECT_NE(modified.content_sha256, first.content_sha256);
+}
+
+TEST(Gltf, HashCoversSideBuffers) {
+  TempDir dir;
+  fs::copy_file(kData + "quad.gltf", dir.file("quad.gltf"));
+  fs::copy_file(kData + "quad.bin", dir.file("quad.bin"));
+  const auto original = load_ok(dir.file("quad.gltf"));
+  EXPECT_EQ(original.content_sha256,
+            util::sha256_hex(read_bytes(kData + "quad.gltf") + read_bytes(kData + "quad.bin")));
+
+  std::string bin = read_bytes(dir.file("quad.bin"));
+  bin[0] = static_cast<char>(bin[0] ^ 0x01);  // a tiny change to the first x coordinate
+  write_bytes(dir.file("quad.bin"), bin);
+  const auto changed = load_ok(dir.file("quad.gltf"));
+  EXPECT_NE(changed.content_sha256, original.content_sha256);
+}
+
+// --- other files
+
+TEST(Gltf, SideBufferFlatNormalsDefaultMaterialAndLight) {
+  const auto loaded = load_ok(kData + "quad.gltf");
+  const auto& scene = loaded.scene;
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  const auto& mesh = scene.meshes[0];
+  ASSERT_EQ(mesh.indices.size(), 6u);
+  ASSERT_EQ(mesh.vertices.size(), 6u);  // flat: three vertices per triangle
+  for (const auto& vertex : mesh.vertices) {
+    EXPECT_FLOAT_EQ(vertex.normal.x, 0.0f);
+    EXPECT_FLOAT_EQ(vertex.normal.y, 0.0f);
+    EXPECT_FLOAT_EQ(vertex.normal.z, 1.0f);
+  }
+  ASSERT_EQ(scene.materials.size(), 1u);  // the default grey
+  EXPECT_EQ(scene.materials[0].base_colour, Material{}.base_colour);
+  ASSERT_EQ(scene.instances.size(), 1u);
+  EXPECT_TRUE(scene.objects.empty());
+  // holder: translate (0, 1, −1), scale 2; quad: a matrix translating x by 0.25.
+  expect_near(glm::dvec3(scene.instances[0].transform[3]), {0.5, 1.0, -1.0});
+  EXPECT_DOUBLE_EQ(scene.instances[0].transform[0][0], 2.0);
+  // No lights in the file: one at the bounding box's centre + (0, 2, 2).
+  ASSERT_EQ(scene.lights.size(), 1u);
+  expect_near(scene.lights[0].position, {0.5, 3.0, 1.0});
+  EXPECT_TRUE(contains(loaded.warnings, "no point lights")) << loaded.warnings.size();
+}
+
+TEST(Gltf, BinaryGltfWithInterleavedVertices) {
+  const auto loaded = load_ok(kData + "triangle.glb");
+  const auto& scene = loaded.scene;
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  ASSERT_EQ(scene.meshes[0].vertices.size(), 3u);
+  EXPECT_EQ(scene.meshes[0].indices, (std::vector<std::uint32_t>{0, 1, 2}));
+  EXPECT_FLOAT_EQ(scene.meshes[0].vertices[1].position.x, 1.0f);
+  EXPECT_FLOAT_EQ(scene.meshes[0].vertices[2].normal.z, 1.0f);
+  ASSERT_EQ(scene.lights.size(), 1u);
+  expect_near(scene.lights[0].position, {0.0, 0.0, 3.0});
+  EXPECT_FLOAT_EQ(scene.lights[0].intensity, 0.5f);
+  EXPECT_EQ(scene.lights[0].colour, glm::vec3(1.0f));
+  EXPECT_EQ(loaded.content_sha256, util::sha256_hex(read_bytes(kData + "triangle.glb")));
+}
+
+TEST(Gltf, CubicSplineAndStepInterpolation) {
+  const auto loaded = load_ok(kData + "interpolation.gltf");
+  ASSERT_EQ(loaded.scene.objects.size(), 1u);
+  const auto& mover = loaded.scene.objects[0];
+  // Translation: x from 0 to 2 over 2 s, Hermite with zero tangents:
+  // x(u) = 2·(3u² − 2u³).
+  expect_near(mover.pose_at(0.5).position, {0.3125, 0.0, 0.0});
+  expect_near(mover.pose_at(1.0).position, {1.0, 0.0, 0.0});
+  expect_near(mover.pose_at(1.5).position, {1.6875, 0.0, 0.0});
+  // Rotation steps from 0° to 90° about x at 1 s.
+  expect_rotation(mover.pose_at(0.99).rotation, glm::dquat(1.0, 0.0, 0.0, 0.0));
+  expect_rotation(mover.pose_at(1.0).rotation, about({1, 0, 0}, 90.0));
+  expect_rotation(mover.pose_at(1.9).rotation, about({1, 0, 0}, 90.0));
+  EXPECT_EQ(mover.pose_at(2.5), mover.pose_at(0.5));  // duration 2 s
+}
+
+TEST(Gltf, StripsAndFansBecomeTriangleLists) {
+  TempDir dir;
+  for (int mode : {5, 6}) {
+    const auto path = cubes_variant(dir, [mode](json& doc) { doc["meshes"][0]["primitives"][0]["mode"] = mode; });
+    const auto loaded = load_ok(path);
+    ASSERT_EQ(loaded.scene.meshes.size(), 3u);
+    EXPECT_EQ(loaded.scene.meshes[0].indices.size(), 3u * 34u) << "mode " << mode;  // 36 indices, 34 triangles
+  }
+}
+
+TEST(Gltf, TexturesAndSpotLightsAreIgnoredWithWarnings) {
+  TempDir dir;
+  const auto path = cubes_variant(dir, [](json& doc) {
+    doc["images"] = json::array({{{"uri", "checker.png"}}});
+    doc["textures"] = json::array({{{"source", 0}}});
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+    doc["extensions"]["KHR_lights_punctual"]["lights"][1] = {{"type", "spot"}, {"spot", json::object()}};
+  });
+  const auto loaded = load_ok(path);
+  EXPECT_TRUE(contains(loaded.warnings, "baseColorTexture"));
+  EXPECT_TRUE(contains(loaded.warnings, "spot lights are not supported"));
+  EXPECT_EQ(loaded.scene.lights.size(), 1u);
+  EXPECT_EQ(loaded.scene.instances.size(), 3u);
+}
+
+// --- errors
+
+TEST(Gltf, MissingFile) { expect_error(kData + "no-such.gltf", {"no such file"}); }
+
+TEST(Gltf, MalformedJson) {
+  TempDir dir;
+  const std::string path = dir.file("broken.gltf");
+  const std::string bytes = read_bytes(kCubes);
+  write_bytes(path, bytes.substr(0, bytes.size() / 2));
+  expect_error(path, {"malformed glTF"});
+}
+
+TEST(Gltf, MissingBufferFile) {
+  TempDir dir;
+  fs::copy_file(kData + "quad.gltf", dir.file("quad.gltf"));
+  expect_error(dir.file("quad.gltf"), {"missing buffer file", "quad.bin"});
+}
+
+TEST(Gltf, SkinsAreRefused) {
+  TempDir dir;
+  const auto path = cubes_variant(dir, [](json& doc) {
+    doc["skins"] = json::array({{{"joints", json::array({0})}}});
+    doc["nodes"][1]["skin"] = 0;
+  });
+  expect_error(path, {"skinned meshes are not supported"});
+}
+
+TEST(Gltf, MorphTargetWeightsAreRefused) {
+  TempDir dir;
+  const auto path = cubes_variant(dir, [](json& doc) {
+    doc["animations"][0]["channels"].push_back({{"sampler", 1}, {"target", {{"node", 1}, {"path", "weights"}}}});
+  });
+  expect_error(path, {"morph targets are not supported"});
+}
+
+TEST(Gltf, UnsupportedRequiredExtensionIsRefused) {
+  TempDir dir;
+  const auto path = cubes_variant(dir, [](json& doc) {
+    doc["extensionsUsed"].push_back("KHR_draco_mesh_compression");
+    doc["extensionsRequired"] = json::array({"KHR_lights_punctual", "KHR_draco_mesh_compression"});
+  });
+  expect_error(path, {"required extension", "KHR_draco_mesh_compression", "not supported"});
+}
+
+TEST(Gltf, AccessorOutOfRange) {
+  TempDir dir;
+  const auto path = cubes_variant(dir, [](json& doc) { doc["accessors"][0]["count"] = 1000; });
+  expect_error(path, {"accessor 0", "POSITION", "out of range"});
+}
+
+TEST(Gltf, IndexOutOfRange) {
+  TempDir dir;
+  json doc = read_json(kData + "quad.gltf");
+  doc["accessors"][0]["count"] = 2;
+  doc["accessors"][0]["min"] = {-0.5, -0.5, 0};
+  doc["accessors"][0]["max"] = {0.5, -0.5, 0};
+  write_json(dir.file("quad.gltf"), doc);
+  fs::copy_file(kData + "quad.bin", dir.file("quad.bin"));
+  expect_error(dir.file("quad.gltf"), {"index 2", "out of range"});
+}
+
+TEST(Gltf, NonFloatPositionsNameTheAccessor) {
+  TempDir dir;
+  const auto path = cubes_variant(dir, [](json& doc) { doc["accessors"][0]["componentType"] = 5123; });
+  expect_error(path, {"accessor 0", "POSITION", "UNSIGNED_SHORT", "FLOAT only"});
+}
+
+TEST(Gltf, PointsAreRefused) {
+  TempDir dir;
+  const auto path = cubes_variant(dir, [](json& doc) { doc["meshes"][1]["primitives"][0]["mode"] = 0; });
+  expect_error(path, {"POINTS is not supported"});
+}
+
+TEST(Gltf, ShearOnAnAnimatedNodeIsRefused) {
+  TempDir dir;
+  // A non-uniformly scaled parent above the turning pivot.
+  const auto path = cubes_variant(dir, [](json& doc) {
+    doc["nodes"].push_back({{"name", "stretch"}, {"scale", {1.0, 2.0, 1.0}}, {"children", {2}}});
+    doc["scenes"][0]["nodes"] = {0, 1, 6, 4, 5};
+  });
+  expect_error(path, {"blue-box", "shear"});
+}
+
+TEST(Gltf, NonFiniteWorldTransformsAreRefused) {
+  TempDir dir;
+  // Every number is finite in JSON, but a parent scaled by 1e308 above a child
+  // translated by 1e308 overflows.
+  const auto path = cubes_variant(dir, [](json& doc) {
+    doc["nodes"].push_back({{"name", "huge"}, {"scale", {1e308, 1e308, 1e308}}, {"children", {0}}});
+    doc["nodes"][0]["translation"] = {1e308, 0.0, 0.0};
+    doc["scenes"][0]["nodes"] = {6, 1, 2, 4, 5};
+  });
+  expect_error(path, {"red-box", "not finite"});
+}
+
+}  // namespace
+}  // namespace optique::scene
