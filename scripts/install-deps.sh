@@ -16,6 +16,7 @@ packages=(
   libepoxy-dev libegl-dev            # GL/EGL function loading, headless contexts
   libegl-mesa0 libgl1-mesa-dri       # Mesa's EGL and llvmpipe: GL without a GPU
   libgtest-dev libgmock-dev          # tests
+  xvfb xauth                         # a virtual display for the window tests
   libssl-dev                         # SHA-256 of configs, HMAC (libcrypto)
   python3                            # bench plots and helper scripts
 )

@@ -56,6 +56,12 @@ std::string variant(const std::string& shipped, const std::function<void(config:
   return path;
 }
 
+double largest_difference(const image::FloatImage& a, const image::FloatImage& b) {
+  auto comparison = image::compare(a, b);
+  EXPECT_TRUE(comparison.ok()) << (comparison.ok() ? "" : comparison.error());
+  return comparison.ok() ? comparison.value().max_abs_error : 1.0;
+}
+
 // Where the image is lit (above `threshold` in green): runs of rows in one column.
 std::vector<std::pair<int, int>> lit_runs_in_column(const image::FloatImage& image, int column,
                                                     float threshold = 0.5f) {
@@ -181,15 +187,25 @@ TEST(Rendering, LeftAndRightEyesDifferByTheParallaxOfTheDepth) {
   EXPECT_NEAR(right_x - left_x, separation * 1.0 / (2.0 + 1.0) * pixels_per_metre, 0.5);
 }
 
+TEST(Rendering, AWindowOnAProjectorShowsWhatHeadlessRenders) {
+  // A window needs a display: a virtual X server stands in for the projector.
+  const std::string windowed = variant("single-wall.json", [](config::Installation& inst) {
+    inst.mutable_projectors(0)->mutable_output()->set_kind("window");
+  });
+  const std::string dir = make_temp_dir("optique-gl");
+  Process master({"/usr/bin/xvfb-run", "-a", "-s", "-screen 0 1280x720x24", kMaster, "--config", windowed, "--local",
+                  "--frames", "11", "--capture-every", "10", "--out", dir + "/out", "--no-status"},
+                 dir + "/master.log");
+  ASSERT_EQ(master.wait(120s), 0) << master.output();
+  EXPECT_NE(read_file(dir + "/out/logs/wall.log").find(", window"), std::string::npos)
+      << read_file(dir + "/out/logs/wall.log");
+  const std::string headless = run_and_capture(kConfigs + "/single-wall.json", 11, 10);
+  EXPECT_EQ(largest_difference(capture(dir + "/out", "wall", 10), capture(headless, "wall", 10)), 0.0);
+}
+
 // ------------------------------------------------------------- glTF scenes
 
 const std::string kAnimatedCubes = kConfigs + "/assets/animated-cubes.gltf";
-
-double largest_difference(const image::FloatImage& a, const image::FloatImage& b) {
-  auto comparison = image::compare(a, b);
-  EXPECT_TRUE(comparison.ok()) << (comparison.ok() ? "" : comparison.error());
-  return comparison.ok() ? comparison.value().max_abs_error : 1.0;
-}
 
 TEST(Rendering, AnAnimatedGltfRendersTheSameOnStackedNodes) {
   const std::string config = variant("single-wall.json", [](config::Installation& inst) {
