@@ -118,9 +118,11 @@ void Connection::close_after_sending(const std::string& reason) {
   closing_reason_ = reason;
   if (in_flight_.empty() && outbox_.empty()) {
     finish(reason);
-  } else if (in_flight_.empty()) {
-    write_more();
+    return;
   }
+  if (in_flight_.empty()) write_more();
+  // A peer that does not read must not keep this side from closing.
+  set_deadline(kDrainTimeout, reason + " (the peer did not take the last messages)");
 }
 
 void Connection::set_liveness_timeout(std::chrono::milliseconds timeout, std::string reason) {

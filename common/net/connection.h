@@ -60,6 +60,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
 
   // A peer that does not read its messages is dropped past this much backlog.
   static constexpr std::size_t kMaxQueuedBytes = 64u << 20;
+  // How long close_after_sending() waits for the peer to take what is queued.
+  static constexpr std::chrono::milliseconds kDrainTimeout{2000};
 
  private:
   Connection(asio::ip::tcp::socket socket, std::uint32_t max_payload_bytes);
