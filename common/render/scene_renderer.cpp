@@ -1,5 +1,8 @@
 #include "render/scene_renderer.h"
 
+#include <algorithm>
+#include <string>
+
 #include <epoxy/gl.h>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -11,25 +14,32 @@ namespace {
 constexpr const char* kSceneVertex = R"(#version 450 core
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
+layout(location = 2) in vec2 uv;
 uniform mat4 model_view_projection;
 uniform mat4 model;
 uniform mat3 normal_matrix;
 out vec3 world_position;
 out vec3 world_normal;
+out vec2 texture_uv;
 void main() {
   world_position = (model * vec4(position, 1.0)).xyz;
   world_normal = normal_matrix * normal;
+  texture_uv = uv;
   gl_Position = model_view_projection * vec4(position, 1.0);
 }
 )";
 
 // Blinn-Phong with a roughness-derived exponent and a normalized specular lobe,
-// Fresnel F0 from metallic: a cheap stand-in for metallic/roughness. All linear.
+// Fresnel F0 from metallic: a cheap stand-in for metallic/roughness. All linear:
+// the base colour texture is sRGB8_ALPHA8, so sampling it decodes to linear.
 constexpr const char* kSceneFragment = R"(#version 450 core
 in vec3 world_position;
 in vec3 world_normal;
+in vec2 texture_uv;
 uniform vec3 eye;
-uniform vec3 base_colour;
+uniform vec3 base_colour_factor;
+uniform bool has_base_colour_texture;
+layout(binding = 1) uniform sampler2D base_colour_texture;
 uniform float metallic;
 uniform float roughness;
 uniform vec3 emissive;
@@ -39,6 +49,8 @@ layout(std430, binding = 0) readonly buffer Lights { vec4 lights[]; };  // posit
 out vec4 colour;
 const float kPi = 3.14159265358979;
 void main() {
+  vec3 base_colour = base_colour_factor;
+  if (has_base_colour_texture) base_colour *= texture(base_colour_texture, texture_uv).rgb;
   vec3 n = normalize(world_normal);
   if (!gl_FrontFacing) n = -n;
   vec3 v = normalize(eye - world_position);
@@ -145,6 +157,7 @@ struct SceneRenderer::Gl {
   GLuint depth = 0;
   GLuint encoded_framebuffer = 0;
   GLuint encoded_colour = 0;
+  std::vector<GLuint> scene_textures;  // by index in the scene's textures
   std::vector<MeshRange> meshes;
   std::vector<scene::Material> materials;
   std::vector<scene::Instance> instances;
@@ -152,8 +165,8 @@ struct SceneRenderer::Gl {
   glm::vec3 background{0.0f};
   int light_count = 0;
   struct {
-    GLint model_view_projection, model, normal_matrix, eye, base_colour, metallic, roughness, emissive, ambient,
-        light_count;
+    GLint model_view_projection, model, normal_matrix, eye, base_colour, has_base_colour_texture, metallic, roughness,
+        emissive, ambient, light_count;
   } uniforms{};
 
   ~Gl() {
@@ -167,6 +180,7 @@ struct SceneRenderer::Gl {
     glDeleteFramebuffers(2, framebuffers);
     const GLuint textures[] = {linear_colour, depth, encoded_colour};
     glDeleteTextures(3, textures);
+    glDeleteTextures(static_cast<GLsizei>(scene_textures.size()), scene_textures.data());
   }
 };
 
@@ -190,7 +204,8 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
                   glGetUniformLocation(p, "model"),
                   glGetUniformLocation(p, "normal_matrix"),
                   glGetUniformLocation(p, "eye"),
-                  glGetUniformLocation(p, "base_colour"),
+                  glGetUniformLocation(p, "base_colour_factor"),
+                  glGetUniformLocation(p, "has_base_colour_texture"),
                   glGetUniformLocation(p, "metallic"),
                   glGetUniformLocation(p, "roughness"),
                   glGetUniformLocation(p, "emissive"),
@@ -224,6 +239,38 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   glEnableVertexArrayAttrib(gl->vertex_array, 1);
   glVertexArrayAttribFormat(gl->vertex_array, 1, 3, GL_FLOAT, GL_FALSE, offsetof(scene::Vertex, normal));
   glVertexArrayAttribBinding(gl->vertex_array, 1, 0);
+  glEnableVertexArrayAttrib(gl->vertex_array, 2);
+  glVertexArrayAttribFormat(gl->vertex_array, 2, 2, GL_FLOAT, GL_FALSE, offsetof(scene::Vertex, uv));
+  glVertexArrayAttribBinding(gl->vertex_array, 2, 0);
+
+  // Textures: sRGB colour (decoded to linear when sampled), linear alpha; mipmapped,
+  // trilinear, repeating. Rows go up as they are stored, top row first: that row
+  // is t = 0, which is where glTF's v = 0 (the image's top) is, so glTF uvs
+  // sample the texture unchanged.
+  for (const auto& texture : scene.textures) {
+    if (texture.width <= 0 || texture.height <= 0 ||
+        texture.rgba.size() != static_cast<std::size_t>(texture.width) * static_cast<std::size_t>(texture.height) * 4) {
+      return Error{"texture '" + texture.name + "' has no or the wrong number of texels"};
+    }
+    GLuint name = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &name);
+    gl->scene_textures.push_back(name);
+    int levels = 1;
+    for (int side = std::max(texture.width, texture.height); side > 1; side /= 2) ++levels;
+    glTextureStorage2D(name, levels, GL_SRGB8_ALPHA8, texture.width, texture.height);
+    glTextureSubImage2D(name, 0, 0, 0, texture.width, texture.height, GL_RGBA, GL_UNSIGNED_BYTE, texture.rgba.data());
+    glGenerateTextureMipmap(name);
+    glTextureParameteri(name, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTextureParameteri(name, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(name, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTextureParameteri(name, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  }
+  for (const auto& material : scene.materials) {
+    if (material.base_colour_texture && *material.base_colour_texture >= scene.textures.size()) {
+      return Error{"a material's base colour texture " + std::to_string(*material.base_colour_texture) +
+                   " is out of range (" + std::to_string(scene.textures.size()) + " textures)"};
+    }
+  }
 
   std::vector<glm::vec4> lights;
   for (const auto& light : scene.lights) {
@@ -300,6 +347,8 @@ void SceneRenderer::draw(const scene::SceneState& state, double fraction, const 
     glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
     const scene::Material& m = gl.materials[instance.material];
     glUniform3fv(u.base_colour, 1, glm::value_ptr(m.base_colour));
+    glUniform1i(u.has_base_colour_texture, m.base_colour_texture ? 1 : 0);
+    if (m.base_colour_texture) glBindTextureUnit(1, gl.scene_textures[*m.base_colour_texture]);  // unit 0: encode
     glUniform1f(u.metallic, m.metallic);
     glUniform1f(u.roughness, m.roughness);
     const glm::vec3 emissive = terms.emissive ? m.emissive : glm::vec3(0.0f);

@@ -2,7 +2,8 @@
 // What a scene is made of: meshes, materials, instances of meshes (static, or
 // attached to an animated object whose pose the master sends each frame), point
 // lights, and the ambient term. The master needs only the animated objects; a
-// node needs all of it to draw. Colours are linear light.
+// node needs all of it to draw. Colours are linear light, except texture texels,
+// which are sRGB-encoded as image files store them (the renderer decodes them).
 
 #include <cstdint>
 #include <functional>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
 #include "scene/state.h"
@@ -20,6 +22,7 @@ namespace optique::scene {
 struct Vertex {
   glm::vec3 position{0.0f};
   glm::vec3 normal{0.0f, 0.0f, 1.0f};
+  glm::vec2 uv{0.0f};  // texture coordinates, glTF convention: (0, 0) is the image's top-left corner
 };
 
 struct Mesh {
@@ -28,11 +31,33 @@ struct Mesh {
   std::vector<std::uint32_t> indices;  // triangles, counter-clockwise seen from outside
 };
 
+// An 8-bit RGBA image, `width`·`height`·4 bytes, top row first: colour
+// sRGB-encoded, alpha linear.
+struct Texture {
+  std::string name;
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;
+};
+
 struct Material {
+  // Not an aggregate, so that the many {colour, metallic, roughness, emissive}
+  // initializations need not name the texture.
+  Material() = default;
+  Material(const glm::vec3& base_colour_, float metallic_, float roughness_, const glm::vec3& emissive_,
+           std::optional<std::uint32_t> base_colour_texture_ = std::nullopt)
+      : base_colour(base_colour_),
+        metallic(metallic_),
+        roughness(roughness_),
+        emissive(emissive_),
+        base_colour_texture(base_colour_texture_) {}
+
   glm::vec3 base_colour{0.8f};  // linear albedo
   float metallic = 0.0f;
   float roughness = 0.5f;
   glm::vec3 emissive{0.0f};  // linear radiance added as is
+  // Multiplies base_colour (after sRGB decoding), sampled at the vertices' uv.
+  std::optional<std::uint32_t> base_colour_texture;  // index into SceneDefinition::textures
 };
 
 struct Instance {
@@ -58,6 +83,7 @@ struct SceneDefinition {
   std::string name;
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
+  std::vector<Texture> textures;
   std::vector<Instance> instances;
   std::vector<PointLight> lights;
   glm::vec3 ambient{0.02f};  // linear irradiance-like term, times albedo

@@ -26,11 +26,15 @@
 #include <glm/mat3x3.hpp>
 #include <glm/vec4.hpp>
 
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
 #include "util/sha256.h"
 
 // TinyGLTF's implementation lives here (Debian ships a shared library too, but
-// building it in keeps the link line as it is). It uses nlohmann/json; images
-// are never decoded (no stb_image) and external image files never read.
+// building it in keeps the link line as it is). It uses nlohmann/json; tinygltf
+// decodes no images itself (no stb_image; base colour images are decoded here
+// with OpenImageIO) and reads no external image files.
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
@@ -103,8 +107,17 @@ bool fs_write_whole_file(std::string* error, const std::string&, const std::vect
   return false;
 }
 
-// Images are not decoded: textures are ignored (with a warning per material).
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int, const unsigned char*, int, void*) {
+// tinygltf hands over every image's encoded bytes while parsing. Decoding
+// waits until a material uses the image as its base colour (normal maps and the
+// like are never decoded), so an image embedded as a data URI keeps its encoded
+// bytes in Image::image (width and height stay 0) until then; an image in a
+// buffer view is read from its buffer then, with bounds checks. Never fails: an
+// image that cannot be decoded costs a warning, not the load.
+bool keep_encoded_image(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                        const unsigned char* bytes, int size, void*) {
+  if (image->bufferView < 0 && bytes != nullptr && size > 0) {
+    image->image.assign(bytes, bytes + size);
+  }
   return true;
 }
 
@@ -364,6 +377,64 @@ bool reproduces(const Pose& pose, const glm::dmat4& m) {
     if (!(std::abs(m[c][3] - (c == 3 ? 1.0 : 0.0)) <= 1e-9)) return false;
   }
   return true;
+}
+
+// ---------------------------------------------------------------------------
+// Images.
+
+// A file name extension for OpenImageIO to pick its reader by: from the MIME type
+// tinygltf records (or the data URI's), else ".png" (OpenImageIO then still
+// checks the bytes' signature).
+std::string extension_for(const std::string& mime_type) {
+  if (mime_type == "image/jpeg") return ".jpg";
+  if (mime_type == "image/bmp") return ".bmp";
+  if (mime_type == "image/gif") return ".gif";
+  if (mime_type == "image/webp") return ".webp";
+  return ".png";
+}
+
+// Decodes an encoded image (PNG, JPEG, ... as OpenImageIO reads them) from
+// memory to 8-bit RGBA: grey becomes RGB, a missing alpha 255. Colour values are
+// kept as stored (sRGB-encoded), alpha unassociated.
+Result<Texture> decode_image(const std::vector<unsigned char>& bytes, const std::string& mime_type) {
+  if (bytes.empty()) return Error{"no image data"};
+  OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
+  OIIO::Filesystem::IOProxy* proxy = &memory;
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // PNG: no premultiplication on read
+  // OpenImageIO 2.4 ignores open()'s ioproxy argument when a config is given; the
+  // config attribute works.
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto input = OIIO::ImageInput::open("image" + extension_for(mime_type), &config);
+  if (!input) return Error{one_line(OIIO::geterror())};
+  const OIIO::ImageSpec& spec = input->spec();
+  constexpr int kMaxSide = 16384;
+  if (spec.width <= 0 || spec.height <= 0 || spec.width > kMaxSide || spec.height > kMaxSide || spec.depth > 1 ||
+      spec.nchannels <= 0) {
+    return Error{"unsupported image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height)};
+  }
+  const int channels = std::min(spec.nchannels, 4);
+  const auto pixels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
+  std::vector<std::uint8_t> stored(pixels * static_cast<std::size_t>(channels));
+  if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, stored.data())) {
+    return Error{one_line(input->geterror())};
+  }
+  Texture out;
+  out.width = spec.width;
+  out.height = spec.height;
+  out.rgba.resize(pixels * 4);
+  // Grey, grey + alpha, RGB or RGBA (first four channels).
+  const bool grey = channels <= 2;
+  const bool alpha = channels == 2 || channels == 4;
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const std::uint8_t* in = stored.data() + i * static_cast<std::size_t>(channels);
+    std::uint8_t* to = out.rgba.data() + i * 4;
+    to[0] = in[0];
+    to[1] = grey ? in[0] : in[1];
+    to[2] = grey ? in[0] : in[2];
+    to[3] = alpha ? in[channels - 1] : std::uint8_t{255};
+  }
+  return out;
 }
 
 // ---------------------------------------------------------------------------
@@ -949,6 +1020,27 @@ class Loader {
       }
     }
 
+    // Texture coordinates: FLOAT, or normalized UNSIGNED_BYTE / UNSIGNED_SHORT.
+    std::vector<double> uvs;
+    const auto uv_it = primitive.attributes.find("TEXCOORD_0");
+    if (uv_it != primitive.attributes.end()) {
+      const auto& acc = accessor(uv_it->second, label + " TEXCOORD_0");
+      if (acc.componentType == TINYGLTF_COMPONENT_TYPE_BYTE || acc.componentType == TINYGLTF_COMPONENT_TYPE_SHORT) {
+        fail(accessor_label(uv_it->second, label + " TEXCOORD_0") + ": component type " +
+             component_type_name(acc.componentType) +
+             " is not allowed for texture coordinates (FLOAT, or normalized UNSIGNED_BYTE or UNSIGNED_SHORT)");
+      }
+      uvs = read_floats(uv_it->second, label + " TEXCOORD_0", TINYGLTF_TYPE_VEC2, /*normalized_ok=*/true);
+      if (uvs.size() / 2 != vertex_count) {
+        fail(label + ": TEXCOORD_0 has " + std::to_string(uvs.size() / 2) + " elements but POSITION has " +
+             std::to_string(vertex_count));
+      }
+    }
+    const auto uv = [&](std::uint32_t i) {
+      if (uvs.empty()) return glm::vec2(0.0f);
+      return glm::vec2(static_cast<float>(uvs[2 * i]), static_cast<float>(uvs[2 * i + 1]));
+    };
+
     std::vector<std::uint32_t> order;
     if (primitive.indices >= 0) {
       order = read_indices(primitive.indices, label + " indices");
@@ -1006,7 +1098,7 @@ class Loader {
         } else {
           degenerate = true;
         }
-        out.vertices.push_back({position(static_cast<std::uint32_t>(i)), normal});
+        out.vertices.push_back({position(static_cast<std::uint32_t>(i)), normal, uv(static_cast<std::uint32_t>(i))});
       }
       if (degenerate) warn(label + ": some normals have zero length; they point along +z");
       out.indices = std::move(triangles);
@@ -1025,18 +1117,23 @@ class Loader {
             length > 0.0 && std::isfinite(length) ? glm::vec3(cross / length) : glm::vec3(0.0f, 0.0f, 1.0f);
         for (int k = 0; k < 3; ++k) {
           out.indices.push_back(static_cast<std::uint32_t>(out.vertices.size()));
-          out.vertices.push_back({position(triangles[t + static_cast<std::size_t>(k)]), normal});
+          const std::uint32_t corner = triangles[t + static_cast<std::size_t>(k)];
+          out.vertices.push_back({position(corner), normal, uv(corner)});
         }
       }
     }
     for (const auto& vertex : out.vertices) {
-      if (!finite(glm::dvec3(vertex.position)) || !finite(glm::dvec3(vertex.normal))) {
+      if (!finite(glm::dvec3(vertex.position)) || !finite(glm::dvec3(vertex.normal)) || !std::isfinite(vertex.uv.x) ||
+          !std::isfinite(vertex.uv.y)) {
         fail(label + ": a vertex is not finite in single precision");
       }
     }
 
     Part part;
     part.material = material(primitive.material, label);
+    if (uvs.empty() && materials_[part.material].base_colour_texture) {
+      warn(label + " has no TEXCOORD_0; its base colour texture is sampled at (0, 0) only");
+    }
     meshes_.push_back(std::move(out));
     part.mesh = static_cast<std::uint32_t>(meshes_.size() - 1);
     return part;
@@ -1096,8 +1193,8 @@ class Loader {
       }
     }
 
+    if (pbr.baseColorTexture.index >= 0) out.base_colour_texture = base_colour_texture(pbr.baseColorTexture, label);
     std::vector<std::string> textures;
-    if (pbr.baseColorTexture.index >= 0) textures.emplace_back("baseColorTexture");
     if (pbr.metallicRoughnessTexture.index >= 0) textures.emplace_back("metallicRoughnessTexture");
     if (source.normalTexture.index >= 0) textures.emplace_back("normalTexture");
     if (source.occlusionTexture.index >= 0) textures.emplace_back("occlusionTexture");
@@ -1105,12 +1202,69 @@ class Loader {
     if (!textures.empty()) {
       std::string list;
       for (const auto& name : textures) list += (list.empty() ? "" : ", ") + name;
-      warn(label + ": textures are not supported and are ignored (" + list + ")");
+      warn(label + ": only base colour textures are supported; ignored " + list);
     }
     if (!source.alphaMode.empty() && source.alphaMode != "OPAQUE") {
       warn(label + ": alphaMode " + source.alphaMode + " is ignored; drawn opaque");
     }
     return out;
+  }
+
+  // The texture for a material's baseColorTexture, or nothing (with a warning)
+  // where it cannot be had. Sampler settings are not read: the renderer always
+  // filters linearly (with mipmaps) and repeats.
+  std::optional<std::uint32_t> base_colour_texture(const tinygltf::TextureInfo& info, const std::string& label) {
+    const std::string what = label + ": baseColorTexture";
+    if (info.texCoord != 0) {
+      warn(what + " uses TEXCOORD_" + std::to_string(info.texCoord) + " (only TEXCOORD_0 is supported); ignored");
+      return std::nullopt;
+    }
+    if (static_cast<std::size_t>(info.index) >= model_.textures.size()) {
+      fail(what + ": texture " + std::to_string(info.index) + " is out of range");
+    }
+    if (info.extensions.contains("KHR_texture_transform")) {
+      warn(what + ": KHR_texture_transform is ignored");
+    }
+    const auto& texture = model_.textures[static_cast<std::size_t>(info.index)];
+    if (texture.source < 0) {
+      warn(what + ": texture " + std::to_string(info.index) + " has no image we can read; ignored");
+      return std::nullopt;
+    }
+    const auto image_index = static_cast<std::size_t>(texture.source);
+    if (image_index >= model_.images.size()) {
+      fail(what + ": image " + std::to_string(image_index) + " is out of range");
+    }
+    const auto cached = texture_of_image_.find(image_index);
+    if (cached != texture_of_image_.end()) return cached->second;
+    auto& slot = texture_of_image_[image_index];
+
+    const auto& image = model_.images[image_index];
+    const std::string image_label = labelled("image", image_index, image.name.empty() ? image.uri : image.name);
+    std::vector<unsigned char> view_bytes;
+    const std::vector<unsigned char>* encoded = &image.image;
+    if (image.bufferView >= 0) {
+      const auto& view = model_.bufferViews[static_cast<std::size_t>(image.bufferView)];  // checked by tinygltf
+      const auto& buffer = model_.buffers[static_cast<std::size_t>(view.buffer)];
+      if (view.byteOffset > buffer.data.size() || view.byteLength > buffer.data.size() - view.byteOffset) {
+        fail(image_label + ": buffer view " + std::to_string(image.bufferView) + " is out of range of its buffer");
+      }
+      const auto begin = buffer.data.begin() + static_cast<std::ptrdiff_t>(view.byteOffset);
+      view_bytes.assign(begin, begin + static_cast<std::ptrdiff_t>(view.byteLength));
+      encoded = &view_bytes;
+    } else if (!image.uri.empty()) {
+      warn(what + ": " + image_label + " is an external file, which is not supported (embed it); ignored");
+      return std::nullopt;
+    }
+    auto decoded = decode_image(*encoded, image.mimeType);
+    if (!decoded) {
+      warn(what + ": " + image_label + " cannot be decoded (" + decoded.error() + "); ignored");
+      return std::nullopt;
+    }
+    Texture out = std::move(decoded.value());
+    out.name = image.name.empty() ? "image " + std::to_string(image_index) : image.name;
+    textures_.push_back(std::move(out));
+    slot = static_cast<std::uint32_t>(textures_.size() - 1);
+    return slot;
   }
 
   // --- putting the scene together
@@ -1143,6 +1297,7 @@ class Loader {
     }
     scene.meshes = std::move(meshes_);
     scene.materials = std::move(materials_);
+    scene.textures = std::move(textures_);
   }
 
   void add_lights(SceneDefinition& scene) {
@@ -1221,7 +1376,9 @@ class Loader {
 
   std::vector<Mesh> meshes_;
   std::vector<Material> materials_;
-  std::vector<std::optional<std::vector<Part>>> parts_;  // by glTF mesh
+  std::vector<Texture> textures_;
+  std::map<std::size_t, std::optional<std::uint32_t>> texture_of_image_;  // decoded (or not) glTF images
+  std::vector<std::optional<std::vector<Part>>> parts_;                   // by glTF mesh
   std::vector<std::optional<std::uint32_t>> material_index_;
   std::optional<std::uint32_t> default_material_;
 };
@@ -1243,7 +1400,7 @@ Result<LoadedGltf> load(const std::string& path) {
   context.prefix = base_dir + (base_dir.ends_with('/') ? "" : "/");
 
   tinygltf::TinyGLTF reader;
-  reader.SetImageLoader(&skip_image, nullptr);
+  reader.SetImageLoader(&keep_encoded_image, nullptr);
   reader.SetFsCallbacks({&fs_file_exists, &fs_expand_path, &fs_read_whole_file, &fs_write_whole_file, &context});
   tinygltf::Model model;
   std::string load_error;

@@ -1,11 +1,15 @@
 #pragma once
 // glTF 2.0 scenes (.gltf with embedded or side buffers, or .glb) as a
-// SceneDefinition: triangle meshes, metallic-roughness materials (factors only),
-// the default scene's node hierarchy, TRS animations and KHR_lights_punctual
-// point lights. Whatever the file uses that we cannot draw either fails the load
-// with a message naming the feature (skins, morph targets, unknown required
-// extensions, points and lines) or, where drawing without it is still honest
-// (textures, spot and directional lights), is left out with a warning.
+// SceneDefinition: triangle meshes (with TEXCOORD_0), metallic-roughness
+// materials (factors, and the base colour texture), the default scene's node
+// hierarchy, TRS animations and KHR_lights_punctual point lights. Whatever the
+// file uses that we cannot draw either fails the load with a message naming the
+// feature (skins, morph targets, unknown required extensions, points and lines)
+// or, where drawing without it is still honest, is left out with a warning: spot
+// and directional lights; metallic-roughness, normal, occlusion and emissive
+// textures; base colour textures on other texture coordinate sets, in external
+// image files, or whose image OpenImageIO cannot decode. Texture samplers are
+// not read (the renderer filters linearly and repeats).
 //
 // Animated nodes become animated objects: every node that is the target of an
 // animation channel, or has such an ancestor, and has a mesh gets its own object,
@@ -27,7 +31,7 @@ struct LoadedGltf {
   // external buffer file, in buffer order: equal on master and nodes when they
   // loaded the same content.
   std::string content_sha256;
-  // What was ignored or assumed (textures, spot lights, a default light, ...).
+  // What was ignored or assumed (some textures, spot lights, a default light, ...).
   std::vector<std::string> warnings;
 };
 

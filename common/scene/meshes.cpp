@@ -17,7 +17,7 @@ constexpr double kTau = 2.0 * std::numbers::pi;
 void add_face(Mesh& mesh, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d,
               const glm::vec3& normal) {
   const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
-  for (const auto& p : {a, b, c, d}) mesh.vertices.push_back({p, normal});
+  for (const auto& p : {a, b, c, d}) mesh.vertices.push_back({p, normal, glm::vec2(0.0f)});
   for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) mesh.indices.push_back(base + i);
 }
 
@@ -26,7 +26,7 @@ void add_face(Mesh& mesh, const glm::vec3& a, const glm::vec3& b, const glm::vec
 void add_triangle(Mesh& mesh, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c) {
   const glm::vec3 normal = glm::normalize(glm::cross(b - a, c - a));
   const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
-  for (const auto& p : {a, b, c}) mesh.vertices.push_back({p, normal});
+  for (const auto& p : {a, b, c}) mesh.vertices.push_back({p, normal, glm::vec2(0.0f)});
   for (std::uint32_t i : {0u, 1u, 2u}) mesh.indices.push_back(base + i);
 }
 
@@ -43,7 +43,7 @@ void append(Mesh& mesh, const Mesh& part, const glm::mat3& rotation = glm::mat3(
             const glm::vec3& offset = glm::vec3(0.0f)) {
   const auto base = static_cast<std::uint32_t>(mesh.vertices.size());
   for (const Vertex& v : part.vertices) {
-    mesh.vertices.push_back({rotation * v.position + offset, glm::normalize(rotation * v.normal)});
+    mesh.vertices.push_back({rotation * v.position + offset, glm::normalize(rotation * v.normal), v.uv});
   }
   for (std::uint32_t i : part.indices) mesh.indices.push_back(base + i);
 }
@@ -104,7 +104,7 @@ Mesh make_uv_sphere(float radius, std::uint32_t segments, std::uint32_t rings) {
       const double phi = kTau * (j % segments) / segments;
       const glm::vec3 normal(static_cast<float>(sin_theta * std::cos(phi)), static_cast<float>(cos_theta),
                              static_cast<float>(-sin_theta * std::sin(phi)));
-      mesh.vertices.push_back({normal * radius, glm::normalize(normal)});
+      mesh.vertices.push_back({normal * radius, glm::normalize(normal), glm::vec2(0.0f)});
     }
   }
   for (std::uint32_t i = 0; i < rings; ++i) {
@@ -148,7 +148,7 @@ Mesh make_torus(float major_radius, float minor_radius, std::uint32_t segments, 
       const double v = kTau * (j % sides) / sides;
       const glm::dvec3 normal = std::cos(v) * outward + std::sin(v) * glm::dvec3(0.0, 0.0, 1.0);
       const glm::dvec3 position = double(major_radius) * outward + double(minor_radius) * normal;
-      mesh.vertices.push_back({glm::vec3(position), glm::vec3(glm::normalize(normal))});
+      mesh.vertices.push_back({glm::vec3(position), glm::vec3(glm::normalize(normal)), glm::vec2(0.0f)});
     }
   }
   for (std::uint32_t i = 0; i < segments; ++i) {

@@ -1,8 +1,9 @@
 // glTF scenes (common/scene/gltf.h): the shipped animated-cubes asset loads into
 // the meshes, instances, lights and animated objects it describes, with poses that
 // match hand-computed values, loop, and are pure functions of time; the content
-// hash covers the file and its side buffers; what we cannot draw fails with a
-// message that starts with the path and names the feature.
+// hash covers the file and its side buffers; base colour textures are decoded
+// (embedded images only) and texture coordinates read; what we cannot draw fails
+// with a message that starts with the path and names the feature.
 
 #include <gtest/gtest.h>
 
@@ -388,6 +389,121 @@ TEST(Gltf, TexturesAndSpotLightsAreIgnoredWithWarnings) {
   EXPECT_TRUE(contains(loaded.warnings, "spot lights are not supported"));
   EXPECT_EQ(loaded.scene.lights.size(), 1u);
   EXPECT_EQ(loaded.scene.instances.size(), 3u);
+}
+
+// --- base colour textures
+
+const std::string kTexturedQuad = kData + "textured-quad.gltf";
+
+// textured-quad.gltf's 2×2 RGB PNG, top row first, as RGBA (no alpha: 255).
+const std::vector<std::uint8_t> kCheckerRgba{255, 128, 64,  255, 0,   255, 128, 255,   // top-left, top-right
+                                             64,  0,   255, 255, 128, 64,  0,   255};  // bottom-left, bottom-right
+
+// textured-quad.gltf with `change` applied, written to `dir` (its buffer and
+// images are data URIs, so it needs nothing beside it).
+std::string textured_variant(const TempDir& dir, const std::function<void(json&)>& change) {
+  json doc = read_json(kTexturedQuad);
+  change(doc);
+  const std::string path = dir.file("textured.gltf");
+  write_json(path, doc);
+  return path;
+}
+
+void expect_checker(const SceneDefinition& scene) {
+  ASSERT_EQ(scene.textures.size(), 1u);
+  const Texture& texture = scene.textures[0];
+  EXPECT_EQ(texture.width, 2);
+  EXPECT_EQ(texture.height, 2);
+  EXPECT_EQ(texture.rgba, kCheckerRgba);
+  ASSERT_EQ(scene.materials.size(), 1u);
+  ASSERT_TRUE(scene.materials[0].base_colour_texture.has_value());
+  EXPECT_EQ(*scene.materials[0].base_colour_texture, 0u);
+  EXPECT_EQ(scene.materials[0].base_colour, glm::vec3(1.0f));
+}
+
+void expect_quad_uvs(const SceneDefinition& scene) {
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  const auto& vertices = scene.meshes[0].vertices;
+  ASSERT_EQ(vertices.size(), 4u);
+  // uv (0, 0) at the top-left corner, (1, 1) at the bottom-right.
+  const glm::vec2 expected[] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}};
+  const glm::vec3 corners[] = {{-1.0f, 1.0f, 0.0f}, {1.0f, 1.0f, 0.0f}, {1.0f, -1.0f, 0.0f}, {-1.0f, -1.0f, 0.0f}};
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(vertices[i].position, corners[i]) << "vertex " << i;
+    EXPECT_EQ(vertices[i].uv, expected[i]) << "vertex " << i;
+  }
+}
+
+TEST(Gltf, TexturedQuadHasItsTextureAndUvs) {
+  const auto loaded = load_ok(kTexturedQuad);
+  expect_checker(loaded.scene);
+  expect_quad_uvs(loaded.scene);
+  EXPECT_FALSE(contains(loaded.warnings, "baseColorTexture")) << ::testing::PrintToString(loaded.warnings);
+}
+
+TEST(Gltf, ImageInABufferView) {
+  TempDir dir;
+  const auto path = textured_variant(dir, [](json& doc) { doc["textures"][0]["source"] = 1; });
+  const auto loaded = load_ok(path);
+  expect_checker(loaded.scene);
+}
+
+TEST(Gltf, NormalizedUnsignedByteTexCoords) {
+  TempDir dir;
+  const auto path =
+      textured_variant(dir, [](json& doc) { doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = 3; });
+  const auto loaded = load_ok(path);
+  expect_quad_uvs(loaded.scene);
+}
+
+TEST(Gltf, SignedTexCoordsAreRefused) {
+  TempDir dir;
+  const auto path = textured_variant(dir, [](json& doc) {
+    doc["accessors"][3]["componentType"] = 5120;  // BYTE
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = 3;
+  });
+  expect_error(path, {"TEXCOORD_0", "BYTE"});
+}
+
+TEST(Gltf, SameImageInTwoMaterialsIsOneTexture) {
+  TempDir dir;
+  const auto path = textured_variant(dir, [](json& doc) {
+    doc["materials"][1] = doc["materials"][0];
+    doc["meshes"][0]["primitives"][1] = doc["meshes"][0]["primitives"][0];
+    doc["meshes"][0]["primitives"][1]["material"] = 1;
+  });
+  const auto loaded = load_ok(path);
+  ASSERT_EQ(loaded.scene.materials.size(), 2u);
+  EXPECT_EQ(loaded.scene.textures.size(), 1u);
+  EXPECT_EQ(loaded.scene.materials[1].base_colour_texture, loaded.scene.materials[0].base_colour_texture);
+}
+
+TEST(Gltf, UndecodableImageIsAWarningNotAnError) {
+  TempDir dir;
+  const auto path = textured_variant(dir, [](json& doc) {
+    doc["images"][0]["uri"] = "data:image/png;base64,bm90IGEgcG5nIGF0IGFsbA==";  // "not a png at all"
+  });
+  const auto loaded = load_ok(path);
+  EXPECT_TRUE(loaded.scene.textures.empty());
+  ASSERT_EQ(loaded.scene.materials.size(), 1u);
+  EXPECT_FALSE(loaded.scene.materials[0].base_colour_texture.has_value());
+  EXPECT_TRUE(contains(loaded.warnings, "image 0 'checker' cannot be decoded"))
+      << ::testing::PrintToString(loaded.warnings);
+  expect_quad_uvs(loaded.scene);
+}
+
+TEST(Gltf, OtherTexCoordSetsAndTexturesAreIgnoredWithWarnings) {
+  TempDir dir;
+  const auto path = textured_variant(dir, [](json& doc) {
+    doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["texCoord"] = 1;
+    doc["materials"][0]["normalTexture"] = {{"index", 0}};
+  });
+  const auto loaded = load_ok(path);
+  EXPECT_TRUE(loaded.scene.textures.empty());
+  EXPECT_FALSE(loaded.scene.materials[0].base_colour_texture.has_value());
+  EXPECT_TRUE(contains(loaded.warnings, "TEXCOORD_1")) << ::testing::PrintToString(loaded.warnings);
+  EXPECT_TRUE(contains(loaded.warnings, "ignored normalTexture")) << ::testing::PrintToString(loaded.warnings);
+  EXPECT_FALSE(contains(loaded.warnings, "ignored baseColorTexture"));
 }
 
 // --- errors
