@@ -12,6 +12,7 @@ packages=(
   nlohmann-json3-dev                 # JSON syntax errors with line and column
   libtinygltf-dev                    # glTF 2.0 scene files
   libglfw3-dev libglm-dev            # windows on projectors, render math
+  libeigen3-dev                      # SVD and least squares for calibration
   libopenimageio-dev openimageio-tools  # image files and operations; oiiotool to inspect them
   libepoxy-dev libegl-dev            # GL/EGL function loading, headless contexts
   libegl-mesa0 libgl1-mesa-dri       # Mesa's EGL and llvmpipe: GL without a GPU
