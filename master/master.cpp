@@ -44,14 +44,14 @@ Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
       heartbeat_timer_(io),
       status_(options_.status_line) {
   for (const auto& projector : options_.config.installation.projectors()) slots_.push_back({&projector, nullptr});
-  frame_period_ = static_cast<clock::Nanos>(1e9 / settings_.frame_rate());
 }
 
 Master::~Master() = default;
 
 Result<void> Master::start() {
   const auto& installation = options_.config.installation;
-  authority_.emplace(options_.scene.definition, installation.viewer(), frame_period_);
+  authority_.emplace(options_.scene.definition.objects, installation.viewer(), settings_.frame_rate());
+  frame_period_ = authority_->frame_period();
   current_state_ = authority_->state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
 
@@ -103,11 +103,7 @@ Result<void> Master::start() {
         args.push_back((std::filesystem::path(options_.out_dir) / "nodes" / s.projector->id()).string());
       }
       args.insert(args.end(), options_.node_args.begin(), options_.node_args.end());
-      const std::string log_file =
-          options_.out_dir.empty()
-              ? std::string()
-              : (std::filesystem::path(options_.out_dir) / "logs" / (s.projector->id() + ".log")).string();
-      auto pid = launcher_->spawn(s.projector->id(), args, log_file);
+      auto pid = launcher_->spawn(s.projector->id(), args, node_log_path(s.projector->id()));
       if (!pid) return Error{"cannot start the node for projector '" + s.projector->id() + "': " + pid.error()};
       log_.debug("started node '{}' as pid {}", s.projector->id(), pid.value());
     }
@@ -597,10 +593,7 @@ void Master::write_outputs() {
 void Master::housekeeping() {
   if (launcher_) {
     for (const ChildExit& exit : launcher_->reap()) {
-      const std::string log_hint =
-          options_.out_dir.empty()
-              ? std::string()
-              : "; its log: " + (std::filesystem::path(options_.out_dir) / "logs" / (exit.id + ".log")).string();
+      const std::string log_hint = options_.out_dir.empty() ? std::string() : "; its log: " + node_log_path(exit.id);
       if (state_ == RunState::closing && exit.clean()) {
         log_.debug("node '{}' (pid {}) {}", exit.id, exit.pid, exit.describe());
       } else {
@@ -683,5 +676,10 @@ std::size_t Master::nodes_up() const {
 }
 
 std::string Master::slot_id(std::size_t slot) const { return slots_[slot].projector->id(); }
+
+std::string Master::node_log_path(const std::string& id) const {
+  if (options_.out_dir.empty()) return {};
+  return (std::filesystem::path(options_.out_dir) / "logs" / (id + ".log")).string();
+}
 
 }  // namespace optique::master

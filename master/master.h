@@ -110,6 +110,8 @@ class Master {
 
   [[nodiscard]] std::size_t nodes_up() const;
   [[nodiscard]] std::string slot_id(std::size_t slot) const;
+  // Where a local node's output goes (empty without --out).
+  [[nodiscard]] std::string node_log_path(const std::string& id) const;
 
   asio::io_context& io_;
   MasterOptions options_;

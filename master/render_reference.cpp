@@ -14,8 +14,7 @@ namespace optique::master {
 Result<void> render_reference(const config::LoadedConfig& config, const scene::LoadedScene& scene, std::uint64_t frame,
                               const std::string& out_dir, spdlog::logger& log) {
   const auto& installation = config.installation;
-  const auto period = static_cast<clock::Nanos>(1e9 / installation.master().frame_rate());
-  const SceneAuthority authority(scene.definition, installation.viewer(), period);
+  const SceneAuthority authority(scene.definition.objects, installation.viewer(), installation.master().frame_rate());
   const scene::SceneState state = authority.state_at_frame(frame);
 
   auto context = render::make_headless_context();

@@ -6,21 +6,22 @@
 
 #include "clock/clock.h"
 #include "optique/config.pb.h"
-#include "scene/builtin.h"
+#include "scene/definition.h"
 #include "scene/state.h"
 
 namespace optique::master {
 
 class SceneAuthority {
  public:
-  SceneAuthority(scene::SceneDefinition script, config::Viewer viewer, clock::Nanos frame_period);
+  // Keeps only what moves (the objects), not the scene's meshes and textures.
+  SceneAuthority(std::vector<scene::AnimatedObject> objects, config::Viewer viewer, double frame_rate);
 
   [[nodiscard]] scene::SceneState state_at_frame(std::uint64_t frame) const;
   [[nodiscard]] clock::Nanos simulation_time(std::uint64_t frame) const;
   [[nodiscard]] clock::Nanos frame_period() const { return period_; }
 
  private:
-  scene::SceneDefinition script_;
+  std::vector<scene::AnimatedObject> objects_;
   config::Viewer viewer_;
   clock::Nanos period_;
 };

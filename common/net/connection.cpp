@@ -42,9 +42,8 @@ void Connection::send(wire::Envelope& message) {
     outbox_.clear();
     asio::post(socket_.get_executor(),
                [self = shared_from_this(), reason = "peer is not reading its messages (more than " +
-                                                    std::to_string(kMaxQueuedBytes >> 20) + " MiB queued)"] {
-                 self->finish(reason);
-               });
+                                                    std::to_string(kMaxQueuedBytes >> 20) +
+                                                    " MiB queued)"] { self->finish(reason); });
     return;
   }
   if (in_flight_.empty()) write_more();
@@ -165,7 +164,9 @@ void Connection::cancel_deadline() {
   deadline_timer_.cancel();
 }
 
-void Connection::set_max_payload_bytes(std::uint32_t max_payload_bytes) { reader_.set_max_payload_bytes(max_payload_bytes); }
+void Connection::set_max_payload_bytes(std::uint32_t max_payload_bytes) {
+  reader_.set_max_payload_bytes(max_payload_bytes);
+}
 
 void Connection::finish(const std::string& reason) {
   if (!open_) return;

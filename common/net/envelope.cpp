@@ -8,11 +8,7 @@ void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envel
   const std::size_t size = envelope.ByteSizeLong();
   const std::size_t start = out.size();
   out.resize(start + kFrameHeaderBytes + size);
-  const auto length = static_cast<std::uint32_t>(size);
-  out[start + 0] = static_cast<std::uint8_t>(length >> 24);
-  out[start + 1] = static_cast<std::uint8_t>(length >> 16);
-  out[start + 2] = static_cast<std::uint8_t>(length >> 8);
-  out[start + 3] = static_cast<std::uint8_t>(length);
+  write_frame_header(out.data() + start, static_cast<std::uint32_t>(size));
   const bool serialized = envelope.SerializeWithCachedSizesToArray(out.data() + start + kFrameHeaderBytes) != nullptr;
   assert(serialized);
   (void)serialized;

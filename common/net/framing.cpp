@@ -27,12 +27,17 @@ DecodedFrame decode_frame(std::span<const std::uint8_t> bytes, std::uint32_t max
   return frame;
 }
 
+void write_frame_header(std::uint8_t* at, std::uint32_t payload_length) {
+  at[0] = static_cast<std::uint8_t>(payload_length >> 24);
+  at[1] = static_cast<std::uint8_t>(payload_length >> 16);
+  at[2] = static_cast<std::uint8_t>(payload_length >> 8);
+  at[3] = static_cast<std::uint8_t>(payload_length);
+}
+
 void append_frame(std::vector<std::uint8_t>& out, std::span<const std::uint8_t> payload) {
-  const auto length = static_cast<std::uint32_t>(payload.size());
-  out.push_back(static_cast<std::uint8_t>(length >> 24));
-  out.push_back(static_cast<std::uint8_t>(length >> 16));
-  out.push_back(static_cast<std::uint8_t>(length >> 8));
-  out.push_back(static_cast<std::uint8_t>(length));
+  const std::size_t start = out.size();
+  out.resize(start + kFrameHeaderBytes);
+  write_frame_header(out.data() + start, static_cast<std::uint32_t>(payload.size()));
   out.insert(out.end(), payload.begin(), payload.end());
 }
 

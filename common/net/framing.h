@@ -27,6 +27,9 @@ struct DecodedFrame {
 // Looks at the start of `bytes` for one whole frame.
 [[nodiscard]] DecodedFrame decode_frame(std::span<const std::uint8_t> bytes, std::uint32_t max_payload_bytes);
 
+// Writes the 4-byte big-endian length header at `at`.
+void write_frame_header(std::uint8_t* at, std::uint32_t payload_length);
+
 // Appends header + payload to `out`.
 void append_frame(std::vector<std::uint8_t>& out, std::span<const std::uint8_t> payload);
 
