@@ -14,6 +14,7 @@
 #include "../integration/process.h"
 #include "metrics/distribution.h"
 #include "ready_go_baseline.h"
+#include "spread.h"
 
 namespace {
 
@@ -69,22 +70,6 @@ Sample run_once(const std::string& master_bin, const std::string& work, std::siz
   return s;
 }
 
-// Median over repeats, and the spread (min..max) as the error.
-struct Spread {
-  double median, low, high;
-};
-Spread spread(std::vector<double> v) {
-  std::vector<double> copy = v;
-  const double mid = metrics::percentile(copy, 50.0);
-  return {mid, *std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end())};
-}
-
-std::string cell(const Spread& s) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.0f (%.0f–%.0f)", s.median, s.low, s.high);
-  return text;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -129,12 +114,11 @@ int main(int argc, char** argv) {
       std::cerr << "nodes " << nodes << " repeat " << r << ": barrier " << s.barrier_median << " µs, skew "
                 << s.skew_median << " µs, ready/go " << s.baseline_median << " µs\n";
     }
-    const Spread q = spread(ratio);
-    char ratio_text[64];
-    std::snprintf(ratio_text, sizeof ratio_text, "%.2f (%.2f–%.2f)", q.median, q.low, q.high);
-    table << "| " << nodes << " | " << cell(spread(bm)) << " | " << cell(spread(bp)) << " | " << cell(spread(sm))
-          << " | " << cell(spread(sp)) << " | " << cell(spread(gm)) << " | " << cell(spread(gp)) << " | " << ratio_text
-          << " |\n";
+    using bench::cell;
+    using bench::spread;
+    table << "| " << nodes << " | " << cell(spread(bm), 0) << " | " << cell(spread(bp), 0) << " | "
+          << cell(spread(sm), 0) << " | " << cell(spread(sp), 0) << " | " << cell(spread(gm), 0) << " | "
+          << cell(spread(gp), 0) << " | " << cell(spread(ratio), 2) << " |\n";
   }
   std::ofstream md(out + "/barrier.md");
   md << "Barrier benchmark: " << frames << " frames at " << rate << " Hz, " << repeats

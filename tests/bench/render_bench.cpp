@@ -16,6 +16,7 @@
 #include "render/projection.h"
 #include "render/scene_renderer.h"
 #include "scene/builtin.h"
+#include "spread.h"
 
 namespace {
 
@@ -92,16 +93,9 @@ int main(int argc, char** argv) {
       csv << '"' << gl << "\"," << c.scene << ',' << c.width << ',' << c.height << ',' << r << ',' << frames << ','
           << summary.median() << ',' << summary.p99() << '\n';
     }
-    auto spread = [](std::vector<double> v) {
-      std::vector<double> copy = v;
-      char text[64];
-      std::snprintf(text, sizeof text, "%.2f (%.2f–%.2f)", metrics::percentile(copy, 50.0),
-                    *std::min_element(v.begin(), v.end()), *std::max_element(v.begin(), v.end()));
-      return std::string(text);
-    };
-    std::vector<double> copy = medians;
-    table << "| " << c.scene << " | " << c.width << "×" << c.height << " | " << spread(medians) << " | "
-          << spread(p99s) << " | " << static_cast<int>(1000.0 / metrics::percentile(copy, 50.0)) << " |\n";
+    const bench::Spread median = bench::spread(medians);
+    table << "| " << c.scene << " | " << c.width << "×" << c.height << " | " << bench::cell(median, 2) << " | "
+          << bench::cell(bench::spread(p99s), 2) << " | " << static_cast<int>(1000.0 / median.median) << " |\n";
   }
   std::ofstream md(out + "/render.md");
   md << "Render benchmark on " << gl << ": " << frames << " frames per run, " << repeats

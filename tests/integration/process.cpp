@@ -65,12 +65,7 @@ bool Process::running() { return !wait(std::chrono::milliseconds(0)).has_value()
 std::string Process::output() const { return read_file(log_path_); }
 
 bool Process::wait_for_output(const std::string& needle, std::chrono::milliseconds timeout) const {
-  const auto deadline = std::chrono::steady_clock::now() + timeout;
-  while (std::chrono::steady_clock::now() < deadline) {
-    if (output().find(needle) != std::string::npos) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  return false;
+  return poll_until([&] { return output().find(needle) != std::string::npos; }, timeout);
 }
 
 std::string make_temp_dir(const std::string& prefix) {
@@ -89,10 +84,18 @@ std::string read_file(const std::string& path) {
 }
 
 bool wait_for_file(const std::string& path, std::chrono::milliseconds timeout) {
+  return poll_until(
+      [&] {
+        std::error_code ec;
+        return std::filesystem::file_size(path, ec) > 0 && !ec;
+      },
+      timeout);
+}
+
+bool poll_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < deadline) {
-    std::error_code ec;
-    if (std::filesystem::file_size(path, ec) > 0 && !ec) return true;
+    if (done()) return true;
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   return false;

@@ -5,6 +5,7 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -38,6 +39,8 @@ class Process {
 // A fresh empty folder under the system temp dir.
 [[nodiscard]] std::string make_temp_dir(const std::string& prefix);
 [[nodiscard]] std::string read_file(const std::string& path);
+// Checks `done` every 10 ms until it holds (true) or the timeout passes (false).
+[[nodiscard]] bool poll_until(const std::function<bool()>& done, std::chrono::milliseconds timeout);
 // Polls until `path` exists and is non-empty, or the timeout passes.
 [[nodiscard]] bool wait_for_file(const std::string& path, std::chrono::milliseconds timeout);
 // Processes whose command line contains `needle` (from /proc), excluding this one.
