@@ -3,12 +3,17 @@
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <boost/asio/io_context.hpp>
+#include <cinttypes>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
 #include <spdlog/sinks/sink.h>
+#include "calibrate.h"
 #include "check_config.h"
+#include "compose.h"
 
 #include "log/logger.h"
 #include "master.h"
@@ -39,6 +44,30 @@ int check_config(const std::vector<std::string>& files) {
     for (const auto& warning : loaded.value().second.warnings) std::cout << "  scene warning: " << warning << "\n";
   }
   return status;
+}
+
+// Composes every frame that all projectors captured; a frame some node missed
+// (it left the barrier) is skipped with a warning.
+void compose_local_captures(const config::LoadedConfig& config, const std::string& out_dir, spdlog::logger& log) {
+  const auto& projectors = config.installation.projectors();
+  if (projectors.empty()) return;
+  const std::filesystem::path first = std::filesystem::path(out_dir) / "nodes" / projectors.Get(0).id();
+  std::error_code ec;
+  std::vector<std::uint64_t> frames;
+  for (const auto& entry : std::filesystem::directory_iterator(first, ec)) {
+    const std::string name = entry.path().filename().string();
+    std::uint64_t frame = 0;
+    if (std::sscanf(name.c_str(), "frame-%" SCNu64 ".exr", &frame) == 1 && name.ends_with(".exr")) {
+      frames.push_back(frame);
+    }
+  }
+  std::sort(frames.begin(), frames.end());
+  for (std::uint64_t frame : frames) {
+    if (auto composed = compose_frame(config, frame, (std::filesystem::path(out_dir) / "nodes").string(), out_dir, log);
+        !composed) {
+      log.warn("frame {} not composed: {}", frame, composed.error());
+    }
+  }
 }
 
 }  // namespace
@@ -85,6 +114,31 @@ int run_cli(int argc, char** argv) {
   reference->add_option("--frame", reference_frame, "frame number (simulation time = frame / frame rate)");
   reference->add_option("--out", reference_out, "writes OUT/reference/<screen-id>/frame-NNNNNN.exr and .png")
       ->required();
+  ReferenceOptions reference_options;
+  reference
+      ->add_option("--supersample", reference_options.supersample,
+                   "S×S samples per pixel, box-filtered (compare with composites, which integrate each pixel)")
+      ->check(CLI::Range(1, 8));
+
+  std::string compose_config;
+  std::uint64_t compose_frame_number = 0;
+  std::string compose_out;
+  std::string compose_captures;
+  auto* compose = app.add_subcommand("compose", "what each screen receives at one frame, from the nodes' captures");
+  compose->add_option("--config", compose_config, "installation file")->required();
+  compose->add_option("--frame", compose_frame_number, "a captured frame number")->required();
+  compose->add_option("--out", compose_out, "writes OUT/screens/<screen-id>/frame-NNNNNN.exr and .png")->required();
+  compose->add_option("--captures", compose_captures,
+                      "folder with <projector-id>/frame-NNNNNN.exr (default: OUT/nodes, where --local runs put them)");
+
+  CalibrateOptions calibrate_options;
+  auto* calibrate_command =
+      app.add_subcommand("calibrate", "fit a projector's homography (screen → pixels) from measured points");
+  calibrate_command
+      ->add_option("--points", calibrate_options.points_path, "points file (JSON: pixel ↔ screen or tracker)")
+      ->required();
+  calibrate_command->add_option("--out", calibrate_options.out_path, "calibration file to write (JSON)")->required();
+  calibrate_command->add_flag("--robust", calibrate_options.robust, "RANSAC: leave gross outliers out of the fit");
 
   try {
     app.parse(argc, argv);
@@ -94,6 +148,22 @@ int run_cli(int argc, char** argv) {
   }
 
   if (check->parsed()) return check_config(check_files);
+  if (calibrate_command->parsed()) return calibrate(calibrate_options, std::cout, std::cerr);
+  if (compose->parsed()) {
+    auto loaded = config::load_installation(compose_config);
+    if (!loaded) {
+      std::cerr << loaded.error() << "\n";
+      return kExitUsage;
+    }
+    auto logger = log::make_logger("master", log_level);
+    const std::string captures = compose_captures.empty() ? compose_out + "/nodes" : compose_captures;
+    if (auto composed = compose_frame(loaded.value(), compose_frame_number, captures, compose_out, *logger);
+        !composed) {
+      logger->error("{}", composed.error());
+      return kExitUsage;
+    }
+    return kExitOk;
+  }
   if (reference->parsed()) {
     auto loaded = load_config_and_scene(reference_config);
     if (!loaded) {
@@ -101,8 +171,8 @@ int run_cli(int argc, char** argv) {
       return kExitUsage;
     }
     auto logger = log::make_logger("master", log_level);
-    if (auto done =
-            render_reference(loaded.value().first, loaded.value().second, reference_frame, reference_out, *logger);
+    if (auto done = render_reference(loaded.value().first, loaded.value().second, reference_frame, reference_out,
+                                     *logger, reference_options);
         !done) {
       logger->error("{}", done.error());
       return kExitFailed;
@@ -145,6 +215,9 @@ int run_cli(int argc, char** argv) {
     return kExitUsage;
   }
   options.out_dir = out_dir;
+  // A --local run that captured frames also shows what the screens received.
+  const bool local_captures = options.local && options.capture_every != 0;
+  const config::LoadedConfig config_for_composites = options.config;
   options.status_line = !no_status && isatty(STDERR_FILENO) == 1;
   auto logger = log::make_logger("master", log_level, log_file);
   // On a terminal, each log line first clears the status line (stderr only, not the log file).
@@ -157,7 +230,9 @@ int run_cli(int argc, char** argv) {
     return kExitFailed;
   }
   io.run();
-  return master.exit_code();
+  const int status = master.exit_code();
+  if (status == kExitOk && local_captures) compose_local_captures(config_for_composites, out_dir, *logger);
+  return status;
 }
 
 }  // namespace optique::master

@@ -283,6 +283,11 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
   for (const auto& screen : installation.screens()) {
     if (screen.id() == target.projector->screen()) *welcome.mutable_screen() = screen;
   }
+  for (const auto& other : installation.projectors()) {
+    if (other.screen() == target.projector->screen() && other.eye() == target.projector->eye()) {
+      *welcome.add_blend_group() = other;
+    }
+  }
   *welcome.mutable_viewer() = installation.viewer();
   *welcome.mutable_scene() = installation.scene();
   if (!installation.scene().gltf().empty()) {

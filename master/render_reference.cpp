@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "image/frame_files.h"
+#include "optics/compose.h"
 #include "render/gl_context.h"
 #include "render/projection.h"
 #include "render/scene_renderer.h"
@@ -12,7 +13,11 @@
 namespace optique::master {
 
 Result<void> render_reference(const config::LoadedConfig& config, const scene::LoadedScene& scene, std::uint64_t frame,
-                              const std::string& out_dir, spdlog::logger& log) {
+                              const std::string& out_dir, spdlog::logger& log, const ReferenceOptions& options) {
+  if (options.supersample < 1) {
+    return Error{"the supersample factor must be at least 1, not " + std::to_string(options.supersample)};
+  }
+  const int s = options.supersample;
   const auto& installation = config.installation;
   const SceneAuthority authority(scene.definition.objects, installation.viewer(), installation.master().frame_rate());
   const scene::SceneState state = authority.state_at_frame(frame);
@@ -23,16 +28,23 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
   for (const auto& screen : installation.screens()) {
     const int width = static_cast<int>(std::lround(screen.width() * screen.pixels_per_metre()));
     const int height = static_cast<int>(std::lround(screen.height() * screen.pixels_per_metre()));
-    auto renderer = render::SceneRenderer::create(scene.definition, width, height);
+    auto renderer = render::SceneRenderer::create(scene.definition, width * s, height * s);
     if (!renderer) return Error{"screen '" + screen.id() + "': " + renderer.error()};
     auto frustum = render::off_axis_frustum(render::whole_screen(screen), state.eye_now, viewer.near(), viewer.far());
     if (!frustum)
       return Error{"screen '" + screen.id() + "' at frame " + std::to_string(frame) + ": " + frustum.error()};
     renderer.value()->draw(state, 0.0, state.eye_now, frustum.value());
     const std::string folder = (std::filesystem::path(out_dir) / "reference" / screen.id()).string();
-    auto written = image::write_frame(folder, frame, renderer.value()->read_linear(), renderer.value()->read_encoded());
+    Result<void> written;
+    if (s == 1) {
+      written = image::write_frame(folder, frame, renderer.value()->read_linear(), renderer.value()->read_encoded());
+    } else {
+      const image::FloatImage linear = optics::box_downsample(renderer.value()->read_linear(), s);
+      written = image::write_frame(folder, frame, linear, optics::encode_srgb(linear));
+    }
     if (!written) return written;
-    log.info("screen '{}': {}×{} px → {}", screen.id(), width, height, image::frame_path(folder, frame, "png"));
+    log.info("screen '{}': {}×{} px ({}×{} samples per pixel) → {}", screen.id(), width, height, s, s,
+             image::frame_path(folder, frame, "png"));
   }
   return {};
 }

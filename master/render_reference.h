@@ -15,8 +15,17 @@
 
 namespace optique::master {
 
+struct ReferenceOptions {
+  // Renders at supersample × the screen's pixels and averages each block down
+  // (box filter, linear light; the PNG is encoded from the averaged image), so
+  // that each pixel holds the light over its footprint as screen composites do.
+  // 1 = one sample per pixel centre.
+  int supersample = 1;
+};
+
 // Writes OUT/reference/<screen-id>/frame-NNNNNN.exr and .png for every screen.
 [[nodiscard]] Result<void> render_reference(const config::LoadedConfig& config, const scene::LoadedScene& scene,
-                                            std::uint64_t frame, const std::string& out_dir, spdlog::logger& log);
+                                            std::uint64_t frame, const std::string& out_dir, spdlog::logger& log,
+                                            const ReferenceOptions& options = {});
 
 }  // namespace optique::master

@@ -1,8 +1,39 @@
 #include "gl_renderer.h"
 
+#include "config/geometry.h"
+#include "optics/blend.h"
 #include "scene/load_scene.h"
 
 namespace optique::node {
+namespace {
+
+// This projector's share of the light where it overlaps others of its group (the
+// same screen and eye), zero where it is masked outside the usable area.
+Result<image::FloatImage> blend_weights(const wire::Welcome& welcome, const optics::ProjectorGeometry& own) {
+  std::vector<optics::ProjectorGeometry> group;
+  std::vector<double> ramps;
+  std::size_t self = 0;
+  bool found = false;
+  for (const auto& member : welcome.blend_group()) {
+    auto geometry = config::projector_geometry(member);
+    if (!geometry) return Error{"blend partner '" + member.id() + "': " + geometry.error()};
+    if (member.id() == welcome.projector().id()) {
+      self = group.size();
+      found = true;
+    }
+    group.push_back(std::move(geometry).value());
+    ramps.push_back(member.blend_ramp());
+  }
+  if (!found) {  // a master that sends no group: this projector alone
+    self = group.size();
+    group.push_back(own);
+    ramps.push_back(welcome.projector().blend_ramp());
+  }
+  const optics::BlendField field(group, config::usable_area(welcome.screen()), ramps);
+  return optics::blend_weights(field, group[self], self);
+}
+
+}  // namespace
 
 GlRenderer::GlRenderer(spdlog::logger& log, std::string capture_folder)
     : log_(log), capture_folder_(std::move(capture_folder)) {}
@@ -15,8 +46,9 @@ GlRenderer::~GlRenderer() {
 
 Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
   const auto& projector = welcome.projector();
-  const std::string key = projector.SerializeAsString() + welcome.screen().SerializeAsString() +
-                          welcome.scene().SerializeAsString() + welcome.viewer().SerializeAsString();
+  std::string key = projector.SerializeAsString() + welcome.screen().SerializeAsString() +
+                    welcome.scene().SerializeAsString() + welcome.viewer().SerializeAsString();
+  for (const auto& other : welcome.blend_group()) key += other.SerializeAsString();
   if (key == configured_for_ && renderer_) return {};  // a rejoin: same job, keep everything
 
   auto definition = scene::load_scene(welcome.scene(), ".");
@@ -31,6 +63,12 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
   }
   for (const auto& warning : definition.value().warnings) log_.warn("scene: {}", warning);
 
+  auto geometry = config::projector_geometry(projector);
+  if (!geometry) return Error{"projector '" + projector.id() + "': " + geometry.error()};
+  auto view = render::ProjectorView::make(welcome.screen(), geometry.value(),
+                                          render::parse_render_method(projector.rendering()));
+  if (!view) return Error{"projector '" + projector.id() + "': " + view.error()};
+
   renderer_.reset();
   context_.reset();
   const int width = static_cast<int>(projector.width());
@@ -42,11 +80,17 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
           : render::make_headless_context();
   if (!context) return Error{context.error()};
   context_ = std::move(context).value();
-  auto renderer = render::SceneRenderer::create(definition.value().definition, width, height);
+  auto renderer = render::SceneRenderer::create(definition.value().definition, view.value().render_width(),
+                                                view.value().render_height());
   if (!renderer) return Error{renderer.error()};
   renderer_ = std::move(renderer).value();
+  auto weights = blend_weights(welcome, geometry.value());
+  if (!weights) return Error{"projector '" + projector.id() + "': " + weights.error()};
+  if (auto output = renderer_->set_output(view.value().output_stage(std::move(weights).value())); !output) {
+    return Error{output.error()};
+  }
+  view_ = std::move(view).value();
 
-  rect_ = render::screen_region(welcome.screen(), projector.region());
   eye_ = render::parse_eye(projector.eye());
   const auto& viewer = welcome.viewer();
   head_right_ = glm::dvec3(viewer.head_right(0), viewer.head_right(1), viewer.head_right(2));
@@ -55,14 +99,18 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
   far_ = viewer.far();
   // One draw now, seen from a metre in front of the region: drivers compile
   // shaders lazily, and the first frame should not pay for it.
-  const glm::dvec3 warm_eye = rect_.at(0.5, 0.5) + rect_.normal();
-  if (auto frustum = render::off_axis_frustum(rect_, warm_eye, near_, far_)) {
+  const glm::dvec3 warm_eye = view_->bounds().at(0.5, 0.5) + view_->bounds().normal();
+  if (auto frustum = view_->frustum(warm_eye, near_, far_)) {
     renderer_->draw(scene::SceneState{}, 0.0, warm_eye, frustum.value());
   }
   if (!captures_) captures_.emplace(capture_folder_, log_);
   configured_for_ = key;
-  log_.info("rendering {} with {} ({}), {}×{} px", definition.value().source, context_->renderer_name(),
-            context_->has_window() ? "window" : "headless", width, height);
+  log_.info("rendering {} with {} ({}), {}×{} px, {}", definition.value().source, context_->renderer_name(),
+            context_->has_window() ? "window" : "headless", width, height,
+            view_->method() == render::RenderMethod::two_pass
+                ? "two passes (" + std::to_string(view_->render_width()) + "×" +
+                      std::to_string(view_->render_height()) + " px, then warped)"
+                : "single pass");
   return {};
 }
 
@@ -73,7 +121,7 @@ std::string GlRenderer::description() const {
 
 void GlRenderer::render(const FrameInput& frame) {
   const glm::dvec3 eye = render::eye_position(frame.state->eye_now, head_right_, eye_separation_, eye_);
-  auto frustum = render::off_axis_frustum(rect_, eye, near_, far_);
+  auto frustum = view_->frustum(eye, near_, far_);
   if (!frustum) {
     // The eye left the space in front of this screen: nothing of the scene can be
     // seen through it, so the projector shows black rather than a wrong picture.

@@ -12,6 +12,7 @@
 #include "capture_writer.h"
 #include "render/gl_context.h"
 #include "render/projection.h"
+#include "render/projector_view.h"
 #include "render/scene_renderer.h"
 #include "renderer.h"
 #include "scene/definition.h"
@@ -36,7 +37,7 @@ class GlRenderer final : public Renderer {
   std::unique_ptr<render::GlContext> context_;
   std::unique_ptr<render::SceneRenderer> renderer_;
   std::optional<CaptureWriter> captures_;
-  render::WorldRect rect_;
+  std::optional<render::ProjectorView> view_;
   render::Eye eye_ = render::Eye::mono;
   glm::dvec3 head_right_{1.0, 0.0, 0.0};
   double eye_separation_ = 0.0;

@@ -1,17 +1,13 @@
 #pragma once
 // A projector's homography H: screen coordinates (metres, in the screen's own
-// frame) → projector pixels (origin at the image's top-left corner, x right,
-// y down, pixel centres at half-integers), [x y 1]ᵀ ≅ H [X Y 1]ᵀ. Fitted from
-// measured correspondences by the Hartley-normalized DLT (SVD).
-
-#include <span>
-#include <string>
-#include <vector>
+// frame: origin lower-left, y up) → projector pixels (origin at the image's
+// top-left corner, x right, y down, pixel centres at half-integers),
+// [x y 1]ᵀ ≅ H [X Y 1]ᵀ. glm matrices are column-major: h[col][row].
+//
+// The fit itself is in calib/fit.h (DLT, refinement, robust mode, diagnostics).
 
 #include <glm/mat3x3.hpp>
 #include <glm/vec2.hpp>
-
-#include "util/result.h"
 
 namespace optique::calib {
 
@@ -20,19 +16,20 @@ struct Correspondence {
   glm::dvec2 pixel;   // projector pixel
 };
 
-struct HomographyFit {
-  glm::dmat3 homography{1.0};  // column-major (glm); h33 = 1
-  double rms_px = 0.0;         // reprojection error of the correspondences
-  double max_px = 0.0;
-  double condition = 0.0;  // of the normalized DLT system: σ_max / σ_8
-  std::vector<std::string> warnings;
+// A projector's image in pixels: corners (0, 0) and (width, height).
+struct ImageSize {
+  int width = 0;
+  int height = 0;
 };
 
 // Maps a screen point to pixels.
 [[nodiscard]] glm::dvec2 apply(const glm::dmat3& homography, const glm::dvec2& screen);
 
-// Fails, saying why, on fewer than 4 points, non-finite numbers, repeated points,
-// or points (on either side) that are all on one line.
-[[nodiscard]] Result<HomographyFit> fit_homography(std::span<const Correspondence> points);
+// The homogeneous w of a screen point, (H·[X Y 1]ᵀ)_z: its sign says on which
+// side of the projector's horizon the point is.
+[[nodiscard]] double homogeneous_w(const glm::dmat3& homography, const glm::dvec2& screen);
+
+// Distance in pixels between where H puts the screen point and the measured pixel.
+[[nodiscard]] double reprojection_error(const glm::dmat3& homography, const Correspondence& point);
 
 }  // namespace optique::calib

@@ -9,10 +9,21 @@
 #include <sstream>
 
 #include "config/defaults.h"
+#include "config/geometry.h"
 #include "config/validate.h"
 #include "util/sha256.h"
 
 namespace optique::config {
+namespace {
+
+std::string describe(const std::vector<Problem>& problems, const std::string& origin) {
+  std::string message;
+  for (const Problem& p : problems)
+    message += (message.empty() ? "" : "\n") + origin + ": " + p.path + ": " + p.message;
+  return message;
+}
+
+}  // namespace
 
 Result<Installation> parse_installation(const std::string& json, const std::string& origin,
                                         const std::string& directory) {
@@ -44,14 +55,10 @@ Result<Installation> parse_installation(const std::string& json, const std::stri
     return Error{origin + ": not a valid installation: " + std::string(status.message())};
   }
   const std::vector<Problem> problems = validate(installation, directory);
-  if (!problems.empty()) {
-    std::string message;
-    for (const Problem& p : problems) {
-      message += (message.empty() ? "" : "\n") + origin + ": " + p.path + ": " + p.message;
-    }
-    return Error{message};
-  }
+  if (!problems.empty()) return Error{describe(problems, origin)};
   apply_defaults(installation);
+  const std::vector<Problem> geometry = resolve_geometry(installation, directory);
+  if (!geometry.empty()) return Error{describe(geometry, origin)};
   return installation;
 }
 
@@ -103,7 +110,8 @@ void apply_defaults(Installation& installation) {
     if (p.host().empty()) p.set_host("localhost");
     if (p.output().kind().empty()) p.mutable_output()->set_kind("headless");
     if (p.eye().empty()) p.set_eye("mono");
-    if (!p.has_region()) {
+    const bool other_geometry = !p.homography().empty() || !p.calibration().empty() || p.has_camera();
+    if (!p.has_region() && !other_geometry) {
       for (const Screen& s : installation.screens()) {
         if (s.id() != p.screen()) continue;
         Region& r = *p.mutable_region();

@@ -132,7 +132,37 @@ void check_region(Checker& check, const std::string& at, const Region& r, const 
   }
 }
 
-void check_projectors(Checker& check, const Installation& inst) {
+// Nine finite numbers, row-major 3×3.
+void check_matrix3(Checker& check, const std::string& path, const google::protobuf::RepeatedField<double>& m) {
+  if (m.size() != 9) {
+    check.fail(path, "must be 9 numbers, the 3×3 matrix row by row (got " + std::to_string(m.size()) + ")");
+    return;
+  }
+  for (int i = 0; i < 9; ++i) check.finite(path + "[" + std::to_string(i) + "]", m[i]);
+}
+
+// At most one way to say where the projector's pixels land (a camera view may
+// accompany a direct one: it then relates partners to this projector).
+void check_geometry_source(Checker& check, const std::string& at, const Projector& p, const std::string& config_dir) {
+  if (!p.homography().empty() && !p.calibration().empty()) {
+    check.fail(at, "give either homography or calibration, not both");
+  }
+  if (p.has_region() && (!p.calibration().empty() || p.has_camera() || !p.homography().empty())) {
+    check.fail(at + ".region", "a projector with a homography, calibration or camera view takes no region");
+  }
+  if (!p.homography().empty()) check_matrix3(check, at + ".homography", p.homography());
+  if (!p.calibration().empty()) {
+    const std::filesystem::path file = std::filesystem::path(config_dir) / p.calibration();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) check.fail(at + ".calibration", "no such file: " + file.string());
+  }
+  if (p.has_camera()) {
+    if (p.camera().camera().empty()) check.fail(at + ".camera.camera", "name the camera (partners share the name)");
+    check_matrix3(check, at + ".camera.homography", p.camera().homography());
+  }
+}
+
+void check_projectors(Checker& check, const Installation& inst, const std::string& config_dir) {
   if (inst.projectors().empty()) check.fail("projectors", "at least one projector is needed");
   std::set<std::string> ids;
   constexpr std::uint32_t kMaxPixels = 16384;
@@ -160,8 +190,11 @@ void check_projectors(Checker& check, const Installation& inst) {
       check.fail(at + ".screen", "unknown screen '" + p.screen() + "' (screens are: " + known + ")");
     }
     if (p.has_region()) check_region(check, at + ".region", p.region(), screen);
+    check_geometry_source(check, at, p, config_dir);
     check.one_of(at + ".output.kind", p.output().kind(), {"headless", "window"});
     check.one_of(at + ".eye", p.eye(), {"mono", "left", "right"});
+    check.one_of(at + ".rendering", p.rendering(), {"single-pass", "two-pass"});
+    check.non_negative(at + ".blend_ramp", p.blend_ramp());
   }
 }
 
@@ -247,7 +280,7 @@ std::vector<Problem> validate(const Installation& installation, const std::strin
   Checker check(problems);
   std::set<std::string> screen_ids;
   check_screens(check, installation, screen_ids);
-  check_projectors(check, installation);
+  check_projectors(check, installation, config_dir);
   check_viewer(check, installation.viewer());
   check_master(check, installation.master());
   check_scene(check, installation.scene(), config_dir);

@@ -79,4 +79,24 @@ void paste(FloatImage& target, const FloatImage& source, int x, int y) {
   }
 }
 
+double luma(const FloatImage& image, int x, int y) {
+  return 0.299 * image.at(x, y, 0) + 0.587 * image.at(x, y, 1) + 0.114 * image.at(x, y, 2);
+}
+
+double psnr_luma_where(const FloatImage& a, const FloatImage& b, const std::function<bool(int x, int y)>& where,
+                       double peak) {
+  double squared = 0.0;
+  std::size_t count = 0;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      if (!where(x, y)) continue;
+      const double d = luma(a, x, y) - luma(b, x, y);
+      squared += d * d;
+      ++count;
+    }
+  }
+  if (count == 0 || squared == 0.0) return std::numeric_limits<double>::infinity();
+  return 10.0 * std::log10(peak * peak * static_cast<double>(count) / squared);
+}
+
 }  // namespace optique::image

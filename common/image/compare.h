@@ -3,6 +3,7 @@
 // seed-001 weighting (PSNR_Y = 0.299·PSNR_R + 0.587·PSNR_G + 0.114·PSNR_B), the
 // largest absolute difference, and a difference image to look at.
 
+#include <functional>
 #include <limits>
 
 #include "image/image.h"
@@ -21,6 +22,14 @@ struct Comparison {
 
 // RGB of both images (alpha ignored); `peak` is the largest possible value.
 [[nodiscard]] Result<Comparison> compare(const FloatImage& a, const FloatImage& b, double peak = 1.0);
+
+// Rec. 601 luma, 0.299 R + 0.587 G + 0.114 B, of one pixel.
+[[nodiscard]] double luma(const FloatImage& image, int x, int y);
+
+// PSNR of luma (dB, `peak`) over the pixels `where` accepts: e.g. a screen's
+// usable area. +infinity when they agree there (or no pixel is accepted).
+[[nodiscard]] double psnr_luma_where(const FloatImage& a, const FloatImage& b,
+                                     const std::function<bool(int x, int y)>& where, double peak = 1.0);
 
 // |a − b| per RGB channel, scaled by `gain`, alpha 1. Sizes must match.
 [[nodiscard]] FloatImage difference(const FloatImage& a, const FloatImage& b, float gain = 1.0f);

@@ -83,18 +83,36 @@ void main() {
 }
 )";
 
-// The projector's response, applied last: the sRGB transfer function for now.
+// The output stage: the two-pass warp (if any), the blend weights, then the
+// projector's response (the sRGB transfer function for now). Writes the light the
+// projector emits and what is sent to it.
 constexpr const char* kEncodeFragment = R"(#version 450 core
 in vec2 uv;
-uniform sampler2D linear_image;
-out vec4 colour;
+layout(binding = 0) uniform sampler2D rendered;
+layout(binding = 2) uniform sampler2D weights;
+uniform bool warp;
+uniform mat3 projector_to_user;
+uniform vec2 output_size;
+uniform bool has_weights;
+layout(location = 0) out vec4 light;
+layout(location = 1) out vec4 encoded;
 vec3 encode(vec3 c) {
   c = clamp(c, 0.0, 1.0);
   return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
 }
 void main() {
-  vec4 linear = texelFetch(linear_image, ivec2(gl_FragCoord.xy), 0);
-  colour = vec4(encode(linear.rgb), 1.0);
+  vec3 c;
+  if (warp) {
+    vec3 user = projector_to_user * vec3(gl_FragCoord.xy / output_size * 2.0 - 1.0, 1.0);
+    vec2 at = (user.xy / user.z + 1.0) * 0.5;
+    bool inside = user.z > 0.0 && all(greaterThanEqual(at, vec2(0.0))) && all(lessThanEqual(at, vec2(1.0)));
+    c = inside ? texture(rendered, at).rgb : vec3(0.0);
+  } else {
+    c = texelFetch(rendered, ivec2(gl_FragCoord.xy), 0).rgb;
+  }
+  if (has_weights) c *= texelFetch(weights, ivec2(gl_FragCoord.xy), 0).r;
+  light = vec4(c, 1.0);
+  encoded = vec4(encode(c), 1.0);
 }
 )";
 
@@ -155,8 +173,17 @@ struct SceneRenderer::Gl {
   GLuint linear_framebuffer = 0;
   GLuint linear_colour = 0;
   GLuint depth = 0;
-  GLuint encoded_framebuffer = 0;
+  GLuint encoded_framebuffer = 0;  // the encoded image alone, for blits
   GLuint encoded_colour = 0;
+  GLuint output_framebuffer = 0;  // light and encoded image
+  GLuint output_light = 0;
+  GLuint weights = 0;
+  int output_width = 0;
+  int output_height = 0;
+  std::optional<glm::dmat3> projector_to_user;
+  struct {
+    GLint warp, projector_to_user, output_size, has_weights;
+  } encode_uniforms{};
   std::vector<GLuint> scene_textures;  // by index in the scene's textures
   std::vector<MeshRange> meshes;
   std::vector<scene::Material> materials;
@@ -176,10 +203,10 @@ struct SceneRenderer::Gl {
     glDeleteVertexArrays(2, arrays);
     const GLuint buffers[] = {vertex_buffer, index_buffer, light_buffer};
     glDeleteBuffers(3, buffers);
-    const GLuint framebuffers[] = {linear_framebuffer, encoded_framebuffer};
-    glDeleteFramebuffers(2, framebuffers);
-    const GLuint textures[] = {linear_colour, depth, encoded_colour};
-    glDeleteTextures(3, textures);
+    const GLuint framebuffers[] = {linear_framebuffer, encoded_framebuffer, output_framebuffer};
+    glDeleteFramebuffers(3, framebuffers);
+    const GLuint textures[] = {linear_colour, depth, encoded_colour, output_light, weights};
+    glDeleteTextures(5, textures);
     glDeleteTextures(static_cast<GLsizei>(scene_textures.size()), scene_textures.data());
   }
 };
@@ -187,8 +214,8 @@ struct SceneRenderer::Gl {
 SceneRenderer::SceneRenderer(std::unique_ptr<Gl> gl) : gl_(std::move(gl)) {}
 SceneRenderer::~SceneRenderer() = default;
 
-Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneDefinition& scene, int width,
-                                                             int height) {
+Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneDefinition& scene, int width, int height,
+                                                             DepthFormat depth) {
   if (width <= 0 || height <= 0) return Error{"the image size must be positive"};
   auto gl = std::make_unique<Gl>();
   gl->width = width;
@@ -199,6 +226,9 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   auto encode_program = link(kFullscreenVertex, kEncodeFragment);
   if (!encode_program) return Error{encode_program.error()};
   gl->encode_program = encode_program.value();
+  gl->encode_uniforms = {
+      glGetUniformLocation(gl->encode_program, "warp"), glGetUniformLocation(gl->encode_program, "projector_to_user"),
+      glGetUniformLocation(gl->encode_program, "output_size"), glGetUniformLocation(gl->encode_program, "has_weights")};
   const GLuint p = gl->scene_program;
   gl->uniforms = {glGetUniformLocation(p, "model_view_projection"),
                   glGetUniformLocation(p, "model"),
@@ -288,25 +318,73 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   gl->ambient = scene.ambient;
   gl->background = scene.background;
 
-  // Linear light in half floats, depth in 32-bit float.
+  // Linear light in half floats, depth in 32-bit float (or 24-bit fixed point).
   glCreateTextures(GL_TEXTURE_2D, 1, &gl->linear_colour);
   glTextureStorage2D(gl->linear_colour, 1, GL_RGBA16F, width, height);
+  // Bilinear for the two-pass warp; the single pass reads texels exactly.
+  glTextureParameteri(gl->linear_colour, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(gl->linear_colour, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(gl->linear_colour, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(gl->linear_colour, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   glCreateTextures(GL_TEXTURE_2D, 1, &gl->depth);
-  glTextureStorage2D(gl->depth, 1, GL_DEPTH_COMPONENT32F, width, height);
+  glTextureStorage2D(gl->depth, 1, depth == DepthFormat::fixed24 ? GL_DEPTH_COMPONENT24 : GL_DEPTH_COMPONENT32F, width,
+                     height);
   glCreateFramebuffers(1, &gl->linear_framebuffer);
   glNamedFramebufferTexture(gl->linear_framebuffer, GL_COLOR_ATTACHMENT0, gl->linear_colour, 0);
   glNamedFramebufferTexture(gl->linear_framebuffer, GL_DEPTH_ATTACHMENT, gl->depth, 0);
-  glCreateTextures(GL_TEXTURE_2D, 1, &gl->encoded_colour);
-  glTextureStorage2D(gl->encoded_colour, 1, GL_RGBA8, width, height);
-  glCreateFramebuffers(1, &gl->encoded_framebuffer);
-  glNamedFramebufferTexture(gl->encoded_framebuffer, GL_COLOR_ATTACHMENT0, gl->encoded_colour, 0);
-  for (GLuint fb : {gl->linear_framebuffer, gl->encoded_framebuffer}) {
+  auto renderer = std::unique_ptr<SceneRenderer>(new SceneRenderer(std::move(gl)));
+  if (auto output = renderer->set_output({}); !output) return Error{output.error()};
+  return renderer;
+}
+
+Result<void> SceneRenderer::set_output(const OutputStage& stage) {
+  Gl& gl = *gl_;
+  const int width = stage.width > 0 ? stage.width : gl.width;
+  const int height = stage.height > 0 ? stage.height : gl.height;
+  if (!stage.weights.empty() &&
+      (stage.weights.width != width || stage.weights.height != height || stage.weights.channels != 1)) {
+    return Error{"blend weights are " + std::to_string(stage.weights.width) + "×" +
+                 std::to_string(stage.weights.height) + "×" + std::to_string(stage.weights.channels) + ", the output " +
+                 std::to_string(width) + "×" + std::to_string(height) + "×1"};
+  }
+  if (!stage.projector_to_user && (width != gl.width || height != gl.height)) {
+    return Error{"a single-pass output must have the rendered image's size"};
+  }
+  const GLuint framebuffers[] = {gl.encoded_framebuffer, gl.output_framebuffer};
+  glDeleteFramebuffers(2, framebuffers);
+  const GLuint textures[] = {gl.encoded_colour, gl.output_light, gl.weights};
+  glDeleteTextures(3, textures);
+  gl.weights = 0;
+  gl.output_width = width;
+  gl.output_height = height;
+  gl.projector_to_user = stage.projector_to_user;
+
+  glCreateTextures(GL_TEXTURE_2D, 1, &gl.encoded_colour);
+  glTextureStorage2D(gl.encoded_colour, 1, GL_RGBA8, width, height);
+  glCreateTextures(GL_TEXTURE_2D, 1, &gl.output_light);
+  glTextureStorage2D(gl.output_light, 1, GL_RGBA16F, width, height);
+  glCreateFramebuffers(1, &gl.encoded_framebuffer);
+  glNamedFramebufferTexture(gl.encoded_framebuffer, GL_COLOR_ATTACHMENT0, gl.encoded_colour, 0);
+  glCreateFramebuffers(1, &gl.output_framebuffer);
+  glNamedFramebufferTexture(gl.output_framebuffer, GL_COLOR_ATTACHMENT0, gl.output_light, 0);
+  glNamedFramebufferTexture(gl.output_framebuffer, GL_COLOR_ATTACHMENT1, gl.encoded_colour, 0);
+  const GLenum draw_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(gl.output_framebuffer, 2, draw_buffers);
+  if (!stage.weights.empty()) {
+    image::FloatImage rows_up = stage.weights;  // GL's first row is the bottom one
+    image::flip_rows(rows_up);
+    glCreateTextures(GL_TEXTURE_2D, 1, &gl.weights);
+    glTextureStorage2D(gl.weights, 1, GL_R32F, width, height);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTextureSubImage2D(gl.weights, 0, 0, 0, width, height, GL_RED, GL_FLOAT, rows_up.pixels.data());
+  }
+  for (GLuint fb : {gl.linear_framebuffer, gl.encoded_framebuffer, gl.output_framebuffer}) {
     const GLenum status = glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
       return Error{"framebuffer incomplete (status " + std::to_string(status) + ")"};
     }
   }
-  return std::unique_ptr<SceneRenderer>(new SceneRenderer(std::move(gl)));
+  return {};
 }
 
 void SceneRenderer::draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye, const Frustum& frustum,
@@ -373,35 +451,60 @@ void SceneRenderer::draw_black() {
 // The projector's response, last: linear light → what is sent to it.
 void SceneRenderer::encode() {
   Gl& gl = *gl_;
-  glBindFramebuffer(GL_FRAMEBUFFER, gl.encoded_framebuffer);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl.output_framebuffer);
+  glViewport(0, 0, gl.output_width, gl.output_height);
   glDisable(GL_DEPTH_TEST);
   glUseProgram(gl.encode_program);
+  const auto& u = gl.encode_uniforms;
+  glUniform1i(u.warp, gl.projector_to_user ? 1 : 0);
+  const glm::mat3 to_user(gl.projector_to_user.value_or(glm::dmat3(1.0)));
+  glUniformMatrix3fv(u.projector_to_user, 1, GL_FALSE, glm::value_ptr(to_user));
+  glUniform2f(u.output_size, static_cast<float>(gl.output_width), static_cast<float>(gl.output_height));
+  glUniform1i(u.has_weights, gl.weights != 0 ? 1 : 0);
   glBindTextureUnit(0, gl.linear_colour);
+  if (gl.weights != 0) glBindTextureUnit(2, gl.weights);
   glBindVertexArray(gl.empty_vertex_array);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glFinish();
 }
 
-image::FloatImage SceneRenderer::read_linear() const {
-  image::FloatImage image(gl_->width, gl_->height, 4);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->linear_framebuffer);
+namespace {
+
+image::FloatImage read_float(GLuint framebuffer, int width, int height, GLenum format, int channels) {
+  image::FloatImage image(width, height, channels);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  glReadBuffer(format == GL_DEPTH_COMPONENT ? GL_NONE : GL_COLOR_ATTACHMENT0);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, gl_->width, gl_->height, GL_RGBA, GL_FLOAT, image.pixels.data());
+  glReadPixels(0, 0, width, height, format, GL_FLOAT, image.pixels.data());
   image::flip_rows(image);
   return image;
 }
 
+}  // namespace
+
+image::FloatImage SceneRenderer::read_linear() const {
+  return read_float(gl_->output_framebuffer, gl_->output_width, gl_->output_height, GL_RGBA, 4);
+}
+
+image::FloatImage SceneRenderer::read_rendered() const {
+  return read_float(gl_->linear_framebuffer, gl_->width, gl_->height, GL_RGBA, 4);
+}
+
+image::FloatImage SceneRenderer::read_depth() const {
+  return read_float(gl_->linear_framebuffer, gl_->width, gl_->height, GL_DEPTH_COMPONENT, 1);
+}
+
 image::ByteImage SceneRenderer::read_encoded() const {
-  image::ByteImage image(gl_->width, gl_->height, 4);
+  image::ByteImage image(gl_->output_width, gl_->output_height, 4);
   glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->encoded_framebuffer);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, gl_->width, gl_->height, GL_RGBA, GL_UNSIGNED_BYTE, image.pixels.data());
+  glReadPixels(0, 0, gl_->output_width, gl_->output_height, GL_RGBA, GL_UNSIGNED_BYTE, image.pixels.data());
   image::flip_rows(image);
   return image;
 }
 
 unsigned SceneRenderer::output_framebuffer() const { return gl_->encoded_framebuffer; }
-int SceneRenderer::width() const { return gl_->width; }
-int SceneRenderer::height() const { return gl_->height; }
+int SceneRenderer::width() const { return gl_->output_width; }
+int SceneRenderer::height() const { return gl_->output_height; }
 
 }  // namespace optique::render

@@ -5,6 +5,9 @@
 // code runs headless and in a window.
 
 #include <memory>
+#include <optional>
+
+#include <glm/mat3x3.hpp>
 
 #include "image/image.h"
 #include "render/projection.h"
@@ -21,12 +24,31 @@ struct LightTerms {
   bool emissive = true;
 };
 
+// The depth buffer's format: 32-bit float by default; 24-bit fixed point to
+// measure what a common hardware default does to depth order.
+enum class DepthFormat { float32, fixed24 };
+
+// What lies between the rendered image and the projector. A two-pass projector
+// warps the viewer's image (drawn through R) to its own pixels; every projector
+// multiplies by its blend weights, which are zero where it is masked. The
+// default does neither: the projector shows the rendered image as it is.
+struct OutputStage {
+  int width = 0;  // projector pixels; 0: the rendered image's size
+  int height = 0;
+  // Two-pass only: projector NDC → user NDC (A⁻¹); the rendered image spans
+  // user NDC [−1, 1]² and is sampled bilinearly.
+  std::optional<glm::dmat3> projector_to_user;
+  image::FloatImage weights;  // 1 channel, width × height, top row first; empty: 1 everywhere
+};
+
 class SceneRenderer {
  public:
-  // Uploads the scene's static content. Fails with the GL driver's message when
-  // a shader does not build or a framebuffer is incomplete.
+  // Uploads the scene's static content; draws `width` × `height` pixels. Fails
+  // with the GL driver's message when a shader does not build or a framebuffer is
+  // incomplete.
   [[nodiscard]] static Result<std::unique_ptr<SceneRenderer>> create(const scene::SceneDefinition& scene, int width,
-                                                                     int height);
+                                                                     int height,
+                                                                     DepthFormat depth = DepthFormat::float32);
   ~SceneRenderer();
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;
@@ -36,14 +58,21 @@ class SceneRenderer {
   void draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye, const Frustum& frustum,
             const LightTerms& terms = {});
 
+  // Fails when the weights do not match the output size.
+  [[nodiscard]] Result<void> set_output(const OutputStage& stage);
+
   // Black everywhere (the projector shows nothing), encoded like a drawn frame.
   void draw_black();
 
-  [[nodiscard]] image::FloatImage read_linear() const;  // RGBA, linear light
+  // The output, after the output stage (projector pixels).
+  [[nodiscard]] image::FloatImage read_linear() const;  // RGBA, linear light the projector emits
   [[nodiscard]] image::ByteImage read_encoded() const;  // RGBA8, as sent to the projector
   [[nodiscard]] unsigned output_framebuffer() const;    // the encoded image, for a window blit
-  [[nodiscard]] int width() const;
+  [[nodiscard]] int width() const;                      // of the output
   [[nodiscard]] int height() const;
+  // The rendered image before the output stage, and its depth (window z in [0, 1]).
+  [[nodiscard]] image::FloatImage read_rendered() const;
+  [[nodiscard]] image::FloatImage read_depth() const;
 
  private:
   struct Gl;

@@ -66,6 +66,17 @@ SceneDefinition cubes() {
   return scene;
 }
 
+SceneDefinition cubes_backdrop() {
+  // The cubes in front of a matte back wall that their lights shade smoothly:
+  // light everywhere on the screen, so seams and masks show.
+  SceneDefinition scene = cubes();
+  scene.name = "cubes-backdrop";
+  const auto wall = add_mesh(scene, make_quad(8.0f, 4.0f));
+  const auto matte = add_material(scene, {glm::vec3(0.55f, 0.5f, 0.45f), 0.0f, 0.9f, {}});
+  scene.instances.push_back({wall, matte, std::nullopt, glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 1.2, -1.4))});
+  return scene;
+}
+
 SceneDefinition many_lights() {
   // One slowly turning object lit by 24 coloured specular lights on a ring.
   SceneDefinition scene;
@@ -305,6 +316,7 @@ constexpr std::array kScenes{
     Entry{"many-lights", many_lights},
     Entry{"depth-stack", depth_stack},
     Entry{"moving-square", moving_square},
+    Entry{"cubes-backdrop", cubes_backdrop},
     // seed-001
     Entry{"cube-fast-rotation", cube_fast_rotation},
     Entry{"cube-slow-rotation", cube_slow_rotation},

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "config/geometry.h"
 #include "config/load.h"
 #include "config/validate.h"
 
@@ -101,7 +102,12 @@ TEST(ShippedConfigs, EveryConfigLoadsAndHasAProjector) {
     EXPECT_EQ(c.sha256.find_first_not_of("0123456789abcdef"), std::string::npos) << c.sha256;
     // Defaults were applied.
     EXPECT_GT(c.installation.master().frame_rate(), 0.0);
-    for (const auto& p : c.installation.projectors()) EXPECT_TRUE(p.has_region()) << p.id();
+    // Every projector's geometry is resolved, and it lights its screen.
+    for (const auto& p : c.installation.projectors()) {
+      EXPECT_TRUE(p.has_region() || p.homography_size() == 9) << p.id();
+      auto geometry = projector_geometry(p);
+      EXPECT_TRUE(geometry.ok()) << p.id() << ": " << (geometry.ok() ? "" : geometry.error());
+    }
   }
   EXPECT_GE(count, 1u) << "no *.json in " << dir;
 }

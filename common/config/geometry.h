@@ -1,0 +1,28 @@
+#pragma once
+// Every projector's homography, whichever way the config gave it: directly, a
+// calibration file, a camera view shared with a partner (A₂₁ = A₂c⁻¹ · A₁c), or a
+// region (an aligned projector). After resolve_geometry, every projector has
+// either its region or its homography (a calibration file is read into it), so
+// nodes need no files of the master's.
+
+#include <string>
+#include <vector>
+
+#include "config/validate.h"
+#include "optics/projector_geometry.h"
+#include "optique/config.pb.h"
+#include "util/result.h"
+
+namespace optique::config {
+
+// Fills Projector.homography where it comes from a file or a camera view, and checks that each one lights
+// part of its screen. Runs on a validated installation with defaults applied.
+[[nodiscard]] std::vector<Problem> resolve_geometry(Installation& installation, const std::string& config_dir);
+
+// The screen area that is shown: the whole screen rectangle.
+[[nodiscard]] optics::ScreenRect usable_area(const Screen& screen);
+
+// The geometry of a resolved projector: from its homography, or its region.
+[[nodiscard]] Result<optics::ProjectorGeometry> projector_geometry(const Projector& projector);
+
+}  // namespace optique::config

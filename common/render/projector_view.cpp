@@ -1,0 +1,61 @@
+#include "render/projector_view.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/matrix.hpp>
+
+#include "config/geometry.h"
+
+namespace optique::render {
+
+RenderMethod parse_render_method(const std::string& name) {
+  return name == "two-pass" ? RenderMethod::two_pass : RenderMethod::single_pass;
+}
+
+Result<ProjectorView> ProjectorView::make(const config::Screen& screen, const optics::ProjectorGeometry& geometry,
+                                          RenderMethod method, double two_pass_pixels_per_metre) {
+  auto oblique = optics::oblique_projection(geometry, config::usable_area(screen));
+  if (!oblique) return Error{oblique.error()};
+  ProjectorView view;
+  view.method_ = method;
+  view.oblique_ = oblique.value();
+  const optics::ScreenRect& r = view.oblique_.bounds;
+  config::Region region;
+  region.set_x(r.min.x);
+  region.set_y(r.min.y);
+  region.set_width(r.width());
+  region.set_height(r.height());
+  view.bounds_ = screen_region(screen, region);
+  view.width_ = geometry.width();
+  view.height_ = geometry.height();
+  if (method == RenderMethod::single_pass) {
+    view.render_width_ = geometry.width();
+    view.render_height_ = geometry.height();
+  } else {
+    constexpr double kLargest = 8192.0;
+    const double density =
+        two_pass_pixels_per_metre > 0.0 ? two_pass_pixels_per_metre : geometry.max_pixels_per_metre();
+    view.render_width_ = static_cast<int>(std::clamp(std::ceil(r.width() * density), 1.0, kLargest));
+    view.render_height_ = static_cast<int>(std::clamp(std::ceil(r.height() * density), 1.0, kLargest));
+  }
+  return view;
+}
+
+Result<Frustum> ProjectorView::frustum(const glm::dvec3& eye, double near, double far) const {
+  auto frustum = off_axis_frustum(bounds_, eye, near, far);
+  if (!frustum) return frustum;
+  if (method_ == RenderMethod::single_pass) frustum.value().projection = oblique_.matrix() * frustum.value().projection;
+  return frustum;
+}
+
+OutputStage ProjectorView::output_stage(image::FloatImage weights) const {
+  OutputStage stage;
+  stage.width = width_;
+  stage.height = height_;
+  if (method_ == RenderMethod::two_pass) stage.projector_to_user = glm::inverse(oblique_.user_to_projector);
+  stage.weights = std::move(weights);
+  return stage;
+}
+
+}  // namespace optique::render

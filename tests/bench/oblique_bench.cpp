@@ -1,0 +1,228 @@
+// Single pass against two passes for keystoned projectors (Raskar, seed 002): the
+// same frames drawn both ways in one run, alternating, for each projector of an
+// installation. Frame time of each, and the PSNR of each against a 4×-supersampled
+// image of the same projector (drawn at 4× its pixels with the exact single-pass
+// projection and box-filtered down: the average of the scene over each pixel's
+// footprint, which any exact method converges to). The paper claims the single
+// pass is free and avoids the resampling blur of the two-pass warp.
+//
+//   optique-bench-oblique [--config FILE] [--out DIR] [--frames N] [--repeats R]
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <map>
+
+#include "clock/clock.h"
+#include "config/geometry.h"
+#include "config/load.h"
+#include "image/compare.h"
+#include "metrics/distribution.h"
+#include "render/gl_context.h"
+#include "render/projector_view.h"
+#include "render/scene_renderer.h"
+#include "scene/load_scene.h"
+#include "spread.h"
+
+namespace {
+
+using namespace optique;
+
+constexpr int kSupersample = 4;
+
+struct Method {
+  render::ProjectorView view;
+  std::unique_ptr<render::SceneRenderer> renderer;
+};
+
+Method make_method(const scene::SceneDefinition& scene, const config::Screen& screen,
+                   const optics::ProjectorGeometry& geometry, render::RenderMethod how, double texture_density = 0.0) {
+  auto view = render::ProjectorView::make(screen, geometry, how, texture_density);
+  if (!view) throw std::runtime_error(view.error());
+  auto renderer = render::SceneRenderer::create(scene, view.value().render_width(), view.value().render_height());
+  if (!renderer) throw std::runtime_error(renderer.error());
+  if (auto output = renderer.value()->set_output(view.value().output_stage({})); !output) {
+    throw std::runtime_error(output.error());
+  }
+  return {std::move(view).value(), std::move(renderer).value()};
+}
+
+// Draws one frame; returns the time to a finished image, in ms.
+double draw(Method& m, const scene::SceneState& state, const config::Viewer& viewer) {
+  auto frustum = m.view.frustum(state.eye_now, viewer.near(), viewer.far());
+  if (!frustum) throw std::runtime_error(frustum.error());
+  const clock::Nanos start = clock::monotonic_now();
+  m.renderer->draw(state, 0.0, state.eye_now, frustum.value());
+  return static_cast<double>(clock::monotonic_now() - start) / 1e6;
+}
+
+image::FloatImage box_down(const image::FloatImage& big, int factor) {
+  image::FloatImage small(big.width / factor, big.height / factor, big.channels);
+  const float scale = 1.0f / static_cast<float>(factor * factor);
+  for (int y = 0; y < small.height; ++y) {
+    for (int x = 0; x < small.width; ++x) {
+      for (int c = 0; c < big.channels; ++c) {
+        float sum = 0.0f;
+        for (int j = 0; j < factor; ++j) {
+          for (int i = 0; i < factor; ++i) sum += big.at(x * factor + i, y * factor + j, c);
+        }
+        small.at(x, y, c) = sum * scale;
+      }
+    }
+  }
+  return small;
+}
+
+// The pixels whose centre lands in the screen's usable area: outside it the
+// projector is masked, and the methods differ by construction.
+std::vector<bool> usable_pixels(const optics::ProjectorGeometry& geometry, const optics::ScreenRect& usable) {
+  std::vector<bool> inside;
+  for (int y = 0; y < geometry.height(); ++y) {
+    for (int x = 0; x < geometry.width(); ++x) {
+      inside.push_back(usable.contains(geometry.to_screen(glm::dvec2(x + 0.5, y + 0.5))));
+    }
+  }
+  return inside;
+}
+
+// PSNR of luma over the usable pixels, peak 1 (linear light).
+double psnr_luma(const image::FloatImage& a, const image::FloatImage& b, const std::vector<bool>& inside) {
+  return image::psnr_luma_where(a, b, [&](int x, int y) { return inside[static_cast<std::size_t>(y) * a.width + x]; });
+}
+
+scene::SceneState state_at(const scene::SceneDefinition& scene, const config::Viewer& viewer, double t) {
+  scene::SceneState state;
+  for (const auto& object : scene.objects) state.objects[object.id] = {object.pose_at(t), object.pose_at(t)};
+  state.eye_now = glm::dvec3(viewer.eye(0), viewer.eye(1), viewer.eye(2));
+  state.eye_next = state.eye_now;
+  return state;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"optique oblique-projection benchmark: single pass vs two passes"};
+  std::string config_path = std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-oblique-3.json";
+  std::string out = "docs/bench";
+  int frames = 12;
+  int repeats = 3;
+  app.add_option("--config", config_path, "installation with keystoned projectors (fixed eye)");
+  app.add_option("--out", out, "folder for oblique.md and oblique.csv");
+  app.add_option("--frames", frames, "frames per run (0.25 s of animation apart)");
+  app.add_option("--repeats", repeats, "runs; times are medians per run, the table their median and min–max");
+  CLI11_PARSE(app, argc, argv);
+
+  try {
+    auto loaded = config::load_installation(config_path);
+    if (!loaded) throw std::runtime_error(loaded.error());
+    const auto& installation = loaded.value().installation;
+    if (installation.viewer().eye().empty()) throw std::runtime_error("the bench needs a fixed viewer eye");
+    auto scene = scene::load_scene(installation.scene(), loaded.value().directory);
+    if (!scene) throw std::runtime_error(scene.error());
+    const auto& definition = scene.value().definition;
+    auto context = render::make_headless_context();
+    if (!context) throw std::runtime_error(context.error());
+    const std::string gl = context.value()->renderer_name();
+
+    std::filesystem::create_directories(out);
+    std::ofstream csv(out + "/oblique.csv");
+    csv << "renderer,projector,run,frame,single_ms,two_ms,two_equal_ms,single_psnr_db,two_psnr_db,two_equal_psnr_db\n";
+    std::ostringstream table;
+    table << "| projector | k | method | texture | frame ms | time ratio to single | PSNR dB |\n"
+          << "|---|---:|---|---|---:|---:|---:|\n";
+    for (const auto& projector : installation.projectors()) {
+      const config::Screen* screen = nullptr;
+      for (const auto& s : installation.screens()) {
+        if (s.id() == projector.screen()) screen = &s;
+      }
+      auto geometry = config::projector_geometry(projector);
+      if (!geometry || screen == nullptr) throw std::runtime_error(projector.id() + ": no geometry");
+      const optics::ScreenRect usable = config::usable_area(*screen);
+      Method single = make_method(definition, *screen, geometry.value(), render::RenderMethod::single_pass);
+      Method two = make_method(definition, *screen, geometry.value(), render::RenderMethod::two_pass);
+      // Two passes with as many texels as the projector has pixels: less work, more blur.
+      const optics::ScreenRect& r = two.view.oblique().bounds;
+      const double equal_density = std::sqrt(static_cast<double>(geometry.value().width()) * geometry.value().height() /
+                                             (r.width() * r.height()));
+      Method two_equal =
+          make_method(definition, *screen, geometry.value(), render::RenderMethod::two_pass, equal_density);
+      const std::vector<bool> inside = usable_pixels(geometry.value(), usable);
+      const glm::dmat3 scale(kSupersample, 0.0, 0.0, 0.0, kSupersample, 0.0, 0.0, 0.0, 1.0);
+      auto fine_geometry = optics::ProjectorGeometry::make(scale * geometry.value().screen_to_pixel(),
+                                                           kSupersample * geometry.value().width(),
+                                                           kSupersample * geometry.value().height());
+      if (!fine_geometry) throw std::runtime_error(fine_geometry.error());
+      Method reference = make_method(definition, *screen, fine_geometry.value(), render::RenderMethod::single_pass);
+
+      std::vector<double> single_medians, two_medians, equal_medians, ratios, equal_ratios, single_psnrs, two_psnrs,
+          equal_psnrs;
+      for (int run = 0; run < repeats; ++run) {
+        std::vector<double> single_ms, two_ms, equal_ms;
+        for (int k = -2; k < frames; ++k) {  // two unmeasured frames first
+          const auto state = state_at(definition, installation.viewer(), 0.25 * std::max(k, 0));
+          // Rotate which goes first, so none always follows another.
+          std::array<Method*, 3> order{&single, &two, &two_equal};
+          std::rotate(order.begin(), order.begin() + (k + 3) % 3, order.end());
+          std::map<Method*, double> ms;
+          for (Method* m : order) ms[m] = draw(*m, state, installation.viewer());
+          if (k < 0) continue;
+          single_ms.push_back(ms[&single]);
+          two_ms.push_back(ms[&two]);
+          equal_ms.push_back(ms[&two_equal]);
+          std::array<double, 3> psnr{};
+          if (run == 0) {  // the images do not change between runs
+            draw(reference, state, installation.viewer());
+            const image::FloatImage ideal = box_down(reference.renderer->read_linear(), kSupersample);
+            psnr = {psnr_luma(single.renderer->read_linear(), ideal, inside),
+                    psnr_luma(two.renderer->read_linear(), ideal, inside),
+                    psnr_luma(two_equal.renderer->read_linear(), ideal, inside)};
+            single_psnrs.push_back(psnr[0]);
+            two_psnrs.push_back(psnr[1]);
+            equal_psnrs.push_back(psnr[2]);
+          }
+          csv << '"' << gl << "\"," << projector.id() << ',' << run << ',' << k << ',' << ms[&single] << ',' << ms[&two]
+              << ',' << ms[&two_equal];
+          for (double p : psnr) csv << ',' << (run == 0 ? std::to_string(p) : "");
+          csv << '\n';
+        }
+        const double sm = metrics::summarize(single_ms).median();
+        single_medians.push_back(sm);
+        two_medians.push_back(metrics::summarize(two_ms).median());
+        equal_medians.push_back(metrics::summarize(equal_ms).median());
+        ratios.push_back(two_medians.back() / sm);
+        equal_ratios.push_back(equal_medians.back() / sm);
+      }
+      auto row = [&](const char* method, const Method& m, const std::vector<double>& times,
+                     const std::vector<double>& ratio, const std::vector<double>& psnrs) {
+        char k[32];
+        std::snprintf(k, sizeof k, "%.3f", single.view.oblique().depth_scale);
+        table << "| " << projector.id() << " | " << k << " | " << method << " | "
+              << (m.view.method() == render::RenderMethod::two_pass
+                      ? std::to_string(m.view.render_width()) + "×" + std::to_string(m.view.render_height())
+                      : std::string("–"))
+              << " | " << bench::cell(bench::spread(times), 2) << " | "
+              << (ratio.empty() ? std::string("1") : bench::cell(bench::spread(ratio), 2)) << " | "
+              << bench::cell(bench::spread(psnrs), 1) << " |\n";
+      };
+      row("single pass", single, single_medians, {}, single_psnrs);
+      row("two passes, texels at the densest pixel pitch", two, two_medians, ratios, two_psnrs);
+      row("two passes, as many texels as pixels", two_equal, equal_medians, equal_ratios, equal_psnrs);
+    }
+    std::ofstream md(out + "/oblique.md");
+    md << "Single pass vs two passes on " << gl << ", " << config_path.substr(config_path.rfind('/') + 1) << ", "
+       << frames << " frames × " << repeats
+       << " runs, alternating. Times: median per run, then median (min–max) over runs; ratio per run. PSNR (luma, "
+          "linear light, over the screen's usable area) against the 4×-supersampled image of the same projector: "
+          "median (min–max) over frames.\n\n"
+       << table.str();
+    std::cout << "renderer: " << gl << "\n" << table.str();
+  } catch (const std::exception& e) {
+    std::cerr << "optique-bench-oblique: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

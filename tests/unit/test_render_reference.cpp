@@ -1,0 +1,91 @@
+// render-reference with a supersample factor: the same raster, each pixel the
+// average of S × S samples. Needs GL (headless; llvmpipe in CI): label `gpu`.
+
+#include "render_reference.h"
+
+#include <gtest/gtest.h>
+#include <spdlog/sinks/null_sink.h>
+#include <stdlib.h>
+
+#include <filesystem>
+
+#include "image/compare.h"
+#include "image/frame_files.h"
+#include "image/image_io.h"
+#include "optics/compose.h"
+
+namespace optique::master {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Rendered {
+  image::FloatImage linear;
+  image::FloatImage encoded;
+};
+
+Rendered render(int supersample) {
+  auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
+  EXPECT_TRUE(config.ok()) << config.error();
+  auto scene = scene::load_scene(config.value().installation.scene(), config.value().directory);
+  EXPECT_TRUE(scene.ok()) << scene.error();
+  std::string dir = (fs::temp_directory_path() / "optique-reference-XXXXXX").string();
+  EXPECT_NE(mkdtemp(dir.data()), nullptr);
+  spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
+  ReferenceOptions options;
+  options.supersample = supersample;
+  auto written = render_reference(config.value(), scene.value(), 30, dir, log, options);
+  EXPECT_TRUE(written.ok()) << written.error();
+  const std::string folder = dir + "/reference/front";
+  auto linear = image::read_image(image::frame_path(folder, 30, "exr"));
+  auto encoded = image::read_image(image::frame_path(folder, 30, "png"));
+  EXPECT_TRUE(linear.ok() && encoded.ok());
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  if (!linear.ok() || !encoded.ok()) return {};
+  return {std::move(linear).value(), std::move(encoded).value()};
+}
+
+TEST(RenderReference, SupersampledHasTheScreensPixelsAndAveragesThem) {
+  const Rendered one = render(1);
+  const Rendered four = render(4);
+  ASSERT_FALSE(one.linear.empty());
+  ASSERT_FALSE(four.linear.empty());
+  // single-wall: 4 m × 2.25 m at 160 px/m.
+  EXPECT_EQ(four.linear.width, 640);
+  EXPECT_EQ(four.linear.height, 360);
+  EXPECT_EQ(one.linear.width, 640);
+  // Same picture, edges antialiased: close but not identical.
+  auto comparison = image::compare(one.linear, four.linear);
+  ASSERT_TRUE(comparison.ok()) << comparison.error();
+  std::printf("1×1 vs 4×4 samples: PSNR luma %.1f dB, max |Δ| %.3f\n", comparison.value().psnr_luma,
+              comparison.value().max_abs_error);
+  EXPECT_GT(comparison.value().psnr_luma, 25.0);
+  EXPECT_GT(comparison.value().max_abs_error, 0.05);
+  // The PNG is the sRGB encoding of the averaged linear image (to the EXR's
+  // half-float rounding).
+  const image::ByteImage expected = optics::encode_srgb(four.linear);
+  int off = 0;
+  for (int y = 0; y < four.encoded.height; ++y) {
+    for (int x = 0; x < four.encoded.width; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        off += std::abs(four.encoded.at(x, y, c) * 255.0f - expected.at(x, y, c)) > 1.01f ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_EQ(off, 0);
+}
+
+TEST(RenderReference, RefusesAZeroFactor) {
+  auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
+  ASSERT_TRUE(config.ok()) << config.error();
+  auto scene = scene::load_scene(config.value().installation.scene(), config.value().directory);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
+  auto written = render_reference(config.value(), scene.value(), 0, "/nonexistent", log, ReferenceOptions{0});
+  ASSERT_FALSE(written.ok());
+  EXPECT_NE(written.error().find("supersample"), std::string::npos) << written.error();
+}
+
+}  // namespace
+}  // namespace optique::master
