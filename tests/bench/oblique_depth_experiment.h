@@ -63,7 +63,7 @@ struct Projector {
   double throw_ratio = 0.0;
   glm::dmat3 screen_to_pixel{1.0};  // H
   render::ProjectorView view;
-  // Ours: A normalized so that w ∈ [k, 1] over the lit quad, third row k.
+  // Ours: A normalized so that w ∈ [k, 1] over the lit quad within the wall, third row k.
   double k = 0.0;
   // Eq. 5: A with a33 = 1, third row 1 − |a31| − |a32| (≤ 0: the method has no
   // valid depth for this projector).

@@ -122,7 +122,7 @@ TEST_F(ObliqueDepthTest, TenthOfAMillimetreKeepsMarginWhereEquationFivePops) {
   EXPECT_GT(paper.errors, paper.front_pixels / 10);
 }
 
-// Ours bounds w over the lit quad, eq. 5 over R's corners; in this setup R's
+// Ours bounds w over the lit quad within the wall, eq. 5 over R's corners; in this setup R's
 // unlit corner crosses the projector's horizon before the image does.
 TEST_F(ObliqueDepthTest, DepthScaleStaysPositiveWhereEquationFiveFactorDoesNot) {
   double smallest_paper_factor = 1.0;

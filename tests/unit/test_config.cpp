@@ -449,5 +449,110 @@ TEST(ApplyDefaults, KeepsGivenValuesAndFillsTheRest) {
   EXPECT_DOUBLE_EQ(inst.projectors(0).region().height(), 1.5);
 }
 
+// ------------------------------------------------------------- projector geometry
+
+namespace geometry_tests {
+
+// A keystoned front projector and a second one related to it through a camera:
+// projector pixels → camera pixels for each.
+const char* const kFirstH = "[300, 20, 10,  -5, -290, 600,  0.02, 0.05, 1]";
+const char* const kFirstCamera = "[0.9, 0.05, 40,  0.02, 1.1, 30,  0.0001, 0.0002, 1]";
+const char* const kSecondCamera = "[1.2, -0.03, -500,  0.01, 1.0, 20,  0.0002, -0.0001, 1]";
+
+std::string two_through_a_camera(const std::string& second_extra = "") {
+  return with(R"({"id": "p-front", "width": 640, "height": 320, "screen": "front"})",
+              std::string(R"({"id": "p-front", "width": 640, "height": 320, "screen": "front", "homography": )") +
+                  kFirstH + R"(, "camera": {"camera": "cam", "homography": )" + kFirstCamera +
+                  R"(}}, {"id": "p-front-2", "width": 640, "height": 320, "screen": "front", "camera": {"camera": )" +
+                  R"("cam", "homography": )" + kSecondCamera + "}" + second_extra + "}");
+}
+
+glm::dvec2 through(const glm::dmat3& m, const glm::dvec2& p) {
+  const glm::dvec3 q = m * glm::dvec3(p, 1.0);
+  return glm::dvec2(q) / q.z;
+}
+
+glm::dmat3 rows(const std::vector<double>& nine) {
+  return optics::homography_from_rows(std::span<const double, 9>(nine.data(), 9));
+}
+
+TEST(ProjectorGeometry, ACameraViewRelatesAPartnerToTheScreen) {
+  auto parsed = parse(two_through_a_camera());
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  const auto& first = parsed.value().projectors(0);
+  const auto& second = parsed.value().projectors(1);
+  ASSERT_EQ(second.id(), "p-front-2");
+  ASSERT_EQ(second.homography_size(), 9);
+  const glm::dmat3 h1 = rows({first.homography().begin(), first.homography().end()});
+  const glm::dmat3 h2 = rows({second.homography().begin(), second.homography().end()});
+  const glm::dmat3 a1c = rows({0.9, 0.05, 40, 0.02, 1.1, 30, 0.0001, 0.0002, 1});
+  const glm::dmat3 a2c = rows({1.2, -0.03, -500, 0.01, 1.0, 20, 0.0002, -0.0001, 1});
+  // A screen point seen by the camera through either projector is the same
+  // camera pixel: A2c · H2 ≅ A1c · H1.
+  for (const glm::dvec2 s : {glm::dvec2(0.5, 0.5), glm::dvec2(1.5, 1.2), glm::dvec2(1.0, 0.2)}) {
+    const glm::dvec2 via_first = through(a1c, through(h1, s));
+    const glm::dvec2 via_second = through(a2c, through(h2, s));
+    EXPECT_NEAR(via_first.x, via_second.x, 1e-9);
+    EXPECT_NEAR(via_first.y, via_second.y, 1e-9);
+  }
+}
+
+TEST(ProjectorGeometry, ACameraViewWithoutAPartnerIsRefused) {
+  std::string json = two_through_a_camera();
+  json = replaced(json, R"("camera": {"camera": "cam", "homography": [0.9)",
+                  R"("camera": {"camera": "other", "homography": [0.9)");
+  auto parsed = parse(json);
+  ASSERT_FALSE(parsed.ok());
+  expect_problem(parsed, "projectors[1].camera", {"camera 'cam'", "no projector"});
+}
+
+TEST(ProjectorGeometry, RegionAndHomographyTogetherAreRefused) {
+  auto parsed =
+      parse(with(R"("screen": "floor",)", R"("screen": "floor", "homography": [1, 0, 0, 0, 1, 0, 0, 0, 1],)"));
+  ASSERT_FALSE(parsed.ok());
+  expect_problem(parsed, "projectors[1].region", {"takes no region"});
+}
+
+TEST(ProjectorGeometry, AHomographyNeedsNineFiniteNumbers) {
+  auto parsed = parse(with(R"("screen": "front"})", R"("screen": "front", "homography": [1, 0, 0, 0, 1, 0, 0, 0]})"));
+  ASSERT_FALSE(parsed.ok());
+  expect_problem(parsed, "projectors[0].homography", {"9 numbers", "got 8"});
+}
+
+TEST(ProjectorGeometry, AProjectorThatMissesItsScreenIsRefused) {
+  // Pixels land 100 m to the right of the 4 m screen.
+  auto parsed = parse(
+      with(R"("screen": "front"})", R"("screen": "front", "homography": [100, 0, -10000, 0, -100, 200, 0, 0, 1]})"));
+  ASSERT_FALSE(parsed.ok());
+  expect_problem(parsed, "projectors[0]", {"misses the screen"});
+}
+
+TEST(ProjectorGeometry, AHorizonThroughTheImageIsRefused) {
+  // w of H⁻¹ changes sign across the image: some pixels would land at infinity.
+  auto parsed =
+      parse(with(R"("screen": "front"})", R"("screen": "front", "homography": [100, 0, 0, 0, 100, 0, 0, 1, -1]})"));
+  ASSERT_FALSE(parsed.ok());
+  expect_problem(parsed, "projectors[0].homography", {"horizon"});
+}
+
+TEST(ProjectorGeometry, ACalibrationFileIsReadIntoTheHomography) {
+  const std::string file = test_dir() + "/front.calibration.json";
+  std::ofstream(file) << R"({"homography": [[160, 0, 0], [0, -160, 320], [0, 0, 1]], "rms_px": 0.1})";
+  auto parsed = parse(with(R"("screen": "front"})", R"("screen": "front", "calibration": "front.calibration.json"})"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  const auto& p = parsed.value().projectors(0);
+  EXPECT_TRUE(p.calibration().empty());  // the installation now carries the matrix itself
+  ASSERT_EQ(p.homography_size(), 9);
+  EXPECT_DOUBLE_EQ(p.homography(0), 160.0);
+  EXPECT_DOUBLE_EQ(p.homography(5), 320.0);
+
+  std::ofstream(file) << R"({"homography": [[160, 0], [0, -160, 320], [0, 0, 1]]})";
+  auto broken = parse(with(R"("screen": "front"})", R"("screen": "front", "calibration": "front.calibration.json"})"));
+  ASSERT_FALSE(broken.ok());
+  expect_problem(broken, "projectors[0].calibration", {"homography[0]", "3 numbers"});
+}
+
+}  // namespace geometry_tests
+
 }  // namespace
 }  // namespace optique::config
