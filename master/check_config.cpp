@@ -1,9 +1,34 @@
 #include "check_config.h"
 
+#include <iomanip>
 #include <map>
 #include <sstream>
 
+#include "config/geometry.h"
+
 namespace optique::master {
+namespace {
+
+// Where a calibrated projector lands: the lit quad's bounding box on the screen,
+// and what the single pass keeps of the depth range.
+std::string keystoned_summary(const config::Installation& inst, const config::Projector& p) {
+  auto geometry = config::projector_geometry(p);
+  if (!geometry) return "(" + geometry.error() + ")";
+  for (const auto& screen : inst.screens()) {
+    if (screen.id() != p.screen()) continue;
+    auto oblique = optics::oblique_projection(geometry.value(), config::usable_area(screen));
+    if (!oblique) return "(" + oblique.error() + ")";
+    const auto& b = oblique.value().bounds;
+    std::ostringstream text;
+    text << std::setprecision(3) << "keystoned, lights (within the screen) [" << b.min.x << ", " << b.min.y << "] – ["
+         << b.max.x << ", " << b.max.y << "] m, " << (p.rendering().empty() ? "single-pass" : p.rendering())
+         << " (depth scale " << oblique.value().depth_scale << ")";
+    return text.str();
+  }
+  return "(unknown screen)";
+}
+
+}  // namespace
 
 std::string summarize(const config::LoadedConfig& config) {
   const auto& inst = config.installation;
@@ -20,10 +45,14 @@ std::string summarize(const config::LoadedConfig& config) {
   }
   out << "  projectors (" << inst.projectors_size() << "):\n";
   for (const auto& p : inst.projectors()) {
-    const auto& r = p.region();
-    out << "    " << p.id() << ": " << p.width() << "×" << p.height() << " px on " << p.screen() << " [" << r.x()
-        << ", " << r.y() << "] + " << r.width() << " × " << r.height() << " m, host " << p.host() << ", "
-        << p.output().kind() << ", eye " << p.eye() << "\n";
+    out << "    " << p.id() << ": " << p.width() << "×" << p.height() << " px on " << p.screen() << " ";
+    if (p.homography().empty()) {
+      const auto& r = p.region();
+      out << "[" << r.x() << ", " << r.y() << "] + " << r.width() << " × " << r.height() << " m";
+    } else {
+      out << keystoned_summary(inst, p);
+    }
+    out << ", host " << p.host() << ", " << p.output().kind() << ", eye " << p.eye() << "\n";
   }
   const auto& v = inst.viewer();
   out << "  viewer: ";
