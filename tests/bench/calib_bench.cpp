@@ -20,10 +20,12 @@
 #include "calib/fit.h"
 #include "clock/clock.h"
 #include "image/image_io.h"
+#include "plot.h"
 #include "spread.h"
 
 namespace {
 
+using optique::bench::Plot;
 using namespace optique;
 
 constexpr double kSigma = 0.5;
@@ -121,59 +123,6 @@ Sample run_repeat(const testing::PinholeProjector& p, const Case& c, Method m, i
   return s;
 }
 
-// A small line plot, drawn by hand into an RGB image: no labels (the Markdown
-// says what the axes are), log–log, one colour per method.
-class Plot {
- public:
-  Plot(int width, int height) : image_(width, height, 3) {
-    std::fill(image_.pixels.begin(), image_.pixels.end(), std::uint8_t{255});
-  }
-
-  // A panel at (x0, y0) of size w × h with log axes over [x_lo, x_hi] × [y_lo, y_hi].
-  struct Panel {
-    int x0, y0, w, h;
-    double x_lo, x_hi, y_lo, y_hi;
-    [[nodiscard]] glm::dvec2 at(double x, double y) const {
-      const double u = (std::log10(x) - std::log10(x_lo)) / (std::log10(x_hi) - std::log10(x_lo));
-      const double v = (std::log10(y) - std::log10(y_lo)) / (std::log10(y_hi) - std::log10(y_lo));
-      return {x0 + u * w, y0 + h - v * h};
-    }
-  };
-
-  void frame(const Panel& p) {
-    const glm::u8vec3 grid(220, 220, 220);
-    for (double d = std::pow(10.0, std::floor(std::log10(p.y_lo))); d <= p.y_hi; d *= 10.0) {
-      if (d < p.y_lo) continue;
-      line(p.at(p.x_lo, d), p.at(p.x_hi, d), grid, 1);
-    }
-    for (const double n : {4.0, 20.0, 200.0}) line(p.at(n, p.y_lo), p.at(n, p.y_hi), grid, 1);
-    const glm::u8vec3 black(0, 0, 0);
-    line({p.x0, p.y0}, {p.x0, p.y0 + p.h}, black, 1);
-    line({p.x0, p.y0 + p.h}, {p.x0 + p.w, p.y0 + p.h}, black, 1);
-  }
-
-  void line(glm::dvec2 a, glm::dvec2 b, glm::u8vec3 colour, int thickness) {
-    const int steps = static_cast<int>(std::ceil(std::max(std::abs(b.x - a.x), std::abs(b.y - a.y)))) + 1;
-    for (int i = 0; i <= steps; ++i) dot(a + (b - a) * (static_cast<double>(i) / steps), colour, thickness);
-  }
-
-  void dot(glm::dvec2 c, glm::u8vec3 colour, int radius) {
-    for (int dy = -radius; dy <= radius; ++dy) {
-      for (int dx = -radius; dx <= radius; ++dx) {
-        const int x = static_cast<int>(std::lround(c.x)) + dx;
-        const int y = static_cast<int>(std::lround(c.y)) + dy;
-        if (x < 0 || y < 0 || x >= image_.width || y >= image_.height) continue;
-        for (int k = 0; k < 3; ++k) image_.at(x, y, k) = colour[k];
-      }
-    }
-  }
-
-  [[nodiscard]] const image::ByteImage& image() const { return image_; }
-
- private:
-  image::ByteImage image_;
-};
-
 glm::u8vec3 colour_of(Method m) {
   switch (m) {
     case Method::kDlt:
@@ -257,8 +206,8 @@ int main(int argc, char** argv) {
   Plot plot(960, 400);
   const Plot::Panel time_panel{50, 30, 400, 330, 3.0, 260.0, 1.0, 1e4};
   const Plot::Panel error_panel{530, 30, 400, 330, 3.0, 260.0, 0.5, 500.0};
-  plot.frame(time_panel);
-  plot.frame(error_panel);
+  plot.frame(time_panel, {4.0, 20.0, 200.0});
+  plot.frame(error_panel, {4.0, 20.0, 200.0});
   plot.line(error_panel.at(3.0, 1.0), error_panel.at(260.0, 1.0), {120, 120, 120}, 1);
   const auto draw = [&](const Plot::Panel& panel, const std::vector<Point>& curve, bool time, glm::u8vec3 colour) {
     const auto at = [&](const Point& p) {
