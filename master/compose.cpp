@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "config/defaults.h"
 #include "config/geometry.h"
+#include "image/convert.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
 #include "optics/blend.h"
@@ -19,24 +19,21 @@ struct Group {
   std::vector<const config::Projector*> projectors;
 };
 
+// The blend groups, in the order their first projector appears.
 std::vector<Group> groups_of(const config::Installation& installation) {
   std::vector<Group> groups;
-  for (const config::Screen& screen : installation.screens()) {
-    for (const char* eye : {"mono", "left", "right"}) {
-      Group group{&screen, eye, {}};
-      for (const config::Projector& p : installation.projectors()) {
-        // An installation straight from the parser (no defaults) leaves mono empty.
-        const std::string own = p.eye().empty() ? std::string("mono") : p.eye();
-        if (p.screen() == screen.id() && own == eye) group.projectors.push_back(&p);
-      }
-      if (!group.projectors.empty()) groups.push_back(std::move(group));
+  for (const config::Projector& p : installation.projectors()) {
+    auto group = std::find_if(groups.begin(), groups.end(),
+                              [&](const Group& g) { return config::same_blend_group(*g.projectors.front(), p); });
+    if (group != groups.end()) {
+      group->projectors.push_back(&p);
+      continue;
+    }
+    for (const config::Screen& screen : installation.screens()) {
+      if (screen.id() == p.screen()) groups.push_back({&screen, p.eye(), {&p}});
     }
   }
   return groups;
-}
-
-double pixels_per_metre(const config::Screen& screen) {
-  return screen.pixels_per_metre() > 0.0 ? screen.pixels_per_metre() : config::defaults::kPixelsPerMetre;
 }
 
 std::string capture_path(const std::string& captures_dir, const config::Projector& projector, std::uint64_t frame) {
@@ -64,7 +61,7 @@ double covered_share(const std::vector<optics::ProjectorGeometry>& geometries, c
                      int height) {
   if (width <= 0 || height <= 0) return 0.0;
   const optics::BlendField field(geometries, config::usable_area(screen), 0.0);
-  const double ppm = pixels_per_metre(screen);
+  const double ppm = screen.pixels_per_metre();
   std::size_t lit = 0;
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
@@ -126,17 +123,17 @@ Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::ui
     for (std::size_t i = 0; i < geometries.size(); ++i) {
       projected.push_back({&geometries[i], &captures[i]});
       composed.subsamples =
-          std::max(composed.subsamples, optics::subsamples_for(geometries[i], pixels_per_metre(screen)));
+          std::max(composed.subsamples, optics::subsamples_for(geometries[i], screen.pixels_per_metre()));
     }
     optics::ComposeOptions options;
-    options.pixels_per_metre = pixels_per_metre(screen);
+    options.pixels_per_metre = screen.pixels_per_metre();
     const image::FloatImage linear = optics::compose_screen(projected, screen.width(), screen.height(), options);
     composed.width = linear.width;
     composed.height = linear.height;
     composed.covered = covered_share(geometries, screen, linear.width, linear.height);
 
     const std::string folder = (std::filesystem::path(out_dir) / "screens" / composed.folder).string();
-    if (auto written = image::write_frame(folder, frame, linear, optics::encode_srgb(linear)); !written) {
+    if (auto written = image::write_frame(folder, frame, linear, image::encode_srgb(linear)); !written) {
       return Error{"screen '" + screen.id() + "': " + written.error()};
     }
     composed.exr_path = image::frame_path(folder, frame, "exr");

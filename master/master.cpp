@@ -7,6 +7,7 @@
 #include <fstream>
 #include <random>
 
+#include "config/geometry.h"
 #include "net/envelope.h"
 
 namespace optique::master {
@@ -284,9 +285,7 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
     if (screen.id() == target.projector->screen()) *welcome.mutable_screen() = screen;
   }
   for (const auto& other : installation.projectors()) {
-    if (other.screen() == target.projector->screen() && other.eye() == target.projector->eye()) {
-      *welcome.add_blend_group() = other;
-    }
+    if (config::same_blend_group(other, *target.projector)) *welcome.add_blend_group() = other;
   }
   *welcome.mutable_viewer() = installation.viewer();
   *welcome.mutable_scene() = installation.scene();

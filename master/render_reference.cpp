@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "image/convert.h"
 #include "image/frame_files.h"
 #include "optics/compose.h"
 #include "render/gl_context.h"
@@ -26,8 +27,9 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
   if (!context) return Error{"cannot render: " + context.error()};
   const auto& viewer = installation.viewer();
   for (const auto& screen : installation.screens()) {
-    const int width = static_cast<int>(std::lround(screen.width() * screen.pixels_per_metre()));
-    const int height = static_cast<int>(std::lround(screen.height() * screen.pixels_per_metre()));
+    // The composite's raster, so the two compare pixel for pixel.
+    const int width = optics::screen_pixels(screen.width(), screen.pixels_per_metre());
+    const int height = optics::screen_pixels(screen.height(), screen.pixels_per_metre());
     auto renderer = render::SceneRenderer::create(scene.definition, width * s, height * s);
     if (!renderer) return Error{"screen '" + screen.id() + "': " + renderer.error()};
     auto frustum = render::off_axis_frustum(render::whole_screen(screen), state.eye_now, viewer.near(), viewer.far());
@@ -39,8 +41,8 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
     if (s == 1) {
       written = image::write_frame(folder, frame, renderer.value()->read_linear(), renderer.value()->read_encoded());
     } else {
-      const image::FloatImage linear = optics::box_downsample(renderer.value()->read_linear(), s);
-      written = image::write_frame(folder, frame, linear, optics::encode_srgb(linear));
+      const image::FloatImage linear = image::box_downsample(renderer.value()->read_linear(), s);
+      written = image::write_frame(folder, frame, linear, image::encode_srgb(linear));
     }
     if (!written) return written;
     log.info("screen '{}': {}×{} px ({}×{} samples per pixel) → {}", screen.id(), width, height, s, s,

@@ -27,6 +27,8 @@ const Screen* screen_of(const Installation& installation, const Projector& proje
 
 }  // namespace
 
+bool same_blend_group(const Projector& a, const Projector& b) { return a.screen() == b.screen() && a.eye() == b.eye(); }
+
 optics::ScreenRect usable_area(const Screen& screen) {
   return optics::ScreenRect{glm::dvec2(0.0), glm::dvec2(screen.width(), screen.height())};
 }
@@ -48,7 +50,6 @@ std::vector<Problem> resolve_geometry(Installation& installation, const std::str
   std::vector<Problem> problems;
   auto at = [](int i) { return "projectors[" + std::to_string(i) + "]"; };
   // Direct geometry first; camera-only projectors then take theirs from a partner.
-  std::vector<bool> known(static_cast<std::size_t>(installation.projectors_size()), false);
   for (int i = 0; i < installation.projectors_size(); ++i) {
     Projector& p = *installation.mutable_projectors(i);
     if (!p.calibration().empty()) {
@@ -60,10 +61,11 @@ std::vector<Problem> resolve_geometry(Installation& installation, const std::str
       store(p, h.value());
       p.clear_calibration();  // the installation now carries it, for nodes and for writing it back
     }
-    known[static_cast<std::size_t>(i)] = !p.homography().empty() || p.has_region();
   }
   for (int i = 0; i < installation.projectors_size(); ++i) {
-    if (known[static_cast<std::size_t>(i)]) continue;
+    // Validation allows a camera view without a region only; defaults gave every
+    // projector with nothing at all a region.
+    if (!installation.projectors(i).homography().empty() || !installation.projectors(i).has_camera()) continue;
     Projector& p = *installation.mutable_projectors(i);
     const Projector* partner = nullptr;
     for (int j = 0; j < installation.projectors_size(); ++j) {

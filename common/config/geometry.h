@@ -19,6 +19,10 @@ namespace optique::config {
 // part of its screen. Runs on a validated installation with defaults applied.
 [[nodiscard]] std::vector<Problem> resolve_geometry(Installation& installation, const std::string& config_dir);
 
+// Whether two projectors light the same screen for the same eye: their overlaps
+// are blended, and the screen simulator composes them into one image.
+[[nodiscard]] bool same_blend_group(const Projector& a, const Projector& b);
+
 // The screen area that is shown: the whole screen rectangle.
 [[nodiscard]] optics::ScreenRect usable_area(const Screen& screen);
 

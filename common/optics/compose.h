@@ -45,14 +45,4 @@ struct ComposeOptions {
 [[nodiscard]] image::FloatImage compose_screen(std::span<const ProjectedImage> projectors, double width, double height,
                                                const ComposeOptions& options);
 
-// Helpers for comparing composites with reference renders.
-
-// The sRGB transfer function, as the renderer's encoding pass applies it (RGB
-// clamped to [0, 1], rounded to 8 bits; alpha 255): for PNGs of linear images.
-[[nodiscard]] image::ByteImage encode_srgb(const image::FloatImage& linear);
-
-// Averages each `factor` × `factor` block (box filter, linear light). The size
-// must be a multiple of `factor`.
-[[nodiscard]] image::FloatImage box_downsample(const image::FloatImage& image, int factor);
-
 }  // namespace optique::optics

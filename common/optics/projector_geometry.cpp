@@ -8,13 +8,12 @@
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 
+#include "calib/homography.h"
+
 namespace optique::optics {
 namespace {
 
-glm::dvec2 apply(const glm::dmat3& m, const glm::dvec2& p) {
-  const glm::dvec3 q = m * glm::dvec3(p, 1.0);
-  return glm::dvec2(q) / q.z;
-}
+using calib::apply;
 
 bool all_finite(const glm::dmat3& m) {
   for (int c = 0; c < 3; ++c) {

@@ -180,10 +180,6 @@ struct SceneRenderer::Gl {
   GLuint weights = 0;
   int output_width = 0;
   int output_height = 0;
-  std::optional<glm::dmat3> projector_to_user;
-  struct {
-    GLint warp, projector_to_user, output_size, has_weights;
-  } encode_uniforms{};
   std::vector<GLuint> scene_textures;  // by index in the scene's textures
   std::vector<MeshRange> meshes;
   std::vector<scene::Material> materials;
@@ -226,9 +222,6 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   auto encode_program = link(kFullscreenVertex, kEncodeFragment);
   if (!encode_program) return Error{encode_program.error()};
   gl->encode_program = encode_program.value();
-  gl->encode_uniforms = {
-      glGetUniformLocation(gl->encode_program, "warp"), glGetUniformLocation(gl->encode_program, "projector_to_user"),
-      glGetUniformLocation(gl->encode_program, "output_size"), glGetUniformLocation(gl->encode_program, "has_weights")};
   const GLuint p = gl->scene_program;
   gl->uniforms = {glGetUniformLocation(p, "model_view_projection"),
                   glGetUniformLocation(p, "model"),
@@ -357,7 +350,15 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
   gl.weights = 0;
   gl.output_width = width;
   gl.output_height = height;
-  gl.projector_to_user = stage.projector_to_user;
+  // The output stage's uniforms stay with the program: set once here, not per frame.
+  const GLuint program = gl.encode_program;
+  glProgramUniform1i(program, glGetUniformLocation(program, "warp"), stage.projector_to_user ? 1 : 0);
+  const glm::mat3 to_user(stage.projector_to_user.value_or(glm::dmat3(1.0)));
+  glProgramUniformMatrix3fv(program, glGetUniformLocation(program, "projector_to_user"), 1, GL_FALSE,
+                            glm::value_ptr(to_user));
+  glProgramUniform2f(program, glGetUniformLocation(program, "output_size"), static_cast<float>(width),
+                     static_cast<float>(height));
+  glProgramUniform1i(program, glGetUniformLocation(program, "has_weights"), stage.weights.empty() ? 0 : 1);
 
   glCreateTextures(GL_TEXTURE_2D, 1, &gl.encoded_colour);
   glTextureStorage2D(gl.encoded_colour, 1, GL_RGBA8, width, height);
@@ -455,12 +456,6 @@ void SceneRenderer::encode() {
   glViewport(0, 0, gl.output_width, gl.output_height);
   glDisable(GL_DEPTH_TEST);
   glUseProgram(gl.encode_program);
-  const auto& u = gl.encode_uniforms;
-  glUniform1i(u.warp, gl.projector_to_user ? 1 : 0);
-  const glm::mat3 to_user(gl.projector_to_user.value_or(glm::dmat3(1.0)));
-  glUniformMatrix3fv(u.projector_to_user, 1, GL_FALSE, glm::value_ptr(to_user));
-  glUniform2f(u.output_size, static_cast<float>(gl.output_width), static_cast<float>(gl.output_height));
-  glUniform1i(u.has_weights, gl.weights != 0 ? 1 : 0);
   glBindTextureUnit(0, gl.linear_colour);
   if (gl.weights != 0) glBindTextureUnit(2, gl.weights);
   glBindVertexArray(gl.empty_vertex_array);

@@ -21,6 +21,7 @@
 #include "config/geometry.h"
 #include "config/load.h"
 #include "image/compare.h"
+#include "image/convert.h"
 #include "image/image_io.h"
 #include "metrics/distribution.h"
 #include "plot.h"
@@ -60,23 +61,6 @@ double draw(Method& m, const scene::SceneState& state, const config::Viewer& vie
   const clock::Nanos start = clock::monotonic_now();
   m.renderer->draw(state, 0.0, state.eye_now, frustum.value());
   return static_cast<double>(clock::monotonic_now() - start) / 1e6;
-}
-
-image::FloatImage box_down(const image::FloatImage& big, int factor) {
-  image::FloatImage small(big.width / factor, big.height / factor, big.channels);
-  const float scale = 1.0f / static_cast<float>(factor * factor);
-  for (int y = 0; y < small.height; ++y) {
-    for (int x = 0; x < small.width; ++x) {
-      for (int c = 0; c < big.channels; ++c) {
-        float sum = 0.0f;
-        for (int j = 0; j < factor; ++j) {
-          for (int i = 0; i < factor; ++i) sum += big.at(x * factor + i, y * factor + j, c);
-        }
-        small.at(x, y, c) = sum * scale;
-      }
-    }
-  }
-  return small;
 }
 
 // The pixels whose centre lands in the screen's usable area: outside it the
@@ -180,7 +164,7 @@ int main(int argc, char** argv) {
           std::array<double, 3> psnr{};
           if (run == 0) {  // the images do not change between runs
             draw(reference, state, installation.viewer());
-            const image::FloatImage ideal = box_down(reference.renderer->read_linear(), kSupersample);
+            const image::FloatImage ideal = image::box_downsample(reference.renderer->read_linear(), kSupersample);
             psnr = {psnr_luma(single.renderer->read_linear(), ideal, inside),
                     psnr_luma(two.renderer->read_linear(), ideal, inside),
                     psnr_luma(two_equal.renderer->read_linear(), ideal, inside)};

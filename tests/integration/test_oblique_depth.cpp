@@ -32,8 +32,8 @@ Placement yaw(double incidence) {
   return p;
 }
 
-// From the upper right, rolled 30°, 0.9 m away: the lit quad runs off the wall
-// and k falls to a few hundredths (the strongest compression of the sweep).
+// From the upper right, rolled 30°, 0.9 m away: the lit quad runs off the wall,
+// and the shown part is compressed to about a quarter of the depth range.
 Placement diagonal_rolled(double incidence) {
   Placement p = yaw(incidence);
   p.series = "diagonal-rolled";

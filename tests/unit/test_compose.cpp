@@ -9,6 +9,7 @@
 
 #include <glm/vec2.hpp>
 
+#include "image/convert.h"
 #include "keystoned_wall.h"
 #include "optics/blend.h"
 
@@ -360,7 +361,7 @@ TEST(EncodeSrgb, IsTheRenderersTransferFunction) {
     for (int k = 0; k < 3; ++k) linear.at(x, 0, k) = values[x];
     linear.at(x, 0, 3) = 0.25f;
   }
-  const image::ByteImage encoded = encode_srgb(linear);
+  const image::ByteImage encoded = image::encode_srgb(linear);
   ASSERT_EQ(encoded.channels, 4);
   EXPECT_EQ(encoded.at(0, 0, 0), 0);
   EXPECT_EQ(encoded.at(1, 0, 0), 255);
@@ -374,12 +375,12 @@ TEST(BoxDownsample, AveragesBlocks) {
   image::FloatImage image(4, 2, 1);
   const float values[] = {1, 2, 3, 4, 5, 6, 7, 8};
   std::copy(std::begin(values), std::end(values), image.pixels.begin());
-  const image::FloatImage half = box_downsample(image, 2);
+  const image::FloatImage half = image::box_downsample(image, 2);
   ASSERT_EQ(half.width, 2);
   ASSERT_EQ(half.height, 1);
   EXPECT_FLOAT_EQ(half.at(0, 0, 0), (1 + 2 + 5 + 6) / 4.0f);
   EXPECT_FLOAT_EQ(half.at(1, 0, 0), (3 + 4 + 7 + 8) / 4.0f);
-  EXPECT_EQ(box_downsample(image, 1).pixels, image.pixels);
+  EXPECT_EQ(image::box_downsample(image, 1).pixels, image.pixels);
 }
 
 }  // namespace

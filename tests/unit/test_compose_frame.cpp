@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "config/geometry.h"
+#include "image/convert.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
 #include "keystoned_wall.h"
@@ -96,7 +97,7 @@ void write_captures(const config::LoadedConfig& loaded, const std::string& captu
         linear.at(x, y, 3) = 1.0f;
       }
     }
-    ASSERT_TRUE(image::write_frame(captures + "/" + p.id(), kFrame, linear, optics::encode_srgb(linear)).ok());
+    ASSERT_TRUE(image::write_frame(captures + "/" + p.id(), kFrame, linear, image::encode_srgb(linear)).ok());
   }
 }
 
@@ -154,7 +155,7 @@ TEST(ComposeFrame, WritesOneCompositePerScreenAndEye) {
     EXPECT_NEAR(floor.value().at(50, 25, 1), level, 1e-3) << folder;
     auto png = image::read_image(image::frame_path(f.out + "/screens/" + folder, kFrame, "png"));
     ASSERT_TRUE(png.ok()) << png.error();
-    EXPECT_NEAR(png.value().at(50, 25, 1), optics::encode_srgb(floor.value()).at(50, 25, 1) / 255.0, 1e-6);
+    EXPECT_NEAR(png.value().at(50, 25, 1), image::encode_srgb(floor.value()).at(50, 25, 1) / 255.0, 1e-6);
   }
   // One log line per composite, naming its file.
   EXPECT_NE(f.log_text.str().find("screens/floor.right/frame-000007.png"), std::string::npos) << f.log_text.str();

@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "image/compare.h"
+#include "image/convert.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
 #include "optics/compose.h"
@@ -64,7 +65,7 @@ TEST(RenderReference, SupersampledHasTheScreensPixelsAndAveragesThem) {
   EXPECT_GT(comparison.value().max_abs_error, 0.05);
   // The PNG is the sRGB encoding of the averaged linear image (to the EXR's
   // half-float rounding).
-  const image::ByteImage expected = optics::encode_srgb(four.linear);
+  const image::ByteImage expected = image::encode_srgb(four.linear);
   int off = 0;
   for (int y = 0; y < four.encoded.height; ++y) {
     for (int x = 0; x < four.encoded.width; ++x) {
