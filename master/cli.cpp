@@ -18,6 +18,7 @@
 #include "log/logger.h"
 #include "master.h"
 #include "render_reference.h"
+#include "stacked_groups.h"
 
 namespace optique::master {
 namespace {
@@ -28,6 +29,8 @@ Result<std::pair<config::LoadedConfig, scene::LoadedScene>> load_config_and_scen
   if (!loaded) return Error{loaded.error()};
   auto scene = scene::load_scene(loaded.value().installation.scene(), loaded.value().directory);
   if (!scene) return Error{path + ": scene: " + scene.error()};
+  const auto problems = check_lighting_groups(loaded.value().installation, scene.value().definition.lights.size());
+  if (!problems.empty()) return Error{config::describe_problems(problems, path)};
   return std::pair{std::move(loaded).value(), std::move(scene).value()};
 }
 
@@ -129,7 +132,7 @@ int run_cli(int argc, char** argv) {
   compose->add_option("--frame", compose_frame_number, "a captured frame number")->required();
   compose->add_option("--out", compose_out, "writes OUT/screens/<screen-id>/frame-NNNNNN.exr and .png")->required();
   compose->add_option("--captures", compose_captures,
-                      "folder with <projector-id>/frame-NNNNNN.exr (default: OUT/nodes, where --local runs put them)");
+                      "folder with <projector-id>/frame-NNNNNN.png (default: OUT/nodes, where --local runs put them)");
 
   CalibrateOptions calibrate_options;
   auto* calibrate_command =

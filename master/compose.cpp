@@ -9,6 +9,8 @@
 #include "image/image_io.h"
 #include "optics/blend.h"
 #include "optics/compose.h"
+#include "optics/defocus.h"
+#include "optics/projector_model.h"
 
 namespace optique::master {
 namespace {
@@ -19,12 +21,12 @@ struct Group {
   std::vector<const config::Projector*> projectors;
 };
 
-// The blend groups, in the order their first projector appears.
+// The screen images (screen and eye), in the order their first projector appears.
 std::vector<Group> groups_of(const config::Installation& installation) {
   std::vector<Group> groups;
   for (const config::Projector& p : installation.projectors()) {
     auto group = std::find_if(groups.begin(), groups.end(),
-                              [&](const Group& g) { return config::same_blend_group(*g.projectors.front(), p); });
+                              [&](const Group& g) { return config::same_screen_image(*g.projectors.front(), p); });
     if (group != groups.end()) {
       group->projectors.push_back(&p);
       continue;
@@ -36,8 +38,10 @@ std::vector<Group> groups_of(const config::Installation& installation) {
   return groups;
 }
 
+// The signal the node sent its projector: the simulator turns it into light with
+// the projector's model, as the projector would.
 std::string capture_path(const std::string& captures_dir, const config::Projector& projector, std::uint64_t frame) {
-  return image::frame_path((std::filesystem::path(captures_dir) / projector.id()).string(), frame, "exr");
+  return image::frame_path((std::filesystem::path(captures_dir) / projector.id()).string(), frame, "png");
 }
 
 Result<image::FloatImage> read_capture(const std::string& path, const config::Projector& projector) {
@@ -53,7 +57,9 @@ Result<image::FloatImage> read_capture(const std::string& path, const config::Pr
     return Error{"projector '" + projector.id() + "': capture " + path + " has " + std::to_string(capture.channels) +
                  " channel(s); expected RGB or RGBA"};
   }
-  return capture;
+  auto model = optics::ProjectorModel::from_config(projector);
+  if (!model) return Error{"projector '" + projector.id() + "': " + model.error()};
+  return optics::emitted_image(capture, model.value());
 }
 
 // Share of the raster's pixel centres inside some projector's lit quad.
@@ -96,7 +102,7 @@ Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::ui
     if (missing.size() > 1) message += " (and " + std::to_string(missing.size() - 1) + " more)";
     message += "; was frame " + std::to_string(frame) +
                " captured? Run the cluster with --capture-every N so that frame " + std::to_string(frame) +
-               " is a multiple of N, and pass the folder that holds <projector-id>/frame-NNNNNN.exr";
+               " is a multiple of N, and pass the folder that holds <projector-id>/frame-NNNNNN.png";
     return Error{message};
   }
 
@@ -119,15 +125,30 @@ Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::ui
       captures.push_back(std::move(capture).value());
       composed.projectors.push_back(p->id());
     }
-    std::vector<optics::ProjectedImage> projected;
+    // Sharp projectors land together; a defocused one lands alone and its optics
+    // blur what it throws by its circle of confusion, in screen pixels.
+    std::vector<optics::ProjectedImage> sharp;
+    std::vector<std::pair<optics::ProjectedImage, double>> blurred;
     for (std::size_t i = 0; i < geometries.size(); ++i) {
-      projected.push_back({&geometries[i], &captures[i]});
+      const optics::ProjectedImage projected{&geometries[i], &captures[i]};
+      if (group.projectors[i]->content().role() == "defocus") {
+        blurred.emplace_back(projected, group.projectors[i]->content().blur_radius());
+      } else {
+        sharp.push_back(projected);
+      }
       composed.subsamples =
           std::max(composed.subsamples, optics::subsamples_for(geometries[i], screen.pixels_per_metre()));
     }
     optics::ComposeOptions options;
     options.pixels_per_metre = screen.pixels_per_metre();
-    const image::FloatImage linear = optics::compose_screen(projected, screen.width(), screen.height(), options);
+    image::FloatImage linear = optics::compose_screen(sharp, screen.width(), screen.height(), options);
+    for (const auto& [projected, radius] : blurred) {
+      const image::FloatImage thrown = optics::disc_blur(
+          optics::compose_screen(std::span(&projected, 1), screen.width(), screen.height(), options), radius);
+      for (std::size_t k = 0; k < linear.pixels.size(); ++k) {
+        if (k % 4 != 3) linear.pixels[k] += thrown.pixels[k];
+      }
+    }
     composed.width = linear.width;
     composed.height = linear.height;
     composed.covered = covered_share(geometries, screen, linear.width, linear.height);

@@ -39,7 +39,7 @@ struct ComposeSummary {
 // The folder name of a screen's composite for one eye ("mono" → the screen id).
 [[nodiscard]] std::string composite_folder(const std::string& screen_id, const std::string& eye);
 
-// Reads CAPTURES/<projector-id>/frame-NNNNNN.exr for every projector (as the
+// Reads CAPTURES/<projector-id>/frame-NNNNNN.png (the signal) for every projector (as the
 // nodes write them under OUT/nodes), composes each screen × eye group and writes
 // OUT_DIR/screens/<folder>/frame-NNNNNN.{exr,png}. Logs one line per composite.
 // Fails, naming the file, when a capture is missing (was the frame captured? run

@@ -44,7 +44,8 @@ Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
       housekeeping_timer_(io),
       heartbeat_timer_(io),
       status_(options_.status_line) {
-  for (const auto& projector : options_.config.installation.projectors()) slots_.push_back({&projector, nullptr});
+  for (const auto& projector : options_.config.installation.projectors())
+    slots_.push_back({&projector, nullptr, std::nullopt});
 }
 
 Master::~Master() = default;
@@ -55,6 +56,11 @@ Result<void> Master::start() {
   frame_period_ = authority_->frame_period();
   current_state_ = authority_->state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
+  light_plan_.emplace(installation, options_.scene.definition);
+  // Until nodes come, plan as if all were up: each node's welcome then carries a
+  // sensible share.
+  light_plan_->rebalance(std::vector<bool>(slots_.size(), true), current_state_, current_state_.eye_now, true);
+  focus_ = FocusSchedule::make(installation);
 
   std::vector<std::string> ids;
   for (const Slot& s : slots_) ids.push_back(s.projector->id());
@@ -294,6 +300,12 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
     welcome.mutable_scene()->set_gltf(options_.scene.source);
     welcome.set_scene_sha256(options_.scene.content_sha256);
   }
+  if (const LightShare* share = light_plan_->share(*slot)) {
+    welcome.mutable_lights()->mutable_lights()->Add(share->lights.begin(), share->lights.end());
+    welcome.mutable_lights()->set_ambient(share->ambient);
+    target.sent_share = *share;
+  }
+  if (installation.has_depth_of_field()) *welcome.mutable_depth_of_field() = installation.depth_of_field();
   welcome.set_frame_period_ns(frame_period_);
   welcome.set_heartbeat_ms(settings_.heartbeat_ms());
   welcome.set_liveness_timeout_ms(settings_.liveness_timeout_ms());
@@ -309,6 +321,7 @@ void Master::handle_configured(Session& session, const wire::Configured& configu
   send_resync(session);
   session.phase = Phase::joined;
   recorder_->node_joined(*session.slot);
+  rebalance_lights(true);
   log_.info("node '{}' joined from {} with {} ({}/{} up)", slot_id(*session.slot), session.connection->peer(),
             configured.renderer(), nodes_up(), slots_.size());
   if (state_ == RunState::starting && nodes_up() == slots_.size()) start_frames();
@@ -339,6 +352,7 @@ void Master::on_closed(const std::shared_ptr<Session>& session, const std::strin
       log_.debug("node '{}' closed: {}", slot_id(slot), reason);
     }
     std::erase(ready_for_swap_, slot);  // a node that is gone is not told to swap
+    if (state_ != RunState::closing && state_ != RunState::done) rebalance_lights(true);
     if (barrier_.active()) {
       barrier_.leave(slot);
       if (barrier_.complete()) swap();
@@ -379,6 +393,14 @@ void Master::begin_frame() {
   begin.set_capture(options_.capture_every != 0 && frame % options_.capture_every == 0);
   begin.set_present_time_ns(schedule_origin_ +
                             static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_);
+  if (focus_) {
+    *begin.mutable_focus() = focus_->at(static_cast<double>(begin.simulation_time_ns()) / 1e9,
+                                        options_.scene.definition, current_state_, current_state_.eye_now);
+  }
+  // The scene moves: about once a second, see whether another split of the
+  // automatic groups' lights would finish clearly sooner.
+  const auto frames_per_second = static_cast<std::uint64_t>(std::max(1.0, settings_.frame_rate()));
+  if (frame % frames_per_second == 0) rebalance_lights(false);
 
   std::vector<std::size_t> sent;
   std::vector<std::size_t> waited;
@@ -387,7 +409,21 @@ void Master::begin_frame() {
     const std::shared_ptr<Session> session = slots_[i].session;
     if (!session || session->phase == Phase::handshake || session->phase == Phase::configuring) continue;
     if (session->phase == Phase::joined) session->phase = Phase::in_barrier;
-    session->connection->send(envelope);
+    const LightShare* share = light_plan_->share(i);
+    if (share != nullptr && (!slots_[i].sent_share || slots_[i].sent_share->lights != share->lights ||
+                             slots_[i].sent_share->ambient != share->ambient)) {
+      // A new share applies from this frame on, on every node of the group at once.
+      wire::Envelope with_share = envelope;
+      auto& lights = *with_share.mutable_frame_begin()->mutable_lights();
+      lights.mutable_lights()->Add(share->lights.begin(), share->lights.end());
+      lights.set_ambient(share->ambient);
+      session->connection->send(with_share);
+      slots_[i].sent_share = *share;
+      log_.info("node '{}' draws lights [{}]{} from frame {}", slot_id(i), format_light_list(share->lights),
+                share->ambient ? " and ambient" : "", frame);
+    } else {
+      session->connection->send(envelope);
+    }
     sent.push_back(i);
     if (session->phase == Phase::in_barrier) waited.push_back(i);
   }
@@ -477,7 +513,7 @@ void Master::schedule_next_frame(clock::Nanos now) {
 }
 
 void Master::handle_presented(Session& session, const wire::Presented& presented) {
-  recorder_->presented(presented.frame_id(), *session.slot, presented.presented_ns());
+  recorder_->presented(presented.frame_id(), *session.slot, presented.presented_ns(), presented.content_frame_id());
 }
 
 // ---------------------------------------------------------------- stopping
@@ -593,6 +629,15 @@ void Master::write_outputs() {
 }
 
 // ---------------------------------------------------------------- periodic
+
+void Master::rebalance_lights(bool force) {
+  std::vector<bool> up(slots_.size(), false);
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    const auto& session = slots_[i].session;
+    up[i] = session && session->phase != Phase::handshake && session->phase != Phase::configuring;
+  }
+  light_plan_->rebalance(up, current_state_, current_state_.eye_now, force);
+}
 
 void Master::housekeeping() {
   if (launcher_) {

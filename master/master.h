@@ -17,11 +17,13 @@
 
 #include "barrier.h"
 #include "config/load.h"
+#include "focus_schedule.h"
 #include "local_launcher.h"
 #include "net/connection.h"
 #include "run_recorder.h"
 #include "scene/load_scene.h"
 #include "scene_authority.h"
+#include "stacked_groups.h"
 #include "status_line.h"
 #include "util/result.h"
 
@@ -77,6 +79,7 @@ class Master {
   struct Slot {
     const config::Projector* projector = nullptr;
     std::shared_ptr<Session> session;
+    std::optional<LightShare> sent_share;  // the share of the lights its node was last told
   };
 
   void accept_next();
@@ -102,6 +105,9 @@ class Master {
   void finish();
   void fail(const std::string& reason);
 
+  // Shares automatic groups' lights among the nodes that are up (a node came or
+  // went: `force`); the changes go out with the next FrameBegin.
+  void rebalance_lights(bool force);
   void housekeeping();
   void send_heartbeats();
   void on_signal(int signal);
@@ -131,6 +137,8 @@ class Master {
   std::vector<Slot> slots_;
   std::vector<std::shared_ptr<Session>> sessions_;
   std::optional<SceneAuthority> authority_;
+  std::optional<LightPlan> light_plan_;
+  std::optional<FocusSchedule> focus_;
   scene::SceneState current_state_;
   std::uint64_t current_hash_ = 0;
   Barrier barrier_;

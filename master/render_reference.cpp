@@ -39,9 +39,9 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
     const std::string folder = (std::filesystem::path(out_dir) / "reference" / screen.id()).string();
     Result<void> written;
     if (s == 1) {
-      written = image::write_frame(folder, frame, renderer.value()->read_linear(), renderer.value()->read_encoded());
+      written = image::write_frame(folder, frame, renderer.value()->read_rendered(), renderer.value()->read_encoded());
     } else {
-      const image::FloatImage linear = image::box_downsample(renderer.value()->read_linear(), s);
+      const image::FloatImage linear = image::box_downsample(renderer.value()->read_rendered(), s);
       written = image::write_frame(folder, frame, linear, image::encode_srgb(linear));
     }
     if (!written) return written;

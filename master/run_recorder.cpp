@@ -45,10 +45,11 @@ void RunRecorder::swapped(std::uint64_t frame, clock::Nanos sent, const std::vec
   barrier_round_us_.add(static_cast<double>(sent - record->begin_sent) / 1e3);
 }
 
-void RunRecorder::presented(std::uint64_t frame, std::size_t node, clock::Nanos at) {
+void RunRecorder::presented(std::uint64_t frame, std::size_t node, clock::Nanos at, std::uint64_t content_frame) {
   FrameRecord* record = find(frame);
   if (record == nullptr || !record->nodes[node].swapped || record->nodes[node].presented != 0) return;
   record->nodes[node].presented = at;
+  record->nodes[node].content_frame = content_frame;
   totals_[node].presented += 1;
 }
 
@@ -67,6 +68,7 @@ void RunRecorder::finalize(const FrameRecord& record) {
       earliest = presented == 0 ? f.presented : std::min(earliest, f.presented);
       latest = presented == 0 ? f.presented : std::max(latest, f.presented);
       ++presented;
+      if (f.content_frame != record.id) incoherent = true;  // showed another frame's content
     } else if (f.swapped) {
       incoherent = true;  // told to show this frame, never said it did
     }

@@ -24,7 +24,9 @@ class RunRecorder {
   void frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
   void ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time);
   void swapped(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
-  void presented(std::uint64_t frame, std::size_t node, clock::Nanos at);
+  // `content_frame`: the frame whose content the node showed (a node out of step
+  // shows an older one: the frame is then incoherent).
+  void presented(std::uint64_t frame, std::size_t node, clock::Nanos at, std::uint64_t content_frame);
 
   void node_joined(std::size_t node);
   void node_missed_barrier(std::size_t node);
@@ -49,6 +51,7 @@ class RunRecorder {
     bool swapped = false;
     clock::Nanos ready = 0;
     clock::Nanos presented = 0;
+    std::uint64_t content_frame = 0;
   };
   struct FrameRecord {
     std::uint64_t id = 0;

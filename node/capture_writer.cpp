@@ -16,13 +16,14 @@ CaptureWriter::~CaptureWriter() {
   worker_.join();
 }
 
-void CaptureWriter::submit(std::uint64_t frame, image::FloatImage linear, image::ByteImage encoded) {
+void CaptureWriter::submit(std::uint64_t frame, image::FloatImage linear, image::ByteImage encoded,
+                           image::WordImage deep) {
   std::unique_lock lock(mutex_);
   if (jobs_.size() >= max_queued_) {
     log_.warn("capture writer is {} frames behind; waiting for it", jobs_.size());
     changed_.wait(lock, [this] { return jobs_.size() < max_queued_; });
   }
-  jobs_.push_back({frame, std::move(linear), std::move(encoded)});
+  jobs_.push_back({frame, std::move(linear), std::move(encoded), std::move(deep)});
   lock.unlock();
   changed_.notify_all();
 }
@@ -36,7 +37,9 @@ void CaptureWriter::run() {
     jobs_.pop_front();
     lock.unlock();
     changed_.notify_all();
-    if (auto written = image::write_frame(folder_, job.frame, job.linear, job.encoded); !written) {
+    const auto written = job.deep.empty() ? image::write_frame(folder_, job.frame, job.linear, job.encoded)
+                                          : image::write_frame(folder_, job.frame, job.linear, job.deep);
+    if (!written) {
       log_.error("capture of frame {} lost: {}", job.frame, written.error());
     }
   }

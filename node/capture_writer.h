@@ -24,7 +24,8 @@ class CaptureWriter {
   CaptureWriter(const CaptureWriter&) = delete;
   CaptureWriter& operator=(const CaptureWriter&) = delete;
 
-  void submit(std::uint64_t frame, image::FloatImage linear, image::ByteImage encoded);
+  // `encoded` is the signal: 8 bits, or 16 (`deep`, non-empty) for deeper projectors.
+  void submit(std::uint64_t frame, image::FloatImage linear, image::ByteImage encoded, image::WordImage deep = {});
   [[nodiscard]] const std::string& folder() const { return folder_; }
 
  private:
@@ -32,6 +33,7 @@ class CaptureWriter {
     std::uint64_t frame;
     image::FloatImage linear;
     image::ByteImage encoded;
+    image::WordImage deep;
   };
   void run();
 

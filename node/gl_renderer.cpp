@@ -2,6 +2,8 @@
 
 #include "config/geometry.h"
 #include "optics/blend.h"
+#include "optics/defocus.h"
+#include "optics/projector_model.h"
 #include "scene/load_scene.h"
 
 namespace optique::node {
@@ -31,6 +33,19 @@ Result<image::FloatImage> blend_weights(const wire::Welcome& welcome, const opti
   }
   const optics::BlendField field(group, config::usable_area(welcome.screen()), ramps);
   return optics::blend_weights(field, group[self], self);
+}
+
+// Where the output pass's fragments (GL window coordinates: rows go up) land on
+// the screen: flip to projector pixels (rows down), then H⁻¹.
+glm::dmat3 fragment_to_screen(const optics::ProjectorGeometry& geometry) {
+  const glm::dmat3 flip(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, static_cast<double>(geometry.height()), 1.0);
+  return geometry.pixel_to_screen() * flip;
+}
+
+render::FocusRole focus_role(const config::Content& content) {
+  if (content.role() == "focus") return render::FocusRole::focus;
+  if (content.role() == "defocus") return render::FocusRole::defocus;
+  return render::FocusRole::none;
 }
 
 }  // namespace
@@ -86,10 +101,28 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
   renderer_ = std::move(renderer).value();
   auto weights = blend_weights(welcome, geometry.value());
   if (!weights) return Error{"projector '" + projector.id() + "': " + weights.error()};
-  if (auto output = renderer_->set_output(view.value().output_stage(std::move(weights).value())); !output) {
-    return Error{output.error()};
+  render::OutputStage stage = view.value().output_stage(std::move(weights).value());
+  auto model = optics::ProjectorModel::from_config(projector);
+  if (!model) return Error{"projector '" + projector.id() + "': " + model.error()};
+  stage.projector = std::move(model).value();
+  deep_signal_ = stage.projector.bits() > 8;
+  focus_role_ = focus_role(projector.content());
+  depth_of_field_ = welcome.depth_of_field();
+  if (focus_role_ != render::FocusRole::none) {
+    stage.focus.role = focus_role_;
+    stage.focus.user_to_projector = view.value().oblique().user_to_projector;
+    stage.focus.depth_scale = view.value().oblique().depth_scale;
+    stage.focus.fragment_to_screen = fragment_to_screen(geometry.value());
+    stage.focus.screen_metres_per_pixel = 1.0 / geometry.value().max_pixels_per_metre();
   }
+  if (auto output = renderer_->set_output(stage); !output) return Error{output.error()};
   view_ = std::move(view).value();
+  terms_ = {};
+  if (projector.content().role() == "lights") {
+    const auto& share = welcome.lights();
+    renderer_->set_lights(std::vector<std::uint32_t>(share.lights().begin(), share.lights().end()));
+    terms_ = {share.ambient(), share.ambient()};
+  }
 
   eye_ = render::parse_eye(projector.eye());
   const auto& viewer = welcome.viewer();
@@ -128,9 +161,26 @@ void GlRenderer::render(const FrameInput& frame) {
     log_.debug("frame {}: {}", frame.frame_id, frustum.error());
     renderer_->draw_black();
   } else {
-    renderer_->draw(*frame.state, 0.0, eye, frustum.value());
+    if (frame.lights != nullptr) {
+      renderer_->set_lights(std::vector<std::uint32_t>(frame.lights->lights().begin(), frame.lights->lights().end()));
+      terms_ = {frame.lights->ambient(), frame.lights->ambient()};
+    }
+    if (focus_role_ != render::FocusRole::none && frame.focus != nullptr) {
+      render::FocusFrame focus;
+      focus.coc = optics::coc_from_window_depth(frame.focus->depth(), {depth_of_field_.near(), depth_of_field_.far()},
+                                                near_, far_);
+      focus.inset = depth_of_field_.inset_radius() > 0.0;
+      focus.gaze = {frame.focus->gaze_x(), frame.focus->gaze_y()};
+      focus.inset_radius = depth_of_field_.inset_radius();
+      renderer_->set_focus(focus);
+    }
+    renderer_->draw(*frame.state, 0.0, eye, frustum.value(), terms_);
   }
-  if (frame.capture) captures_->submit(frame.frame_id, renderer_->read_linear(), renderer_->read_encoded());
+  if (frame.capture) {
+    captures_->submit(frame.frame_id, renderer_->read_linear(),
+                      deep_signal_ ? image::ByteImage{} : renderer_->read_encoded(),
+                      deep_signal_ ? renderer_->read_signal() : image::WordImage{});
+  }
 }
 
 void GlRenderer::present() {

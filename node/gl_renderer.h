@@ -43,6 +43,10 @@ class GlRenderer final : public Renderer {
   double eye_separation_ = 0.0;
   double near_ = 0.05;
   double far_ = 100.0;
+  render::LightTerms terms_;
+  bool deep_signal_ = false;  // the projector takes more than 8 bits: captures are 16-bit PNGs
+  render::FocusRole focus_role_ = render::FocusRole::none;
+  config::DepthOfField depth_of_field_;  // resolved by the master: near/far set
 };
 
 }  // namespace optique::node

@@ -201,6 +201,7 @@ void Node::handle_resync(const wire::Resync& resync) {
     return;
   }
   state_ = std::move(state).value();
+  past_frames_.clear();
   next_frame_ = resync.next_frame_id();
   rendered_any_ = false;
   if (phase_ == Phase::joined) {
@@ -235,11 +236,25 @@ void Node::handle_frame_begin(const wire::FrameBegin& begin) {
     log_.warn("state hash {:016x} differs from the master's {:016x} at frame {}", hash, begin.state_hash(),
               begin.frame_id());
   }
+  // A node that lags shows an older frame's content (the light share applies at
+  // once: it is how this node's light is split, not content).
+  const wire::FrameBegin* shown = &begin;
+  const scene::SceneState* shown_state = &state_;
+  if (options_.lag_frames > 0) {
+    past_frames_.push_back({begin, state_});
+    while (past_frames_.size() > options_.lag_frames + 1) past_frames_.pop_front();
+    shown = &past_frames_.front().begin;
+    shown_state = &past_frames_.front().state;
+  }
+  FrameInput input{begin.frame_id(), shown->simulation_time_ns(), shown->present_time_ns(), frame_period_, shown_state,
+                   begin.capture()};
+  if (shown->has_focus()) input.focus = &shown->focus();
+  if (begin.has_lights()) input.lights = &begin.lights();
   const clock::Nanos started = clock::monotonic_now();
-  renderer_.render(
-      {begin.frame_id(), begin.simulation_time_ns(), begin.present_time_ns(), frame_period_, &state_, begin.capture()});
+  renderer_.render(input);
   const clock::Nanos render_time = clock::monotonic_now() - started;
   last_rendered_ = begin.frame_id();
+  last_content_frame_ = shown->frame_id();
   rendered_any_ = true;
 
   wire::Envelope envelope;
@@ -275,6 +290,7 @@ void Node::handle_swap(const wire::FrameSwap& swap) {
   auto& report = *envelope.mutable_presented();
   report.set_frame_id(swap.frame_id());
   report.set_presented_ns(presented);
+  report.set_content_frame_id(last_content_frame_);
   report.set_clock_offset_ns(to_master);
   if (const auto best = estimator_.best()) report.set_clock_rtt_ns(best->round_trip);
   connection_->send(envelope);

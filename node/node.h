@@ -10,6 +10,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include <chrono>
+#include <deque>
 #include <memory>
 #include <string>
 
@@ -31,6 +32,9 @@ struct NodeOptions {
   std::chrono::milliseconds give_up_after{10000};          // master unreachable this long: exit
   std::uint32_t protocol_version = net::kProtocolVersion;  // test hook: speak another version
   clock::LocalClock clock;                                 // test hook: a skewed clock
+  // Test hook: show the content of this many frames ago, as a node out of step
+  // with its stacked partners would (reported in Presented.content_frame_id).
+  std::uint32_t lag_frames = 0;
 };
 
 inline constexpr int kExitOk = 0;
@@ -82,6 +86,13 @@ class Node {
 
   Phase phase_ = Phase::disconnected;
   scene::SceneState state_;
+  // The lag hook's memory: the last lag_frames + 1 frames as they came.
+  struct PastFrame {
+    wire::FrameBegin begin;
+    scene::SceneState state;
+  };
+  std::deque<PastFrame> past_frames_;
+  std::uint64_t last_content_frame_ = 0;
   clock::OffsetEstimator estimator_;
   std::uint64_t next_frame_ = 0;
   std::uint64_t last_rendered_ = 0;

@@ -17,7 +17,9 @@ struct FrameInput {
   clock::Nanos present_time = 0;  // predicted, master clock
   clock::Nanos frame_period = 0;
   const scene::SceneState* state = nullptr;
-  bool capture = false;  // also write this frame to the capture folder
+  bool capture = false;                      // also write this frame to the capture folder
+  const wire::Focus* focus = nullptr;        // the frame's focal depth and gaze (focus/defocus nodes)
+  const wire::LightShare* lights = nullptr;  // a new share of the lights from this frame on, if any
 };
 
 class Renderer {

@@ -18,5 +18,6 @@ inline constexpr double kEyeSeparation = 0.065;
 inline constexpr double kNear = 0.05;
 inline constexpr double kFar = 100.0;
 inline constexpr double kPixelsPerMetre = 200.0;
+inline constexpr double kBlurRadius = 8.0;  // a defocus projector's, screen pixels
 
 }  // namespace optique::config::defaults

@@ -27,7 +27,20 @@ const Screen* screen_of(const Installation& installation, const Projector& proje
 
 }  // namespace
 
-bool same_blend_group(const Projector& a, const Projector& b) { return a.screen() == b.screen() && a.eye() == b.eye(); }
+bool same_screen_image(const Projector& a, const Projector& b) {
+  return a.screen() == b.screen() && a.eye() == b.eye();
+}
+
+bool same_layer(const Projector& a, const Projector& b) {
+  const Content& x = a.content();
+  const Content& y = b.content();
+  const auto role = [](const Content& c) { return c.role().empty() ? std::string("full") : c.role(); };
+  return role(x) == role(y) && x.lights() == y.lights() && x.ambient() == y.ambient() && x.lights() != "auto";
+}
+
+bool same_blend_group(const Projector& a, const Projector& b) {
+  return same_screen_image(a, b) && (a.id() == b.id() || same_layer(a, b));
+}
 
 optics::ScreenRect usable_area(const Screen& screen) {
   return optics::ScreenRect{glm::dvec2(0.0), glm::dvec2(screen.width(), screen.height())};

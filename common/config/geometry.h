@@ -19,8 +19,18 @@ namespace optique::config {
 // part of its screen. Runs on a validated installation with defaults applied.
 [[nodiscard]] std::vector<Problem> resolve_geometry(Installation& installation, const std::string& config_dir);
 
-// Whether two projectors light the same screen for the same eye: their overlaps
-// are blended, and the screen simulator composes them into one image.
+// Whether two projectors light the same screen for the same eye: their light adds
+// into one image, which the screen simulator composes.
+[[nodiscard]] bool same_screen_image(const Projector& a, const Projector& b);
+
+// Whether two projectors show the same share of the light (the same content role,
+// lights and ambient): a layer of a stacked group, or all projectors of a plain
+// wall. Projectors whose lights the master shares out ("auto") are each a layer.
+[[nodiscard]] bool same_layer(const Projector& a, const Projector& b);
+
+// Whether two projectors blend their overlaps with each other: the same screen
+// image and the same layer. Stacked layers do not blend with each other: their
+// light is meant to add.
 [[nodiscard]] bool same_blend_group(const Projector& a, const Projector& b);
 
 // The screen area that is shown: the whole screen rectangle.

@@ -14,16 +14,6 @@
 #include "util/sha256.h"
 
 namespace optique::config {
-namespace {
-
-std::string describe(const std::vector<Problem>& problems, const std::string& origin) {
-  std::string message;
-  for (const Problem& p : problems)
-    message += (message.empty() ? "" : "\n") + origin + ": " + p.path + ": " + p.message;
-  return message;
-}
-
-}  // namespace
 
 Result<Installation> parse_installation(const std::string& json, const std::string& origin,
                                         const std::string& directory) {
@@ -55,10 +45,10 @@ Result<Installation> parse_installation(const std::string& json, const std::stri
     return Error{origin + ": not a valid installation: " + std::string(status.message())};
   }
   const std::vector<Problem> problems = validate(installation, directory);
-  if (!problems.empty()) return Error{describe(problems, origin)};
+  if (!problems.empty()) return Error{describe_problems(problems, origin)};
   apply_defaults(installation);
   const std::vector<Problem> geometry = resolve_geometry(installation, directory);
-  if (!geometry.empty()) return Error{describe(geometry, origin)};
+  if (!geometry.empty()) return Error{describe_problems(geometry, origin)};
   return installation;
 }
 
@@ -103,6 +93,12 @@ void apply_defaults(Installation& installation) {
     v.add_head_right(0.0);
   }
 
+  if (installation.has_depth_of_field()) {
+    DepthOfField& d = *installation.mutable_depth_of_field();
+    if (d.near() == 0.0) d.set_near(v.near());
+    if (d.far() == 0.0) d.set_far(v.far());
+  }
+
   for (Screen& s : *installation.mutable_screens()) {
     if (s.pixels_per_metre() == 0.0) s.set_pixels_per_metre(defaults::kPixelsPerMetre);
   }
@@ -110,6 +106,11 @@ void apply_defaults(Installation& installation) {
     if (p.host().empty()) p.set_host("localhost");
     if (p.output().kind().empty()) p.mutable_output()->set_kind("headless");
     if (p.eye().empty()) p.set_eye("mono");
+    if (p.content().role().empty()) p.mutable_content()->set_role("full");
+    if (p.content().role() == "defocus" && p.content().blur_radius() == 0.0) {
+      p.mutable_content()->set_blur_radius(defaults::kBlurRadius);
+    }
+    if (p.brightness() == 0.0) p.set_brightness(1.0);
     const bool other_geometry = !p.homography().empty() || !p.calibration().empty() || p.has_camera();
     if (!p.has_region() && !other_geometry) {
       for (const Screen& s : installation.screens()) {

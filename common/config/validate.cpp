@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "config/defaults.h"
+#include "optics/projector_model.h"
 #include "scene/builtin.h"
 
 namespace optique::config {
@@ -162,6 +163,115 @@ void check_geometry_source(Checker& check, const std::string& at, const Projecto
   }
 }
 
+void check_content(Checker& check, const std::string& at, const Content& c) {
+  check.one_of(at + ".role", c.role(), {"full", "lights", "focus", "defocus"});
+  const bool lights = c.role() == "lights";
+  if (lights && c.lights().empty()) {
+    check.fail(at + ".lights",
+               "role 'lights' needs its lights: indices and ranges of the scene's lights (\"0-6\", "
+               "\"0, 3, 7-9\") or \"auto\"");
+  }
+  if (!lights && !c.lights().empty()) check.fail(at + ".lights", "only a projector of role 'lights' takes lights");
+  if (!lights && c.ambient()) check.fail(at + ".ambient", "only a projector of role 'lights' takes ambient");
+  check.non_negative(at + ".blur_radius", c.blur_radius());
+  if (c.role() != "defocus" && c.blur_radius() != 0.0) {
+    check.fail(at + ".blur_radius", "only a projector of role 'defocus' has a blur radius");
+  }
+}
+
+// A defocus projector shows only the blurred share of the image: without a focus
+// partner on the same screen for the same eye, the sharp share is missing, and
+// the other way round.
+void check_stacked_pairs(Checker& check, const Installation& inst) {
+  for (int i = 0; i < inst.projectors_size(); ++i) {
+    const Projector& p = inst.projectors(i);
+    const std::string& role = p.content().role();
+    if (role != "focus" && role != "defocus") continue;
+    const std::string wanted = role == "focus" ? "defocus" : "focus";
+    bool partnered = false;
+    for (const Projector& other : inst.projectors()) {
+      partnered = partnered || (other.content().role() == wanted && other.screen() == p.screen() &&
+                                (other.eye().empty() ? "mono" : other.eye()) == (p.eye().empty() ? "mono" : p.eye()));
+    }
+    if (!partnered) {
+      check.fail("projectors[" + std::to_string(i) + "].content.role",
+                 "a '" + role + "' projector needs a '" + wanted + "' partner on screen '" + p.screen() +
+                     "' for the same eye, and '" + p.id() + "' has none: the pair shows depth of field together");
+    }
+  }
+}
+
+void check_depth_of_field(Checker& check, const Installation& inst) {
+  bool needed = false;
+  for (const Projector& p : inst.projectors()) {
+    needed = needed || p.content().role() == "focus" || p.content().role() == "defocus";
+  }
+  const DepthOfField& d = inst.depth_of_field();
+  const bool given = inst.has_depth_of_field();
+  if (!needed) {
+    if (given) check.fail("depth_of_field", "set, but no projector has role 'focus' or 'defocus'");
+    return;
+  }
+  const int sources = (d.focal_depth() != 0.0 ? 1 : 0) + (d.focal_path().empty() ? 0 : 1) + (d.has_gaze() ? 1 : 0);
+  if (sources != 1) {
+    check.fail("depth_of_field", sources == 0 ? "focus/defocus projectors need the focal depth: give focal_depth, "
+                                                "focal_path or gaze"
+                                              : "give only one of focal_depth, focal_path and gaze");
+  }
+  if (d.focal_depth() != 0.0) check.positive("depth_of_field.focal_depth", d.focal_depth());
+  for (int i = 0; i < d.focal_path_size(); ++i) {
+    const std::string at = "depth_of_field.focal_path[" + std::to_string(i) + "]";
+    check.non_negative(at + ".time", d.focal_path(i).time());
+    check.positive(at + ".depth", d.focal_path(i).depth());
+    if (i > 0 && !(d.focal_path(i).time() > d.focal_path(i - 1).time())) {
+      check.fail(at + ".time", "times must increase (" + number(d.focal_path(i).time()) + " after " +
+                                   number(d.focal_path(i - 1).time()) + ")");
+    }
+  }
+  if (d.has_gaze()) {
+    const Gaze& g = d.gaze();
+    const Screen* screen = nullptr;
+    for (const Screen& s : inst.screens()) {
+      if (s.id() == g.screen()) screen = &s;
+    }
+    if (screen == nullptr) check.fail("depth_of_field.gaze.screen", "unknown screen '" + g.screen() + "'");
+    if (g.point().empty() == g.path().empty()) {
+      check.fail("depth_of_field.gaze", "give either point [x, y] or a path of points");
+    }
+    const auto check_point = [&](const std::string& path, const google::protobuf::RepeatedField<double>& point) {
+      if (point.size() != 2) {
+        check.fail(path, "must be [x, y] in metres on the screen (got " + std::to_string(point.size()) + " numbers)");
+        return;
+      }
+      if (!check.finite(path + "[0]", point[0]) || !check.finite(path + "[1]", point[1]) || screen == nullptr) return;
+      if (point[0] < 0.0 || point[0] > screen->width() || point[1] < 0.0 || point[1] > screen->height()) {
+        check.fail(path, "[" + number(point[0]) + ", " + number(point[1]) + "] is off screen '" + screen->id() + "' (" +
+                             number(screen->width()) + " × " + number(screen->height()) + " m)");
+      }
+    };
+    if (!g.point().empty()) check_point("depth_of_field.gaze.point", g.point());
+    for (int i = 0; i < g.path_size(); ++i) {
+      const std::string at = "depth_of_field.gaze.path[" + std::to_string(i) + "]";
+      check.non_negative(at + ".time", g.path(i).time());
+      check_point(at + ".point", g.path(i).point());
+      if (i > 0 && !(g.path(i).time() > g.path(i - 1).time())) {
+        check.fail(at + ".time",
+                   "times must increase (" + number(g.path(i).time()) + " after " + number(g.path(i - 1).time()) + ")");
+      }
+    }
+  }
+  check.non_negative("depth_of_field.near", d.near());
+  check.non_negative("depth_of_field.far", d.far());
+  if (d.near() != 0.0 && d.far() != 0.0 && std::isfinite(d.near()) && std::isfinite(d.far()) && !(d.far() > d.near())) {
+    check.fail("depth_of_field.far",
+               "must be greater than near (" + number(d.far()) + " m <= " + number(d.near()) + " m)");
+  }
+  check.non_negative("depth_of_field.inset_radius", d.inset_radius());
+  if (d.inset_radius() > 0.0 && !d.has_gaze()) {
+    check.fail("depth_of_field.inset_radius", "the focused inset follows the gaze point: give gaze too");
+  }
+}
+
 void check_projectors(Checker& check, const Installation& inst, const std::string& config_dir) {
   if (inst.projectors().empty()) check.fail("projectors", "at least one projector is needed");
   std::set<std::string> ids;
@@ -195,7 +305,15 @@ void check_projectors(Checker& check, const Installation& inst, const std::strin
     check.one_of(at + ".eye", p.eye(), {"mono", "left", "right"});
     check.one_of(at + ".rendering", p.rendering(), {"single-pass", "two-pass"});
     check.non_negative(at + ".blend_ramp", p.blend_ramp());
+    if (auto model = optics::ProjectorModel::from_config(p); !model) {
+      // The model's messages start with the field ("response.table[3]: …").
+      const std::string& e = model.error();
+      const auto colon = e.find(": ");
+      check.fail(at + "." + e.substr(0, colon), colon == std::string::npos ? e : e.substr(colon + 2));
+    }
+    check_content(check, at + ".content", p.content());
   }
+  check_stacked_pairs(check, inst);
 }
 
 void check_viewer(Checker& check, const Viewer& v) {
@@ -275,6 +393,13 @@ void check_scene(Checker& check, const Scene& s, const std::string& config_dir) 
 
 }  // namespace
 
+std::string describe_problems(const std::vector<Problem>& problems, const std::string& origin) {
+  std::string message;
+  for (const Problem& p : problems)
+    message += (message.empty() ? "" : "\n") + origin + ": " + p.path + ": " + p.message;
+  return message;
+}
+
 std::vector<Problem> validate(const Installation& installation, const std::string& config_dir) {
   std::vector<Problem> problems;
   Checker check(problems);
@@ -284,6 +409,7 @@ std::vector<Problem> validate(const Installation& installation, const std::strin
   check_viewer(check, installation.viewer());
   check_master(check, installation.master());
   check_scene(check, installation.scene(), config_dir);
+  check_depth_of_field(check, installation);
   return problems;
 }
 

@@ -16,6 +16,9 @@ struct Problem {
   std::string message;  // e.g. "must be > 0 (got -1)"
 };
 
+// One line per problem: "ORIGIN: PATH: MESSAGE".
+[[nodiscard]] std::string describe_problems(const std::vector<Problem>& problems, const std::string& origin);
+
 // `config_dir` resolves relative asset paths (the glTF scene).
 [[nodiscard]] std::vector<Problem> validate(const Installation& installation, const std::string& config_dir);
 

@@ -15,5 +15,8 @@ namespace optique::image {
 // Creates `folder` if needed and writes both files.
 [[nodiscard]] Result<void> write_frame(const std::string& folder, std::uint64_t frame, const FloatImage& linear,
                                        const ByteImage& encoded);
+// The same with a 16-bit PNG, for signals deeper than 8 bits.
+[[nodiscard]] Result<void> write_frame(const std::string& folder, std::uint64_t frame, const FloatImage& linear,
+                                       const WordImage& encoded);
 
 }  // namespace optique::image

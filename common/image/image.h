@@ -26,6 +26,7 @@ struct Image {
 
 using FloatImage = Image<float>;
 using ByteImage = Image<std::uint8_t>;
+using WordImage = Image<std::uint16_t>;  // a signal deeper than 8 bits
 
 // Reverses the row order (OpenGL reads bottom row first).
 template <class T>

@@ -27,6 +27,10 @@ Result<void> write_png(const std::string& path, const ByteImage& image) {
   return write(path, image, OIIO::TypeDesc::UINT8, OIIO::TypeDesc::UINT8);
 }
 
+Result<void> write_png(const std::string& path, const WordImage& image) {
+  return write(path, image, OIIO::TypeDesc::UINT16, OIIO::TypeDesc::UINT16);
+}
+
 Result<FloatImage> read_image(const std::string& path) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) return Error{"cannot read " + path + ": " + OIIO::geterror()};

@@ -1,6 +1,7 @@
 #include "render/scene_renderer.h"
 
 #include <algorithm>
+#include <cassert>
 #include <string>
 
 #include <epoxy/gl.h>
@@ -83,36 +84,115 @@ void main() {
 }
 )";
 
-// The output stage: the two-pass warp (if any), the blend weights, then the
-// projector's response (the sRGB transfer function for now). Writes the light the
-// projector emits and what is sent to it.
+// The output stage: the two-pass warp (if any), this projector's share of the
+// light (its blend weights; for a focus/defocus pair its share of the depth of
+// field), then the projector's model: the signal that makes it add exactly this
+// light to its black, quantized to its bit depth (optics/projector_model.h does
+// the same on the CPU; the tests hold the two together). Writes the light the
+// projector then emits and the signal sent to it.
 constexpr const char* kEncodeFragment = R"(#version 450 core
 in vec2 uv;
 layout(binding = 0) uniform sampler2D rendered;
 layout(binding = 2) uniform sampler2D weights;
+layout(binding = 3) uniform sampler2D depth;
+layout(binding = 4) uniform sampler2D response_table;
 uniform bool warp;
 uniform mat3 projector_to_user;
 uniform vec2 output_size;
+uniform vec2 rendered_size;
 uniform bool has_weights;
+uniform int curve;  // 0 sRGB, 1 gamma, 2 table
+uniform float gamma;
+uniform int table_size;
+uniform float levels;
+uniform float black_level;
+uniform float brightness;
+uniform int share;          // 0 all, 1 focus: (1 − c_r), 2 defocus: c_r
+uniform vec4 coc;           // k, b', lowest and highest window depth (optics/defocus.h)
+uniform vec4 depth_unwarp;  // single pass: a31, a32, a33 and the depth scale
+uniform bool inset;         // share by a disc around the gaze point instead of c_r
+uniform mat3 fragment_to_screen;
+uniform vec3 inset_disc;    // centre x, y and radius, screen metres
+uniform float screen_metres_per_pixel;
 layout(location = 0) out vec4 light;
 layout(location = 1) out vec4 encoded;
-vec3 encode(vec3 c) {
-  c = clamp(c, 0.0, 1.0);
-  return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+
+float table_at(int i) { return texelFetch(response_table, ivec2(i, 0), 0).r; }
+
+float response(float v) {
+  v = clamp(v, 0.0, 1.0);
+  if (curve == 0) return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
+  if (curve == 1) return pow(v, gamma);
+  float at = v * float(table_size - 1);
+  int i = min(int(at), table_size - 2);
+  return mix(table_at(i), table_at(i + 1), at - float(i));
 }
+
+float inverse_response(float l) {
+  l = clamp(l, 0.0, 1.0);
+  if (curve == 0) return clamp(l <= 0.0031308 ? l * 12.92 : 1.055 * pow(l, 1.0 / 2.4) - 0.055, 0.0, 1.0);
+  if (curve == 1) return pow(l, 1.0 / gamma);
+  // The first entry ≥ l, by bisection (the table does not decrease).
+  int lo = 0;
+  int hi = table_size;
+  while (lo < hi) {
+    int mid = (lo + hi) / 2;
+    if (table_at(mid) < l) lo = mid + 1; else hi = mid;
+  }
+  if (lo == 0) return 0.0;
+  float a = table_at(lo - 1);
+  float b = table_at(lo);
+  float f = b > a ? (l - a) / (b - a) : 0.0;
+  return (float(lo - 1) + f) / float(table_size - 1);
+}
+
+// Relative circle of confusion from the depth buffer: c_r = k·|z' − b'| with z'
+// the window depth a plain perspective frustum gives (the single pass's depth is
+// first undone: its third row scales z_ndc, its fourth divides by a31·x + a32·y + a33).
+float circle_of_confusion(vec2 user_ndc, vec2 at) {
+  float d;
+  if (warp) {
+    d = texelFetch(depth, ivec2(clamp(at * rendered_size, vec2(0.0), rendered_size - 1.0)), 0).r;
+  } else {
+    d = texelFetch(depth, ivec2(gl_FragCoord.xy), 0).r;
+    float z_ndc = (2.0 * d - 1.0) * dot(depth_unwarp.xyz, vec3(user_ndc, 1.0)) / depth_unwarp.w;
+    d = 0.5 * z_ndc + 0.5;
+  }
+  return min(1.0, coc.x * abs(clamp(d, coc.z, coc.w) - coc.y));
+}
+
+float focus_weight(vec2 user_ndc, vec2 at) {
+  if (inset) {
+    vec3 s = fragment_to_screen * vec3(gl_FragCoord.xy, 1.0);
+    float distance_to_edge = inset_disc.z - length(s.xy / s.z - inset_disc.xy);
+    return clamp(distance_to_edge / screen_metres_per_pixel + 0.5, 0.0, 1.0);
+  }
+  return 1.0 - circle_of_confusion(user_ndc, at);
+}
+
 void main() {
   vec3 c;
+  vec3 user = projector_to_user * vec3(gl_FragCoord.xy / output_size * 2.0 - 1.0, 1.0);
+  vec2 user_ndc = user.xy / user.z;
+  vec2 at = (user_ndc + 1.0) * 0.5;
   if (warp) {
-    vec3 user = projector_to_user * vec3(gl_FragCoord.xy / output_size * 2.0 - 1.0, 1.0);
-    vec2 at = (user.xy / user.z + 1.0) * 0.5;
     bool inside = user.z > 0.0 && all(greaterThanEqual(at, vec2(0.0))) && all(lessThanEqual(at, vec2(1.0)));
     c = inside ? texture(rendered, at).rgb : vec3(0.0);
   } else {
     c = texelFetch(rendered, ivec2(gl_FragCoord.xy), 0).rgb;
   }
   if (has_weights) c *= texelFetch(weights, ivec2(gl_FragCoord.xy), 0).r;
-  light = vec4(c, 1.0);
-  encoded = vec4(encode(c), 1.0);
+  if (share != 0) {
+    float in_focus = focus_weight(user_ndc, at);
+    c *= share == 1 ? in_focus : 1.0 - in_focus;
+  }
+  float headroom = brightness * (1.0 - black_level);
+  vec3 signal;
+  for (int i = 0; i < 3; ++i) signal[i] = round(inverse_response(c[i] / headroom) * levels) / levels;
+  vec3 emitted;
+  for (int i = 0; i < 3; ++i) emitted[i] = brightness * (black_level + (1.0 - black_level) * response(signal[i]));
+  light = vec4(emitted, 1.0);
+  encoded = vec4(signal, 1.0);
 }
 )";
 
@@ -178,6 +258,7 @@ struct SceneRenderer::Gl {
   GLuint output_framebuffer = 0;  // light and encoded image
   GLuint output_light = 0;
   GLuint weights = 0;
+  GLuint response_table = 0;
   int output_width = 0;
   int output_height = 0;
   std::vector<GLuint> scene_textures;  // by index in the scene's textures
@@ -186,7 +267,11 @@ struct SceneRenderer::Gl {
   std::vector<scene::Instance> instances;
   glm::vec3 ambient{0.0f};
   glm::vec3 background{0.0f};
+  std::vector<glm::vec4> all_lights;  // position, radiance: two per light
   int light_count = 0;
+  struct {
+    GLint coc, inset, inset_disc;
+  } focus_uniforms{};
   struct {
     GLint model_view_projection, model, normal_matrix, eye, base_colour, has_base_colour_texture, metallic, roughness,
         emissive, ambient, light_count;
@@ -201,8 +286,8 @@ struct SceneRenderer::Gl {
     glDeleteBuffers(3, buffers);
     const GLuint framebuffers[] = {linear_framebuffer, encoded_framebuffer, output_framebuffer};
     glDeleteFramebuffers(3, framebuffers);
-    const GLuint textures[] = {linear_colour, depth, encoded_colour, output_light, weights};
-    glDeleteTextures(5, textures);
+    const GLuint textures[] = {linear_colour, depth, encoded_colour, output_light, weights, response_table};
+    glDeleteTextures(6, textures);
     glDeleteTextures(static_cast<GLsizei>(scene_textures.size()), scene_textures.data());
   }
 };
@@ -295,16 +380,19 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
     }
   }
 
-  std::vector<glm::vec4> lights;
   for (const auto& light : scene.lights) {
-    lights.emplace_back(glm::vec3(light.position), 1.0f);
-    lights.emplace_back(light.colour * light.intensity, 0.0f);
+    gl->all_lights.emplace_back(glm::vec3(light.position), 1.0f);
+    gl->all_lights.emplace_back(light.colour * light.intensity, 0.0f);
   }
-  gl->light_count = static_cast<int>(scene.lights.size());
   glCreateBuffers(1, &gl->light_buffer);
   glNamedBufferStorage(gl->light_buffer,
-                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, lights.size()) * sizeof(glm::vec4)),
-                       lights.empty() ? nullptr : lights.data(), 0);
+                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, gl->all_lights.size()) * sizeof(glm::vec4)),
+                       nullptr, GL_DYNAMIC_STORAGE_BIT);
+  {
+    const GLuint e = gl->encode_program;
+    gl->focus_uniforms = {glGetUniformLocation(e, "coc"), glGetUniformLocation(e, "inset"),
+                          glGetUniformLocation(e, "inset_disc")};
+  }
 
   gl->materials = scene.materials;
   gl->instances = scene.instances;
@@ -326,6 +414,7 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   glNamedFramebufferTexture(gl->linear_framebuffer, GL_COLOR_ATTACHMENT0, gl->linear_colour, 0);
   glNamedFramebufferTexture(gl->linear_framebuffer, GL_DEPTH_ATTACHMENT, gl->depth, 0);
   auto renderer = std::unique_ptr<SceneRenderer>(new SceneRenderer(std::move(gl)));
+  renderer->set_all_lights();
   if (auto output = renderer->set_output({}); !output) return Error{output.error()};
   return renderer;
 }
@@ -345,23 +434,53 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
   }
   const GLuint framebuffers[] = {gl.encoded_framebuffer, gl.output_framebuffer};
   glDeleteFramebuffers(2, framebuffers);
-  const GLuint textures[] = {gl.encoded_colour, gl.output_light, gl.weights};
-  glDeleteTextures(3, textures);
+  const GLuint textures[] = {gl.encoded_colour, gl.output_light, gl.weights, gl.response_table};
+  glDeleteTextures(4, textures);
   gl.weights = 0;
   gl.output_width = width;
   gl.output_height = height;
   // The output stage's uniforms stay with the program: set once here, not per frame.
   const GLuint program = gl.encode_program;
   glProgramUniform1i(program, glGetUniformLocation(program, "warp"), stage.projector_to_user ? 1 : 0);
-  const glm::mat3 to_user(stage.projector_to_user.value_or(glm::dmat3(1.0)));
-  glProgramUniformMatrix3fv(program, glGetUniformLocation(program, "projector_to_user"), 1, GL_FALSE,
-                            glm::value_ptr(to_user));
-  glProgramUniform2f(program, glGetUniformLocation(program, "output_size"), static_cast<float>(width),
-                     static_cast<float>(height));
-  glProgramUniform1i(program, glGetUniformLocation(program, "has_weights"), stage.weights.empty() ? 0 : 1);
+  // A single pass needs A⁻¹ too: a focus/defocus share undoes A's effect on depth.
+  const glm::mat3 to_user(stage.projector_to_user.value_or(glm::inverse(stage.focus.user_to_projector)));
+  const auto uniform = [program](const char* name) { return glGetUniformLocation(program, name); };
+  glProgramUniformMatrix3fv(program, uniform("projector_to_user"), 1, GL_FALSE, glm::value_ptr(to_user));
+  glProgramUniform2f(program, uniform("output_size"), static_cast<float>(width), static_cast<float>(height));
+  glProgramUniform2f(program, uniform("rendered_size"), static_cast<float>(gl.width), static_cast<float>(gl.height));
+  glProgramUniform1i(program, uniform("has_weights"), stage.weights.empty() ? 0 : 1);
+
+  const optics::ProjectorModel& model = stage.projector;
+  glProgramUniform1i(program, uniform("curve"), static_cast<int>(model.curve()));
+  glProgramUniform1f(program, uniform("gamma"), static_cast<float>(model.gamma()));
+  glProgramUniform1i(program, uniform("table_size"), static_cast<int>(model.table().size()));
+  glProgramUniform1f(program, uniform("levels"), static_cast<float>(model.levels()));
+  glProgramUniform1f(program, uniform("black_level"), static_cast<float>(model.black_level()));
+  glProgramUniform1f(program, uniform("brightness"), static_cast<float>(model.brightness()));
+  {
+    // A texture even when there is no table: every bound sampler needs one.
+    std::vector<float> table(model.table().begin(), model.table().end());
+    if (table.empty()) table = {0.0f, 1.0f};
+    glCreateTextures(GL_TEXTURE_2D, 1, &gl.response_table);
+    glTextureStorage2D(gl.response_table, 1, GL_R32F, static_cast<GLsizei>(table.size()), 1);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTextureSubImage2D(gl.response_table, 0, 0, 0, static_cast<GLsizei>(table.size()), 1, GL_RED, GL_FLOAT,
+                        table.data());
+  }
+
+  const FocusShare& focus = stage.focus;
+  glProgramUniform1i(program, uniform("share"), static_cast<int>(focus.role));
+  const glm::dmat3& a = focus.user_to_projector;
+  glProgramUniform4f(program, uniform("depth_unwarp"), static_cast<float>(a[0][2]), static_cast<float>(a[1][2]),
+                     static_cast<float>(a[2][2]), static_cast<float>(focus.depth_scale));
+  const glm::mat3 fragment_to_screen(focus.fragment_to_screen);
+  glProgramUniformMatrix3fv(program, uniform("fragment_to_screen"), 1, GL_FALSE, glm::value_ptr(fragment_to_screen));
+  glProgramUniform1f(program, uniform("screen_metres_per_pixel"), static_cast<float>(focus.screen_metres_per_pixel));
+  set_focus({});
 
   glCreateTextures(GL_TEXTURE_2D, 1, &gl.encoded_colour);
-  glTextureStorage2D(gl.encoded_colour, 1, GL_RGBA8, width, height);
+  // The signal at the projector's depth: 8 bits, or 16 to hold up to 16.
+  glTextureStorage2D(gl.encoded_colour, 1, model.bits() <= 8 ? GL_RGBA8 : GL_RGBA16, width, height);
   glCreateTextures(GL_TEXTURE_2D, 1, &gl.output_light);
   glTextureStorage2D(gl.output_light, 1, GL_RGBA16F, width, height);
   glCreateFramebuffers(1, &gl.encoded_framebuffer);
@@ -386,6 +505,37 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
     }
   }
   return {};
+}
+
+void SceneRenderer::set_lights(std::span<const std::uint32_t> lights) {
+  Gl& gl = *gl_;
+  std::vector<glm::vec4> chosen;
+  for (std::uint32_t i : lights) {
+    assert(2 * static_cast<std::size_t>(i) + 1 < gl.all_lights.size());
+    chosen.push_back(gl.all_lights[2 * i]);
+    chosen.push_back(gl.all_lights[2 * i + 1]);
+  }
+  if (!chosen.empty()) {
+    glNamedBufferSubData(gl.light_buffer, 0, static_cast<GLsizeiptr>(chosen.size() * sizeof(glm::vec4)), chosen.data());
+  }
+  gl.light_count = static_cast<int>(lights.size());
+}
+
+void SceneRenderer::set_all_lights() {
+  std::vector<std::uint32_t> all(gl_->all_lights.size() / 2);
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
+  set_lights(all);
+}
+
+void SceneRenderer::set_focus(const FocusFrame& frame) {
+  const Gl& gl = *gl_;
+  const GLuint program = gl.encode_program;
+  glProgramUniform4f(program, gl.focus_uniforms.coc, static_cast<float>(frame.coc.k),
+                     static_cast<float>(frame.coc.focal), static_cast<float>(frame.coc.lo),
+                     static_cast<float>(frame.coc.hi));
+  glProgramUniform1i(program, gl.focus_uniforms.inset, frame.inset ? 1 : 0);
+  glProgramUniform3f(program, gl.focus_uniforms.inset_disc, static_cast<float>(frame.gaze.x),
+                     static_cast<float>(frame.gaze.y), static_cast<float>(frame.inset_radius));
 }
 
 void SceneRenderer::draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye, const Frustum& frustum,
@@ -458,6 +608,8 @@ void SceneRenderer::encode() {
   glUseProgram(gl.encode_program);
   glBindTextureUnit(0, gl.linear_colour);
   if (gl.weights != 0) glBindTextureUnit(2, gl.weights);
+  glBindTextureUnit(3, gl.depth);
+  glBindTextureUnit(4, gl.response_table);
   glBindVertexArray(gl.empty_vertex_array);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glFinish();
@@ -494,6 +646,15 @@ image::ByteImage SceneRenderer::read_encoded() const {
   glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->encoded_framebuffer);
   glPixelStorei(GL_PACK_ALIGNMENT, 1);
   glReadPixels(0, 0, gl_->output_width, gl_->output_height, GL_RGBA, GL_UNSIGNED_BYTE, image.pixels.data());
+  image::flip_rows(image);
+  return image;
+}
+
+image::Image<std::uint16_t> SceneRenderer::read_signal() const {
+  image::Image<std::uint16_t> image(gl_->output_width, gl_->output_height, 4);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, gl_->encoded_framebuffer);
+  glPixelStorei(GL_PACK_ALIGNMENT, 2);
+  glReadPixels(0, 0, gl_->output_width, gl_->output_height, GL_RGBA, GL_UNSIGNED_SHORT, image.pixels.data());
   image::flip_rows(image);
   return image;
 }

@@ -6,10 +6,13 @@
 
 #include <memory>
 #include <optional>
+#include <span>
 
 #include <glm/mat3x3.hpp>
 
 #include "image/image.h"
+#include "optics/defocus.h"
+#include "optics/projector_model.h"
 #include "render/projection.h"
 #include "scene/definition.h"
 #include "scene/state.h"
@@ -18,10 +21,33 @@
 namespace optique::render {
 
 // Which light terms this renderer draws (a node of a stacked group may carry only
-// some of them).
+// some of them); the point lights are chosen with SceneRenderer::set_lights.
 struct LightTerms {
   bool ambient = true;
   bool emissive = true;
+};
+
+// A focus/defocus pair's share of the image: the focus projector shows (1 − c_r)
+// of the light, the defocus one c_r (or, in the inset variant, inside and outside
+// a disc around the gaze point).
+enum class FocusRole { none, focus, defocus };
+
+struct FocusShare {
+  FocusRole role = FocusRole::none;
+  // Single pass: A and the depth scale, to undo what they did to window depth.
+  glm::dmat3 user_to_projector{1.0};
+  double depth_scale = 1.0;
+  // Output pixels (GL fragment coordinates, rows up) → screen metres, for the inset.
+  glm::dmat3 fragment_to_screen{1.0};
+  double screen_metres_per_pixel = 1e-3;  // the inset's edge is this soft
+};
+
+// What changes per frame for a focus/defocus projector.
+struct FocusFrame {
+  optics::CocFromWindowDepth coc;  // from the frame's focal depth
+  bool inset = false;
+  glm::dvec2 gaze{0.0};  // screen metres
+  double inset_radius = 0.0;
 };
 
 // The depth buffer's format: 32-bit float by default; 24-bit fixed point to
@@ -38,7 +64,9 @@ struct OutputStage {
   // Two-pass only: projector NDC → user NDC (A⁻¹); the rendered image spans
   // user NDC [−1, 1]² and is sampled bilinearly.
   std::optional<glm::dmat3> projector_to_user;
-  image::FloatImage weights;  // 1 channel, width × height, top row first; empty: 1 everywhere
+  image::FloatImage weights;         // 1 channel, width × height, top row first; empty: 1 everywhere
+  optics::ProjectorModel projector;  // response, bit depth, black level, brightness
+  FocusShare focus;
 };
 
 class SceneRenderer {
@@ -61,12 +89,20 @@ class SceneRenderer {
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);
 
+  // Draws only these of the scene's point lights (indices; all by default).
+  // Asserts that each exists.
+  void set_lights(std::span<const std::uint32_t> lights);
+  void set_all_lights();
+  // The focal depth and gaze of the frame to come (focus/defocus projectors).
+  void set_focus(const FocusFrame& frame);
+
   // Black everywhere (the projector shows nothing), encoded like a drawn frame.
   void draw_black();
 
   // The output, after the output stage (projector pixels).
   [[nodiscard]] image::FloatImage read_linear() const;  // RGBA, linear light the projector emits
-  [[nodiscard]] image::ByteImage read_encoded() const;  // RGBA8, as sent to the projector
+  [[nodiscard]] image::ByteImage read_encoded() const;  // RGBA8, the signal (8 bits deep at most)
+  [[nodiscard]] image::WordImage read_signal() const;   // RGBA16: the signal at any depth, ·65535
   [[nodiscard]] unsigned output_framebuffer() const;    // the encoded image, for a window blit
   [[nodiscard]] int width() const;                      // of the output
   [[nodiscard]] int height() const;

@@ -77,24 +77,36 @@ SceneDefinition cubes_backdrop() {
   return scene;
 }
 
-SceneDefinition many_lights() {
-  // One slowly turning object lit by 24 coloured specular lights on a ring.
+// A slowly turning glossy statue before a matte wall, lit by `count` coloured
+// point lights spread in front of the wall: every light shades the whole wall
+// smoothly and puts its own highlight on the statue, so a split of the lights
+// across projectors shows anywhere it is wrong. The total light stays the same
+// whatever the count.
+SceneDefinition many_lights(int count) {
   SceneDefinition scene;
-  scene.name = "many-lights";
+  scene.name = count == 20 ? "many-lights" : "many-lights-" + std::to_string(count);
+  scene.ambient = glm::vec3(0.01f);
   const auto box = add_mesh(scene, make_box(glm::vec3(1.0f)));
-  const auto material = add_material(scene, {glm::vec3(0.8f), 0.0f, 0.25f, {}});
-  add_animated(scene, box, material, "statue", [](double t) {
+  const auto glossy = add_material(scene, {glm::vec3(0.8f), 0.0f, 0.25f, {}});
+  add_animated(scene, box, glossy, "statue", [](double t) {
     return Pose{kStage, spin({0, 1, 0}, 0.3 * t), glm::dvec3(0.6)};
   });
-  constexpr int kLights = 24;
-  for (int i = 0; i < kLights; ++i) {
-    const double angle = 2.0 * std::numbers::pi * i / kLights;
-    const float h = static_cast<float>(i) / kLights;
+  const auto wall = add_mesh(scene, make_quad(8.0f, 4.0f));
+  const auto matte = add_material(scene, {glm::vec3(0.5f), 0.0f, 0.9f, {}});
+  scene.instances.push_back({wall, matte, std::nullopt, glm::translate(glm::dmat4(1.0), glm::dvec3(0.0, 1.2, -1.4))});
+  const float intensity = 0.25f * 20.0f / static_cast<float>(count);
+  for (int i = 0; i < count; ++i) {
+    // A golden-angle spiral over an ellipse in front of the stage, at varying
+    // distances from the wall: no two lights alike.
+    const double f = (i + 0.5) / count;
+    const double angle = 2.399963229728653 * i;
+    const double r = std::sqrt(f);
+    const float h = static_cast<float>(i) / static_cast<float>(count);
     const glm::vec3 colour(0.5f + 0.5f * std::cos(6.2832f * h), 0.5f + 0.5f * std::cos(6.2832f * (h - 0.333f)),
                            0.5f + 0.5f * std::cos(6.2832f * (h - 0.667f)));
-    scene.lights.push_back(
-        {kStage + glm::dvec3(1.1 * std::cos(angle), 0.5 * std::sin(3.0 * angle), 1.1 * std::sin(angle)), colour,
-         0.12f});
+    scene.lights.push_back({kStage + glm::dvec3(1.6 * r * std::cos(angle), 0.8 * r * std::sin(angle),
+                                                -0.3 + 1.2 * std::fmod(0.618033988749895 * i, 1.0)),
+                            colour, intensity});
   }
   return scene;
 }
@@ -313,10 +325,12 @@ struct Entry {
 
 constexpr std::array kScenes{
     Entry{"cubes", cubes},
-    Entry{"many-lights", many_lights},
+    Entry{"many-lights", [] { return many_lights(20); }},
     Entry{"depth-stack", depth_stack},
     Entry{"moving-square", moving_square},
     Entry{"cubes-backdrop", cubes_backdrop},
+    Entry{"many-lights-50", [] { return many_lights(50); }},
+    Entry{"many-lights-100", [] { return many_lights(100); }},
     // seed-001
     Entry{"cube-fast-rotation", cube_fast_rotation},
     Entry{"cube-slow-rotation", cube_slow_rotation},

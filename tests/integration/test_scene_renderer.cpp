@@ -133,7 +133,7 @@ TEST_F(SceneRendererTest, BaseColourFactorMultipliesTheTexture) {
   auto renderer = SceneRenderer::create(scene, kSize, kSize);
   ASSERT_TRUE(renderer.ok()) << renderer.error();
   renderer.value()->draw(scene::SceneState{}, 0.0, kEye, view_of_unit_square());
-  const auto image = renderer.value()->read_linear();
+  const auto image = renderer.value()->read_rendered();
   EXPECT_NEAR(image.at(kSize / 2, kSize / 2, 0), 0.5f, kTolerance);
   EXPECT_NEAR(image.at(kSize / 2, kSize / 2, 1), 0.25f, kTolerance);
   EXPECT_NEAR(image.at(kSize / 2, kSize / 2, 2), 1.0f, kTolerance);

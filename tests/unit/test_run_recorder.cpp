@@ -35,21 +35,21 @@ void feed_three_frames(RunRecorder& r) {
   r.ready(0, 0, 1'000'300'000, 250'000);
   r.ready(0, 1, 1'000'500'000, 450'000);
   r.swapped(0, 1'000'600'000, both);
-  r.presented(0, 0, 1'002'000'000);
-  r.presented(0, 1, 1'002'030'000);
+  r.presented(0, 0, 1'002'000'000, 0);
+  r.presented(0, 1, 1'002'030'000, 0);
 
   r.frame_begun(1, 1'016'666'667, both);
   r.ready(1, 0, 1'017'000'000, 300'000);
   r.ready(1, 1, 1'017'400'000, 500'000);
   r.swapped(1, 1'017'466'667, both);
-  r.presented(1, 0, 1'018'700'000);
+  r.presented(1, 0, 1'018'700'000, 1);
 
   r.frame_begun(2, 1'033'333'333, both);
   r.ready(2, 0, 1'033'500'000, 200'000);
   r.ready(2, 1, 1'033'700'000, 350'000);
   r.swapped(2, 1'033'733'333, both);
-  r.presented(2, 0, 1'035'070'000);
-  r.presented(2, 1, 1'035'000'000);
+  r.presented(2, 0, 1'035'070'000, 2);
+  r.presented(2, 1, 1'035'000'000, 2);
 }
 
 TEST(RunRecorder, CsvHeaderIsWrittenOnConstruction) {
@@ -164,7 +164,7 @@ TEST(RunRecorder, NodeNotBegunHasNoRowAndCountsAsMissing) {
   r.frame_begun(5, 2'000'000'000, {0});  // b is not connected
   r.ready(5, 0, 2'000'100'000, 90'000);
   r.swapped(5, 2'000'150'000, {0});
-  r.presented(5, 0, 2'001'000'000);
+  r.presented(5, 0, 2'001'000'000, 5);
   r.finalize_all();
   const std::vector<std::string> expected{kHeader, "5,a,2000000000,2000100000,2000150000,2001000000"};
   EXPECT_EQ(lines_of(csv.str()), expected);
@@ -180,9 +180,9 @@ TEST(RunRecorder, NodeThatMissedTheBarrierHasEmptyCells) {
   r.frame_begun(9, 3'000'000'000, {0, 1});
   r.ready(9, 0, 3'000'100'000, 90'000);
   r.node_missed_barrier(1);
-  r.swapped(9, 3'500'000'000, {0});  // swapped without b
-  r.presented(9, 1, 3'500'900'000);  // b was not told to swap: ignored
-  r.presented(9, 0, 3'501'000'000);
+  r.swapped(9, 3'500'000'000, {0});     // swapped without b
+  r.presented(9, 1, 3'500'900'000, 9);  // b was not told to swap: ignored
+  r.presented(9, 0, 3'501'000'000, 9);
   r.finalize_all();
   const std::vector<std::string> expected{kHeader, "9,a,3000000000,3000100000,3500000000,3501000000",
                                           "9,b,3000000000,,,"};
@@ -203,9 +203,9 @@ TEST(RunRecorder, DuplicateAndUnknownEventsAreIgnored) {
   r.ready(1, 0, 2'500, 700);  // duplicate FrameReady
   r.ready(8, 0, 2'600, 700);  // unknown frame
   r.swapped(1, 3'000, {0});
-  r.presented(1, 0, 4'000);
-  r.presented(1, 0, 4'500);  // duplicate Presented
-  r.presented(8, 0, 4'600);  // unknown frame
+  r.presented(1, 0, 4'000, 1);
+  r.presented(1, 0, 4'500, 1);  // duplicate Presented
+  r.presented(8, 0, 4'600, 8);  // unknown frame
   r.hash_mismatch(0);
   r.hash_mismatch(0);
   r.finalize_all();

@@ -1,0 +1,77 @@
+#pragma once
+// What a projector does with the signal it is sent: its response (how signal
+// becomes light), the depth the signal is quantized to, the black it shows at
+// signal 0 and its brightness. A node sends response⁻¹ of the light it rendered
+// so that the projector adds exactly that light on top of its own black:
+//
+//   emitted(v) = brightness · (black_level + (1 − black_level) · response(v))
+//   signal_for(L) = quantize(response⁻¹(L / (brightness · (1 − black_level))))
+//
+// so emitted(signal_for(L)) = black + L up to quantization, and the light of a
+// stacked group adds linearly: Σ emitted = Σ black + Σ rendered. The renderer's
+// output pass does the same in GLSL (render/scene_renderer.cpp); the screen
+// simulator decodes captured signals with emitted().
+
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+#include "optique/config.pb.h"
+#include "util/result.h"
+
+namespace optique::optics {
+
+class ProjectorModel {
+ public:
+  enum class Curve { srgb, gamma, table };
+
+  // The sRGB curve, 8 bits, no black, brightness 1: what a projector without
+  // response settings is taken to be.
+  ProjectorModel() = default;
+  // Fails, naming the field, on a gamma ≤ 0, a table that is too short, not
+  // finite, not from 0 to 1 or decreasing, bits outside 1…16, a black level
+  // outside [0, 1) or a brightness < 0. Paths are relative to the projector
+  // ("response.table[3]").
+  [[nodiscard]] static Result<ProjectorModel> from_config(const config::Projector& projector);
+
+  // Normalized response: light in [0, 1] for a signal in [0, 1], non-decreasing.
+  [[nodiscard]] double response(double signal) const;
+  // The smallest signal whose response reaches `light` (clamped to [0, 1]).
+  [[nodiscard]] double inverse_response(double light) const;
+  // To the nearest of the 2^bits levels.
+  [[nodiscard]] double quantize(double signal) const;
+  // Light leaving the lens for a signal, in the installation's unit of light.
+  [[nodiscard]] double emitted(double signal) const;
+  // The quantized signal that makes the projector add `light` to its black;
+  // light beyond what it can add is clipped.
+  [[nodiscard]] double signal_for(double light) const;
+
+  // Light at signal 0 (brightness · black level) and at full signal.
+  [[nodiscard]] double black() const { return brightness_ * black_level_; }
+  [[nodiscard]] double white() const { return brightness_; }
+  // The most light it can add above its black.
+  [[nodiscard]] double headroom() const { return brightness_ * (1.0 - black_level_); }
+
+  [[nodiscard]] Curve curve() const { return curve_; }
+  [[nodiscard]] double gamma() const { return gamma_; }
+  [[nodiscard]] const std::vector<double>& table() const { return table_; }
+  [[nodiscard]] int bits() const { return bits_; }
+  [[nodiscard]] int levels() const { return (1 << bits_) - 1; }  // the largest code
+  [[nodiscard]] double black_level() const { return black_level_; }
+  [[nodiscard]] double brightness() const { return brightness_; }
+
+ private:
+  Curve curve_ = Curve::srgb;
+  double gamma_ = 2.2;
+  std::vector<double> table_;
+  int bits_ = 8;
+  double black_level_ = 0.0;
+  double brightness_ = 1.0;
+};
+
+// The light a projector emits for a captured signal image (values in [0, 1] as
+// read from its 8- or 16-bit PNG; snapped to the projector's levels): RGB
+// through the model, alpha 1.
+[[nodiscard]] image::FloatImage emitted_image(const image::FloatImage& signal, const ProjectorModel& model);
+
+}  // namespace optique::optics

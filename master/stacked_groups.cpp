@@ -1,0 +1,261 @@
+#include "stacked_groups.h"
+
+#include <algorithm>
+#include <cassert>
+#include <limits>
+
+#include "config/geometry.h"
+#include "scene/light_coverage.h"
+
+namespace optique::master {
+namespace {
+
+// The modelled cost of a node's pixels before any light, and of the ambient and
+// emissive terms, in units of a light that reaches every pixel (light_share.h):
+// rasterizing and the material fetch cost about half a light in the scene shader;
+// ambient and emissive are two multiply-adds.
+constexpr double kBaseCost = 0.5;
+constexpr double kAmbientCost = 0.05;
+
+std::string group_name(const StackedGroup& group) {
+  return "stacked group on screen '" + group.screen + "' (eye " + group.eye + ")";
+}
+
+std::string lights_path(std::size_t projector) {
+  return "projectors[" + std::to_string(projector) + "].content.lights";
+}
+
+// The group's layers: the first member of each, and the members it stands for.
+std::vector<std::vector<std::size_t>> layers_of(const config::Installation& inst, const StackedGroup& group) {
+  std::vector<std::vector<std::size_t>> layers;
+  for (std::size_t member : group.members) {
+    auto layer = std::find_if(layers.begin(), layers.end(), [&](const std::vector<std::size_t>& l) {
+      return config::same_layer(inst.projectors(static_cast<int>(l.front())),
+                                inst.projectors(static_cast<int>(member)));
+    });
+    if (layer != layers.end()) {
+      layer->push_back(member);
+    } else {
+      layers.push_back({member});
+    }
+  }
+  return layers;
+}
+
+}  // namespace
+
+std::vector<StackedGroup> lighting_groups(const config::Installation& inst) {
+  std::vector<StackedGroup> groups;
+  for (int i = 0; i < inst.projectors_size(); ++i) {
+    const config::Projector& p = inst.projectors(i);
+    if (p.content().role() != "lights") continue;
+    auto group = std::find_if(groups.begin(), groups.end(), [&](const StackedGroup& g) {
+      return config::same_screen_image(inst.projectors(static_cast<int>(g.members.front())), p);
+    });
+    if (group == groups.end()) {
+      groups.push_back({p.screen(), p.eye(), {}, p.content().lights() == "auto"});
+      group = std::prev(groups.end());
+    }
+    group->members.push_back(static_cast<std::size_t>(i));
+  }
+  return groups;
+}
+
+std::vector<config::Problem> check_lighting_groups(const config::Installation& inst, std::size_t light_count) {
+  std::vector<config::Problem> problems;
+  for (const StackedGroup& group : lighting_groups(inst)) {
+    const auto projector = [&](std::size_t i) -> const config::Projector& {
+      return inst.projectors(static_cast<int>(i));
+    };
+    bool mixed = false;
+    for (std::size_t member : group.members) {
+      if ((projector(member).content().lights() == "auto") != group.automatic) mixed = true;
+    }
+    if (mixed) {
+      problems.push_back({lights_path(group.members.front()),
+                          "the " + group_name(group) +
+                              " mixes \"auto\" with listed lights: use \"auto\" for all its projectors, or list "
+                              "the lights of each"});
+      continue;
+    }
+    if (group.automatic) continue;  // the master shares them out: nothing can be missing or twice
+
+    std::vector<std::string> drawn_by(light_count);
+    std::vector<std::string> ambient_carriers;
+    bool parsed = true;
+    for (const std::vector<std::size_t>& layer : layers_of(inst, group)) {
+      const config::Projector& first = projector(layer.front());
+      auto lights = parse_light_list(first.content().lights(), light_count);
+      if (!lights) {
+        problems.push_back({lights_path(layer.front()), lights.error()});
+        parsed = false;
+        continue;
+      }
+      for (std::uint32_t light : lights.value()) {
+        if (!drawn_by[light].empty()) {
+          problems.push_back({lights_path(layer.front()), "light " + std::to_string(light) + " is drawn twice in the " +
+                                                              group_name(group) + ", by '" + drawn_by[light] +
+                                                              "' and '" + first.id() +
+                                                              "': give each light to exactly one projector"});
+        } else {
+          drawn_by[light] = first.id();
+        }
+      }
+      if (first.content().ambient()) ambient_carriers.push_back(first.id());
+    }
+    if (parsed) {
+      std::vector<std::uint32_t> missing;
+      for (std::size_t light = 0; light < light_count; ++light) {
+        if (drawn_by[light].empty()) missing.push_back(static_cast<std::uint32_t>(light));
+      }
+      if (!missing.empty()) {
+        problems.push_back({lights_path(group.members.front()), "the " + group_name(group) + " draws no light " +
+                                                                    format_light_list(missing) + " of the scene's " +
+                                                                    std::to_string(light_count) +
+                                                                    ": give each light to exactly one projector"});
+      }
+    }
+    const std::string ambient_path = "projectors[" + std::to_string(group.members.front()) + "].content.ambient";
+    if (ambient_carriers.empty()) {
+      problems.push_back({ambient_path, "no projector of the " + group_name(group) +
+                                            " carries ambient and emissive light: set ambient on exactly one"});
+    } else if (ambient_carriers.size() > 1) {
+      problems.push_back({ambient_path, "ambient and emissive light are carried twice in the " + group_name(group) +
+                                            ", by '" + ambient_carriers[0] + "' and '" + ambient_carriers[1] +
+                                            "': set ambient on exactly one projector"});
+    }
+  }
+  return problems;
+}
+
+std::map<std::size_t, LightShare> listed_shares(const config::Installation& inst, std::size_t light_count) {
+  std::map<std::size_t, LightShare> shares;
+  for (const StackedGroup& group : lighting_groups(inst)) {
+    if (group.automatic) continue;
+    for (std::size_t member : group.members) {
+      const config::Content& content = inst.projectors(static_cast<int>(member)).content();
+      auto lights = parse_light_list(content.lights(), light_count);
+      assert(lights);
+      shares[member] = {lights ? std::move(lights).value() : std::vector<std::uint32_t>{}, content.ambient()};
+    }
+  }
+  return shares;
+}
+
+namespace {
+
+// Each light's estimated cost to the group: its coverage of the area the group
+// lights (the members' lit quads, bounded, within the screen) seen from `eye`.
+std::vector<double> light_costs(const config::Installation& inst, const StackedGroup& group,
+                                const scene::SceneDefinition& scene, const scene::SceneState& state,
+                                const glm::dvec3& eye) {
+  const config::Screen* screen = nullptr;
+  for (const config::Screen& s : inst.screens()) {
+    if (s.id() == group.screen) screen = &s;
+  }
+  assert(screen != nullptr);
+  optics::ScreenRect area{{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()},
+                          {std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()}};
+  for (std::size_t member : group.members) {
+    auto geometry = config::projector_geometry(inst.projectors(static_cast<int>(member)));
+    if (!geometry) continue;
+    for (const glm::dvec2& corner : geometry.value().lit_quad()) {
+      area.min = glm::min(area.min, corner);
+      area.max = glm::max(area.max, corner);
+    }
+  }
+  const optics::ScreenRect usable = config::usable_area(*screen);
+  area.min = glm::clamp(area.min, usable.min, usable.max);
+  area.max = glm::clamp(area.max, usable.min, usable.max);
+  const glm::dvec3 origin(screen->origin(0), screen->origin(1), screen->origin(2));
+  const glm::dvec3 right(screen->right(0), screen->right(1), screen->right(2));
+  const glm::dvec3 up(screen->up(0), screen->up(1), screen->up(2));
+  scene::CoverageGrid grid;
+  grid.eye = eye;
+  grid.corner = origin + area.min.x * right + area.min.y * up;
+  grid.across = area.width() * right;
+  grid.up = area.height() * up;
+  return scene::light_coverage(scene, state, grid);
+}
+
+}  // namespace
+
+std::vector<LightShare> automatic_shares(const config::Installation& inst, const StackedGroup& group,
+                                         const std::vector<bool>& live, const scene::SceneDefinition& scene,
+                                         const scene::SceneState& state, const glm::dvec3& eye) {
+  assert(live.size() == group.members.size());
+  std::vector<LightShare> shares(group.members.size());
+  std::vector<std::size_t> up;
+  std::vector<double> pixels;
+  for (std::size_t k = 0; k < group.members.size(); ++k) {
+    if (!live[k]) continue;
+    const config::Projector& p = inst.projectors(static_cast<int>(group.members[k]));
+    up.push_back(k);
+    pixels.push_back(static_cast<double>(p.width()) * p.height());
+  }
+  if (up.empty()) return shares;
+  const std::vector<LightShare> live_shares =
+      share_lights(light_costs(inst, group, scene, state, eye), pixels, kBaseCost, kAmbientCost);
+  for (std::size_t i = 0; i < up.size(); ++i) shares[up[i]] = live_shares[i];
+  return shares;
+}
+
+LightPlan::LightPlan(const config::Installation& installation, const scene::SceneDefinition& scene)
+    : installation_(installation), scene_(scene), groups_(lighting_groups(installation)) {
+  shares_ = listed_shares(installation, scene.lights.size());
+}
+
+bool LightPlan::rebalance(const std::vector<bool>& up, const scene::SceneState& state, const glm::dvec3& eye,
+                          bool force) {
+  // A split this much faster (modelled) than the current one is worth switching
+  // to; smaller gains would let the split flicker between near-equal choices.
+  constexpr double kWorthwhileGain = 0.05;
+  bool changed = false;
+  for (const StackedGroup& group : groups_) {
+    if (!group.automatic) continue;
+    std::vector<bool> live;
+    for (std::size_t member : group.members) live.push_back(up[member]);
+    std::vector<LightShare> proposed = automatic_shares(installation_, group, live, scene_, state, eye);
+    bool differs = false;
+    for (std::size_t k = 0; k < group.members.size(); ++k) {
+      const auto current = shares_.find(group.members[k]);
+      differs = differs || current == shares_.end() || current->second.lights != proposed[k].lights ||
+                current->second.ambient != proposed[k].ambient;
+    }
+    if (!differs) continue;
+    if (!force) {
+      // Compare the modelled times of both splits under today's costs.
+      std::vector<double> costs;
+      std::vector<double> pixels;
+      std::vector<LightShare> current;
+      std::vector<LightShare> candidate;
+      bool complete = true;
+      for (std::size_t k = 0; k < group.members.size(); ++k) {
+        if (!live[k]) continue;
+        const config::Projector& p = installation_.projectors(static_cast<int>(group.members[k]));
+        pixels.push_back(static_cast<double>(p.width()) * p.height());
+        const auto found = shares_.find(group.members[k]);
+        complete = complete && found != shares_.end();
+        current.push_back(found != shares_.end() ? found->second : LightShare{});
+        candidate.push_back(proposed[k]);
+      }
+      if (complete && !pixels.empty()) {
+        costs = light_costs(installation_, group, scene_, state, eye);
+        const auto slowest = [](const std::vector<double>& t) { return *std::max_element(t.begin(), t.end()); };
+        const double now = slowest(modelled_times(costs, pixels, kBaseCost, kAmbientCost, current));
+        const double then = slowest(modelled_times(costs, pixels, kBaseCost, kAmbientCost, candidate));
+        if (then > now * (1.0 - kWorthwhileGain)) continue;
+      }
+    }
+    for (std::size_t k = 0; k < group.members.size(); ++k) shares_[group.members[k]] = std::move(proposed[k]);
+    changed = true;
+  }
+  return changed;
+}
+
+const LightShare* LightPlan::share(std::size_t projector) const {
+  const auto found = shares_.find(projector);
+  return found == shares_.end() ? nullptr : &found->second;
+}
+
+}  // namespace optique::master

@@ -1,0 +1,128 @@
+#include "optics/projector_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+namespace optique::optics {
+namespace {
+
+ProjectorModel model_of(const config::Projector& projector) {
+  auto model = ProjectorModel::from_config(projector);
+  EXPECT_TRUE(model) << (model ? "" : model.error());
+  return model ? model.value() : ProjectorModel{};
+}
+
+std::string error_of(const config::Projector& projector) {
+  auto model = ProjectorModel::from_config(projector);
+  return model ? std::string("(accepted)") : model.error();
+}
+
+TEST(ProjectorModel, DefaultIsEightBitSrgbWithoutBlack) {
+  const ProjectorModel model;
+  EXPECT_EQ(model.bits(), 8);
+  EXPECT_EQ(model.levels(), 255);
+  EXPECT_EQ(model.black(), 0.0);
+  EXPECT_NEAR(model.response(0.5), 0.2140, 1e-4);  // sRGB 128/255 ≈ 0.2158; 0.5 → 0.2140
+  EXPECT_NEAR(model.inverse_response(0.2140), 0.5, 1e-4);
+}
+
+TEST(ProjectorModel, EmittedLightIsBlackPlusWhatWasRendered) {
+  for (const double gamma : {1.0, 1.8, 2.2, 2.6}) {
+    config::Projector p;
+    p.mutable_response()->set_gamma(gamma);
+    p.mutable_response()->set_bits(16);
+    p.set_black_level(0.02);
+    p.set_brightness(0.7);
+    const ProjectorModel model = model_of(p);
+    for (double light = 0.0; light <= model.headroom(); light += 0.01) {
+      // 16-bit quantization: the step in light is at most slope · 2⁻¹⁶.
+      EXPECT_NEAR(model.emitted(model.signal_for(light)), model.black() + light, 2e-4) << gamma << " " << light;
+    }
+    // Beyond the headroom the projector is at full white.
+    EXPECT_NEAR(model.emitted(model.signal_for(2.0)), model.white(), 1e-12);
+  }
+}
+
+TEST(ProjectorModel, MeasuredTableIsInvertedWhereItIsFlatAndSteep) {
+  config::Projector p;
+  for (const double v : {0.0, 0.0, 0.05, 0.2, 0.2, 0.6, 1.0}) p.mutable_response()->add_table(v);
+  p.mutable_response()->set_bits(16);
+  const ProjectorModel model = model_of(p);
+  EXPECT_EQ(model.curve(), ProjectorModel::Curve::table);
+  EXPECT_DOUBLE_EQ(model.response(0.5), 0.2);  // signal 0.5 = table index 3
+  EXPECT_NEAR(model.response(0.75), 0.4, 1e-12);
+  for (double light = 0.0; light <= 1.0; light += 0.013) {
+    EXPECT_NEAR(model.response(model.inverse_response(light)), light, 1e-9) << light;
+  }
+  // A flat stretch sends its smallest signal.
+  EXPECT_NEAR(model.inverse_response(0.2), 0.5, 1e-12);
+  EXPECT_EQ(model.inverse_response(0.0), 0.0);
+}
+
+TEST(ProjectorModel, QuantizationHasTwoToTheBitsLevels) {
+  for (const int bits : {1, 4, 8, 10}) {
+    config::Projector p;
+    p.mutable_response()->set_gamma(2.2);
+    p.mutable_response()->set_bits(static_cast<unsigned>(bits));
+    const ProjectorModel model = model_of(p);
+    // Every level is reached by the light it emits, and nothing lies between levels.
+    std::set<double> levels;
+    for (int k = 0; k <= model.levels(); ++k) {
+      const double signal = static_cast<double>(k) / model.levels();
+      EXPECT_DOUBLE_EQ(model.signal_for(model.response(signal) * model.headroom()), signal) << bits << " " << k;
+    }
+    for (int i = 0; i <= 5000; ++i) levels.insert(model.signal_for(std::pow(i / 5000.0, 2.2)));
+    EXPECT_EQ(static_cast<int>(levels.size()), std::min(1 << bits, 5001)) << bits;
+    EXPECT_EQ(*levels.begin(), 0.0);
+    EXPECT_EQ(*levels.rbegin(), 1.0);
+  }
+}
+
+TEST(ProjectorModel, BadSettingsNameTheField) {
+  config::Projector p;
+  p.mutable_response()->set_gamma(-1.0);
+  EXPECT_NE(error_of(p).find("response.gamma"), std::string::npos) << error_of(p);
+  p.mutable_response()->set_gamma(std::nan(""));
+  EXPECT_NE(error_of(p).find("response.gamma"), std::string::npos);
+
+  config::Projector both;
+  both.mutable_response()->set_gamma(2.2);
+  both.mutable_response()->add_table(0.0);
+  both.mutable_response()->add_table(1.0);
+  EXPECT_NE(error_of(both).find("either gamma or table"), std::string::npos) << error_of(both);
+
+  config::Projector short_table;
+  short_table.mutable_response()->add_table(0.0);
+  EXPECT_NE(error_of(short_table).find("at least 2"), std::string::npos) << error_of(short_table);
+
+  config::Projector dips;
+  for (const double v : {0.0, 0.5, 0.4, 1.0}) dips.mutable_response()->add_table(v);
+  EXPECT_NE(error_of(dips).find("response.table[2]"), std::string::npos) << error_of(dips);
+
+  config::Projector unnormalized;
+  for (const double v : {0.01, 0.5, 0.9}) unnormalized.mutable_response()->add_table(v);
+  EXPECT_NE(error_of(unnormalized).find("from 0"), std::string::npos) << error_of(unnormalized);
+
+  config::Projector infinite;
+  for (const double v : {0.0, static_cast<double>(INFINITY), 1.0}) infinite.mutable_response()->add_table(v);
+  EXPECT_NE(error_of(infinite).find("response.table[1]"), std::string::npos) << error_of(infinite);
+
+  config::Projector bits;
+  bits.mutable_response()->set_bits(17);
+  EXPECT_NE(error_of(bits).find("response.bits"), std::string::npos) << error_of(bits);
+
+  config::Projector black;
+  black.set_black_level(1.0);
+  EXPECT_NE(error_of(black).find("black_level"), std::string::npos) << error_of(black);
+  black.set_black_level(-0.1);
+  EXPECT_NE(error_of(black).find("black_level"), std::string::npos);
+
+  config::Projector brightness;
+  brightness.set_brightness(-2.0);
+  EXPECT_NE(error_of(brightness).find("brightness"), std::string::npos) << error_of(brightness);
+}
+
+}  // namespace
+}  // namespace optique::optics

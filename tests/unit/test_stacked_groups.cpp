@@ -1,0 +1,153 @@
+// Stacked groups: the checks check-config makes on lights and focus pairs
+// (master/stacked_groups.h, common/config/validate.cpp) and the light plan.
+
+#include "stacked_groups.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "config/load.h"
+#include "config/validate.h"
+#include "scene/builtin.h"
+#include "scene_authority.h"
+
+namespace optique::master {
+namespace {
+
+// Three stacked projectors on one screen sharing 20 lights; each test changes
+// the projectors' content by text.
+std::string stacked(const std::string& a, const std::string& b, const std::string& c,
+                    const std::string& extra_projector = "") {
+  return R"json({
+  "screens": [{"id": "front", "origin": [-1.6, 0.3, 0.0], "right": [1, 0, 0], "up": [0, 1, 0],
+               "width": 3.2, "height": 1.8}],
+  "projectors": [
+    {"id": "a", "width": 320, "height": 180, "screen": "front", "content": )json" +
+         a + R"json(},
+    {"id": "b", "width": 320, "height": 180, "screen": "front", "content": )json" +
+         b + R"json(},
+    {"id": "c", "width": 640, "height": 360, "screen": "front", "content": )json" +
+         c + "}" + extra_projector + R"json(
+  ],
+  "viewer": {"eye": [0.0, 1.2, 2.0]},
+  "scene": {"builtin": "many-lights"}
+})json";
+}
+
+config::Installation parsed(const std::string& json) {
+  auto installation = config::parse_installation(json, "stacked.json", ::testing::TempDir());
+  EXPECT_TRUE(installation) << (installation ? "" : installation.error());
+  return installation ? installation.value() : config::Installation{};
+}
+
+std::string light_problems(const std::string& json) {
+  return config::describe_problems(check_lighting_groups(parsed(json), 20), "stacked.json");
+}
+
+const std::string kA = R"({"role": "lights", "lights": "0-6", "ambient": true})";
+const std::string kB = R"({"role": "lights", "lights": "7-13"})";
+const std::string kC = R"({"role": "lights", "lights": "14-19"})";
+
+TEST(StackedGroups, ASplitOfEveryLightOnceIsAccepted) {
+  EXPECT_EQ(light_problems(stacked(kA, kB, kC)), "");
+  const auto shares = listed_shares(parsed(stacked(kA, kB, kC)), 20);
+  ASSERT_EQ(shares.size(), 3u);
+  EXPECT_EQ(shares.at(0).lights.size(), 7u);
+  EXPECT_TRUE(shares.at(0).ambient);
+  EXPECT_EQ(shares.at(2).lights.front(), 14u);
+  EXPECT_FALSE(shares.at(2).ambient);
+}
+
+TEST(StackedGroups, EachMistakeHasItsOwnMessage) {
+  const std::string missing = light_problems(stacked(kA, kB, R"({"role": "lights", "lights": "14-18"})"));
+  EXPECT_NE(missing.find("projectors[0].content.lights: the stacked group on screen 'front' (eye mono) draws no "
+                         "light 19 of the scene's 20"),
+            std::string::npos)
+      << missing;
+
+  const std::string twice = light_problems(stacked(kA, R"({"role": "lights", "lights": "6-13"})", kC));
+  EXPECT_NE(twice.find("projectors[1].content.lights: light 6 is drawn twice in the stacked group on screen 'front' "
+                       "(eye mono), by 'a' and 'b'"),
+            std::string::npos)
+      << twice;
+
+  const std::string two_ambient =
+      light_problems(stacked(kA, R"({"role": "lights", "lights": "7-13", "ambient": true})", kC));
+  EXPECT_NE(two_ambient.find("ambient and emissive light are carried twice in the stacked group on screen 'front' "
+                             "(eye mono), by 'a' and 'b'"),
+            std::string::npos)
+      << two_ambient;
+
+  const std::string no_ambient = light_problems(stacked(R"({"role": "lights", "lights": "0-6"})", kB, kC));
+  EXPECT_NE(no_ambient.find("no projector of the stacked group on screen 'front' (eye mono) carries ambient"),
+            std::string::npos)
+      << no_ambient;
+
+  const std::string unknown = light_problems(stacked(kA, kB, R"({"role": "lights", "lights": "14-24"})"));
+  EXPECT_NE(unknown.find("projectors[2].content.lights: "), std::string::npos) << unknown;
+  EXPECT_NE(unknown.find("20 lights"), std::string::npos) << unknown;
+
+  const std::string mixed = light_problems(stacked(kA, kB, R"({"role": "lights", "lights": "auto"})"));
+  EXPECT_NE(mixed.find("mixes \"auto\" with listed lights"), std::string::npos) << mixed;
+}
+
+TEST(StackedGroups, TilesOfOneLayerShareTheirLights) {
+  // Two tiles showing the same lights are one layer: their lights count once.
+  const std::string tile = R"(,
+    {"id": "a2", "width": 320, "height": 180, "screen": "front", "region": {"x": 1.6, "y": 0, "width": 1.6,
+     "height": 1.8}, "content": {"role": "lights", "lights": "0-6", "ambient": true}})";
+  EXPECT_EQ(light_problems(stacked(kA, kB, kC, tile)), "");
+}
+
+TEST(StackedGroups, AFocusOrDefocusProjectorNeedsItsPartner) {
+  std::string json = stacked(R"({"role": "defocus"})", R"({"role": "full"})", R"({"role": "full"})");
+  json.insert(json.find("\"viewer\""), R"("depth_of_field": {"focal_depth": 2.0}, )");
+  auto installation = config::parse_installation(json, "dof.json", ::testing::TempDir());
+  ASSERT_FALSE(installation);
+  EXPECT_NE(installation.error().find("dof.json: projectors[0].content.role: a 'defocus' projector needs a 'focus' "
+                                      "partner on screen 'front' for the same eye, and 'a' has none"),
+            std::string::npos)
+      << installation.error();
+
+  auto no_depth = stacked(R"({"role": "focus"})", R"({"role": "defocus"})", R"({"role": "full"})");
+  auto refused = config::parse_installation(no_depth, "dof.json", ::testing::TempDir());
+  ASSERT_FALSE(refused);
+  EXPECT_NE(refused.error().find("depth_of_field: focus/defocus projectors need the focal depth"), std::string::npos)
+      << refused.error();
+}
+
+TEST(LightPlan, AutomaticGroupsShareAmongTheNodesThatAreUp) {
+  const std::string autolights = R"({"role": "lights", "lights": "auto"})";
+  const config::Installation installation = parsed(stacked(autolights, autolights, autolights));
+  EXPECT_EQ(light_problems(stacked(autolights, autolights, autolights)), "");
+  auto scene = scene::builtin_scene("many-lights");
+  ASSERT_TRUE(scene);
+  const SceneAuthority authority(scene.value().objects, installation.viewer(), 60.0);
+  const scene::SceneState state = authority.state_at_frame(0);
+  LightPlan plan(installation, scene.value());
+  EXPECT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));
+  std::size_t total = 0;
+  int ambient = 0;
+  for (std::size_t i = 0; i < 3; ++i) {
+    ASSERT_NE(plan.share(i), nullptr);
+    total += plan.share(i)->lights.size();
+    ambient += plan.share(i)->ambient ? 1 : 0;
+  }
+  EXPECT_EQ(total, 20u);
+  EXPECT_EQ(ambient, 1);
+  // 'c' has four times the pixels of 'a' or 'b': it gets the fewest lights.
+  EXPECT_LT(plan.share(2)->lights.size(), plan.share(0)->lights.size());
+  // Nothing moved: no new split.
+  EXPECT_FALSE(plan.rebalance({true, true, true}, state, state.eye_now, false));
+
+  // 'b' goes: its lights go to the others, none is lost.
+  EXPECT_TRUE(plan.rebalance({true, false, true}, state, state.eye_now, true));
+  EXPECT_TRUE(plan.share(1)->lights.empty());
+  EXPECT_FALSE(plan.share(1)->ambient);
+  EXPECT_EQ(plan.share(0)->lights.size() + plan.share(2)->lights.size(), 20u);
+  EXPECT_TRUE(plan.share(0)->ambient || plan.share(2)->ambient);
+}
+
+}  // namespace
+}  // namespace optique::master
