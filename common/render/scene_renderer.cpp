@@ -399,9 +399,11 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   gl->ambient = scene.ambient;
   gl->background = scene.background;
 
-  // Linear light in half floats, depth in 32-bit float (or 24-bit fixed point).
+  // Linear light in 32-bit floats: stacked projectors add their shares, and half
+  // floats (2⁻¹¹ relative) put highlights of 3 off by 2e-3 after the sum.
+  // Depth in 32-bit float (or 24-bit fixed point).
   glCreateTextures(GL_TEXTURE_2D, 1, &gl->linear_colour);
-  glTextureStorage2D(gl->linear_colour, 1, GL_RGBA16F, width, height);
+  glTextureStorage2D(gl->linear_colour, 1, GL_RGBA32F, width, height);
   // Bilinear for the two-pass warp; the single pass reads texels exactly.
   glTextureParameteri(gl->linear_colour, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(gl->linear_colour, GL_TEXTURE_MAG_FILTER, GL_LINEAR);

@@ -1,7 +1,7 @@
 #pragma once
-// Draws a scene into its own framebuffers: linear light (RGBA16F colour, 32-bit
-// float depth), then an encoding pass to what the projector is sent (8-bit, sRGB
-// response). Needs a current OpenGL 4.5 context (render/gl_context.h); the same
+// Draws a scene into its own framebuffers: linear light (RGBA32F colour, 32-bit
+// float depth), then an output pass to the signal the projector is sent (its
+// response, bit depth, black level and brightness: optics/projector_model.h). Needs a current OpenGL 4.5 context (render/gl_context.h); the same
 // code runs headless and in a window.
 
 #include <memory>

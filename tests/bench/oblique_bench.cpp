@@ -48,9 +48,12 @@ Method make_method(const scene::SceneDefinition& scene, const config::Screen& sc
   if (!view) throw std::runtime_error(view.error());
   auto renderer = render::SceneRenderer::create(scene, view.value().render_width(), view.value().render_height());
   if (!renderer) throw std::runtime_error(renderer.error());
-  if (auto output = renderer.value()->set_output(view.value().output_stage({})); !output) {
-    throw std::runtime_error(output.error());
-  }
+  // A 16-bit projector: the comparison is of rendering methods, not of 8-bit steps.
+  render::OutputStage stage = view.value().output_stage({});
+  config::Projector deep;
+  deep.mutable_response()->set_bits(16);
+  stage.projector = optics::ProjectorModel::from_config(deep).value();
+  if (auto output = renderer.value()->set_output(stage); !output) throw std::runtime_error(output.error());
   return {std::move(view).value(), std::move(renderer).value()};
 }
 
