@@ -10,13 +10,6 @@
 namespace optique::master {
 namespace {
 
-// The modelled cost of a node's pixels before any light, and of the ambient and
-// emissive terms, in units of a light that reaches every pixel (light_share.h):
-// rasterizing and the material fetch cost about half a light in the scene shader;
-// ambient and emissive are two multiply-adds.
-constexpr double kBaseCost = 0.5;
-constexpr double kAmbientCost = 0.05;
-
 std::string group_name(const StackedGroup& group) {
   return "stacked group on screen '" + group.screen + "' (eye " + group.eye + ")";
 }
@@ -142,13 +135,9 @@ std::map<std::size_t, LightShare> listed_shares(const config::Installation& inst
   return shares;
 }
 
-namespace {
-
-// Each light's estimated cost to the group: its coverage of the area the group
-// lights (the members' lit quads, bounded, within the screen) seen from `eye`.
-std::vector<double> light_costs(const config::Installation& inst, const StackedGroup& group,
-                                const scene::SceneDefinition& scene, const scene::SceneState& state,
-                                const glm::dvec3& eye) {
+std::vector<double> group_light_costs(const config::Installation& inst, const StackedGroup& group,
+                                      const scene::SceneDefinition& scene, const scene::SceneState& state,
+                                      const glm::dvec3& eye) {
   const config::Screen* screen = nullptr;
   for (const config::Screen& s : inst.screens()) {
     if (s.id() == group.screen) screen = &s;
@@ -178,8 +167,6 @@ std::vector<double> light_costs(const config::Installation& inst, const StackedG
   return scene::light_coverage(scene, state, grid);
 }
 
-}  // namespace
-
 std::vector<LightShare> automatic_shares(const config::Installation& inst, const StackedGroup& group,
                                          const std::vector<bool>& live, const scene::SceneDefinition& scene,
                                          const scene::SceneState& state, const glm::dvec3& eye) {
@@ -195,7 +182,7 @@ std::vector<LightShare> automatic_shares(const config::Installation& inst, const
   }
   if (up.empty()) return shares;
   const std::vector<LightShare> live_shares =
-      share_lights(light_costs(inst, group, scene, state, eye), pixels, kBaseCost, kAmbientCost);
+      share_lights(group_light_costs(inst, group, scene, state, eye), pixels, kBaseCost, kAmbientCost);
   for (std::size_t i = 0; i < up.size(); ++i) shares[up[i]] = live_shares[i];
   return shares;
 }
@@ -240,7 +227,7 @@ bool LightPlan::rebalance(const std::vector<bool>& up, const scene::SceneState& 
         candidate.push_back(proposed[k]);
       }
       if (complete && !pixels.empty()) {
-        costs = light_costs(installation_, group, scene_, state, eye);
+        costs = group_light_costs(installation_, group, scene_, state, eye);
         const auto slowest = [](const std::vector<double>& t) { return *std::max_element(t.begin(), t.end()); };
         const double now = slowest(modelled_times(costs, pixels, kBaseCost, kAmbientCost, current));
         const double then = slowest(modelled_times(costs, pixels, kBaseCost, kAmbientCost, candidate));

@@ -41,6 +41,20 @@ struct StackedGroup {
 [[nodiscard]] std::map<std::size_t, LightShare> listed_shares(const config::Installation& installation,
                                                               std::size_t light_count);
 
+// The cost model of the automatic split, in units of a light that reaches every
+// pixel (light_share.h): a node's pixels cost kBaseCost before any light (the
+// pass over the scene, the material, the output pass) — fitted to node draw
+// times on llvmpipe, docs/bench/lighting.md: about ten lights' worth — and the
+// ambient and emissive terms two multiply-adds.
+inline constexpr double kBaseCost = 10.0;
+inline constexpr double kAmbientCost = 0.05;
+
+// Each light's estimated cost to the group: its coverage of the area the group
+// lights (the members' lit quads, bounded, within the screen) seen from `eye`.
+[[nodiscard]] std::vector<double> group_light_costs(const config::Installation& installation, const StackedGroup& group,
+                                                    const scene::SceneDefinition& scene, const scene::SceneState& state,
+                                                    const glm::dvec3& eye);
+
 // An automatic group's shares among its live members (`live[k]` for members[k]),
 // by estimated cost: each light's coverage of the group's screen area seen from
 // `eye`, times each member's pixels. Members that are not live get nothing.
