@@ -14,15 +14,13 @@ std::optional<FocusSchedule> FocusSchedule::make(const config::Installation& ins
   if (!installation.has_depth_of_field()) return std::nullopt;
   FocusSchedule schedule;
   schedule.settings_ = installation.depth_of_field();
-  // Without a gaze (fixed or scripted depth), the inset and depths use the first
-  // screen's frame: only its normal matters then.
-  const std::string& gaze_screen = schedule.settings_.gaze().screen();
+  // The gaze's screen; without a gaze (a fixed or scripted depth) no ray is
+  // cast and the frame is not needed.
   for (const config::Screen& s : installation.screens()) {
-    if (s.id() == gaze_screen || (gaze_screen.empty() && &s == &installation.screens(0))) {
-      schedule.origin_ = {s.origin(0), s.origin(1), s.origin(2)};
-      schedule.right_ = {s.right(0), s.right(1), s.right(2)};
-      schedule.up_ = {s.up(0), s.up(1), s.up(2)};
-    }
+    if (s.id() != schedule.settings_.gaze().screen()) continue;
+    schedule.origin_ = {s.origin(0), s.origin(1), s.origin(2)};
+    schedule.right_ = {s.right(0), s.right(1), s.right(2)};
+    schedule.up_ = {s.up(0), s.up(1), s.up(2)};
   }
   return schedule;
 }
@@ -31,9 +29,8 @@ glm::dvec2 FocusSchedule::gaze_at(double seconds) const {
   const config::Gaze& gaze = settings_.gaze();
   if (!gaze.point().empty()) return {gaze.point(0), gaze.point(1)};
   if (gaze.path().empty()) return {0.0, 0.0};
-  std::vector<double> times;
-  for (const auto& p : gaze.path()) times.push_back(p.time());
-  const scene::PathSpot spot = scene::path_spot(times, seconds);
+  const scene::PathSpot spot = scene::path_spot(
+      gaze.path_size(), [&](int i) { return gaze.path(i).time(); }, seconds);
   const auto point = [&](int i) { return glm::dvec2(gaze.path(i).point(0), gaze.path(i).point(1)); };
   return point(spot.from) * (1.0 - spot.fraction) + point(spot.to) * spot.fraction;
 }
@@ -48,9 +45,9 @@ wire::Focus FocusSchedule::at(double seconds, const scene::SceneDefinition& scen
   if (settings_.focal_depth() > 0.0) {
     depth = settings_.focal_depth();
   } else if (!settings_.focal_path().empty()) {
-    std::vector<double> times;
-    for (const auto& p : settings_.focal_path()) times.push_back(p.time());
-    const scene::PathSpot spot = scene::path_spot(times, seconds);
+    const auto& path = settings_.focal_path();
+    const scene::PathSpot spot = scene::path_spot(
+        path.size(), [&](int i) { return path[i].time(); }, seconds);
     depth = settings_.focal_path(spot.from).depth() * (1.0 - spot.fraction) +
             settings_.focal_path(spot.to).depth() * spot.fraction;
   } else {

@@ -18,6 +18,8 @@ namespace optique::master {
 struct LightShare {
   std::vector<std::uint32_t> lights;  // indices into the scene's lights, ascending
   bool ambient = false;               // also draws the ambient and emissive terms
+
+  friend bool operator==(const LightShare&, const LightShare&) = default;
 };
 
 // The least cost a light counts for, whatever its coverage: a light that reaches

@@ -22,6 +22,13 @@ std::string random_nonce() {
   return nonce;
 }
 
+wire::LightShare to_wire(const LightShare& share) {
+  wire::LightShare out;
+  out.mutable_lights()->Add(share.lights.begin(), share.lights.end());
+  out.set_ambient(share.ambient);
+  return out;
+}
+
 std::string format_us(double us) {
   char buffer[32];
   std::snprintf(buffer, sizeof buffer, "%.0f µs", us);
@@ -301,8 +308,7 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
     welcome.set_scene_sha256(options_.scene.content_sha256);
   }
   if (const LightShare* share = light_plan_->share(*slot)) {
-    welcome.mutable_lights()->mutable_lights()->Add(share->lights.begin(), share->lights.end());
-    welcome.mutable_lights()->set_ambient(share->ambient);
+    *welcome.mutable_lights() = to_wire(*share);
     target.sent_share = *share;
   }
   if (installation.has_depth_of_field()) *welcome.mutable_depth_of_field() = installation.depth_of_field();
@@ -410,13 +416,10 @@ void Master::begin_frame() {
     if (!session || session->phase == Phase::handshake || session->phase == Phase::configuring) continue;
     if (session->phase == Phase::joined) session->phase = Phase::in_barrier;
     const LightShare* share = light_plan_->share(i);
-    if (share != nullptr && (!slots_[i].sent_share || slots_[i].sent_share->lights != share->lights ||
-                             slots_[i].sent_share->ambient != share->ambient)) {
+    if (share != nullptr && slots_[i].sent_share != *share) {
       // A new share applies from this frame on, on every node of the group at once.
       wire::Envelope with_share = envelope;
-      auto& lights = *with_share.mutable_frame_begin()->mutable_lights();
-      lights.mutable_lights()->Add(share->lights.begin(), share->lights.end());
-      lights.set_ambient(share->ambient);
+      *with_share.mutable_frame_begin()->mutable_lights() = to_wire(*share);
       session->connection->send(with_share);
       slots_[i].sent_share = *share;
       log_.info("node '{}' draws lights [{}]{} from frame {}", slot_id(i), format_light_list(share->lights),

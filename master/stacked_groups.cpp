@@ -167,24 +167,42 @@ std::vector<double> group_light_costs(const config::Installation& inst, const St
   return scene::light_coverage(scene, state, grid);
 }
 
-std::vector<LightShare> automatic_shares(const config::Installation& inst, const StackedGroup& group,
-                                         const std::vector<bool>& live, const scene::SceneDefinition& scene,
-                                         const scene::SceneState& state, const glm::dvec3& eye) {
-  assert(live.size() == group.members.size());
-  std::vector<LightShare> shares(group.members.size());
-  std::vector<std::size_t> up;
+namespace {
+
+// A group's members that are up: their places in the group and their pixels.
+struct LiveMembers {
+  std::vector<std::size_t> places;
   std::vector<double> pixels;
+};
+
+LiveMembers live_members(const config::Installation& inst, const StackedGroup& group, const std::vector<bool>& live) {
+  assert(live.size() == group.members.size());
+  LiveMembers members;
   for (std::size_t k = 0; k < group.members.size(); ++k) {
     if (!live[k]) continue;
     const config::Projector& p = inst.projectors(static_cast<int>(group.members[k]));
-    up.push_back(k);
-    pixels.push_back(static_cast<double>(p.width()) * p.height());
+    members.places.push_back(k);
+    members.pixels.push_back(static_cast<double>(p.width()) * p.height());
   }
-  if (up.empty()) return shares;
-  const std::vector<LightShare> live_shares =
-      share_lights(group_light_costs(inst, group, scene, state, eye), pixels, kBaseCost, kAmbientCost);
-  for (std::size_t i = 0; i < up.size(); ++i) shares[up[i]] = live_shares[i];
+  return members;
+}
+
+// One share per member of the group: the live members' by cost, nothing for the others.
+std::vector<LightShare> shares_for(const StackedGroup& group, const LiveMembers& members,
+                                   const std::vector<double>& costs) {
+  std::vector<LightShare> shares(group.members.size());
+  if (members.places.empty()) return shares;
+  std::vector<LightShare> live_shares = share_lights(costs, members.pixels, kBaseCost, kAmbientCost);
+  for (std::size_t i = 0; i < members.places.size(); ++i) shares[members.places[i]] = std::move(live_shares[i]);
   return shares;
+}
+
+}  // namespace
+
+std::vector<LightShare> automatic_shares(const config::Installation& inst, const StackedGroup& group,
+                                         const std::vector<bool>& live, const scene::SceneDefinition& scene,
+                                         const scene::SceneState& state, const glm::dvec3& eye) {
+  return shares_for(group, live_members(inst, group, live), group_light_costs(inst, group, scene, state, eye));
 }
 
 LightPlan::LightPlan(const config::Installation& installation, const scene::SceneDefinition& scene)
@@ -202,37 +220,31 @@ bool LightPlan::rebalance(const std::vector<bool>& up, const scene::SceneState& 
     if (!group.automatic) continue;
     std::vector<bool> live;
     for (std::size_t member : group.members) live.push_back(up[member]);
-    std::vector<LightShare> proposed = automatic_shares(installation_, group, live, scene_, state, eye);
+    const LiveMembers members = live_members(installation_, group, live);
+    const std::vector<double> costs = group_light_costs(installation_, group, scene_, state, eye);
+    std::vector<LightShare> proposed = shares_for(group, members, costs);
     bool differs = false;
     for (std::size_t k = 0; k < group.members.size(); ++k) {
       const auto current = shares_.find(group.members[k]);
-      differs = differs || current == shares_.end() || current->second.lights != proposed[k].lights ||
-                current->second.ambient != proposed[k].ambient;
+      differs = differs || current == shares_.end() || current->second != proposed[k];
     }
     if (!differs) continue;
-    if (!force) {
-      // Compare the modelled times of both splits under today's costs.
-      std::vector<double> costs;
-      std::vector<double> pixels;
+    if (!force && !members.places.empty()) {
+      // Both splits' modelled times under today's costs.
       std::vector<LightShare> current;
       std::vector<LightShare> candidate;
       bool complete = true;
-      for (std::size_t k = 0; k < group.members.size(); ++k) {
-        if (!live[k]) continue;
-        const config::Projector& p = installation_.projectors(static_cast<int>(group.members[k]));
-        pixels.push_back(static_cast<double>(p.width()) * p.height());
+      for (std::size_t k : members.places) {
         const auto found = shares_.find(group.members[k]);
         complete = complete && found != shares_.end();
         current.push_back(found != shares_.end() ? found->second : LightShare{});
         candidate.push_back(proposed[k]);
       }
-      if (complete && !pixels.empty()) {
-        costs = group_light_costs(installation_, group, scene_, state, eye);
-        const auto slowest = [](const std::vector<double>& t) { return *std::max_element(t.begin(), t.end()); };
-        const double now = slowest(modelled_times(costs, pixels, kBaseCost, kAmbientCost, current));
-        const double then = slowest(modelled_times(costs, pixels, kBaseCost, kAmbientCost, candidate));
-        if (then > now * (1.0 - kWorthwhileGain)) continue;
-      }
+      const auto slowest = [&](const std::vector<LightShare>& shares) {
+        const std::vector<double> t = modelled_times(costs, members.pixels, kBaseCost, kAmbientCost, shares);
+        return *std::max_element(t.begin(), t.end());
+      };
+      if (complete && slowest(candidate) > slowest(current) * (1.0 - kWorthwhileGain)) continue;
     }
     for (std::size_t k = 0; k < group.members.size(); ++k) shares_[group.members[k]] = std::move(proposed[k]);
     changed = true;

@@ -35,19 +35,6 @@ Result<image::FloatImage> blend_weights(const wire::Welcome& welcome, const opti
   return optics::blend_weights(field, group[self], self);
 }
 
-// Where the output pass's fragments (GL window coordinates: rows go up) land on
-// the screen: flip to projector pixels (rows down), then H⁻¹.
-glm::dmat3 fragment_to_screen(const optics::ProjectorGeometry& geometry) {
-  const glm::dmat3 flip(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, static_cast<double>(geometry.height()), 1.0);
-  return geometry.pixel_to_screen() * flip;
-}
-
-render::FocusRole focus_role(const config::Content& content) {
-  if (content.role() == "focus") return render::FocusRole::focus;
-  if (content.role() == "defocus") return render::FocusRole::defocus;
-  return render::FocusRole::none;
-}
-
 }  // namespace
 
 GlRenderer::GlRenderer(spdlog::logger& log, std::string capture_folder)
@@ -101,28 +88,17 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
   renderer_ = std::move(renderer).value();
   auto weights = blend_weights(welcome, geometry.value());
   if (!weights) return Error{"projector '" + projector.id() + "': " + weights.error()};
-  render::OutputStage stage = view.value().output_stage(std::move(weights).value());
+  focus_role_ = render::parse_focus_role(projector.content().role());
+  render::OutputStage stage = view.value().output_stage(std::move(weights).value(), focus_role_);
   auto model = optics::ProjectorModel::from_config(projector);
   if (!model) return Error{"projector '" + projector.id() + "': " + model.error()};
   stage.projector = std::move(model).value();
   deep_signal_ = stage.projector.bits() > 8;
-  focus_role_ = focus_role(projector.content());
   depth_of_field_ = welcome.depth_of_field();
-  if (focus_role_ != render::FocusRole::none) {
-    stage.focus.role = focus_role_;
-    stage.focus.user_to_projector = view.value().oblique().user_to_projector;
-    stage.focus.depth_scale = view.value().oblique().depth_scale;
-    stage.focus.fragment_to_screen = fragment_to_screen(geometry.value());
-    stage.focus.screen_metres_per_pixel = 1.0 / geometry.value().max_pixels_per_metre();
-  }
   if (auto output = renderer_->set_output(stage); !output) return Error{output.error()};
   view_ = std::move(view).value();
   terms_ = {};
-  if (projector.content().role() == "lights") {
-    const auto& share = welcome.lights();
-    renderer_->set_lights(std::vector<std::uint32_t>(share.lights().begin(), share.lights().end()));
-    terms_ = {share.ambient(), share.ambient()};
-  }
+  if (projector.content().role() == "lights") draw_share(welcome.lights());
 
   eye_ = render::parse_eye(projector.eye());
   const auto& viewer = welcome.viewer();
@@ -147,12 +123,20 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
   return {};
 }
 
+void GlRenderer::draw_share(const wire::LightShare& share) {
+  renderer_->set_lights(std::vector<std::uint32_t>(share.lights().begin(), share.lights().end()));
+  terms_ = {share.ambient(), share.ambient()};
+}
+
 std::string GlRenderer::description() const {
   if (!context_) return "OpenGL (not configured)";
   return context_->renderer_name() + (context_->has_window() ? ", window" : ", headless");
 }
 
 void GlRenderer::render(const FrameInput& frame) {
+  // A new share comes once, with the frame it starts at: taken even when this
+  // frame shows nothing, so it is not lost.
+  if (frame.lights != nullptr) draw_share(*frame.lights);
   const glm::dvec3 eye = render::eye_position(frame.state->eye_now, head_right_, eye_separation_, eye_);
   auto frustum = view_->frustum(eye, near_, far_);
   if (!frustum) {
@@ -161,10 +145,6 @@ void GlRenderer::render(const FrameInput& frame) {
     log_.debug("frame {}: {}", frame.frame_id, frustum.error());
     renderer_->draw_black();
   } else {
-    if (frame.lights != nullptr) {
-      renderer_->set_lights(std::vector<std::uint32_t>(frame.lights->lights().begin(), frame.lights->lights().end()));
-      terms_ = {frame.lights->ambient(), frame.lights->ambient()};
-    }
     if (focus_role_ != render::FocusRole::none && frame.focus != nullptr) {
       render::FocusFrame focus;
       focus.coc = optics::coc_from_window_depth(frame.focus->depth(), {depth_of_field_.near(), depth_of_field_.far()},

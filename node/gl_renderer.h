@@ -31,6 +31,9 @@ class GlRenderer final : public Renderer {
   void present() override;
 
  private:
+  // Draws these lights from now on, and ambient and emissive light if it carries them.
+  void draw_share(const wire::LightShare& share);
+
   spdlog::logger& log_;
   std::string capture_folder_;
   std::string configured_for_;  // the welcome's projector and scene, to skip rebuilding on a rejoin

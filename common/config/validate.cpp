@@ -5,20 +5,16 @@
 #include <cmath>
 #include <filesystem>
 #include <set>
-#include <sstream>
 
 #include "config/defaults.h"
 #include "optics/projector_model.h"
 #include "scene/builtin.h"
+#include "util/number_text.h"
 
 namespace optique::config {
 namespace {
 
-std::string number(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
+using util::number_text;
 
 class Checker {
  public:
@@ -28,16 +24,16 @@ class Checker {
 
   bool finite(const std::string& path, double v) {
     if (std::isfinite(v)) return true;
-    fail(path, "must be a finite number (got " + number(v) + ")");
+    fail(path, "must be a finite number (got " + number_text(v) + ")");
     return false;
   }
 
   void positive(const std::string& path, double v) {
-    if (finite(path, v) && v <= 0.0) fail(path, "must be > 0 (got " + number(v) + ")");
+    if (finite(path, v) && v <= 0.0) fail(path, "must be > 0 (got " + number_text(v) + ")");
   }
 
   void non_negative(const std::string& path, double v) {
-    if (finite(path, v) && v < 0.0) fail(path, "must be >= 0 (got " + number(v) + ")");
+    if (finite(path, v) && v < 0.0) fail(path, "must be >= 0 (got " + number_text(v) + ")");
   }
 
   // A 3-vector of finite numbers; returns whether it is one.
@@ -102,13 +98,15 @@ void check_screens(Checker& check, const Installation& inst, std::set<std::strin
     const bool up_ok = check.vec3(at + ".up", s.up());
     constexpr double kTolerance = 1e-3;
     if (right_ok && std::abs(std::sqrt(dot(s.right(), s.right())) - 1.0) > kTolerance) {
-      check.fail(at + ".right", "must be a unit vector (length " + number(std::sqrt(dot(s.right(), s.right()))) + ")");
+      check.fail(at + ".right",
+                 "must be a unit vector (length " + number_text(std::sqrt(dot(s.right(), s.right()))) + ")");
     }
     if (up_ok && std::abs(std::sqrt(dot(s.up(), s.up())) - 1.0) > kTolerance) {
-      check.fail(at + ".up", "must be a unit vector (length " + number(std::sqrt(dot(s.up(), s.up()))) + ")");
+      check.fail(at + ".up", "must be a unit vector (length " + number_text(std::sqrt(dot(s.up(), s.up()))) + ")");
     }
     if (right_ok && up_ok && std::abs(dot(s.right(), s.up())) > kTolerance) {
-      check.fail(at + ".up", "must be perpendicular to right (dot product " + number(dot(s.right(), s.up())) + ")");
+      check.fail(at + ".up",
+                 "must be perpendicular to right (dot product " + number_text(dot(s.right(), s.up())) + ")");
     }
     check.positive(at + ".width", s.width());
     check.positive(at + ".height", s.height());
@@ -124,12 +122,12 @@ void check_region(Checker& check, const std::string& at, const Region& r, const 
   if (screen == nullptr) return;
   constexpr double kSlack = 1e-9;
   if (std::isfinite(r.x() + r.width()) && r.x() + r.width() > screen->width() + kSlack) {
-    check.fail(at, "extends past the right edge of screen '" + screen->id() +
-                       "' (x + width = " + number(r.x() + r.width()) + " m > " + number(screen->width()) + " m)");
+    check.fail(at, "extends past the right edge of screen '" + screen->id() + "' (x + width = " +
+                       number_text(r.x() + r.width()) + " m > " + number_text(screen->width()) + " m)");
   }
   if (std::isfinite(r.y() + r.height()) && r.y() + r.height() > screen->height() + kSlack) {
-    check.fail(at, "extends past the top edge of screen '" + screen->id() +
-                       "' (y + height = " + number(r.y() + r.height()) + " m > " + number(screen->height()) + " m)");
+    check.fail(at, "extends past the top edge of screen '" + screen->id() + "' (y + height = " +
+                       number_text(r.y() + r.height()) + " m > " + number_text(screen->height()) + " m)");
   }
 }
 
@@ -224,8 +222,8 @@ void check_depth_of_field(Checker& check, const Installation& inst) {
     check.non_negative(at + ".time", d.focal_path(i).time());
     check.positive(at + ".depth", d.focal_path(i).depth());
     if (i > 0 && !(d.focal_path(i).time() > d.focal_path(i - 1).time())) {
-      check.fail(at + ".time", "times must increase (" + number(d.focal_path(i).time()) + " after " +
-                                   number(d.focal_path(i - 1).time()) + ")");
+      check.fail(at + ".time", "times must increase (" + number_text(d.focal_path(i).time()) + " after " +
+                                   number_text(d.focal_path(i - 1).time()) + ")");
     }
   }
   if (d.has_gaze()) {
@@ -245,8 +243,9 @@ void check_depth_of_field(Checker& check, const Installation& inst) {
       }
       if (!check.finite(path + "[0]", point[0]) || !check.finite(path + "[1]", point[1]) || screen == nullptr) return;
       if (point[0] < 0.0 || point[0] > screen->width() || point[1] < 0.0 || point[1] > screen->height()) {
-        check.fail(path, "[" + number(point[0]) + ", " + number(point[1]) + "] is off screen '" + screen->id() + "' (" +
-                             number(screen->width()) + " × " + number(screen->height()) + " m)");
+        check.fail(path, "[" + number_text(point[0]) + ", " + number_text(point[1]) + "] is off screen '" +
+                             screen->id() + "' (" + number_text(screen->width()) + " × " +
+                             number_text(screen->height()) + " m)");
       }
     };
     if (!g.point().empty()) check_point("depth_of_field.gaze.point", g.point());
@@ -255,8 +254,8 @@ void check_depth_of_field(Checker& check, const Installation& inst) {
       check.non_negative(at + ".time", g.path(i).time());
       check_point(at + ".point", g.path(i).point());
       if (i > 0 && !(g.path(i).time() > g.path(i - 1).time())) {
-        check.fail(at + ".time",
-                   "times must increase (" + number(g.path(i).time()) + " after " + number(g.path(i - 1).time()) + ")");
+        check.fail(at + ".time", "times must increase (" + number_text(g.path(i).time()) + " after " +
+                                     number_text(g.path(i - 1).time()) + ")");
       }
     }
   }
@@ -264,7 +263,7 @@ void check_depth_of_field(Checker& check, const Installation& inst) {
   check.non_negative("depth_of_field.far", d.far());
   if (d.near() != 0.0 && d.far() != 0.0 && std::isfinite(d.near()) && std::isfinite(d.far()) && !(d.far() > d.near())) {
     check.fail("depth_of_field.far",
-               "must be greater than near (" + number(d.far()) + " m <= " + number(d.near()) + " m)");
+               "must be greater than near (" + number_text(d.far()) + " m <= " + number_text(d.near()) + " m)");
   }
   check.non_negative("depth_of_field.inset_radius", d.inset_radius());
   if (d.inset_radius() > 0.0 && !d.has_gaze()) {
@@ -329,8 +328,8 @@ void check_viewer(Checker& check, const Viewer& v) {
     check.non_negative(at + ".time", v.path(i).time());
     check.vec3(at + ".position", v.path(i).position());
     if (i > 0 && !(v.path(i).time() > v.path(i - 1).time())) {
-      check.fail(at + ".time",
-                 "times must increase (" + number(v.path(i).time()) + " after " + number(v.path(i - 1).time()) + ")");
+      check.fail(at + ".time", "times must increase (" + number_text(v.path(i).time()) + " after " +
+                                   number_text(v.path(i - 1).time()) + ")");
     }
   }
   check.non_negative("viewer.eye_separation", v.eye_separation());
@@ -339,15 +338,16 @@ void check_viewer(Checker& check, const Viewer& v) {
   const double near = v.near() != 0.0 ? v.near() : defaults::kNear;
   const double far = v.far() != 0.0 ? v.far() : defaults::kFar;
   if (std::isfinite(near) && std::isfinite(far) && near >= 0.0 && far >= 0.0 && !(far > near)) {
-    check.fail("viewer.far", "must be greater than near (" + number(far) + " m <= " + number(near) + " m)");
+    check.fail("viewer.far", "must be greater than near (" + number_text(far) + " m <= " + number_text(near) + " m)");
   }
   if (!v.head_right().empty() && check.vec3("viewer.head_right", v.head_right()) &&
       std::abs(std::sqrt(dot(v.head_right(), v.head_right())) - 1.0) > 1e-3) {
     check.fail("viewer.head_right",
-               "must be a unit vector (length " + number(std::sqrt(dot(v.head_right(), v.head_right()))) + ")");
+               "must be a unit vector (length " + number_text(std::sqrt(dot(v.head_right(), v.head_right()))) + ")");
   }
   if (v.eye_separation() > 1.0)
-    check.fail("viewer.eye_separation", "is in metres; " + number(v.eye_separation()) + " m is not an eye separation");
+    check.fail("viewer.eye_separation",
+               "is in metres; " + number_text(v.eye_separation()) + " m is not an eye separation");
 }
 
 void check_master(Checker& check, const MasterSettings& m) {
@@ -360,7 +360,7 @@ void check_master(Checker& check, const MasterSettings& m) {
   if (m.port() > 65535) check.fail("master.port", "must be 0..65535 (got " + std::to_string(m.port()) + ")");
   if (check.finite("master.frame_rate", m.frame_rate()) && (m.frame_rate() < 0.0 || m.frame_rate() > 1000.0)) {
     check.fail("master.frame_rate",
-               "must be in (0, 1000] Hz, or 0 for the default (got " + number(m.frame_rate()) + ")");
+               "must be in (0, 1000] Hz, or 0 for the default (got " + number_text(m.frame_rate()) + ")");
   }
   if (m.max_message_bytes() != 0 && m.max_message_bytes() < 1024) {
     check.fail("master.max_message_bytes", "must be at least 1024 (got " + std::to_string(m.max_message_bytes()) + ")");

@@ -3,16 +3,13 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <sstream>
+
+#include "util/number_text.h"
 
 namespace optique::optics {
 namespace {
 
-std::string number(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
+using util::number_text;
 
 double srgb_to_linear(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
 double linear_to_srgb(double l) { return l <= 0.0031308 ? l * 12.92 : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055; }
@@ -27,7 +24,7 @@ Result<ProjectorModel> ProjectorModel::from_config(const config::Projector& proj
   }
   if (r.gamma() != 0.0) {
     if (!std::isfinite(r.gamma()) || r.gamma() <= 0.0 || r.gamma() > 10.0) {
-      return Error{"response.gamma: must be in (0, 10] (got " + number(r.gamma()) + ")"};
+      return Error{"response.gamma: must be in (0, 10] (got " + number_text(r.gamma()) + ")"};
     }
     model.curve_ = Curve::gamma;
     model.gamma_ = r.gamma();
@@ -42,15 +39,15 @@ Result<ProjectorModel> ProjectorModel::from_config(const config::Projector& proj
     for (int i = 0; i < r.table_size(); ++i) {
       const std::string path = "response.table[" + std::to_string(i) + "]";
       const double v = r.table(i);
-      if (!std::isfinite(v)) return Error{path + ": must be a finite number (got " + number(v) + ")"};
+      if (!std::isfinite(v)) return Error{path + ": must be a finite number (got " + number_text(v) + ")"};
       if (i > 0 && v < r.table(i - 1)) {
-        return Error{path + ": the response must not decrease (" + number(v) + " after " + number(r.table(i - 1)) +
-                     "); a measured table that dips needs smoothing first"};
+        return Error{path + ": the response must not decrease (" + number_text(v) + " after " +
+                     number_text(r.table(i - 1)) + "); a measured table that dips needs smoothing first"};
       }
     }
     if (r.table(0) != 0.0 || r.table(r.table_size() - 1) != 1.0) {
-      return Error{"response.table: must go from 0 (signal 0) to 1 (full signal), got " + number(r.table(0)) + " … " +
-                   number(r.table(r.table_size() - 1)) +
+      return Error{"response.table: must go from 0 (signal 0) to 1 (full signal), got " + number_text(r.table(0)) +
+                   " … " + number_text(r.table(r.table_size() - 1)) +
                    "; normalize the measured light, and give the light at signal 0 as black_level"};
     }
     model.curve_ = Curve::table;
@@ -62,13 +59,13 @@ Result<ProjectorModel> ProjectorModel::from_config(const config::Projector& proj
   }
   const double black = projector.black_level();
   if (!std::isfinite(black) || black < 0.0 || black >= 1.0) {
-    return Error{"black_level: must be in [0, 1), a fraction of full white (got " + number(black) + ")"};
+    return Error{"black_level: must be in [0, 1), a fraction of full white (got " + number_text(black) + ")"};
   }
   model.black_level_ = black;
   const double brightness = projector.brightness();
   if (!std::isfinite(brightness) || brightness < 0.0) {
-    return Error{"brightness: must be > 0, relative to the installation's unit of light (got " + number(brightness) +
-                 ")"};
+    return Error{"brightness: must be > 0, relative to the installation's unit of light (got " +
+                 number_text(brightness) + ")"};
   }
   if (brightness > 0.0) model.brightness_ = brightness;
   return model;

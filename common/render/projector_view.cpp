@@ -13,6 +13,12 @@ RenderMethod parse_render_method(const std::string& name) {
   return name == "two-pass" ? RenderMethod::two_pass : RenderMethod::single_pass;
 }
 
+FocusRole parse_focus_role(const std::string& role) {
+  if (role == "focus") return FocusRole::focus;
+  if (role == "defocus") return FocusRole::defocus;
+  return FocusRole::none;
+}
+
 Result<ProjectorView> ProjectorView::make(const config::Screen& screen, const optics::ProjectorGeometry& geometry,
                                           RenderMethod method, double two_pass_pixels_per_metre) {
   auto oblique = optics::oblique_projection(geometry, config::usable_area(screen));
@@ -29,6 +35,8 @@ Result<ProjectorView> ProjectorView::make(const config::Screen& screen, const op
   view.bounds_ = screen_region(screen, region);
   view.width_ = geometry.width();
   view.height_ = geometry.height();
+  view.pixel_to_screen_ = geometry.pixel_to_screen();
+  view.max_pixels_per_metre_ = geometry.max_pixels_per_metre();
   if (method == RenderMethod::single_pass) {
     view.render_width_ = geometry.width();
     view.render_height_ = geometry.height();
@@ -49,12 +57,22 @@ Result<Frustum> ProjectorView::frustum(const glm::dvec3& eye, double near, doubl
   return frustum;
 }
 
-OutputStage ProjectorView::output_stage(image::FloatImage weights) const {
+OutputStage ProjectorView::output_stage(image::FloatImage weights, FocusRole role) const {
   OutputStage stage;
   stage.width = width_;
   stage.height = height_;
   if (method_ == RenderMethod::two_pass) stage.projector_to_user = glm::inverse(oblique_.user_to_projector);
   stage.weights = std::move(weights);
+  if (role != FocusRole::none) {
+    stage.focus.role = role;
+    stage.focus.user_to_projector = oblique_.user_to_projector;
+    stage.focus.depth_scale = oblique_.depth_scale;
+    // The output pass's fragments have rows going up: flip to projector pixels
+    // (rows down), then H⁻¹ to the screen.
+    const glm::dmat3 flip(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, static_cast<double>(height_), 1.0);
+    stage.focus.fragment_to_screen = pixel_to_screen_ * flip;
+    stage.focus.screen_metres_per_pixel = 1.0 / max_pixels_per_metre_;
+  }
   return stage;
 }
 

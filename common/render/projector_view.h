@@ -17,6 +17,8 @@ namespace optique::render {
 
 enum class RenderMethod { single_pass, two_pass };
 [[nodiscard]] RenderMethod parse_render_method(const std::string& name);  // "two-pass", anything else single
+// A content role's share of the depth of field: "focus", "defocus", anything else none.
+[[nodiscard]] FocusRole parse_focus_role(const std::string& role);
 
 class ProjectorView {
  public:
@@ -35,8 +37,9 @@ class ProjectorView {
   // the warp never magnifies), at most 8192 on a side.
   [[nodiscard]] int render_width() const { return render_width_; }
   [[nodiscard]] int render_height() const { return render_height_; }
-  // The output stage for these pixels (weights: the blend, or empty).
-  [[nodiscard]] OutputStage output_stage(image::FloatImage weights) const;
+  // The output stage for these pixels (weights: the blend, or empty), with the
+  // share of the depth of field a focus/defocus projector shows.
+  [[nodiscard]] OutputStage output_stage(image::FloatImage weights, FocusRole role = FocusRole::none) const;
 
   [[nodiscard]] const optics::ObliqueProjection& oblique() const { return oblique_; }
   [[nodiscard]] const WorldRect& bounds() const { return bounds_; }
@@ -47,6 +50,8 @@ class ProjectorView {
   RenderMethod method_ = RenderMethod::single_pass;
   optics::ObliqueProjection oblique_;
   WorldRect bounds_;
+  glm::dmat3 pixel_to_screen_{1.0};
+  double max_pixels_per_metre_ = 1.0;
   int width_ = 0;
   int height_ = 0;
   int render_width_ = 0;

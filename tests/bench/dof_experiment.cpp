@@ -40,13 +40,6 @@ ScreenFrame frame_of(const config::Screen& screen) {
   return f;
 }
 
-// Where the output pass's fragments (rows up) land on the screen, as the node
-// computes it (node/gl_renderer.cpp): only the inset variant reads it.
-glm::dmat3 fragment_to_screen(const optics::ProjectorGeometry& geometry) {
-  const glm::dmat3 flip(1.0, 0.0, 0.0, 0.0, -1.0, 0.0, 0.0, static_cast<double>(geometry.height()), 1.0);
-  return geometry.pixel_to_screen() * flip;
-}
-
 // One node of the pair (or a plain one for FocusRole::none), set up as
 // GlRenderer::configure does for an aligned single-pass projector.
 Result<std::unique_ptr<render::SceneRenderer>> make_node(const PairSetup& setup, render::FocusRole role, int bits,
@@ -61,17 +54,10 @@ Result<std::unique_ptr<render::SceneRenderer>> make_node(const PairSetup& setup,
       render::SceneRenderer::create(setup.scene, view.value().render_width(), view.value().render_height(), format);
   if (!renderer) return Error{renderer.error()};
   // One projector per layer: no blend partner, so no weights.
-  render::OutputStage stage = view.value().output_stage({});
+  render::OutputStage stage = view.value().output_stage({}, role);
   auto model = optics::ProjectorModel::from_config(projector);
   if (!model) return Error{model.error()};
   stage.projector = std::move(model).value();
-  if (role != render::FocusRole::none) {
-    stage.focus.role = role;
-    stage.focus.user_to_projector = view.value().oblique().user_to_projector;
-    stage.focus.depth_scale = view.value().oblique().depth_scale;
-    stage.focus.fragment_to_screen = fragment_to_screen(geometry.value());
-    stage.focus.screen_metres_per_pixel = 1.0 / geometry.value().max_pixels_per_metre();
-  }
   if (auto output = renderer.value()->set_output(stage); !output) return Error{output.error()};
   return std::move(renderer).value();
 }
