@@ -90,6 +90,7 @@ Result<void> GlRenderer::configure(const wire::Welcome& welcome) {
   if (!weights) return Error{"projector '" + projector.id() + "': " + weights.error()};
   focus_role_ = render::parse_focus_role(projector.content().role());
   render::OutputStage stage = view.value().output_stage(std::move(weights).value(), focus_role_);
+  stage.focus.inset = welcome.depth_of_field().inset_radius() > 0.0;
   auto model = optics::ProjectorModel::from_config(projector);
   if (!model) return Error{"projector '" + projector.id() + "': " + model.error()};
   stage.projector = std::move(model).value();
@@ -149,7 +150,6 @@ void GlRenderer::render(const FrameInput& frame) {
       render::FocusFrame focus;
       focus.coc = optics::coc_from_window_depth(frame.focus->depth(), {depth_of_field_.near(), depth_of_field_.far()},
                                                 near_, far_);
-      focus.inset = depth_of_field_.inset_radius() > 0.0;
       focus.gaze = {frame.focus->gaze_x(), frame.focus->gaze_y()};
       focus.inset_radius = depth_of_field_.inset_radius();
       renderer_->set_focus(focus);

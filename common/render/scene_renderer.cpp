@@ -88,113 +88,127 @@ void main() {
 // light (its blend weights; for a focus/defocus pair its share of the depth of
 // field), then the projector's model: the signal that makes it add exactly this
 // light to its black, quantized to its bit depth (optics/projector_model.h does
-// the same on the CPU; the tests hold the two together). Writes the light the
-// projector then emits and the signal sent to it.
-constexpr const char* kEncodeFragment = R"(#version 450 core
+// the same on the CPU; the tests hold the two together). Writes the signal sent
+// to the projector; the light it then emits is the projector model's business
+// (read_linear), worked out only when someone asks.
+//
+// Built for each output stage with its choices as preprocessor constants (WARP,
+// WEIGHTS, CURVE, SHARE, INSET: output_stage_defines): a software rasterizer runs both
+// sides of a branch on a uniform, which made this pass cost 5× the old encode.
+constexpr const char* kEncodeFragment = R"(
 in vec2 uv;
 layout(binding = 0) uniform sampler2D rendered;
 layout(binding = 2) uniform sampler2D weights;
 layout(binding = 3) uniform sampler2D depth;
 layout(binding = 4) uniform sampler2D response_table;
-uniform bool warp;
 uniform mat3 projector_to_user;
 uniform vec2 output_size;
 uniform vec2 rendered_size;
-uniform bool has_weights;
-uniform int curve;  // 0 sRGB, 1 gamma, 2 table
 uniform float gamma;
 uniform int table_size;
 uniform float levels;
 uniform float black_level;
 uniform float brightness;
-uniform int share;          // 0 all, 1 focus: (1 − c_r), 2 defocus: c_r
 uniform vec4 coc;           // k, b', lowest and highest window depth (optics/defocus.h)
 uniform vec4 depth_unwarp;  // single pass: a31, a32, a33 and the depth scale
-uniform bool inset;         // share by a disc around the gaze point instead of c_r
 uniform mat3 fragment_to_screen;
 uniform vec3 inset_disc;    // centre x, y and radius, screen metres
 uniform float screen_metres_per_pixel;
-layout(location = 0) out vec4 light;
-layout(location = 1) out vec4 encoded;
+layout(location = 0) out vec4 encoded;
 
 float table_at(int i) { return texelFetch(response_table, ivec2(i, 0), 0).r; }
 
-float response(float v) {
-  v = clamp(v, 0.0, 1.0);
-  if (curve == 0) return v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
-  if (curve == 1) return pow(v, gamma);
-  float at = v * float(table_size - 1);
-  int i = min(int(at), table_size - 2);
-  return mix(table_at(i), table_at(i + 1), at - float(i));
-}
-
-float inverse_response(float l) {
+vec3 inverse_response(vec3 l) {
   l = clamp(l, 0.0, 1.0);
-  if (curve == 0) return clamp(l <= 0.0031308 ? l * 12.92 : 1.055 * pow(l, 1.0 / 2.4) - 0.055, 0.0, 1.0);
-  if (curve == 1) return pow(l, 1.0 / gamma);
+#if CURVE == 0
+  return clamp(mix(l * 12.92, 1.055 * pow(l, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), l)), 0.0, 1.0);
+#elif CURVE == 1
+  return pow(l, vec3(1.0 / gamma));
+#else
   // The first entry ≥ l, by bisection (the table does not decrease).
-  int lo = 0;
-  int hi = table_size;
-  while (lo < hi) {
-    int mid = (lo + hi) / 2;
-    if (table_at(mid) < l) lo = mid + 1; else hi = mid;
+  vec3 v;
+  for (int c = 0; c < 3; ++c) {
+    int lo = 0;
+    int hi = table_size;
+    while (lo < hi) {
+      int mid = (lo + hi) / 2;
+      if (table_at(mid) < l[c]) lo = mid + 1; else hi = mid;
+    }
+    if (lo == 0) {
+      v[c] = 0.0;
+    } else {
+      float a = table_at(lo - 1);
+      float b = table_at(lo);
+      float f = b > a ? (l[c] - a) / (b - a) : 0.0;
+      v[c] = (float(lo - 1) + f) / float(table_size - 1);
+    }
   }
-  if (lo == 0) return 0.0;
-  float a = table_at(lo - 1);
-  float b = table_at(lo);
-  float f = b > a ? (l - a) / (b - a) : 0.0;
-  return (float(lo - 1) + f) / float(table_size - 1);
+  return v;
+#endif
 }
 
-// Relative circle of confusion from the depth buffer: c_r = k·|z' − b'| with z'
+#if SHARE != 0
+// Relative circle of confusion from the depth buffer: c_r = k·|z′ − b′| with z′
 // the window depth a plain perspective frustum gives (the single pass's depth is
 // first undone: its third row scales z_ndc, its fourth divides by a31·x + a32·y + a33).
 float circle_of_confusion(vec2 user_ndc, vec2 at) {
-  float d;
-  if (warp) {
-    d = texelFetch(depth, ivec2(clamp(at * rendered_size, vec2(0.0), rendered_size - 1.0)), 0).r;
-  } else {
-    d = texelFetch(depth, ivec2(gl_FragCoord.xy), 0).r;
-    float z_ndc = (2.0 * d - 1.0) * dot(depth_unwarp.xyz, vec3(user_ndc, 1.0)) / depth_unwarp.w;
-    d = 0.5 * z_ndc + 0.5;
-  }
+#if WARP
+  float d = texelFetch(depth, ivec2(clamp(at * rendered_size, vec2(0.0), rendered_size - 1.0)), 0).r;
+#else
+  float d = texelFetch(depth, ivec2(gl_FragCoord.xy), 0).r;
+  float z_ndc = (2.0 * d - 1.0) * dot(depth_unwarp.xyz, vec3(user_ndc, 1.0)) / depth_unwarp.w;
+  d = 0.5 * z_ndc + 0.5;
+#endif
   return min(1.0, coc.x * abs(clamp(d, coc.z, coc.w) - coc.y));
 }
 
 float focus_weight(vec2 user_ndc, vec2 at) {
-  if (inset) {
-    vec3 s = fragment_to_screen * vec3(gl_FragCoord.xy, 1.0);
-    float distance_to_edge = inset_disc.z - length(s.xy / s.z - inset_disc.xy);
-    return clamp(distance_to_edge / screen_metres_per_pixel + 0.5, 0.0, 1.0);
-  }
+#if INSET
+  vec3 s = fragment_to_screen * vec3(gl_FragCoord.xy, 1.0);
+  float distance_to_edge = inset_disc.z - length(s.xy / s.z - inset_disc.xy);
+  return clamp(distance_to_edge / screen_metres_per_pixel + 0.5, 0.0, 1.0);
+#else
   return 1.0 - circle_of_confusion(user_ndc, at);
+#endif
 }
+#endif
 
 void main() {
   vec3 c;
+#if WARP || SHARE != 0
   vec3 user = projector_to_user * vec3(gl_FragCoord.xy / output_size * 2.0 - 1.0, 1.0);
   vec2 user_ndc = user.xy / user.z;
   vec2 at = (user_ndc + 1.0) * 0.5;
-  if (warp) {
-    bool inside = user.z > 0.0 && all(greaterThanEqual(at, vec2(0.0))) && all(lessThanEqual(at, vec2(1.0)));
-    c = inside ? texture(rendered, at).rgb : vec3(0.0);
-  } else {
-    c = texelFetch(rendered, ivec2(gl_FragCoord.xy), 0).rgb;
-  }
-  if (has_weights) c *= texelFetch(weights, ivec2(gl_FragCoord.xy), 0).r;
-  if (share != 0) {
-    float in_focus = focus_weight(user_ndc, at);
-    c *= share == 1 ? in_focus : 1.0 - in_focus;
-  }
+#endif
+#if WARP
+  bool inside = user.z > 0.0 && all(greaterThanEqual(at, vec2(0.0))) && all(lessThanEqual(at, vec2(1.0)));
+  c = inside ? texture(rendered, at).rgb : vec3(0.0);
+#else
+  c = texelFetch(rendered, ivec2(gl_FragCoord.xy), 0).rgb;
+#endif
+#if WEIGHTS
+  c *= texelFetch(weights, ivec2(gl_FragCoord.xy), 0).r;
+#endif
+#if SHARE == 1
+  c *= focus_weight(user_ndc, at);
+#elif SHARE == 2
+  c *= 1.0 - focus_weight(user_ndc, at);
+#endif
   float headroom = brightness * (1.0 - black_level);
-  vec3 signal;
-  for (int i = 0; i < 3; ++i) signal[i] = round(inverse_response(c[i] / headroom) * levels) / levels;
-  vec3 emitted;
-  for (int i = 0; i < 3; ++i) emitted[i] = brightness * (black_level + (1.0 - black_level) * response(signal[i]));
-  light = vec4(emitted, 1.0);
+  vec3 signal = round(inverse_response(c / headroom) * levels) / levels;
   encoded = vec4(signal, 1.0);
 }
 )";
+
+// The output pass's choices for a stage, as the preprocessor constants it is
+// built with (the enums' values are the shader's numbers).
+std::string output_stage_defines(const OutputStage& stage) {
+  return "#version 450 core\n#define WARP " + std::to_string(stage.projector_to_user ? 1 : 0) + "\n#define CURVE " +
+         std::to_string(static_cast<int>(stage.projector.curve())) + "\n#define SHARE " +
+         std::to_string(static_cast<int>(stage.focus.role)) + "\n#define INSET " +
+         std::to_string(stage.focus.inset ? 1 : 0) + "\n#define WEIGHTS " +
+         std::to_string(stage.weights.empty() ? 0 : 1) + "\n";
+}
 
 Result<GLuint> compile(GLenum type, const char* source) {
   const GLuint shader = glCreateShader(type);
@@ -253,12 +267,11 @@ struct SceneRenderer::Gl {
   GLuint linear_framebuffer = 0;
   GLuint linear_colour = 0;
   GLuint depth = 0;
-  GLuint encoded_framebuffer = 0;  // the encoded image alone, for blits
+  GLuint encoded_framebuffer = 0;  // the signal: drawn by the output pass, blitted to a window
   GLuint encoded_colour = 0;
-  GLuint output_framebuffer = 0;  // light and encoded image
-  GLuint output_light = 0;
   GLuint weights = 0;
   GLuint response_table = 0;
+  optics::ProjectorModel projector;  // of the output stage
   int output_width = 0;
   int output_height = 0;
   std::vector<GLuint> scene_textures;  // by index in the scene's textures
@@ -270,7 +283,7 @@ struct SceneRenderer::Gl {
   std::vector<glm::vec4> all_lights;  // position, radiance: two per light
   int light_count = 0;
   struct {
-    GLint coc, inset, inset_disc;
+    GLint coc, inset_disc;
   } focus_uniforms{};
   struct {
     GLint model_view_projection, model, normal_matrix, eye, base_colour, has_base_colour_texture, metallic, roughness,
@@ -284,10 +297,10 @@ struct SceneRenderer::Gl {
     glDeleteVertexArrays(2, arrays);
     const GLuint buffers[] = {vertex_buffer, index_buffer, light_buffer};
     glDeleteBuffers(3, buffers);
-    const GLuint framebuffers[] = {linear_framebuffer, encoded_framebuffer, output_framebuffer};
-    glDeleteFramebuffers(3, framebuffers);
-    const GLuint textures[] = {linear_colour, depth, encoded_colour, output_light, weights, response_table};
-    glDeleteTextures(6, textures);
+    const GLuint framebuffers[] = {linear_framebuffer, encoded_framebuffer};
+    glDeleteFramebuffers(2, framebuffers);
+    const GLuint textures[] = {linear_colour, depth, encoded_colour, weights, response_table};
+    glDeleteTextures(5, textures);
     glDeleteTextures(static_cast<GLsizei>(scene_textures.size()), scene_textures.data());
   }
 };
@@ -304,9 +317,6 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   auto scene_program = link(kSceneVertex, kSceneFragment);
   if (!scene_program) return Error{scene_program.error()};
   gl->scene_program = scene_program.value();
-  auto encode_program = link(kFullscreenVertex, kEncodeFragment);
-  if (!encode_program) return Error{encode_program.error()};
-  gl->encode_program = encode_program.value();
   const GLuint p = gl->scene_program;
   gl->uniforms = {glGetUniformLocation(p, "model_view_projection"),
                   glGetUniformLocation(p, "model"),
@@ -388,11 +398,6 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   glNamedBufferStorage(gl->light_buffer,
                        static_cast<GLsizeiptr>(std::max<std::size_t>(1, gl->all_lights.size()) * sizeof(glm::vec4)),
                        nullptr, GL_DYNAMIC_STORAGE_BIT);
-  {
-    const GLuint e = gl->encode_program;
-    gl->focus_uniforms = {glGetUniformLocation(e, "coc"), glGetUniformLocation(e, "inset"),
-                          glGetUniformLocation(e, "inset_disc")};
-  }
 
   gl->materials = scene.materials;
   gl->instances = scene.instances;
@@ -434,26 +439,30 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
   if (!stage.projector_to_user && (width != gl.width || height != gl.height)) {
     return Error{"a single-pass output must have the rendered image's size"};
   }
-  const GLuint framebuffers[] = {gl.encoded_framebuffer, gl.output_framebuffer};
-  glDeleteFramebuffers(2, framebuffers);
-  const GLuint textures[] = {gl.encoded_colour, gl.output_light, gl.weights, gl.response_table};
-  glDeleteTextures(4, textures);
+  // The output pass for this stage, built before anything of the old one goes.
+  const std::string source = output_stage_defines(stage) + kEncodeFragment;
+  auto encode_program = link(kFullscreenVertex, source.c_str());
+  if (!encode_program) return Error{encode_program.error()};
+  glDeleteFramebuffers(1, &gl.encoded_framebuffer);
+  const GLuint textures[] = {gl.encoded_colour, gl.weights, gl.response_table};
+  glDeleteTextures(3, textures);
   gl.weights = 0;
   gl.output_width = width;
   gl.output_height = height;
-  // The output stage's uniforms stay with the program: set once here, not per frame.
+  // Its uniforms are set once here, not per frame.
+  glDeleteProgram(gl.encode_program);
+  gl.encode_program = encode_program.value();
   const GLuint program = gl.encode_program;
-  glProgramUniform1i(program, glGetUniformLocation(program, "warp"), stage.projector_to_user ? 1 : 0);
+  gl.focus_uniforms = {glGetUniformLocation(program, "coc"), glGetUniformLocation(program, "inset_disc")};
   // A single pass needs A⁻¹ too: a focus/defocus share undoes A's effect on depth.
   const glm::mat3 to_user(stage.projector_to_user.value_or(glm::inverse(stage.focus.user_to_projector)));
   const auto uniform = [program](const char* name) { return glGetUniformLocation(program, name); };
   glProgramUniformMatrix3fv(program, uniform("projector_to_user"), 1, GL_FALSE, glm::value_ptr(to_user));
   glProgramUniform2f(program, uniform("output_size"), static_cast<float>(width), static_cast<float>(height));
   glProgramUniform2f(program, uniform("rendered_size"), static_cast<float>(gl.width), static_cast<float>(gl.height));
-  glProgramUniform1i(program, uniform("has_weights"), stage.weights.empty() ? 0 : 1);
 
+  gl.projector = stage.projector;
   const optics::ProjectorModel& model = stage.projector;
-  glProgramUniform1i(program, uniform("curve"), static_cast<int>(model.curve()));
   glProgramUniform1f(program, uniform("gamma"), static_cast<float>(model.gamma()));
   glProgramUniform1i(program, uniform("table_size"), static_cast<int>(model.table().size()));
   glProgramUniform1f(program, uniform("levels"), static_cast<float>(model.levels()));
@@ -471,7 +480,6 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
   }
 
   const FocusShare& focus = stage.focus;
-  glProgramUniform1i(program, uniform("share"), static_cast<int>(focus.role));
   const glm::dmat3& a = focus.user_to_projector;
   glProgramUniform4f(program, uniform("depth_unwarp"), static_cast<float>(a[0][2]), static_cast<float>(a[1][2]),
                      static_cast<float>(a[2][2]), static_cast<float>(focus.depth_scale));
@@ -483,15 +491,8 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
   glCreateTextures(GL_TEXTURE_2D, 1, &gl.encoded_colour);
   // The signal at the projector's depth: 8 bits, or 16 to hold up to 16.
   glTextureStorage2D(gl.encoded_colour, 1, model.bits() <= 8 ? GL_RGBA8 : GL_RGBA16, width, height);
-  glCreateTextures(GL_TEXTURE_2D, 1, &gl.output_light);
-  glTextureStorage2D(gl.output_light, 1, GL_RGBA16F, width, height);
   glCreateFramebuffers(1, &gl.encoded_framebuffer);
   glNamedFramebufferTexture(gl.encoded_framebuffer, GL_COLOR_ATTACHMENT0, gl.encoded_colour, 0);
-  glCreateFramebuffers(1, &gl.output_framebuffer);
-  glNamedFramebufferTexture(gl.output_framebuffer, GL_COLOR_ATTACHMENT0, gl.output_light, 0);
-  glNamedFramebufferTexture(gl.output_framebuffer, GL_COLOR_ATTACHMENT1, gl.encoded_colour, 0);
-  const GLenum draw_buffers[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glNamedFramebufferDrawBuffers(gl.output_framebuffer, 2, draw_buffers);
   if (!stage.weights.empty()) {
     image::FloatImage rows_up = stage.weights;  // GL's first row is the bottom one
     image::flip_rows(rows_up);
@@ -500,7 +501,7 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTextureSubImage2D(gl.weights, 0, 0, 0, width, height, GL_RED, GL_FLOAT, rows_up.pixels.data());
   }
-  for (GLuint fb : {gl.linear_framebuffer, gl.encoded_framebuffer, gl.output_framebuffer}) {
+  for (GLuint fb : {gl.linear_framebuffer, gl.encoded_framebuffer}) {
     const GLenum status = glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER);
     if (status != GL_FRAMEBUFFER_COMPLETE) {
       return Error{"framebuffer incomplete (status " + std::to_string(status) + ")"};
@@ -535,7 +536,6 @@ void SceneRenderer::set_focus(const FocusFrame& frame) {
   glProgramUniform4f(program, gl.focus_uniforms.coc, static_cast<float>(frame.coc.k),
                      static_cast<float>(frame.coc.focal), static_cast<float>(frame.coc.lo),
                      static_cast<float>(frame.coc.hi));
-  glProgramUniform1i(program, gl.focus_uniforms.inset, frame.inset ? 1 : 0);
   glProgramUniform3f(program, gl.focus_uniforms.inset_disc, static_cast<float>(frame.gaze.x),
                      static_cast<float>(frame.gaze.y), static_cast<float>(frame.inset_radius));
 }
@@ -604,7 +604,7 @@ void SceneRenderer::draw_black() {
 // The projector's response, last: linear light → what is sent to it.
 void SceneRenderer::encode() {
   Gl& gl = *gl_;
-  glBindFramebuffer(GL_FRAMEBUFFER, gl.output_framebuffer);
+  glBindFramebuffer(GL_FRAMEBUFFER, gl.encoded_framebuffer);
   glViewport(0, 0, gl.output_width, gl.output_height);
   glDisable(GL_DEPTH_TEST);
   glUseProgram(gl.encode_program);
@@ -632,7 +632,10 @@ image::FloatImage read_float(GLuint framebuffer, int width, int height, GLenum f
 }  // namespace
 
 image::FloatImage SceneRenderer::read_linear() const {
-  return read_float(gl_->output_framebuffer, gl_->output_width, gl_->output_height, GL_RGBA, 4);
+  const image::WordImage signal = read_signal();
+  image::FloatImage normalized(signal.width, signal.height, signal.channels);
+  for (std::size_t i = 0; i < signal.pixels.size(); ++i) normalized.pixels[i] = signal.pixels[i] / 65535.0f;
+  return optics::emitted_image(normalized, gl_->projector);
 }
 
 image::FloatImage SceneRenderer::read_rendered() const {

@@ -1,8 +1,8 @@
 #pragma once
 // Draws a scene into its own framebuffers: linear light (RGBA32F colour, 32-bit
 // float depth), then an output pass to the signal the projector is sent (its
-// response, bit depth, black level and brightness: optics/projector_model.h). Needs a current OpenGL 4.5 context (render/gl_context.h); the same
-// code runs headless and in a window.
+// response, bit depth, black level and brightness: optics/projector_model.h). Needs a current OpenGL 4.5 context
+// (render/gl_context.h); the same code runs headless and in a window.
 
 #include <memory>
 #include <optional>
@@ -34,6 +34,7 @@ enum class FocusRole { none, focus, defocus };
 
 struct FocusShare {
   FocusRole role = FocusRole::none;
+  bool inset = false;  // share by a disc around the gaze point instead of c_r
   // Single pass: A and the depth scale, to undo what they did to window depth.
   glm::dmat3 user_to_projector{1.0};
   double depth_scale = 1.0;
@@ -45,8 +46,7 @@ struct FocusShare {
 // What changes per frame for a focus/defocus projector.
 struct FocusFrame {
   optics::CocFromWindowDepth coc;  // from the frame's focal depth
-  bool inset = false;
-  glm::dvec2 gaze{0.0};  // screen metres
+  glm::dvec2 gaze{0.0};            // screen metres
   double inset_radius = 0.0;
 };
 
@@ -100,7 +100,8 @@ class SceneRenderer {
   void draw_black();
 
   // The output, after the output stage (projector pixels).
-  [[nodiscard]] image::FloatImage read_linear() const;  // RGBA, linear light the projector emits
+  [[nodiscard]] image::FloatImage read_linear()
+      const;  // RGBA, the light the projector emits for the signal (its model, on the CPU)
   [[nodiscard]] image::ByteImage read_encoded() const;  // RGBA8, the signal (8 bits deep at most)
   [[nodiscard]] image::WordImage read_signal() const;   // RGBA16: the signal at any depth, ·65535
   [[nodiscard]] unsigned output_framebuffer() const;    // the encoded image, for a window blit
