@@ -44,9 +44,9 @@ struct StackedGroup {
 // The cost model of the automatic split, in units of a light that reaches every
 // pixel (light_share.h): a node's pixels cost kBaseCost before any light (the
 // pass over the scene, the material, the output pass) — fitted to node draw
-// times on llvmpipe, docs/bench/lighting.md: about ten lights' worth — and the
+// times on llvmpipe, docs/bench/lighting.md: about three lights' worth — and the
 // ambient and emissive terms two multiply-adds.
-inline constexpr double kBaseCost = 10.0;
+inline constexpr double kBaseCost = 3.0;
 inline constexpr double kAmbientCost = 0.05;
 
 // Each light's estimated cost to the group: its coverage of the area the group

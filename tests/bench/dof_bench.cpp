@@ -799,9 +799,9 @@ int main(int argc, char** argv) {
           "of the sweep and the pixels off silhouettes (where a 3×3 neighbourhood sees one object). *From "
           "read_depth()*: `relative_coc(float window depth, mapping)`, the shader's arithmetic on the CPU. *From "
           "the output pass*: 1 − focus/I read back from the focus projector's light (16-bit signal) in the "
-          "channel with the most light where I > 10⁻³; it carries the half-float rounding of the stored light "
-          "(2⁻¹¹ relative) and the signal's step at dim pixels, so it bounds the shader's c_r to about 10⁻³, not "
-          "better. 8-bit output resolves 1/255 = "
+          "channel with the most light where I > 10⁻³; it carries the 16-bit signal's step, which at dim pixels is "
+          "larger than the depth's, so it bounds the shader's c_r only to about 10⁻⁴. 8-bit output resolves "
+          "1/255 = "
        << sci(buffer_bound_8bit) << ".\n\n"
        << precision_table.str() << "\n"
        << "## Time per frame\n\nOne process, one GL context, " << runs << " runs of " << frames
@@ -862,9 +862,9 @@ int main(int argc, char** argv) {
        << signed_ms(timing[kFocus].median - full_ms) << " and the defocus node's by "
        << signed_ms(timing[kDefocus].median - full_ms) << " against the full render alone (whose runs spread over "
        << fixed(timing[kFull].low, 2) << "–" << fixed(timing[kFull].high, 2)
-       << " ms): it is one depth fetch per pixel in a pass every node runs anyway. The blur itself is done by the "
-          "defocused projector's optics, so the pair's frame costs what one node's full render costs, on two "
-          "machines and two projectors. The gather costs "
+       << " ms): one depth fetch and the mask's arithmetic per pixel, in a pass every node runs anyway. The blur "
+          "itself is done by the defocused projector's optics, so the pair's frame costs one node's render plus "
+          "that mask, on two machines and two projectors. The gather costs "
        << fixed(timing[kGather].median - full_ms, 1) << " ms more (" << fixed(timing[kGather].median / full_ms, 1)
        << "× the full render) for its " << 2 * gather.reach() + 1 << "² taps per pixel, work that grows with c_max². "
        << (software ? "These are llvmpipe times (the CPU rasterizes, on a shared machine); a GPU is far faster at "
