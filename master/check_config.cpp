@@ -68,7 +68,12 @@ std::string summarize(const config::LoadedConfig& config) {
       << m.frame_rate() << " Hz, frame timeout " << m.frame_timeout_ms() << " ms, present lead " << m.present_lead_us()
       << " µs\n";
   out << "  scene: "
-      << (inst.scene().builtin().empty() ? "glTF " + inst.scene().gltf() : "builtin " + inst.scene().builtin()) << "\n";
+      << (inst.scene().builtin().empty() ? "glTF " + inst.scene().gltf() : "builtin " + inst.scene().builtin());
+  if (inst.scene().light_switches_size() > 0) {
+    out << ", " << inst.scene().light_switches_size() << " light switch(es) from "
+        << inst.scene().light_switches(0).time() << " s";
+  }
+  out << "\n";
   return out.str();
 }
 

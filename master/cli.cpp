@@ -15,6 +15,7 @@
 #include "check_config.h"
 #include "compose.h"
 
+#include "light_switches.h"
 #include "log/logger.h"
 #include "master.h"
 #include "render_reference.h"
@@ -29,7 +30,11 @@ Result<std::pair<config::LoadedConfig, scene::LoadedScene>> load_config_and_scen
   if (!loaded) return Error{loaded.error()};
   auto scene = scene::load_scene(loaded.value().installation.scene(), loaded.value().directory);
   if (!scene) return Error{path + ": scene: " + scene.error()};
-  const auto problems = check_lighting_groups(loaded.value().installation, scene.value().definition.lights.size());
+  const std::size_t light_count = scene.value().definition.lights.size();
+  auto problems = check_lighting_groups(loaded.value().installation, light_count);
+  for (config::Problem& problem : LightSwitches::check(loaded.value().installation.scene(), light_count)) {
+    problems.push_back(std::move(problem));
+  }
   if (!problems.empty()) return Error{config::describe_problems(problems, path)};
   return std::pair{std::move(loaded).value(), std::move(scene).value()};
 }

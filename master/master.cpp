@@ -59,7 +59,12 @@ Master::~Master() = default;
 
 Result<void> Master::start() {
   const auto& installation = options_.config.installation;
-  authority_.emplace(options_.scene.definition.objects, installation.viewer(), settings_.frame_rate());
+  const std::size_t light_count = options_.scene.definition.lights.size();
+  if (auto problems = LightSwitches::check(installation.scene(), light_count); !problems.empty()) {
+    return Error{config::describe_problems(problems, options_.config.path)};
+  }
+  authority_.emplace(options_.scene.definition.objects, installation.viewer(), settings_.frame_rate(),
+                     LightSwitches::from_config(installation.scene(), light_count));
   frame_period_ = authority_->frame_period();
   current_state_ = authority_->state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
@@ -309,7 +314,9 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
   }
   if (const LightShare* share = light_plan_->share(*slot)) {
     *welcome.mutable_lights() = to_wire(*share);
-    target.sent_share = *share;
+    // Its first frame repeats the share, so the log tells from which frame each
+    // node draws what (and a share changed while it set itself up still reaches it).
+    target.sent_share.reset();
   }
   if (installation.has_depth_of_field()) *welcome.mutable_depth_of_field() = installation.depth_of_field();
   welcome.set_frame_period_ns(frame_period_);
@@ -393,6 +400,8 @@ void Master::begin_frame() {
   begin.set_frame_id(frame);
   begin.set_simulation_time_ns(authority_->simulation_time(frame));
   *begin.mutable_delta() = scene::make_delta(current_state_, state);
+  const bool lights_switched = begin.delta().lights_off_size() > 0 || begin.delta().lights_on_size() > 0;
+  if (lights_switched) log_light_switches(frame, begin.delta(), state);
   current_state_ = std::move(state);
   current_hash_ = scene::state_hash(current_state_);
   begin.set_state_hash(current_hash_);
@@ -406,7 +415,11 @@ void Master::begin_frame() {
   // The scene moves: about once a second, see whether another split of the
   // automatic groups' lights would finish clearly sooner.
   const auto frames_per_second = static_cast<std::uint64_t>(std::max(1.0, settings_.frame_rate()));
-  if (frame % frames_per_second == 0) rebalance_lights(false);
+  if (lights_switched) {
+    rebalance_lights(true);
+  } else if (frame % frames_per_second == 0) {
+    rebalance_lights(false);
+  }
 
   std::vector<std::size_t> sent;
   std::vector<std::size_t> waited;
@@ -640,6 +653,19 @@ void Master::rebalance_lights(bool force) {
     up[i] = session && session->phase != Phase::handshake && session->phase != Phase::configuring;
   }
   light_plan_->rebalance(up, current_state_, current_state_.eye_now, force);
+}
+
+void Master::log_light_switches(std::uint64_t frame, const wire::StateDelta& delta, const scene::SceneState& state) {
+  const auto list = [](const auto& lights) {
+    return format_light_list(std::vector<std::uint32_t>(lights.begin(), lights.end()));
+  };
+  std::string what;
+  if (delta.lights_off_size() > 0) what = "lights [" + list(delta.lights_off()) + "] go dark";
+  if (delta.lights_on_size() > 0) {
+    what += (what.empty() ? "" : ", ") + std::string("lights [") + list(delta.lights_on()) + "] come on";
+  }
+  log_.info("frame {}: {} ({} of {} off)", frame, what, state.lights_off.size(),
+            options_.scene.definition.lights.size());
 }
 
 void Master::housekeeping() {

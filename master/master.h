@@ -108,6 +108,7 @@ class Master {
   // Shares automatic groups' lights among the nodes that are up (a node came or
   // went: `force`); the changes go out with the next FrameBegin.
   void rebalance_lights(bool force);
+  void log_light_switches(std::uint64_t frame, const wire::StateDelta& delta, const scene::SceneState& state);
   void housekeeping();
   void send_heartbeats();
   void on_signal(int signal);

@@ -20,7 +20,8 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
   }
   const int s = options.supersample;
   const auto& installation = config.installation;
-  const SceneAuthority authority(scene.definition.objects, installation.viewer(), installation.master().frame_rate());
+  const SceneAuthority authority(scene.definition.objects, installation.viewer(), installation.master().frame_rate(),
+                                 LightSwitches::from_config(installation.scene(), scene.definition.lights.size()));
   const scene::SceneState state = authority.state_at_frame(frame);
 
   auto context = render::make_headless_context();

@@ -4,8 +4,12 @@
 
 namespace optique::master {
 
-SceneAuthority::SceneAuthority(std::vector<scene::AnimatedObject> objects, config::Viewer viewer, double frame_rate)
-    : objects_(std::move(objects)), viewer_(std::move(viewer)), period_(static_cast<clock::Nanos>(1e9 / frame_rate)) {}
+SceneAuthority::SceneAuthority(std::vector<scene::AnimatedObject> objects, config::Viewer viewer, double frame_rate,
+                               LightSwitches switches)
+    : objects_(std::move(objects)),
+      viewer_(std::move(viewer)),
+      switches_(std::move(switches)),
+      period_(static_cast<clock::Nanos>(1e9 / frame_rate)) {}
 
 clock::Nanos SceneAuthority::simulation_time(std::uint64_t frame) const {
   return static_cast<clock::Nanos>(frame) * period_;
@@ -20,6 +24,7 @@ scene::SceneState SceneAuthority::state_at_frame(std::uint64_t frame) const {
   }
   state.eye_now = scene::eye_at(viewer_, now);
   state.eye_next = scene::eye_at(viewer_, next);
+  state.lights_off = switches_.off_at(now);
   return state;
 }
 

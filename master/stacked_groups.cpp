@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <limits>
+#include <set>
 
 #include "config/geometry.h"
 #include "scene/light_coverage.h"
@@ -187,13 +188,25 @@ LiveMembers live_members(const config::Installation& inst, const StackedGroup& g
   return members;
 }
 
-// One share per member of the group: the live members' by cost, nothing for the others.
+// One share per member of the group: the live members' by cost, nothing for the
+// others; the lights that are off go to nobody.
 std::vector<LightShare> shares_for(const StackedGroup& group, const LiveMembers& members,
-                                   const std::vector<double>& costs) {
+                                   const std::vector<double>& costs, const std::set<std::uint32_t>& lights_off) {
   std::vector<LightShare> shares(group.members.size());
   if (members.places.empty()) return shares;
-  std::vector<LightShare> live_shares = share_lights(costs, members.pixels, kBaseCost, kAmbientCost);
-  for (std::size_t i = 0; i < members.places.size(); ++i) shares[members.places[i]] = std::move(live_shares[i]);
+  std::vector<std::uint32_t> shining;
+  std::vector<double> shining_costs;
+  for (std::size_t light = 0; light < costs.size(); ++light) {
+    if (lights_off.contains(static_cast<std::uint32_t>(light))) continue;
+    shining.push_back(static_cast<std::uint32_t>(light));
+    shining_costs.push_back(costs[light]);
+  }
+  std::vector<LightShare> live_shares = share_lights(shining_costs, members.pixels, kBaseCost, kAmbientCost);
+  for (std::size_t i = 0; i < members.places.size(); ++i) {
+    LightShare& share = live_shares[i];
+    for (std::uint32_t& light : share.lights) light = shining[light];  // still ascending
+    shares[members.places[i]] = std::move(share);
+  }
   return shares;
 }
 
@@ -202,7 +215,8 @@ std::vector<LightShare> shares_for(const StackedGroup& group, const LiveMembers&
 std::vector<LightShare> automatic_shares(const config::Installation& inst, const StackedGroup& group,
                                          const std::vector<bool>& live, const scene::SceneDefinition& scene,
                                          const scene::SceneState& state, const glm::dvec3& eye) {
-  return shares_for(group, live_members(inst, group, live), group_light_costs(inst, group, scene, state, eye));
+  return shares_for(group, live_members(inst, group, live), group_light_costs(inst, group, scene, state, eye),
+                    state.lights_off);
 }
 
 LightPlan::LightPlan(const config::Installation& installation, const scene::SceneDefinition& scene)
@@ -222,7 +236,7 @@ bool LightPlan::rebalance(const std::vector<bool>& up, const scene::SceneState& 
     for (std::size_t member : group.members) live.push_back(up[member]);
     const LiveMembers members = live_members(installation_, group, live);
     const std::vector<double> costs = group_light_costs(installation_, group, scene_, state, eye);
-    std::vector<LightShare> proposed = shares_for(group, members, costs);
+    std::vector<LightShare> proposed = shares_for(group, members, costs, state.lights_off);
     bool differs = false;
     for (std::size_t k = 0; k < group.members.size(); ++k) {
       const auto current = shares_.find(group.members[k]);

@@ -57,7 +57,8 @@ inline constexpr double kAmbientCost = 0.05;
 
 // An automatic group's shares among its live members (`live[k]` for members[k]),
 // by estimated cost: each light's coverage of the group's screen area seen from
-// `eye`, times each member's pixels. Members that are not live get nothing.
+// `eye`, times each member's pixels. Members that are not live get nothing, and
+// the lights the state has switched off go to nobody.
 [[nodiscard]] std::vector<LightShare> automatic_shares(const config::Installation& installation,
                                                        const StackedGroup& group, const std::vector<bool>& live,
                                                        const scene::SceneDefinition& scene,
@@ -74,7 +75,8 @@ class LightPlan {
 
   // Shares the automatic groups' lights among the projectors that are up
   // (`up[i]` for projector i), at `state` seen from `eye`. `force`: share them
-  // out anew even if the modelled gain is small (a member came or went).
+  // out anew even if the modelled gain is small (a member came or went, a light
+  // was switched on or off).
   // Returns whether any share changed.
   bool rebalance(const std::vector<bool>& up, const scene::SceneState& state, const glm::dvec3& eye, bool force);
 

@@ -280,7 +280,9 @@ struct SceneRenderer::Gl {
   std::vector<scene::Instance> instances;
   glm::vec3 ambient{0.0f};
   glm::vec3 background{0.0f};
-  std::vector<glm::vec4> all_lights;  // position, radiance: two per light
+  std::vector<glm::vec4> all_lights;           // position, radiance: two per light
+  std::vector<std::uint32_t> chosen_lights;    // set_lights
+  std::vector<std::uint32_t> uploaded_lights;  // those of them that shine, in the light buffer
   int light_count = 0;
   struct {
     GLint coc, inset_disc;
@@ -511,17 +513,29 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
 }
 
 void SceneRenderer::set_lights(std::span<const std::uint32_t> lights) {
+  assert(std::all_of(lights.begin(), lights.end(),
+                     [&](std::uint32_t i) { return 2 * static_cast<std::size_t>(i) + 1 < gl_->all_lights.size(); }));
+  gl_->chosen_lights.assign(lights.begin(), lights.end());
+  upload_shining_lights({});
+}
+
+void SceneRenderer::upload_shining_lights(const std::set<std::uint32_t>& off) {
   Gl& gl = *gl_;
-  std::vector<glm::vec4> chosen;
-  for (std::uint32_t i : lights) {
-    assert(2 * static_cast<std::size_t>(i) + 1 < gl.all_lights.size());
-    chosen.push_back(gl.all_lights[2 * i]);
-    chosen.push_back(gl.all_lights[2 * i + 1]);
+  std::vector<std::uint32_t> shining;
+  for (std::uint32_t i : gl.chosen_lights) {
+    if (!off.contains(i)) shining.push_back(i);
   }
-  if (!chosen.empty()) {
-    glNamedBufferSubData(gl.light_buffer, 0, static_cast<GLsizeiptr>(chosen.size() * sizeof(glm::vec4)), chosen.data());
+  if (shining == gl.uploaded_lights && gl.light_count == static_cast<int>(shining.size())) return;
+  std::vector<glm::vec4> data;
+  for (std::uint32_t i : shining) {
+    data.push_back(gl.all_lights[2 * i]);
+    data.push_back(gl.all_lights[2 * i + 1]);
   }
-  gl.light_count = static_cast<int>(lights.size());
+  if (!data.empty()) {
+    glNamedBufferSubData(gl.light_buffer, 0, static_cast<GLsizeiptr>(data.size() * sizeof(glm::vec4)), data.data());
+  }
+  gl.light_count = static_cast<int>(shining.size());
+  gl.uploaded_lights = std::move(shining);
 }
 
 void SceneRenderer::set_all_lights() {
@@ -552,6 +566,7 @@ void SceneRenderer::draw(const scene::SceneState& state, double fraction, const 
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
+  upload_shining_lights(state.lights_off);
   glUseProgram(gl.scene_program);
   glBindVertexArray(gl.vertex_array);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl.light_buffer);

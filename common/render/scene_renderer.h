@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <optional>
+#include <set>
 #include <span>
 
 #include <glm/mat3x3.hpp>
@@ -89,8 +90,8 @@ class SceneRenderer {
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);
 
-  // Draws only these of the scene's point lights (indices; all by default).
-  // Asserts that each exists.
+  // Draws only these of the scene's point lights (indices; all by default), less
+  // those the drawn state has switched off. Asserts that each exists.
   void set_lights(std::span<const std::uint32_t> lights);
   void set_all_lights();
   // The focal depth and gaze of the frame to come (focus/defocus projectors).
@@ -115,6 +116,7 @@ class SceneRenderer {
   struct Gl;
   explicit SceneRenderer(std::unique_ptr<Gl> gl);
   void encode();
+  void upload_shining_lights(const std::set<std::uint32_t>& off);
   std::unique_ptr<Gl> gl_;
 };
 

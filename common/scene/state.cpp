@@ -146,6 +146,8 @@ std::uint64_t state_hash(const SceneState& state) {
   }
   h.add(state.eye_now);
   h.add(state.eye_next);
+  h.add(static_cast<std::uint64_t>(state.lights_off.size()));
+  for (std::uint32_t light : state.lights_off) h.add(static_cast<std::uint64_t>(light));
   return h.value();
 }
 
@@ -153,6 +155,7 @@ wire::Snapshot to_snapshot(const SceneState& state) {
   wire::Snapshot snapshot;
   for (const auto& [id, object] : state.objects) to_wire(id, object, *snapshot.add_objects());
   to_wire(state, *snapshot.mutable_viewer());
+  snapshot.mutable_lights_off()->Add(state.lights_off.begin(), state.lights_off.end());
   return snapshot;
 }
 
@@ -169,6 +172,11 @@ Result<SceneState> from_snapshot(const wire::Snapshot& snapshot) {
   if (!eye) return Error{eye.error()};
   state.eye_now = eye.value().now;
   state.eye_next = eye.value().next;
+  for (std::uint32_t light : snapshot.lights_off()) {
+    if (!state.lights_off.insert(light).second) {
+      return Error{"snapshot lists light " + std::to_string(light) + " as off twice"};
+    }
+  }
   return state;
 }
 
@@ -183,6 +191,12 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
   }
   if (!identical(before.eye_now, after.eye_now) || !identical(before.eye_next, after.eye_next)) {
     to_wire(after, *delta.mutable_viewer());
+  }
+  for (std::uint32_t light : after.lights_off) {
+    if (!before.lights_off.contains(light)) delta.add_lights_off(light);
+  }
+  for (std::uint32_t light : before.lights_off) {
+    if (!after.lights_off.contains(light)) delta.add_lights_on(light);
   }
   return delta;
 }
@@ -206,11 +220,24 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
     if (!moved) return Error{"delta: " + moved.error()};
     eye = moved.value();
   }
+  std::set<std::uint32_t> lights_off = state.lights_off;
+  for (std::uint32_t light : delta.lights_off()) {
+    if (!lights_off.insert(light).second) {
+      return Error{"delta switches off light " + std::to_string(light) + ", which is off already"};
+    }
+  }
+  for (std::uint32_t light : delta.lights_on()) {
+    // Against the state before the delta, so one delta cannot switch a light off and on.
+    if (!state.lights_off.contains(light) || lights_off.erase(light) == 0) {
+      return Error{"delta switches on light " + std::to_string(light) + ", which is not off"};
+    }
+  }
 
   for (auto& [id, object] : changed) state.objects.insert_or_assign(id, object);
   for (std::uint32_t id : delta.removed()) state.objects.erase(id);
   state.eye_now = eye.now;
   state.eye_next = eye.next;
+  state.lights_off = std::move(lights_off);
   return {};
 }
 

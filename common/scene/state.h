@@ -1,10 +1,12 @@
 #pragma once
 // The scene state every node must agree on: dynamic objects, each with its pose at
-// the frame time and at the next frame time, and the viewer's eye at both times.
+// the frame time and at the next frame time, the viewer's eye at both times, and
+// which of the scene's point lights are switched off.
 // A snapshot on join, then per frame only what changed; a hash both sides compare.
 
 #include <cstdint>
 #include <map>
+#include <set>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
@@ -33,6 +35,9 @@ struct SceneState {
   std::map<std::uint32_t, ObjectState> objects;
   glm::dvec3 eye_now{0.0};
   glm::dvec3 eye_next{0.0};
+  // Indices into the scene's lights. A light that goes dark costs nothing: no node
+  // draws it, and the automatic light split shares out only the others.
+  std::set<std::uint32_t> lights_off;
 
   bool operator==(const SceneState&) const = default;
 };
@@ -48,7 +53,8 @@ struct SceneState {
 [[nodiscard]] wire::StateDelta make_delta(const SceneState& before, const SceneState& after);
 
 // Applies `delta` to `state`, or leaves it untouched and says what is wrong
-// (non-finite numbers, removing an object that does not exist).
+// (non-finite numbers, removing an object that does not exist, switching off a
+// light that is off or on one that is on).
 [[nodiscard]] Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta);
 
 }  // namespace optique::scene

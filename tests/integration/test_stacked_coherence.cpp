@@ -8,18 +8,13 @@
 
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <fstream>
 
 #include "cluster_run.h"
 #include "config/load.h"
-#include "image/compare.h"
-#include "image/frame_files.h"
-#include "image/image_io.h"
-#include "optics/projector_model.h"
 #include "process.h"
+#include "screen_check.h"
 
 namespace optique::testing {
 namespace {
@@ -40,12 +35,6 @@ struct StackedRun {
   // simulator's resampling of edges and the 8-bit steps account for these.
   std::vector<std::size_t> ghost_pixels;
 };
-
-image::FloatImage read(const std::string& path) {
-  auto image = image::read_image(path);
-  EXPECT_TRUE(image.ok()) << (image.ok() ? "" : image.error());
-  return image.ok() ? image.value() : image::FloatImage{};
-}
 
 // The shipped config at 3 Hz: the statue turns 0.1 rad between frames, about
 // eight screen pixels at its corners, so a frame's lag shows plainly.
@@ -88,38 +77,11 @@ StackedRun run_cluster(const std::string& lagging_node) {
   for (auto& node : nodes) EXPECT_EQ(node->wait(30s).value_or(-1), 0) << node->output();
   run.summary = read_cluster_run(run.out);
 
-  double black = 0.0;
-  for (const auto& p : loaded.value().installation.projectors()) {
-    black += optics::ProjectorModel::from_config(p).value().black();
-  }
+  const ScreenCheck check{kMaster, config, run.out + "/nodes", run.out, "front"};
   for (std::uint64_t frame = kCaptureEvery; frame < kFrames; frame += kCaptureEvery) {
-    const std::string k = std::to_string(frame);
-    Process compose({kMaster, "compose", "--config", config, "--frame", k, "--out", run.out}, dir + "/compose.log");
-    EXPECT_EQ(compose.wait(60s).value_or(-1), 0) << compose.output();
-    Process reference({kMaster, "render-reference", "--config", config, "--frame", k, "--out", run.out},
-                      dir + "/reference.log");
-    EXPECT_EQ(reference.wait(60s).value_or(-1), 0) << reference.output();
-    image::FloatImage composite = read(image::frame_path(run.out + "/screens/front", frame, "exr"));
-    const image::FloatImage expected = read(image::frame_path(run.out + "/reference/front", frame, "exr"));
-    for (std::size_t i = 0; i < composite.pixels.size(); ++i) {
-      if (i % 4 != 3) composite.pixels[i] -= static_cast<float>(black);
-    }
-    const int w = composite.width;
-    const int h = composite.height;
-    // Highlights brighter than a share can emit clip in the projectors (the
-    // reference has no projectors): compare where every share fits.
-    const auto shown = [&](int x, int y) {
-      if (x < 2 || y < 2 || x >= w - 2 || y >= h - 2) return false;
-      return std::max({expected.at(x, y, 0), expected.at(x, y, 1), expected.at(x, y, 2)}) <= 0.6f;
-    };
-    run.psnr_db.push_back(image::psnr_luma_where(composite, expected, shown));
-    std::size_t ghost = 0;
-    for (int y = 0; y < h; ++y) {
-      for (int x = 0; x < w; ++x) {
-        if (shown(x, y) && std::abs(image::luma(composite, x, y) - image::luma(expected, x, y)) > 0.01) ++ghost;
-      }
-    }
-    run.ghost_pixels.push_back(ghost);
+    const ScreenMatch match = compare_with_reference(check, frame);
+    run.psnr_db.push_back(match.psnr_db);
+    run.ghost_pixels.push_back(match.pixels_off);
   }
   return run;
 }

@@ -115,6 +115,60 @@ TEST(SceneDelta, RemovingEveryObject) {
   EXPECT_EQ(state_hash(state), state_hash(after));
 }
 
+TEST(SceneDelta, LightsSwitchedOffAndOnAgain) {
+  SceneState before = before_state();
+  before.lights_off = {2, 5};
+  SceneState after = before;
+  after.lights_off = {0, 5, 19};  // 0 and 19 go dark, 2 shines again
+  const wire::StateDelta delta = make_delta(before, after);
+  EXPECT_EQ(std::vector<std::uint32_t>(delta.lights_off().begin(), delta.lights_off().end()),
+            (std::vector<std::uint32_t>{0, 19}));
+  EXPECT_EQ(std::vector<std::uint32_t>(delta.lights_on().begin(), delta.lights_on().end()),
+            std::vector<std::uint32_t>{2});
+  EXPECT_EQ(delta.changed_size(), 0);
+  EXPECT_NE(state_hash(before), state_hash(after));
+
+  SceneState state = before;
+  ASSERT_TRUE(apply_delta(state, delta).ok());
+  EXPECT_EQ(state, after);
+  EXPECT_EQ(state_hash(state), state_hash(after));
+  EXPECT_EQ(make_delta(after, after).lights_off_size() + make_delta(after, after).lights_on_size(), 0);
+}
+
+TEST(SceneDelta, LightSwitchesThatChangeNothingAreRefusedWholesale) {
+  SceneState base = before_state();
+  base.lights_off = {3};
+  const auto refused = [&](const wire::StateDelta& delta, std::string_view expected) {
+    SceneState state = base;
+    auto applied = apply_delta(state, delta);
+    ASSERT_FALSE(applied.ok()) << expected;
+    EXPECT_NE(applied.error().find(expected), std::string::npos) << applied.error();
+    EXPECT_EQ(state, base) << "a refused delta must leave the state as it was";
+  };
+  wire::StateDelta off_again;
+  off_again.add_lights_off(3);
+  refused(off_again, "switches off light 3, which is off already");
+  wire::StateDelta twice;
+  twice.add_lights_off(4);
+  twice.add_lights_off(4);
+  refused(twice, "switches off light 4, which is off already");
+  wire::StateDelta on_while_on;
+  on_while_on.add_lights_on(7);
+  refused(on_while_on, "switches on light 7, which is not off");
+  wire::StateDelta off_and_on;  // one delta cannot do both to one light
+  off_and_on.add_lights_off(8);
+  off_and_on.add_lights_on(8);
+  refused(off_and_on, "switches on light 8, which is not off");
+  wire::StateDelta on_twice;
+  on_twice.add_lights_on(3);
+  on_twice.add_lights_on(3);
+  refused(on_twice, "switches on light 3, which is not off");
+  // A good change to an object in the same delta is not applied either.
+  wire::StateDelta mixed = make_delta(base, after_state());
+  mixed.add_lights_on(9);
+  refused(mixed, "switches on light 9");
+}
+
 TEST(SceneSnapshot, RoundTrip) {
   const SceneState s = after_state();
   wire::Snapshot wire_snapshot;
@@ -131,6 +185,21 @@ TEST(SceneSnapshot, EmptyStateRoundTrip) {
   auto back = from_snapshot(to_snapshot(empty));
   ASSERT_TRUE(back.ok()) << back.error();
   EXPECT_EQ(back.value(), empty);
+}
+
+TEST(SceneSnapshot, CarriesTheLightsThatAreOff) {
+  SceneState s = after_state();
+  s.lights_off = {1, 4, 17};
+  auto back = from_snapshot(to_snapshot(s));
+  ASSERT_TRUE(back.ok()) << back.error();
+  EXPECT_EQ(back.value(), s);
+  EXPECT_EQ(state_hash(back.value()), state_hash(s));
+
+  wire::Snapshot twice = to_snapshot(s);
+  twice.add_lights_off(4);
+  auto refused = from_snapshot(twice);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().find("lists light 4 as off twice"), std::string::npos) << refused.error();
 }
 
 TEST(SceneSnapshot, DuplicateObjectRejected) {
@@ -180,7 +249,8 @@ TEST(SceneHash, ChangesWhenAnySingleDoubleChanges) {
   check("rotation.z", [&](SceneState& s) { bump(s.objects[9].now.rotation.z); });
   check("eye_now.y", [&](SceneState& s) { bump(s.eye_now.y); });
   check("eye_next.z", [&](SceneState& s) { bump(s.eye_next.z); });
-  EXPECT_EQ(variants, 10);
+  check("a light off", [&](SceneState& s) { s.lights_off.insert(0); });
+  EXPECT_EQ(variants, 11);
 }
 
 TEST(SceneHash, DependsOnIdsAndNowNextOrder) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
 #include <string>
 
 #include "config/load.h"
@@ -147,6 +148,39 @@ TEST(LightPlan, AutomaticGroupsShareAmongTheNodesThatAreUp) {
   EXPECT_FALSE(plan.share(1)->ambient);
   EXPECT_EQ(plan.share(0)->lights.size() + plan.share(2)->lights.size(), 20u);
   EXPECT_TRUE(plan.share(0)->ambient || plan.share(2)->ambient);
+}
+
+TEST(LightPlan, LightsThatAreOffGoToNobodyAndComeBackWhenOn) {
+  const std::string autolights = R"({"role": "lights", "lights": "auto"})";
+  const config::Installation installation = parsed(stacked(autolights, autolights, autolights));
+  auto scene = scene::builtin_scene("many-lights");
+  ASSERT_TRUE(scene);
+  const SceneAuthority authority(scene.value().objects, installation.viewer(), 60.0);
+  scene::SceneState state = authority.state_at_frame(0);
+  LightPlan plan(installation, scene.value());
+  ASSERT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));
+
+  const auto drawn = [&] {
+    std::multiset<std::uint32_t> lights;
+    for (std::size_t i = 0; i < 3; ++i) lights.insert(plan.share(i)->lights.begin(), plan.share(i)->lights.end());
+    return lights;
+  };
+  state.lights_off = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13};
+  EXPECT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));
+  EXPECT_EQ(drawn(), (std::multiset<std::uint32_t>{14, 15, 16, 17, 18, 19}));  // each shining light once
+
+  state.lights_off = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19};
+  EXPECT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));
+  EXPECT_TRUE(drawn().empty());
+  int ambient = 0;
+  for (std::size_t i = 0; i < 3; ++i) ambient += plan.share(i)->ambient ? 1 : 0;
+  EXPECT_EQ(ambient, 1) << "with every light off, the ambient still needs its carrier";
+
+  state.lights_off.clear();
+  EXPECT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));
+  const std::multiset<std::uint32_t> all = drawn();
+  EXPECT_EQ(all.size(), 20u);
+  EXPECT_EQ(std::set<std::uint32_t>(all.begin(), all.end()).size(), 20u);
 }
 
 }  // namespace
