@@ -19,6 +19,7 @@
 #include "log/logger.h"
 #include "master.h"
 #include "render_reference.h"
+#include "shared_secret.h"
 #include "stacked_groups.h"
 
 namespace optique::master {
@@ -36,6 +37,10 @@ Result<std::pair<config::LoadedConfig, scene::LoadedScene>> load_config_and_scen
     problems.push_back(std::move(problem));
   }
   if (!problems.empty()) return Error{config::describe_problems(problems, path)};
+  // A refused secret file is a config problem: check-config says so too.
+  if (auto secret = load_installation_secret(loaded.value()); !secret) {
+    return Error{config::describe_problems({{"master.secret_file", secret.error()}}, path)};
+  }
   return std::pair{std::move(loaded).value(), std::move(scene).value()};
 }
 
@@ -199,6 +204,13 @@ int run_cli(int argc, char** argv) {
   }
   options.config = std::move(loaded.value().first);
   options.scene = std::move(loaded.value().second);
+  auto secret = load_installation_secret(options.config);
+  if (!secret) {
+    std::cerr << config::describe_problems({{"master.secret_file", secret.error()}}, config_path) << "\n";
+    return kExitUsage;
+  }
+  options.secret = std::move(secret).value();
+  options.secret_path = secret_path(options.config);
   auto& settings = *options.config.installation.mutable_master();
   if (options.local) {
     settings.set_listen("127.0.0.1");

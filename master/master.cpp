@@ -15,11 +15,11 @@ namespace {
 
 using std::chrono::milliseconds;
 
-std::string random_nonce() {
-  std::random_device device;
-  std::string nonce(16, '\0');
-  for (char& c : nonce) c = static_cast<char>(device() & 0xFF);
-  return nonce;
+bool is_loopback(const asio::ip::address& address) {
+  if (address.is_v6() && address.to_v6().is_v4_mapped()) {
+    return asio::ip::make_address_v4(asio::ip::v4_mapped, address.to_v6()).is_loopback();
+  }
+  return address.is_loopback();
 }
 
 wire::LightShare to_wire(const LightShare& share) {
@@ -110,6 +110,11 @@ Result<void> Master::start() {
   std::string id_list;
   for (const auto& id : ids) id_list += (id_list.empty() ? "" : ", ") + id;
   log_.info("listening on {}:{}; waiting for {} node(s): {}", settings_.listen(), port_, slots_.size(), id_list);
+  if (options_.secret) {
+    log_.info("nodes must prove they hold the shared secret in {}", options_.secret_path);
+  } else {
+    log_.warn("no shared secret (master.secret_file): accepting nodes from this machine's loopback addresses only");
+  }
 
   if (options_.local) {
     launcher_.emplace(options_.node_binary);
@@ -117,6 +122,10 @@ Result<void> Master::start() {
       std::vector<std::string> args{"--master",    "127.0.0.1:" + std::to_string(port_),
                                     "--id",        s.projector->id(),
                                     "--log-level", options_.node_log_level};
+      if (!options_.secret_path.empty()) {
+        args.push_back("--secret-file");
+        args.push_back(options_.secret_path);
+      }
       if (!options_.out_dir.empty()) {
         args.push_back("--capture-dir");
         args.push_back((std::filesystem::path(options_.out_dir) / "nodes" / s.projector->id()).string());
@@ -176,6 +185,28 @@ void Master::accept_next() {
 }
 
 void Master::on_connection(asio::ip::tcp::socket socket) {
+  boost::system::error_code error;
+  const asio::ip::tcp::endpoint peer = socket.remote_endpoint(error);
+  if (error) return;  // gone already
+  const std::string peer_text = peer.address().to_string() + ":" + std::to_string(peer.port());
+  if (!options_.secret && !is_loopback(peer.address())) {
+    log_.warn(
+        "refused connection from {}: no shared secret is configured (master.secret_file), so only nodes on "
+        "this machine are accepted",
+        peer_text);
+    ++refused_connections_;
+    return;  // the socket closes as it goes out of scope
+  }
+  const auto pending = static_cast<std::size_t>(
+      std::count_if(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->phase == Phase::handshake; }));
+  if (pending >= settings_.max_pending_connections()) {
+    log_.warn(
+        "refused connection from {}: {} connections are already waiting to authenticate "
+        "(master.max_pending_connections)",
+        peer_text, pending);
+    ++refused_connections_;
+    return;
+  }
   auto session = std::make_shared<Session>();
   // Until a peer has said who it is, only a hello-sized frame is accepted: nobody
   // makes the master parse megabytes before authenticating.
@@ -194,7 +225,9 @@ void Master::on_connection(asio::ip::tcp::socket socket) {
       milliseconds(settings_.handshake_timeout_ms()),
       "no valid hello within " + std::to_string(settings_.handshake_timeout_ms()) + " ms");
   wire::Envelope challenge;
-  challenge.mutable_challenge()->set_nonce(random_nonce());
+  session->nonce = net::random_nonce();
+  challenge.mutable_challenge()->set_nonce(session->nonce.data(), session->nonce.size());
+  challenge.mutable_challenge()->set_secret_required(options_.secret.has_value());
   session->connection->send(challenge);
   log_.debug("connection from {}", session->connection->peer());
 }
@@ -245,6 +278,8 @@ void Master::on_message(const std::shared_ptr<Session>& session, wire::Envelope&
 
 void Master::refuse(Session& session, const std::string& node_id, const std::string& reason, bool retriable) {
   log_.warn("refused node '{}' from {}: {}", node_id, session.connection->peer(), reason);
+  session.refused = true;
+  ++refused_connections_;
   wire::Envelope envelope;
   envelope.set_protocol_version(net::kProtocolVersion);
   envelope.mutable_refuse()->set_reason(reason);
@@ -266,6 +301,19 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
                "; run the same optique version on master and nodes",
            false);
     return;
+  }
+  if (options_.secret) {
+    const std::string& mac = hello.nonce_mac();
+    if (mac.empty()) {
+      refuse(*session, hello.node_id(),
+             "this master requires the installation's shared secret: start the node with --secret-file", false);
+      return;
+    }
+    if (!net::verify_hello_mac(*options_.secret, session->nonce, hello.node_id(), message.protocol_version(),
+                               std::span(reinterpret_cast<const std::uint8_t*>(mac.data()), mac.size()))) {
+      refuse(*session, hello.node_id(), "authentication failed: the node's secret does not match the master's", false);
+      return;
+    }
   }
   std::optional<std::size_t> slot;
   std::string known;
@@ -353,8 +401,9 @@ void Master::send_resync(Session& session) {
 void Master::on_closed(const std::shared_ptr<Session>& session, const std::string& reason) {
   std::erase(sessions_, session);
   if (!session->slot) {
-    if (state_ == RunState::starting || state_ == RunState::running) {
-      log_.info("connection from {} closed before joining: {}", session->connection->peer(), reason);
+    if ((state_ == RunState::starting || state_ == RunState::running) && !session->refused) {
+      log_.warn("refused connection from {}: {}", session->connection->peer(), reason);
+      ++refused_connections_;
     }
   } else {
     const std::size_t slot = *session->slot;
@@ -530,6 +579,14 @@ void Master::schedule_next_frame(clock::Nanos now) {
 
 void Master::handle_presented(Session& session, const wire::Presented& presented) {
   recorder_->presented(presented.frame_id(), *session.slot, presented.presented_ns(), presented.content_frame_id());
+  report::ClockReport clock;
+  clock.set_offset_ns(presented.clock_offset_ns());
+  clock.set_drift_ppm(presented.clock_drift_ppm());
+  clock.set_round_trip_ns(presented.clock_rtt_ns());
+  clock.set_error_bound_ns(presented.clock_error_bound_ns());
+  recorder_->clock_estimated(
+      presented.frame_id(), *session.slot, clock,
+      presented.clock_truth_known() ? std::optional(presented.clock_true_error_ns()) : std::nullopt);
 }
 
 // ---------------------------------------------------------------- stopping
@@ -619,6 +676,7 @@ void Master::write_outputs() {
   report.set_config_sha256(options_.config.sha256);
   report.set_frame_rate(settings_.frame_rate());
   report.set_stopped_because(stopped_because_);
+  report.set_connections_refused(refused_connections_);
   const auto& sync = report.sync();
   log_.info("{} frames; barrier round median {} p99 {}; present skew median {} p99 {}; {} frame(s) with a node missing",
             report.frames(), format_us(sync.barrier_round_us().median()), format_us(sync.barrier_round_us().p99()),

@@ -19,6 +19,7 @@
 #include "config/load.h"
 #include "focus_schedule.h"
 #include "local_launcher.h"
+#include "net/auth.h"
 #include "net/connection.h"
 #include "run_recorder.h"
 #include "scene/load_scene.h"
@@ -43,6 +44,9 @@ struct MasterOptions {
   std::string node_log_level = "info";
   std::uint64_t capture_every = 0;  // ask nodes to capture every K-th frame (0: never)
   bool status_line = false;
+  // Nodes must prove they hold it; without one only loopback peers are accepted.
+  std::optional<net::Secret> secret;
+  std::string secret_path;  // handed to local nodes
 };
 
 // Process exit statuses, shared by main and the tests.
@@ -74,6 +78,8 @@ class Master {
     std::shared_ptr<net::Connection> connection;
     std::optional<std::size_t> slot;
     Phase phase = Phase::handshake;
+    std::vector<std::uint8_t> nonce;  // of its challenge
+    bool refused = false;             // said so in the log already
   };
 
   struct Slot {
@@ -128,6 +134,7 @@ class Master {
   asio::ip::tcp::acceptor acceptor_;
   asio::steady_timer accept_retry_timer_;
   bool accept_failing_ = false;
+  std::uint64_t refused_connections_ = 0;  // never through the handshake: each logged once with its peer
   asio::signal_set signals_;
   asio::steady_timer frame_timer_;
   asio::steady_timer barrier_timer_;

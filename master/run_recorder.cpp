@@ -1,6 +1,7 @@
 #include "run_recorder.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "metrics/distribution.h"
 
@@ -51,6 +52,18 @@ void RunRecorder::presented(std::uint64_t frame, std::size_t node, clock::Nanos 
   record->nodes[node].presented = at;
   record->nodes[node].content_frame = content_frame;
   totals_[node].presented += 1;
+}
+
+void RunRecorder::clock_estimated(std::uint64_t frame, std::size_t node, const report::ClockReport& latest,
+                                  std::optional<clock::Nanos> true_error) {
+  // The first two seconds are the estimator's to settle in (the bar is set after them).
+  constexpr clock::Nanos kSettling = 2 * clock::kNanosPerSecond;
+  NodeTotals& t = totals_[node];
+  t.clock = latest;
+  const FrameRecord* record = find(frame);
+  if (true_error && record != nullptr && record->begin_sent - first_begin_ >= kSettling) {
+    t.clock_true_error_us.add(std::abs(static_cast<double>(*true_error)) / 1e3);
+  }
 }
 
 void RunRecorder::node_joined(std::size_t node) { totals_[node].joins += 1; }
@@ -121,6 +134,9 @@ report::RunReport RunRecorder::report() const {
     node.set_barrier_misses(t.misses);
     node.set_hash_mismatches(t.mismatches);
     node.set_joins(t.joins);
+    *node.mutable_clock() = t.clock;
+    if (t.clock_true_error_us.count() > 0)
+      *node.mutable_clock()->mutable_true_error_us() = t.clock_true_error_us.summary();
   }
   auto& sync = *r.mutable_sync();
   *sync.mutable_barrier_round_us() = barrier_round_us_.summary();

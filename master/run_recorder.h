@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -27,6 +28,10 @@ class RunRecorder {
   // `content_frame`: the frame whose content the node showed (a node out of step
   // shows an older one: the frame is then incoherent).
   void presented(std::uint64_t frame, std::size_t node, clock::Nanos at, std::uint64_t content_frame);
+
+  // The node's clock estimate at its present of `frame`.
+  void clock_estimated(std::uint64_t frame, std::size_t node, const report::ClockReport& latest,
+                       std::optional<clock::Nanos> true_error);
 
   void node_joined(std::size_t node);
   void node_missed_barrier(std::size_t node);
@@ -66,6 +71,8 @@ class RunRecorder {
     std::uint64_t mismatches = 0;
     std::uint64_t joins = 0;
     metrics::Reservoir render_us;
+    report::ClockReport clock;
+    metrics::Reservoir clock_true_error_us;
   };
 
   FrameRecord* find(std::uint64_t frame);

@@ -30,6 +30,9 @@ int run_cli(int argc, char** argv) {
                  "null: draw nothing (to measure the cluster alone)")
       ->check(CLI::IsMember({"gl", "null"}));
   app.add_option("--capture-dir", capture_dir, "where captured frames go (default: captures/<id>)");
+  std::string secret_file;
+  app.add_option("--secret-file", secret_file,
+                 "the installation's shared secret (the file its master.secret_file names; mode 600)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn or error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   // Test hooks, hidden from --help.
@@ -58,6 +61,14 @@ int run_cli(int argc, char** argv) {
   }
   options.give_up_after = std::chrono::milliseconds(give_up_ms);
   options.clock = clock::LocalClock(clock_offset_ns, clock_drift_ppm);
+  if (!secret_file.empty()) {
+    auto secret = net::load_secret_file(secret_file);
+    if (!secret) {
+      std::cerr << "optique-node: --secret-file: " << secret.error() << "\n";
+      return kExitRefused;
+    }
+    options.secret = std::move(secret).value();
+  }
 
   auto logger = log::make_logger("node " + options.id, log_level);
   boost::asio::io_context io;

@@ -14,6 +14,7 @@ constexpr milliseconds kMaxBackoff{2000};
 constexpr milliseconds kHandshakeTimeout{5000};
 constexpr milliseconds kConnectTimeout{3000};
 constexpr int kPingBurst = 8;
+constexpr milliseconds kPingInterval{100};
 }  // namespace
 
 Node::Node(asio::io_context& io, NodeOptions options, Renderer& renderer, spdlog::logger& log)
@@ -159,15 +160,29 @@ void Node::on_message(wire::Envelope& message) {
   }
 }
 
-void Node::handle_challenge(wire::Envelope&) {
+void Node::handle_challenge(wire::Envelope& message) {
   if (phase_ != Phase::awaiting_challenge) {
     connection_->close("a second challenge from the master");
+    return;
+  }
+  const wire::Challenge& challenge = message.challenge();
+  if (challenge.secret_required() && !options_.secret) {
+    stop(kExitRefused,
+         "the master requires the installation's shared secret: start this node with --secret-file FILE (the file "
+         "the config's master.secret_file names)");
     return;
   }
   wire::Envelope hello;
   hello.set_protocol_version(options_.protocol_version);
   hello.mutable_hello()->set_node_id(options_.id);
   hello.mutable_hello()->add_capabilities("render");
+  if (options_.secret) {
+    const std::string& nonce = challenge.nonce();
+    const auto mac =
+        net::hello_mac(*options_.secret, std::span(reinterpret_cast<const std::uint8_t*>(nonce.data()), nonce.size()),
+                       options_.id, options_.protocol_version);
+    hello.mutable_hello()->set_nonce_mac(mac.data(), mac.size());
+  }
   connection_->send(hello);
   phase_ = Phase::awaiting_welcome;
 }
@@ -270,7 +285,8 @@ void Node::handle_swap(const wire::FrameSwap& swap) {
     log_.warn("swap for frame {} but the last rendered frame is {}; not presenting", swap.frame_id(), last_rendered_);
     return;
   }
-  const clock::Nanos to_master = offset();
+  const std::optional<clock::ClockEstimate> estimate = estimator_.at(options_.clock.now());
+  const clock::Nanos to_master = estimate ? estimate->offset : 0;
   const clock::Nanos local_deadline = swap.present_deadline_ns() - to_master;
   // Never wait on a deadline from a broken or hostile master for longer than a few
   // frames: this wait holds the event loop.
@@ -284,15 +300,28 @@ void Node::handle_swap(const wire::FrameSwap& swap) {
   }
   clock::sleep_until_monotonic(deadline);
   renderer_.present();
-  const clock::Nanos presented = options_.clock.now() + to_master;
+  const clock::Nanos monotonic = clock::monotonic_now();
+  const clock::Nanos local = options_.clock.to_local(monotonic);
+  // The offset drifts while the node waits for the deadline: convert at this instant.
+  const std::optional<clock::ClockEstimate> now_estimate = estimator_.at(local);
+  const clock::Nanos now_offset = now_estimate ? now_estimate->offset : 0;
+  const clock::Nanos presented = local + now_offset;
 
   wire::Envelope envelope;
   auto& report = *envelope.mutable_presented();
   report.set_frame_id(swap.frame_id());
   report.set_presented_ns(presented);
   report.set_content_frame_id(last_content_frame_);
-  report.set_clock_offset_ns(to_master);
-  if (const auto best = estimator_.best()) report.set_clock_rtt_ns(best->round_trip);
+  report.set_clock_offset_ns(now_offset);
+  if (now_estimate) {
+    report.set_clock_rtt_ns(now_estimate->round_trip);
+    report.set_clock_drift_ppm(now_estimate->drift_ppm);
+    report.set_clock_error_bound_ns(now_estimate->error_bound);
+  }
+  if (options_.clock.skewed()) {
+    report.set_clock_truth_known(true);
+    report.set_clock_true_error_ns(now_offset - (monotonic - local));
+  }
   connection_->send(envelope);
   log_.debug("presented frame {} at master time {} ns ({:+.1f} µs from the deadline)", swap.frame_id(), presented,
              static_cast<double>(presented - swap.present_deadline_ns()) / 1e3);
@@ -304,7 +333,8 @@ void Node::send_ping() {
   envelope.mutable_ping()->set_t1(options_.clock.now());
   connection_->send(envelope);
   if (pings_in_burst_ > 0) --pings_in_burst_;
-  schedule_pings(pings_in_burst_ > 0 ? milliseconds(5) : heartbeat_);
+  // Ten a second: the drift fit wants a quiet sample in each of its buckets.
+  schedule_pings(pings_in_burst_ > 0 ? milliseconds(5) : std::min(heartbeat_, kPingInterval));
 }
 
 void Node::schedule_pings(milliseconds interval) {
@@ -317,11 +347,6 @@ void Node::schedule_pings(milliseconds interval) {
 void Node::handle_pong(const wire::Pong& pong) {
   const clock::PingSample sample{pong.t1(), pong.t2(), pong.t3(), options_.clock.now()};
   if (!estimator_.add(sample)) log_.debug("dropped an impossible clock sample");
-}
-
-clock::Nanos Node::offset() const {
-  const auto best = estimator_.best();
-  return best ? best->offset : 0;
 }
 
 void Node::on_closed(const std::string& reason) {

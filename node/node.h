@@ -12,10 +12,12 @@
 #include <chrono>
 #include <deque>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "clock/clock.h"
 #include "clock/offset_estimator.h"
+#include "net/auth.h"
 #include "net/connection.h"
 #include "net/envelope.h"
 #include "renderer.h"
@@ -31,6 +33,7 @@ struct NodeOptions {
   std::string id;
   std::chrono::milliseconds give_up_after{10000};          // master unreachable this long: exit
   std::uint32_t protocol_version = net::kProtocolVersion;  // test hook: speak another version
+  std::optional<net::Secret> secret;                       // proves to the master this node belongs
   clock::LocalClock clock;                                 // test hook: a skewed clock
   // Test hook: show the content of this many frames ago, as a node out of step
   // with its stacked partners would (reported in Presented.content_frame_id).
@@ -68,8 +71,6 @@ class Node {
   void schedule_pings(std::chrono::milliseconds interval);
   void on_signal(int signal);
   void stop(int exit_code, const std::string& reason);
-
-  [[nodiscard]] clock::Nanos offset() const;
 
   asio::io_context& io_;
   NodeOptions options_;

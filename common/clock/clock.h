@@ -27,6 +27,9 @@ class LocalClock {
   [[nodiscard]] Nanos now() const { return to_local(monotonic_now()); }
   [[nodiscard]] Nanos to_local(Nanos monotonic) const;
   [[nodiscard]] Nanos to_monotonic(Nanos local) const;
+  // Skewed on purpose: on one machine, the true offset to a master that reads
+  // the monotonic clock is then known (monotonic − local).
+  [[nodiscard]] bool skewed() const { return offset_ != 0 || drift_ != 0.0; }
 
  private:
   Nanos offset_;

@@ -14,6 +14,7 @@ inline constexpr std::uint32_t kHeartbeatMs = 250;
 inline constexpr std::uint32_t kMinLivenessTimeoutMs = 3000;  // or 3 heartbeats, if longer
 inline constexpr std::uint32_t kPresentLeadUs = 2000;
 inline constexpr std::uint32_t kMaxMessageBytes = 16u << 20;
+inline constexpr std::uint32_t kMaxPendingConnections = 16;
 inline constexpr double kEyeSeparation = 0.065;
 inline constexpr double kNear = 0.05;
 inline constexpr double kFar = 100.0;

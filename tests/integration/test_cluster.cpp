@@ -12,6 +12,7 @@
 
 #include "cluster_run.h"
 #include "config/load.h"
+#include "external_master.h"
 #include "process.h"
 
 namespace optique::testing {
@@ -32,30 +33,6 @@ std::vector<std::string> projector_ids(const std::string& config) {
   }
   return ids;
 }
-
-// A master on 127.0.0.1 with an ephemeral port that the test reads back.
-struct ExternalMaster {
-  std::string dir = make_temp_dir("optique-it");
-  std::unique_ptr<Process> process;
-  std::string port;
-
-  ExternalMaster(const std::string& config, std::vector<std::string> extra) {
-    std::vector<std::string> argv{kMaster, "--config",    config,        "--listen", "127.0.0.1",  "--port",
-                                  "0",     "--port-file", dir + "/port", "--out",    dir + "/out", "--no-status"};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    process = std::make_unique<Process>(argv, dir + "/master.log");
-    if (wait_for_file(dir + "/port", 10s)) {
-      port = read_file(dir + "/port");
-      while (!port.empty() && port.back() == '\n') port.pop_back();
-    }
-  }
-
-  std::unique_ptr<Process> node(const std::string& id, std::vector<std::string> extra = {}) const {
-    std::vector<std::string> argv{kNode, "--master", "127.0.0.1:" + port, "--id", id};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    return std::make_unique<Process>(argv, dir + "/node-" + id + ".log");
-  }
-};
 
 // A port nothing listens on (bound, then released).
 std::string free_port() {

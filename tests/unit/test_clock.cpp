@@ -3,8 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <random>
 
 #include "clock/clock.h"
 #include "clock/offset_estimator.h"
@@ -164,6 +166,121 @@ TEST(OffsetEstimator, ZeroRoundTripIsPossible) {
   EXPECT_TRUE(estimator.add(exchange(3 * kMs, 0, 0, 0, 0)));
   EXPECT_EQ(estimator.best()->round_trip, 0);
   EXPECT_EQ(estimator.best()->offset, 3 * kMs);
+}
+
+// --- drift ---------------------------------------------------------------------------
+
+// A node clock that is `skew` behind the master at master time 0 and runs
+// `drift` (a fraction: 200e-6 is 200 ppm) slow: the true offset, master = node +
+// offset, is skew + drift·m at master time m.
+struct DriftingNode {
+  Nanos skew = 0;
+  double drift = 0.0;
+  [[nodiscard]] Nanos node_time(Nanos master) const {
+    return master - skew - static_cast<Nanos>(std::llround(drift * static_cast<double>(master)));
+  }
+  [[nodiscard]] Nanos true_offset(Nanos master) const { return master - node_time(master); }
+};
+
+// Pings as the node sends them: a burst of 8 five milliseconds apart, then one
+// every 100 ms, each way taking 25 µs plus an exponential jitter (mean 30 µs,
+// independent per leg: asymmetric), and one in twenty held up 2 ms on one leg
+// by a busy scheduler. Returns the estimate and the truth at master time `until`.
+struct DriftRun {
+  Nanos estimate_error = 0;
+  double drift_ppm = 0.0;
+  std::size_t points = 0;
+};
+
+DriftRun run_drifting(const DriftingNode& node, Nanos until, unsigned seed) {
+  std::mt19937 random(seed);
+  std::exponential_distribution<double> jitter(1.0 / 30'000.0);
+  std::uniform_int_distribution<int> one_in_twenty(0, 19);
+  OffsetEstimator estimator;
+  Nanos m = 0;
+  for (int i = 0; m <= until; ++i) {
+    Nanos out = 25 * kUs + static_cast<Nanos>(jitter(random));
+    Nanos back = 25 * kUs + static_cast<Nanos>(jitter(random));
+    if (one_in_twenty(random) == 0) (i % 2 == 0 ? out : back) += 2 * kMs;
+    PingSample s;
+    s.t1 = node.node_time(m);
+    s.t2 = m + out;
+    s.t3 = s.t2 + 5 * kUs;
+    s.t4 = node.node_time(s.t3 + back);
+    EXPECT_TRUE(estimator.add(s));
+    m += i < 8 ? 5 * kMs : 100 * kMs;
+  }
+  const auto estimate = estimator.at(node.node_time(until));
+  EXPECT_TRUE(estimate.has_value());
+  if (!estimate) return {};
+  return {estimate->offset - node.true_offset(until), estimate->drift_ppm, estimate->points};
+}
+
+TEST(OffsetEstimator, FollowsA200PpmDriftWithin25MicrosecondsAfterTwoSeconds) {
+  for (const double drift : {200e-6, -200e-6}) {
+    for (unsigned seed = 1; seed <= 20; ++seed) {
+      const DriftRun run = run_drifting({50 * kMs, drift}, 2 * kNanosPerSecond, seed);
+      EXPECT_LE(std::abs(run.estimate_error), 25 * kUs) << "drift " << drift * 1e6 << " ppm, seed " << seed;
+      EXPECT_NEAR(run.drift_ppm, drift * 1e6, 30.0) << "seed " << seed;
+      EXPECT_GE(run.points, 8u);
+    }
+  }
+}
+
+TEST(OffsetEstimator, WithoutTheDriftTheQuietestSampleWouldBeFarOff) {
+  // What the fit buys: after 2 s at 200 ppm the quietest sample may be from the
+  // burst at the start, 400 µs of drift ago.
+  OffsetEstimator estimator;
+  const DriftingNode node{50 * kMs, 200e-6};
+  PingSample quiet;
+  quiet.t1 = node.node_time(0);
+  quiet.t2 = 10 * kUs;
+  quiet.t3 = quiet.t2;
+  quiet.t4 = node.node_time(20 * kUs);
+  ASSERT_TRUE(estimator.add(quiet));
+  for (Nanos m = 100 * kMs; m <= 2 * kNanosPerSecond; m += 100 * kMs) {
+    PingSample s;
+    s.t1 = node.node_time(m);
+    s.t2 = m + 60 * kUs;
+    s.t3 = s.t2;
+    s.t4 = node.node_time(s.t3 + 60 * kUs);
+    ASSERT_TRUE(estimator.add(s));
+  }
+  const Nanos truth = node.true_offset(2 * kNanosPerSecond);
+  EXPECT_GT(std::abs(estimator.best()->offset - truth), 350 * kUs);
+  EXPECT_LE(std::abs(estimator.at(node.node_time(2 * kNanosPerSecond))->offset - truth), 2 * kUs);
+}
+
+TEST(OffsetEstimator, NoDriftUntilTheSamplesSpanHalfASecond) {
+  OffsetEstimator estimator;
+  const DriftingNode node{-3 * kMs, 100e-6};
+  for (Nanos m = 0; m <= 300 * kMs; m += 100 * kMs) {
+    PingSample s;
+    s.t1 = node.node_time(m);
+    s.t2 = m + 40 * kUs;
+    s.t3 = s.t2;
+    s.t4 = node.node_time(s.t3 + 40 * kUs);
+    ASSERT_TRUE(estimator.add(s));
+  }
+  const auto estimate = estimator.at(node.node_time(300 * kMs));
+  ASSERT_TRUE(estimate.has_value());
+  EXPECT_EQ(estimate->points, 1u);
+  EXPECT_EQ(estimate->drift_ppm, 0.0);
+  EXPECT_EQ(estimate->offset, estimator.best()->offset);
+  EXPECT_EQ(estimate->error_bound, estimate->round_trip / 2);
+}
+
+TEST(OffsetEstimator, AnImplausibleDriftIsNotExtrapolated) {
+  // Offsets that jump 5 ms in a second (5000 ppm): noise or a stepped clock, not
+  // quartz. The estimate stays with the quietest sample.
+  OffsetEstimator estimator;
+  for (Nanos m = 0; m <= 1 * kNanosPerSecond; m += 100 * kMs) {
+    ASSERT_TRUE(estimator.add(exchange(m * 5 / 1000, m, 30 * kUs, 0, 30 * kUs)));
+  }
+  const auto estimate = estimator.at(1 * kNanosPerSecond);
+  ASSERT_TRUE(estimate.has_value());
+  EXPECT_EQ(estimate->drift_ppm, 0.0);
+  EXPECT_EQ(estimate->offset, estimator.best()->offset);
 }
 
 // --- LocalClock ----------------------------------------------------------------------

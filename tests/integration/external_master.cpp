@@ -1,0 +1,29 @@
+#include "external_master.h"
+
+#include <chrono>
+
+namespace optique::testing {
+
+using namespace std::chrono_literals;
+
+std::string master_binary() { return std::string(OPTIQUE_BIN_DIR) + "/optique-master"; }
+std::string node_binary() { return std::string(OPTIQUE_BIN_DIR) + "/optique-node"; }
+
+ExternalMaster::ExternalMaster(const std::string& config, const std::vector<std::string>& extra) {
+  std::vector<std::string> argv{master_binary(), "--config",    config,  "--listen",   "127.0.0.1",  "--port", "0",
+                                "--port-file",   dir + "/port", "--out", dir + "/out", "--no-status"};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  process = std::make_unique<Process>(argv, dir + "/master.log");
+  if (wait_for_file(dir + "/port", 10s)) {
+    port = read_file(dir + "/port");
+    while (!port.empty() && port.back() == '\n') port.pop_back();
+  }
+}
+
+std::unique_ptr<Process> ExternalMaster::node(const std::string& id, const std::vector<std::string>& extra) const {
+  std::vector<std::string> argv{node_binary(), "--master", "127.0.0.1:" + port, "--id", id};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  return std::make_unique<Process>(argv, dir + "/node-" + id + ".log");
+}
+
+}  // namespace optique::testing

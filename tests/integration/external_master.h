@@ -1,0 +1,29 @@
+#pragma once
+// A master process on 127.0.0.1 with an ephemeral port the test reads back, and
+// nodes pointed at it: the cluster as a user runs it, for integration tests.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "process.h"
+
+namespace optique::testing {
+
+[[nodiscard]] std::string master_binary();
+[[nodiscard]] std::string node_binary();
+
+struct ExternalMaster {
+  std::string dir = make_temp_dir("optique-it");
+  std::unique_ptr<Process> process;
+  std::string port;  // empty if the master never wrote its port file
+
+  // Starts `optique-master --config CONFIG --listen 127.0.0.1 --port 0 --out DIR/out
+  // --no-status EXTRA...` and waits up to 10 s for its port.
+  ExternalMaster(const std::string& config, const std::vector<std::string>& extra);
+
+  // A node for projector `id`, its log in DIR/node-ID.log.
+  [[nodiscard]] std::unique_ptr<Process> node(const std::string& id, const std::vector<std::string>& extra = {}) const;
+};
+
+}  // namespace optique::testing

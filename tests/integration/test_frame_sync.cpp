@@ -1,0 +1,344 @@
+// Frame sync under stress, with real master and node processes on 127.0.0.1:
+// clocks skewed and drifting on purpose (the nodes' test hook), where the truth is
+// known because master and nodes share this machine's monotonic clock.
+
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <ifaddrs.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <functional>
+#include <thread>
+
+#include "cluster_run.h"
+#include "config/load.h"
+#include "external_master.h"
+#include "net/auth.h"
+#include "net/envelope.h"
+#include "net/framing.h"
+#include "process.h"
+
+namespace optique::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
+
+// Four null-render nodes at 60 Hz; two with clocks 50 ms off that drift ±200 ppm.
+TEST(FrameSync, SkewedAndDriftingClocksAreEstimatedWithin50MicrosecondsAfterTwoSeconds) {
+  const std::string config = kConfigs + "/powerwall-2x2.json";
+  ExternalMaster master(config, {"--frames", "300"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  auto loaded = config::load_installation(config);
+  ASSERT_TRUE(loaded) << loaded.error();
+  std::vector<std::string> ids;
+  for (const auto& p : loaded.value().installation.projectors()) ids.push_back(p.id());
+  ASSERT_EQ(ids.size(), 4u);
+  const std::vector<std::vector<std::string>> skews{{"--clock-offset-ns", "50000000", "--clock-drift-ppm", "200"},
+                                                    {"--clock-offset-ns", "-50000000", "--clock-drift-ppm", "-200"},
+                                                    {},
+                                                    {}};
+  std::vector<std::unique_ptr<Process>> nodes;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    std::vector<std::string> extra{"--renderer", "null"};
+    extra.insert(extra.end(), skews[i].begin(), skews[i].end());
+    nodes.push_back(master.node(ids[i], extra));
+  }
+  ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const report::NodeReport* node = find_node(run.report, ids[i]);
+    ASSERT_NE(node, nullptr);
+    const report::ClockReport& clock = node->clock();
+    std::cout << ids[i] << ": offset " << clock.offset_ns() / 1e6 << " ms, drift " << clock.drift_ppm()
+              << " ppm, round trip " << clock.round_trip_ns() / 1e3 << " µs; true error after 2 s: median "
+              << clock.true_error_us().median() << " µs, p99 " << clock.true_error_us().p99() << " µs, max "
+              << clock.true_error_us().max() << " µs over " << clock.true_error_us().count() << " presents\n";
+    EXPECT_GE(clock.true_error_us().count(), 100u);
+    EXPECT_LE(clock.true_error_us().max(), 50.0);
+    EXPECT_NEAR(clock.drift_ppm(), i == 0 ? -200.0 : 200.0, 20.0);  // the master gains on a slow node
+  }
+  for (std::size_t i = 2; i < 4; ++i) {
+    EXPECT_EQ(find_node(run.report, ids[i])->clock().true_error_us().count(), 0u) << "no truth without the hook";
+  }
+}
+
+// ------------------------------------------------------------- intruders
+
+// A TCP client that speaks just enough of the protocol to misbehave.
+class RawClient {
+ public:
+  RawClient(const std::string& host, const std::string& port) {
+    fd_ = socket(AF_INET, SOCK_STREAM, 0);
+    timeval timeout{5, 0};
+    setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_port = htons(static_cast<std::uint16_t>(std::stoi(port)));
+    inet_pton(AF_INET, host.c_str(), &address.sin_addr);
+    connected_ = connect(fd_, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0;
+  }
+  RawClient(const RawClient&) = delete;
+  RawClient& operator=(const RawClient&) = delete;
+  ~RawClient() { close(fd_); }
+
+  [[nodiscard]] bool connected() const { return connected_; }
+  void send_bytes(const std::vector<std::uint8_t>& bytes) const {
+    [[maybe_unused]] const auto sent = ::send(fd_, bytes.data(), bytes.size(), MSG_NOSIGNAL);
+  }
+  void send(wire::Envelope envelope) {
+    envelope.set_sequence(++sequence_);  // the master checks that every peer counts its messages
+    std::vector<std::uint8_t> bytes;
+    net::append_envelope(bytes, envelope);
+    send_bytes(bytes);
+  }
+  // The next message, or nothing when the master closed the connection or 5 s passed.
+  [[nodiscard]] std::optional<wire::Envelope> receive() {
+    std::uint8_t buffer[4096];
+    for (;;) {
+      const auto frame = reader_.next();
+      if (frame.status == net::DecodeStatus::good) {
+        auto envelope = net::parse_envelope(frame.payload);
+        if (envelope) return envelope.value();
+        return std::nullopt;
+      }
+      if (frame.status == net::DecodeStatus::bad) return std::nullopt;
+      const auto got = recv(fd_, buffer, sizeof buffer, 0);
+      if (got <= 0) return std::nullopt;
+      reader_.append(std::span(buffer, static_cast<std::size_t>(got)));
+    }
+  }
+  // Whether the master closed the connection within `timeout`.
+  [[nodiscard]] bool closed_within(std::chrono::milliseconds timeout) const {
+    const auto deadline = std::chrono::steady_clock::now() + timeout;
+    std::uint8_t buffer[4096];
+    do {
+      const auto got = recv(fd_, buffer, sizeof buffer, MSG_DONTWAIT);  // the challenge may come first
+      if (got == 0 || (got < 0 && errno != EAGAIN && errno != EWOULDBLOCK)) return true;
+      if (got < 0) std::this_thread::sleep_for(5ms);
+    } while (std::chrono::steady_clock::now() < deadline);
+    return false;
+  }
+
+ private:
+  int fd_ = -1;
+  bool connected_ = false;
+  std::uint64_t sequence_ = 0;
+  net::FrameReader reader_{1u << 20};
+};
+
+std::vector<std::uint8_t> bytes_of(const std::string& text) { return {text.begin(), text.end()}; }
+
+wire::Envelope hello(const std::string& id, const std::string& mac) {
+  wire::Envelope envelope;
+  envelope.set_protocol_version(net::kProtocolVersion);
+  envelope.mutable_hello()->set_node_id(id);
+  envelope.mutable_hello()->set_nonce_mac(mac);
+  return envelope;
+}
+
+std::string mac_text(const net::Secret& secret, const std::string& nonce, const std::string& id) {
+  const auto mac = net::hello_mac(secret, bytes_of(nonce), id, net::kProtocolVersion);
+  return {mac.begin(), mac.end()};
+}
+
+// A two-projector wall whose master requires the secret in DIR/secret (mode 0600).
+struct SecretWall {
+  std::string dir = make_temp_dir("optique-secret");
+  std::string config = dir + "/wall.json";
+  std::string secret_file = dir + "/secret";
+  net::Secret secret;
+
+  explicit SecretWall(mode_t mode = 0600, const std::string& frame_rate = "60") {
+    std::ofstream(secret_file) << "correct horse battery staple\n";
+    chmod(secret_file.c_str(), mode);
+    secret.bytes = bytes_of("correct horse battery staple");
+    std::ofstream(config) << R"({"screens": [{"id": "wall", "origin": [-2, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0],
+      "width": 4, "height": 2.25}],
+      "projectors": [{"id": "left", "width": 160, "height": 90, "screen": "wall",
+                      "region": {"x": 0, "y": 0, "width": 2, "height": 2.25}},
+                     {"id": "right", "width": 160, "height": 90, "screen": "wall",
+                      "region": {"x": 2, "y": 0, "width": 2, "height": 2.25}}],
+      "viewer": {"eye": [0, 1.6, 2]}, "master": {"frame_rate": )"
+                          << frame_rate << R"(, "secret_file": "secret"}, "scene": {"builtin": "cubes"}})";
+  }
+};
+
+TEST(Security, OnlyNodesWithTheSecretJoin) {
+  const SecretWall wall;
+  ExternalMaster master(wall.config, {"--frames", "120"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  auto left = master.node("left", {"--renderer", "null", "--secret-file", wall.secret_file});
+  // An impostor with another secret, then one with none: each told why, each exits 2.
+  const std::string wrong = master.dir + "/wrong";
+  std::ofstream(wrong) << "a different secret of some length\n";
+  chmod(wrong.c_str(), 0600);
+  auto impostor = master.node("right", {"--renderer", "null", "--secret-file", wrong});
+  EXPECT_EQ(impostor->wait(20s).value_or(-1), 2) << impostor->output();
+  EXPECT_NE(impostor->output().find("authentication failed"), std::string::npos) << impostor->output();
+  auto bare = master.node("right", {"--renderer", "null"});
+  EXPECT_EQ(bare->wait(20s).value_or(-1), 2) << bare->output();
+  EXPECT_NE(bare->output().find("--secret-file"), std::string::npos) << bare->output();
+  auto right = master.node("right", {"--renderer", "null", "--secret-file", wall.secret_file});
+  ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  EXPECT_EQ(find_node(run.report, "left")->frames_presented(), 120u);
+  EXPECT_GT(find_node(run.report, "right")->frames_presented(), 0u);
+  EXPECT_EQ(run.report.connections_refused(), 2u);
+  const std::string log = master.process->output();
+  EXPECT_NE(log.find("refused node 'right' from 127.0.0.1:"), std::string::npos) << log;
+  EXPECT_NE(log.find("authentication failed: the node's secret does not match"), std::string::npos) << log;
+}
+
+TEST(Security, AWorldReadableSecretFileStopsTheMasterBeforeAnythingStarts) {
+  const SecretWall wall(0644);
+  Process master({master_binary(), "--config", wall.config, "--no-status"}, wall.dir + "/master.log");
+  EXPECT_EQ(master.wait(20s).value_or(-1), 2);
+  EXPECT_NE(master.output().find("master.secret_file: secret file '"), std::string::npos) << master.output();
+  EXPECT_NE(master.output().find("chmod 600"), std::string::npos) << master.output();
+  Process check({master_binary(), "check-config", wall.config}, wall.dir + "/check.log");
+  EXPECT_EQ(check.wait(20s).value_or(-1), 2);
+  EXPECT_NE(check.output().find("readable by other users"), std::string::npos) << check.output();
+}
+
+// Every kind of bad peer, while two healthy nodes run at 30 Hz for 12 s: each is refused
+// (logged once with its address), and the healthy nodes keep their frame rate.
+TEST(Security, IntrudersAreRefusedAndHealthyNodesKeepTheirFrameRate) {
+  const auto achieved_rate = [](const std::function<void(const std::string& port, const net::Secret&)>& attack,
+                                std::uint64_t* refused, std::string* log) {
+    const SecretWall wall(0600, "30");
+    ExternalMaster master(wall.config, {"--frames", "360"});  // 12 s: the attacks take about 8
+    EXPECT_FALSE(master.port.empty()) << master.process->output();
+    auto left = master.node("left", {"--renderer", "null", "--secret-file", wall.secret_file});
+    auto right = master.node("right", {"--renderer", "null", "--secret-file", wall.secret_file});
+    EXPECT_TRUE(master.process->wait_for_output("starting frames", 20s)) << master.process->output();
+    if (attack) attack(master.port, wall.secret);
+    EXPECT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
+    const ClusterRun run = read_cluster_run(master.dir + "/out");
+    EXPECT_TRUE(run.error.empty()) << run.error;
+    *refused = run.report.connections_refused();
+    *log = master.process->output();
+    EXPECT_EQ(find_node(run.report, "left")->frames_presented(), 360u);
+    EXPECT_EQ(find_node(run.report, "right")->frames_presented(), 360u);
+    return run.report.sync().achieved_frame_rate();
+  };
+
+  std::uint64_t quiet_refused = 0;
+  std::string quiet_log;
+  const double undisturbed = achieved_rate({}, &quiet_refused, &quiet_log);
+  EXPECT_EQ(quiet_refused, 0u);
+
+  std::size_t attempts = 0;
+  const auto attack = [&](const std::string& port, const net::Secret& secret) {
+    // A replayed hello: a mac made for another connection's challenge.
+    RawClient first("127.0.0.1", port);
+    auto first_challenge = first.receive();
+    ASSERT_TRUE(first_challenge && first_challenge->has_challenge());
+    const std::string recorded = mac_text(secret, first_challenge->challenge().nonce(), "left");
+    RawClient replay("127.0.0.1", port);
+    ASSERT_TRUE(replay.receive().has_value());
+    replay.send(hello("left", recorded));
+    auto answer = replay.receive();
+    ASSERT_TRUE(answer && answer->has_refuse()) << "a replayed hello must be refused";
+    EXPECT_NE(answer->refuse().reason().find("authentication failed"), std::string::npos);
+    ++attempts;
+    // A wrong secret.
+    RawClient wrong("127.0.0.1", port);
+    auto challenge = wrong.receive();
+    ASSERT_TRUE(challenge.has_value());
+    net::Secret other{bytes_of("not the installation's secret")};
+    wrong.send(hello("right", mac_text(other, challenge->challenge().nonce(), "right")));
+    answer = wrong.receive();
+    ASSERT_TRUE(answer && answer->has_refuse());
+    ++attempts;
+    // An oversized length, garbage, and a truncated frame.
+    RawClient oversized("127.0.0.1", port);
+    oversized.send_bytes({0x7f, 0xff, 0xff, 0xff, 1, 2, 3});
+    EXPECT_TRUE(oversized.closed_within(3s));
+    RawClient garbage("127.0.0.1", port);
+    garbage.send_bytes({0, 0, 0, 8, 0xde, 0xad, 0xbe, 0xef, 0xde, 0xad, 0xbe, 0xef});
+    EXPECT_TRUE(garbage.closed_within(3s));
+    RawClient truncated("127.0.0.1", port);
+    truncated.send_bytes({0, 0, 1, 0, 0x08, 0x04});  // promises 256 bytes, sends 2, then nothing
+    EXPECT_TRUE(truncated.closed_within(3s)) << "a stalled frame must hit the handshake timeout (2 s)";
+    attempts += 3;
+    // One byte a second: closed within the 2 s handshake timeout all the same.
+    RawClient drip("127.0.0.1", port);
+    const auto started = std::chrono::steady_clock::now();
+    bool closed = false;
+    for (int i = 0; i < 4 && !closed; ++i) {
+      drip.send_bytes({0});
+      closed = drip.closed_within(1s);
+    }
+    EXPECT_TRUE(closed);
+    EXPECT_LT(std::chrono::steady_clock::now() - started, 3500ms);
+    ++attempts;
+    // 200 rapid connects that say nothing.
+    std::vector<std::unique_ptr<RawClient>> crowd;
+    for (int i = 0; i < 200; ++i) {
+      crowd.push_back(std::make_unique<RawClient>("127.0.0.1", port));
+      EXPECT_TRUE(crowd.back()->connected());
+    }
+    attempts += 200;
+    std::this_thread::sleep_for(2500ms);  // past the handshake timeout: every one closed
+    std::size_t closed_crowd = 0;
+    for (const auto& client : crowd) closed_crowd += client->closed_within(10ms) ? 1 : 0;
+    EXPECT_EQ(closed_crowd, crowd.size());
+  };
+  std::uint64_t refused = 0;
+  std::string log;
+  const double disturbed = achieved_rate(attack, &refused, &log);
+  std::cout << "healthy nodes at " << undisturbed << " Hz undisturbed, " << disturbed << " Hz under attack; " << refused
+            << " connections refused of " << attempts + 1 << " bad ones\n";
+  EXPECT_GE(disturbed, undisturbed * 0.95);
+  // Every bad connection refused, the replay's first connection (which never
+  // answered its challenge) included.
+  EXPECT_EQ(refused, attempts + 1);
+  EXPECT_NE(log.find("refused node 'left' from 127.0.0.1:"), std::string::npos);
+  EXPECT_NE(log.find("frame of 2147483647 bytes"), std::string::npos) << log;
+}
+
+// Without a secret only loopback peers are accepted: a connection to this
+// machine's own non-loopback address is refused (skipped where there is none).
+TEST(Security, WithoutASecretOnlyLoopbackPeersAreAccepted) {
+  std::string address;
+  ifaddrs* interfaces = nullptr;
+  if (getifaddrs(&interfaces) == 0) {
+    for (ifaddrs* i = interfaces; i != nullptr && address.empty(); i = i->ifa_next) {
+      if (i->ifa_addr == nullptr || i->ifa_addr->sa_family != AF_INET) continue;
+      const auto* in = reinterpret_cast<const sockaddr_in*>(i->ifa_addr);
+      char text[INET_ADDRSTRLEN];
+      inet_ntop(AF_INET, &in->sin_addr, text, sizeof text);
+      if (std::string(text).rfind("127.", 0) != 0) address = text;
+    }
+    freeifaddrs(interfaces);
+  }
+  if (address.empty()) GTEST_SKIP() << "this machine has no non-loopback IPv4 address";
+  const std::string config = kConfigs + "/single-wall.json";
+  const std::string dir = make_temp_dir("optique-loopback");
+  Process master({master_binary(), "--config", config, "--listen", "0.0.0.0", "--port", "0", "--port-file",
+                  dir + "/port", "--frames", "60", "--no-status"},
+                 dir + "/master.log");
+  ASSERT_TRUE(wait_for_file(dir + "/port", 10s)) << master.output();
+  std::string port = read_file(dir + "/port");
+  while (!port.empty() && port.back() == '\n') port.pop_back();
+  RawClient outsider(address, port);
+  ASSERT_TRUE(outsider.connected());
+  EXPECT_TRUE(outsider.closed_within(3s));
+  EXPECT_TRUE(master.wait_for_output("refused connection from " + address, 5s)) << master.output();
+  EXPECT_NE(master.output().find("only nodes on this machine are accepted"), std::string::npos);
+  master.signal(SIGINT);
+  EXPECT_TRUE(master.wait(20s).has_value());
+}
+
+}  // namespace
+}  // namespace optique::testing
