@@ -512,8 +512,9 @@ void Master::handle_ready(Session& session, const wire::FrameReady& ready, clock
   recorder_->ready(ready.frame_id(), slot, received, ready.render_ns());
   if (ready.frame_id() + 1 == next_frame_ && ready.state_hash() != current_hash_) {
     recorder_->hash_mismatch(slot);
-    log_.warn("node '{}' reports state hash {:016x} for frame {}, master has {:016x}", slot_id(slot),
-              ready.state_hash(), ready.frame_id(), current_hash_);
+    log_.warn("node '{}' reports state hash {:016x} for frame {}, master has {:016x}: sending it a fresh snapshot",
+              slot_id(slot), ready.state_hash(), ready.frame_id(), current_hash_);
+    send_resync(session);  // the next FrameBegin's delta applies to it, so the next frame matches again
   }
   const bool current = barrier_.active() && ready.frame_id() == barrier_.frame();
   if (session.phase == Phase::out_of_barrier) {

@@ -39,6 +39,8 @@ int run_cli(int argc, char** argv) {
   app.add_option("--protocol-version", options.protocol_version, "speak this protocol version")->group("");
   app.add_option("--clock-offset-ns", clock_offset_ns, "skew this node's clock")->group("");
   app.add_option("--clock-drift-ppm", clock_drift_ppm, "make this node's clock drift")->group("");
+  app.add_option("--corrupt-state-at-frame", options.corrupt_state_at_frame, "nudge the scene state at this frame")
+      ->group("");
   app.add_option("--lag-frames", options.lag_frames, "show the content of this many frames ago")
       ->check(CLI::Range(0u, 100u))
       ->group("");

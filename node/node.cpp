@@ -218,11 +218,12 @@ void Node::handle_resync(const wire::Resync& resync) {
   state_ = std::move(state).value();
   past_frames_.clear();
   next_frame_ = resync.next_frame_id();
-  rendered_any_ = false;
   if (phase_ == Phase::joined) {
+    // A repair between frames: the frame already rendered still swaps.
     log_.info("state resynchronized at frame {}", next_frame_);
     return;
   }
+  rendered_any_ = false;
   phase_ = Phase::joined;
   estimator_ = clock::OffsetEstimator{};  // samples from an earlier connection may be from another master
   unreachable_ = false;
@@ -245,6 +246,9 @@ void Node::handle_frame_begin(const wire::FrameBegin& begin) {
   if (auto applied = scene::apply_delta(state_, begin.delta()); !applied) {
     connection_->close("cannot apply frame " + std::to_string(begin.frame_id()) + ": " + applied.error());
     return;
+  }
+  if (options_.corrupt_state_at_frame != 0 && begin.frame_id() == options_.corrupt_state_at_frame) {
+    state_.eye_now.x += 1e-3;
   }
   const std::uint64_t hash = scene::state_hash(state_);
   if (hash != begin.state_hash()) {

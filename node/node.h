@@ -38,6 +38,9 @@ struct NodeOptions {
   // Test hook: show the content of this many frames ago, as a node out of step
   // with its stacked partners would (reported in Presented.content_frame_id).
   std::uint32_t lag_frames = 0;
+  // Test hook: nudge the scene state at this frame, as a bit flip or a bug would,
+  // to see the master notice and repair it (0: never).
+  std::uint64_t corrupt_state_at_frame = 0;
 };
 
 inline constexpr int kExitOk = 0;

@@ -71,6 +71,36 @@ TEST(FrameSync, SkewedAndDriftingClocksAreEstimatedWithin50MicrosecondsAfterTwoS
   }
 }
 
+// A node whose state goes wrong (the test hook nudges it at frame 30) is found
+// out at that frame and repaired with a snapshot: its hash matches again from the
+// next frame on, and it presents every frame.
+TEST(FrameSync, AStateHashMismatchIsRepairedWithinOneFrame) {
+  const std::string config = kConfigs + "/powerwall-2x2.json";
+  ExternalMaster master(config, {"--frames", "90"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  auto loaded = config::load_installation(config);
+  ASSERT_TRUE(loaded) << loaded.error();
+  std::vector<std::unique_ptr<Process>> nodes;
+  std::vector<std::string> ids;
+  for (const auto& p : loaded.value().installation.projectors()) {
+    ids.push_back(p.id());
+    std::vector<std::string> extra{"--renderer", "null"};
+    if (ids.size() == 1) extra.insert(extra.end(), {"--corrupt-state-at-frame", "30"});
+    nodes.push_back(master.node(p.id(), extra));
+  }
+  ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  const report::NodeReport* corrupted = find_node(run.report, ids.front());
+  EXPECT_EQ(corrupted->hash_mismatches(), 1u) << "found at frame 30, matching again from frame 31";
+  EXPECT_EQ(corrupted->frames_presented(), 90u);
+  EXPECT_EQ(run.report.sync().frames_incoherent(), 0u);
+  EXPECT_NE(master.process->output().find("for frame 30, master has"), std::string::npos) << master.process->output();
+  EXPECT_TRUE(nodes.front()->wait(10s).has_value());
+  EXPECT_NE(nodes.front()->output().find("state resynchronized at frame 31"), std::string::npos)
+      << nodes.front()->output();
+}
+
 // ------------------------------------------------------------- intruders
 
 // A TCP client that speaks just enough of the protocol to misbehave.
