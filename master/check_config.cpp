@@ -65,8 +65,9 @@ std::string summarize(const config::LoadedConfig& config) {
   out << ", eye separation " << v.eye_separation() << " m\n";
   const auto& m = inst.master();
   out << "  master: " << m.listen() << ":" << m.port() << (m.port() == 0 ? " (ephemeral)" : "") << ", "
-      << m.frame_rate() << " Hz, frame timeout " << m.frame_timeout_ms() << " ms, present lead " << m.present_lead_us()
-      << " µs\n";
+      << m.frame_rate() << " Hz, frame timeout " << m.frame_timeout_ms() << " ms (then "
+      << (m.straggler_policy() == "drop" ? "drop the frame" : "present without the late node") << "), present lead "
+      << m.present_lead_us() << " µs\n";
   out << "  scene: "
       << (inst.scene().builtin().empty() ? "glTF " + inst.scene().gltf() : "builtin " + inst.scene().builtin());
   if (inst.scene().light_switches_size() > 0) {

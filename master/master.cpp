@@ -533,11 +533,17 @@ void Master::handle_ready(Session& session, const wire::FrameReady& ready, clock
 
 void Master::on_barrier_timeout() {
   if (!barrier_.active()) return;
+  const bool drop = settings_.straggler_policy() == "drop";
   for (std::size_t slot : barrier_.waiting_for()) {
     recorder_->node_missed_barrier(slot);
     if (Session* session = slots_[slot].session.get()) session->phase = Phase::out_of_barrier;
-    log_.warn("node '{}' was not ready for frame {} within {} ms: taken out of the barrier, the others go on",
-              slot_id(slot), barrier_.frame(), settings_.frame_timeout_ms());
+    log_.warn("node '{}' was not ready for frame {} within {} ms: taken out of the barrier; {}", slot_id(slot),
+              barrier_.frame(), settings_.frame_timeout_ms(),
+              drop ? "the frame is dropped everywhere" : "the others show the frame");
+  }
+  if (drop) {
+    recorder_->frame_dropped(barrier_.frame());
+    ready_for_swap_.clear();  // nobody shows it: every projector keeps the previous frame
   }
   swap();
 }

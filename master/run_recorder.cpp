@@ -66,6 +66,8 @@ void RunRecorder::clock_estimated(std::uint64_t frame, std::size_t node, const r
   }
 }
 
+void RunRecorder::frame_dropped(std::uint64_t) { ++frames_dropped_; }
+
 void RunRecorder::node_joined(std::size_t node) { totals_[node].joins += 1; }
 void RunRecorder::node_missed_barrier(std::size_t node) { totals_[node].misses += 1; }
 void RunRecorder::hash_mismatch(std::size_t node) { totals_[node].mismatches += 1; }
@@ -143,6 +145,7 @@ report::RunReport RunRecorder::report() const {
   *sync.mutable_present_skew_us() = present_skew_us_.summary();
   sync.set_frames_with_missing_node(frames_missing_);
   sync.set_frames_incoherent(frames_incoherent_);
+  sync.set_frames_dropped(frames_dropped_);
   if (frames_finalized_ > 1 && last_begin_ > first_begin_) {
     sync.set_achieved_frame_rate(static_cast<double>(frames_finalized_ - 1) * 1e9 /
                                  static_cast<double>(last_begin_ - first_begin_));

@@ -33,6 +33,9 @@ class RunRecorder {
   void clock_estimated(std::uint64_t frame, std::size_t node, const report::ClockReport& latest,
                        std::optional<clock::Nanos> true_error);
 
+  // The straggler policy "drop": no node was told to show `frame`.
+  void frame_dropped(std::uint64_t frame);
+
   void node_joined(std::size_t node);
   void node_missed_barrier(std::size_t node);
   void hash_mismatch(std::size_t node);
@@ -87,6 +90,7 @@ class RunRecorder {
   std::uint64_t frames_finalized_ = 0;
   std::uint64_t frames_missing_ = 0;
   std::uint64_t frames_incoherent_ = 0;
+  std::uint64_t frames_dropped_ = 0;
   clock::Nanos first_begin_ = 0;
   clock::Nanos last_begin_ = 0;
   double last_skew_us_ = 0.0;

@@ -302,6 +302,13 @@ void Node::handle_swap(const wire::FrameSwap& swap) {
               static_cast<double>(deadline - now) / 1e6, static_cast<double>(longest) / 1e6);
     deadline = now + longest;
   }
+  if (now > deadline + frame_period_) {
+    // Held up past the next frame's time (the process was stopped, the machine
+    // stalled): showing it now would put an old frame beside its partners' new one.
+    log_.warn("frame {}'s present deadline passed {:.1f} ms ago: not showing a stale frame", swap.frame_id(),
+              static_cast<double>(now - deadline) / 1e6);
+    return;
+  }
   clock::sleep_until_monotonic(deadline);
   renderer_.present();
   const clock::Nanos monotonic = clock::monotonic_now();

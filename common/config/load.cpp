@@ -83,6 +83,7 @@ void apply_defaults(Installation& installation) {
   if (m.present_lead_us() == 0) m.set_present_lead_us(defaults::kPresentLeadUs);
   if (m.max_message_bytes() == 0) m.set_max_message_bytes(defaults::kMaxMessageBytes);
   if (m.max_pending_connections() == 0) m.set_max_pending_connections(defaults::kMaxPendingConnections);
+  if (m.straggler_policy().empty()) m.set_straggler_policy("present");
 
   Viewer& v = *installation.mutable_viewer();
   if (v.eye_separation() == 0.0) v.set_eye_separation(defaults::kEyeSeparation);

@@ -362,6 +362,11 @@ void check_master(Checker& check, const MasterSettings& m) {
     check.fail("master.frame_rate",
                "must be in (0, 1000] Hz, or 0 for the default (got " + number_text(m.frame_rate()) + ")");
   }
+  if (!m.straggler_policy().empty() && m.straggler_policy() != "present" && m.straggler_policy() != "drop") {
+    check.fail("master.straggler_policy", "unknown policy '" + m.straggler_policy() +
+                                              "' (\"present\": the frame without the late node, or "
+                                              "\"drop\": the frame everywhere)");
+  }
   if (m.max_message_bytes() != 0 && m.max_message_bytes() < 1024) {
     check.fail("master.max_message_bytes", "must be at least 1024 (got " + std::to_string(m.max_message_bytes()) + ")");
   }

@@ -23,6 +23,7 @@
 #include "net/envelope.h"
 #include "net/framing.h"
 #include "process.h"
+#include "screen_check.h"
 
 namespace optique::testing {
 namespace {
@@ -99,6 +100,60 @@ TEST(FrameSync, AStateHashMismatchIsRepairedWithinOneFrame) {
   EXPECT_TRUE(nodes.front()->wait(10s).has_value());
   EXPECT_NE(nodes.front()->output().find("state resynchronized at frame 31"), std::string::npos)
       << nodes.front()->output();
+}
+
+// Straggler policy "drop", frame timeout 500 ms, four null nodes at 30 Hz. One
+// node stopped for half the timeout is waited for (no frame lost); stopped for
+// twice the timeout, the frame it holds up is shown by nobody, it leaves the
+// barrier, and after SIGCONT it answers again and shows frames once more.
+TEST(FrameSync, AStragglerIsWaitedForThenItsFrameIsDroppedEverywhere) {
+  const std::string dir = make_temp_dir("optique-straggler");
+  const std::string config = write_config_variant(
+      kConfigs + "/powerwall-2x2.json",
+      [](config::Installation& installation) {
+        installation.mutable_master()->set_straggler_policy("drop");
+        installation.mutable_master()->set_frame_rate(30.0);
+      },
+      dir + "/drop.json");
+  ExternalMaster master(config, {"--frames", "240"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  auto loaded = config::load_installation(config);
+  ASSERT_TRUE(loaded) << loaded.error();
+  std::vector<std::unique_ptr<Process>> nodes;
+  std::vector<std::string> ids;
+  for (const auto& p : loaded.value().installation.projectors()) {
+    ids.push_back(p.id());
+    nodes.push_back(master.node(p.id(), {"--renderer", "null"}));
+  }
+  ASSERT_TRUE(master.process->wait_for_output("starting frames", 20s)) << master.process->output();
+  std::this_thread::sleep_for(1s);
+  nodes.back()->signal(SIGSTOP);
+  std::this_thread::sleep_for(250ms);  // half the timeout
+  nodes.back()->signal(SIGCONT);
+  std::this_thread::sleep_for(1s);
+  EXPECT_EQ(master.process->output().find("was not ready"), std::string::npos) << "waited for, not dropped";
+  nodes.back()->signal(SIGSTOP);
+  ASSERT_TRUE(master.process->wait_for_output("was not ready", 5s)) << master.process->output();
+  std::this_thread::sleep_for(1s);  // twice the timeout
+  nodes.back()->signal(SIGCONT);
+  ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  const auto& sync = run.report.sync();
+  EXPECT_EQ(sync.frames_dropped(), 1u);
+  EXPECT_EQ(find_node(run.report, ids.back())->barrier_misses(), 1u);
+  for (std::size_t i = 0; i + 1 < ids.size(); ++i) {
+    EXPECT_EQ(find_node(run.report, ids[i])->frames_presented(), 239u) << ids[i] << ": all but the dropped frame";
+  }
+  const auto* straggler = find_node(run.report, ids.back());
+  EXPECT_GT(straggler->frames_presented(), 150u) << "it came back";
+  EXPECT_LT(straggler->frames_presented(), 239u);
+  EXPECT_NE(master.process->output().find("answers again"), std::string::npos) << master.process->output();
+  // A stop that lands between a swap and its present holds that frame past its
+  // time: the node then does not show it (never a stale frame), which counts as
+  // incoherent; at most once per stop.
+  EXPECT_LE(sync.frames_incoherent(), 2u);
+  EXPECT_LT(sync.present_skew_us().max(), 5000.0) << "no frame shown late";
 }
 
 // ------------------------------------------------------------- intruders
