@@ -1,5 +1,7 @@
 #include "cli.h"
 
+#include <sys/prctl.h>
+
 #include <CLI/CLI.hpp>
 #include <boost/asio/io_context.hpp>
 #include <iostream>
@@ -30,6 +32,10 @@ int run_cli(int argc, char** argv) {
                  "null: draw nothing (to measure the cluster alone)")
       ->check(CLI::IsMember({"gl", "null"}));
   app.add_option("--capture-dir", capture_dir, "where captured frames go (default: captures/<id>)");
+  std::string on_master_lost = "black";
+  app.add_option("--on-master-lost", on_master_lost,
+                 "black: show black while reconnecting (default); hold: keep showing the last frame")
+      ->check(CLI::IsMember({"black", "hold"}));
   std::string secret_file;
   app.add_option("--secret-file", secret_file,
                  "the installation's shared secret (the file its master.secret_file names; mode 600)");
@@ -39,6 +45,10 @@ int run_cli(int argc, char** argv) {
   app.add_option("--protocol-version", options.protocol_version, "speak this protocol version")->group("");
   app.add_option("--clock-offset-ns", clock_offset_ns, "skew this node's clock")->group("");
   app.add_option("--clock-drift-ppm", clock_drift_ppm, "make this node's clock drift")->group("");
+  std::int64_t present_spin_us = options.present_spin.count();
+  app.add_option("--present-spin-us", present_spin_us, "spin this long before each present deadline")
+      ->check(CLI::Range(std::int64_t{0}, std::int64_t{5000}))
+      ->group("");
   app.add_option("--corrupt-state-at-frame", options.corrupt_state_at_frame, "nudge the scene state at this frame")
       ->group("");
   app.add_option("--lag-frames", options.lag_frames, "show the content of this many frames ago")
@@ -62,6 +72,8 @@ int run_cli(int argc, char** argv) {
     options.master_host = options.master_host.substr(1, options.master_host.size() - 2);  // [::1]:7400
   }
   options.give_up_after = std::chrono::milliseconds(give_up_ms);
+  options.present_spin = std::chrono::microseconds(present_spin_us);
+  options.hold_last_frame = on_master_lost == "hold";
   options.clock = clock::LocalClock(clock_offset_ns, clock_drift_ppm);
   if (!secret_file.empty()) {
     auto secret = net::load_secret_file(secret_file);
@@ -72,6 +84,9 @@ int run_cli(int argc, char** argv) {
     options.secret = std::move(secret).value();
   }
 
+  // The kernel may wake a sleeper up to its timer slack late (50 µs by default);
+  // presents are timed to tens of microseconds.
+  prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   auto logger = log::make_logger("node " + options.id, log_level);
   boost::asio::io_context io;
   if (capture_dir.empty()) capture_dir = "captures/" + options.id;

@@ -168,3 +168,13 @@ void GlRenderer::present() {
 }
 
 }  // namespace optique::node
+
+namespace optique::node {
+
+void GlRenderer::show_black() {
+  if (!renderer_) return;  // not configured yet: nothing is on the projector
+  renderer_->draw_black();
+  present();
+}
+
+}  // namespace optique::node

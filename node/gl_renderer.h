@@ -29,6 +29,7 @@ class GlRenderer final : public Renderer {
   [[nodiscard]] std::string description() const override;
   void render(const FrameInput& frame) override;
   void present() override;
+  void show_black() override;
 
  private:
   // Draws these lights from now on, and ambient and emissive light if it carries them.

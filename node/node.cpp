@@ -309,7 +309,7 @@ void Node::handle_swap(const wire::FrameSwap& swap) {
               static_cast<double>(now - deadline) / 1e6);
     return;
   }
-  clock::sleep_until_monotonic(deadline);
+  clock::sleep_until_monotonic(deadline, options_.present_spin.count() * clock::kNanosPerMicro);
   renderer_.present();
   const clock::Nanos monotonic = clock::monotonic_now();
   const clock::Nanos local = options_.clock.to_local(monotonic);
@@ -366,7 +366,9 @@ void Node::on_closed(const std::string& reason) {
   const bool was_joined = phase_ == Phase::joined;
   phase_ = Phase::disconnected;
   if (was_joined) {
-    log_.warn("lost the master: {}; reconnecting", reason);
+    log_.warn("lost the master: {}; {} while reconnecting", reason,
+              options_.hold_last_frame ? "holding the last frame" : "showing black");
+    if (!options_.hold_last_frame) renderer_.show_black();
   } else {
     log_.info("connection to the master closed during the handshake: {}", reason);
   }

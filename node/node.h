@@ -41,6 +41,12 @@ struct NodeOptions {
   // Test hook: nudge the scene state at this frame, as a bit flip or a bug would,
   // to see the master notice and repair it (0: never).
   std::uint64_t corrupt_state_at_frame = 0;
+  // Sleep until this long before a present deadline, then spin: covers the
+  // scheduler's wake-up delay when every node of a machine wakes at once.
+  std::chrono::microseconds present_spin{200};
+  // When the master is lost: show black (a frozen wall looks like a fault in the
+  // show), or keep the last frame.
+  bool hold_last_frame = false;
 };
 
 inline constexpr int kExitOk = 0;

@@ -12,6 +12,7 @@ class NullRenderer final : public Renderer {
   [[nodiscard]] std::string description() const override { return "null renderer (draws nothing)"; }
   void render(const FrameInput& frame) override;
   void present() override;
+  void show_black() override {}
 
   [[nodiscard]] std::uint64_t frames_rendered() const { return rendered_; }
   [[nodiscard]] std::uint64_t frames_presented() const { return presented_; }

@@ -33,6 +33,8 @@ class Renderer {
   virtual void render(const FrameInput& frame) = 0;
   // Shows the last rendered frame (swap buffers).
   virtual void present() = 0;
+  // Shows black at once (the master is gone and the picture would freeze).
+  virtual void show_black() = 0;
 };
 
 }  // namespace optique::node

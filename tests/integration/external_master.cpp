@@ -1,5 +1,9 @@
 #include "external_master.h"
 
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
 #include <chrono>
 
 namespace optique::testing {
@@ -8,6 +12,19 @@ using namespace std::chrono_literals;
 
 std::string master_binary() { return std::string(OPTIQUE_BIN_DIR) + "/optique-master"; }
 std::string node_binary() { return std::string(OPTIQUE_BIN_DIR) + "/optique-node"; }
+
+std::string free_port() {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = 0;
+  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
+  socklen_t length = sizeof address;
+  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
+  close(fd);
+  return std::to_string(ntohs(address.sin_port));
+}
 
 ExternalMaster::ExternalMaster(const std::string& config, const std::vector<std::string>& extra) {
   std::vector<std::string> argv{master_binary(), "--config",    config,  "--listen",   "127.0.0.1",  "--port", "0",

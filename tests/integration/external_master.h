@@ -11,6 +11,8 @@
 namespace optique::testing {
 
 [[nodiscard]] std::string master_binary();
+// A port nothing listens on (bound, then released): for a master restarted on the same port.
+[[nodiscard]] std::string free_port();
 [[nodiscard]] std::string node_binary();
 
 struct ExternalMaster {

@@ -34,20 +34,6 @@ std::vector<std::string> projector_ids(const std::string& config) {
   return ids;
 }
 
-// A port nothing listens on (bound, then released).
-std::string free_port() {
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  address.sin_port = 0;
-  bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof address);
-  socklen_t length = sizeof address;
-  getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
-  close(fd);
-  return std::to_string(ntohs(address.sin_port));
-}
-
 // ------------------------------------------------------------- every shipped config
 
 class ShippedConfig : public ::testing::TestWithParam<std::string> {};

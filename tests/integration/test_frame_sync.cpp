@@ -156,6 +156,48 @@ TEST(FrameSync, AStragglerIsWaitedForThenItsFrameIsDroppedEverywhere) {
   EXPECT_LT(sync.present_skew_us().max(), 5000.0) << "no frame shown late";
 }
 
+// The master killed mid-run: its nodes show black and reconnect with backoff; a
+// master restarted on the same port takes them back and they show its frames.
+TEST(FrameSync, NodesShowBlackWhileTheMasterIsGoneAndARestartedMasterTakesThemBack) {
+  const std::string config = kConfigs + "/powerwall-2x2.json";
+  const std::string port = free_port();
+  const std::string dir = make_temp_dir("optique-restart");
+  const auto start_master = [&](const std::string& name, const std::string& frames) {
+    return std::make_unique<Process>(
+        std::vector<std::string>{master_binary(), "--config", config, "--listen", "127.0.0.1", "--port", port,
+                                 "--frames", frames, "--out", dir + "/" + name, "--no-status"},
+        dir + "/" + name + ".log");
+  };
+  auto first = start_master("first", "0");
+  std::vector<std::unique_ptr<Process>> nodes;
+  auto loaded = config::load_installation(config);
+  ASSERT_TRUE(loaded) << loaded.error();
+  for (const auto& p : loaded.value().installation.projectors()) {
+    nodes.push_back(
+        std::make_unique<Process>(std::vector<std::string>{node_binary(), "--master", "127.0.0.1:" + port, "--id",
+                                                           p.id(), "--renderer", "null", "--give-up-after-ms", "20000"},
+                                  dir + "/node-" + p.id() + ".log"));
+  }
+  ASSERT_TRUE(first->wait_for_output("starting frames", 20s)) << first->output();
+  std::this_thread::sleep_for(1s);
+  first->signal(SIGKILL);
+  ASSERT_EQ(first->wait(10s).value_or(-1), 128 + SIGKILL);
+  for (const auto& node : nodes) {
+    EXPECT_TRUE(node->wait_for_output("showing black while reconnecting", 10s)) << node->output();
+  }
+  std::this_thread::sleep_for(1s);
+  for (const auto& node : nodes) EXPECT_TRUE(node->running()) << "still trying: " << node->output();
+  auto second = start_master("second", "120");
+  ASSERT_EQ(second->wait(60s).value_or(-1), 0) << second->output();
+  const ClusterRun run = read_cluster_run(dir + "/second");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  for (const auto& p : loaded.value().installation.projectors()) {
+    EXPECT_EQ(find_node(run.report, p.id())->frames_presented(), 120u) << p.id();
+  }
+  EXPECT_EQ(run.report.sync().frames_incoherent(), 0u);
+  for (const auto& node : nodes) EXPECT_EQ(node->wait(10s).value_or(-1), 0) << node->output();
+}
+
 // ------------------------------------------------------------- intruders
 
 // A TCP client that speaks just enough of the protocol to misbehave.
