@@ -19,6 +19,7 @@
 #include "cluster_run.h"
 #include "config/load.h"
 #include "external_master.h"
+#include "fault_proxy.h"
 #include "net/auth.h"
 #include "net/envelope.h"
 #include "net/framing.h"
@@ -196,6 +197,65 @@ TEST(FrameSync, NodesShowBlackWhileTheMasterIsGoneAndARestartedMasterTakesThemBa
   }
   EXPECT_EQ(run.report.sync().frames_incoherent(), 0u);
   for (const auto& node : nodes) EXPECT_EQ(node->wait(10s).value_or(-1), 0) << node->output();
+}
+
+// One node reaches the master through the fault proxy, which resets its
+// connection 100 times: it rejoins every time with a fresh snapshot, its state
+// hash always matches, and its frame ids never repeat or skip.
+TEST(FrameSync, AHundredConnectionResetsAllResync) {
+  const std::string config = kConfigs + "/powerwall-2x2.json";
+  ExternalMaster master(config, {"--frames", "0", "--log-level", "info"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  FaultProxy proxy(static_cast<std::uint16_t>(std::stoi(master.port)));
+  auto loaded = config::load_installation(config);
+  ASSERT_TRUE(loaded) << loaded.error();
+  std::vector<std::unique_ptr<Process>> nodes;
+  std::vector<std::string> ids;
+  for (const auto& p : loaded.value().installation.projectors()) ids.push_back(p.id());
+  const std::string through_proxy = ids.front();
+  for (const auto& id : ids) {
+    if (id == through_proxy) {
+      nodes.push_back(std::make_unique<Process>(
+          std::vector<std::string>{node_binary(), "--master", "127.0.0.1:" + std::to_string(proxy.port()), "--id", id,
+                                   "--renderer", "null", "--give-up-after-ms", "20000"},
+          master.dir + "/node-" + id + ".log"));
+    } else {
+      nodes.push_back(master.node(id, {"--renderer", "null"}));
+    }
+  }
+  ASSERT_TRUE(master.process->wait_for_output("starting frames", 20s)) << master.process->output();
+  const auto joins = [&] {
+    const std::string log = master.process->output();
+    std::size_t count = 0;
+    for (auto at = log.find("node '" + through_proxy + "' joined"); at != std::string::npos;
+         at = log.find("node '" + through_proxy + "' joined", at + 1)) {
+      ++count;
+    }
+    return count;
+  };
+  for (int reset = 1; reset <= 100; ++reset) {
+    ASSERT_TRUE(poll_until([&] { return joins() == static_cast<std::size_t>(reset); }, 10s))
+        << "rejoin " << reset << ":\n"
+        << master.process->output();
+    std::this_thread::sleep_for(std::chrono::milliseconds(20 + (reset * 37) % 80));  // a few frames in
+    EXPECT_EQ(proxy.reset_all(), 1u);
+  }
+  ASSERT_TRUE(poll_until([&] { return joins() == 101; }, 10s)) << master.process->output();
+  std::this_thread::sleep_for(500ms);
+  master.process->signal(SIGINT);
+  ASSERT_EQ(master.process->wait(30s).value_or(-1), 0) << master.process->output();
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  const report::NodeReport* node = find_node(run.report, through_proxy);
+  EXPECT_EQ(node->joins(), 101u);
+  for (const auto& id : ids) EXPECT_EQ(find_node(run.report, id)->hash_mismatches(), 0u) << id;
+  EXPECT_GT(node->frames_presented(), 100u);
+  EXPECT_TRUE(nodes.front()->wait(10s).has_value());
+  const std::string node_log = nodes.front()->output();
+  EXPECT_EQ(node_log.find("frame ids jumped"), std::string::npos) << node_log;
+  EXPECT_EQ(node_log.find("differs from the master's"), std::string::npos) << node_log;
+  std::cout << "100 resets: " << node->joins() << " joins, " << node->frames_presented() << " frames presented of "
+            << run.report.frames() << ", 0 hash mismatches\n";
 }
 
 // ------------------------------------------------------------- intruders
