@@ -4,6 +4,7 @@
 
 #include <csignal>
 #include <cstring>
+#include <thread>
 
 namespace optique::node {
 
@@ -317,6 +318,9 @@ void Node::handle_swap(const wire::FrameSwap& swap) {
   const std::optional<clock::ClockEstimate> now_estimate = estimator_.at(local);
   const clock::Nanos now_offset = now_estimate ? now_estimate->offset : 0;
   const clock::Nanos presented = local + now_offset;
+  // Nodes sharing a machine present at the same instant: let the others on this
+  // core show theirs before this one does its bookkeeping.
+  std::this_thread::yield();
 
   wire::Envelope envelope;
   auto& report = *envelope.mutable_presented();
