@@ -1,0 +1,286 @@
+#include "fuzz_bodies.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <vector>
+
+#if __has_include(<google/protobuf/stubs/logging.h>)
+#include <google/protobuf/stubs/logging.h>
+#define OPTIQUE_FUZZ_HAS_LOG_SILENCER 1
+#endif
+
+#include "net/envelope.h"
+#include "net/framing.h"
+#include "scene/state.h"
+
+// A failed invariant returns its own text and line from the checking function, so
+// a crash report (or a replay failure) says which one without a debugger.
+#define OPTIQUE_FUZZ_REQUIRE(cond)                                                                             \
+  do {                                                                                                         \
+    if (!(cond)) return std::string("invariant " #cond " (fuzz_bodies.cpp:") + std::to_string(__LINE__) + ")"; \
+  } while (false)
+
+namespace optique::fuzz {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+// xorshift32: the fragment sizes must follow from the input alone, so a crash
+// input replays the same way everywhere.
+std::uint32_t next_random(std::uint32_t& state) {
+  state ^= state << 13;
+  state ^= state >> 17;
+  state ^= state << 5;
+  return state;
+}
+
+std::string check_good_frame(const net::DecodedFrame& frame) {
+  OPTIQUE_FUZZ_REQUIRE(frame.consumed == net::kFrameHeaderBytes + frame.payload.size());
+  OPTIQUE_FUZZ_REQUIRE(frame.payload.size() <= kMaxPayloadBytes);
+  OPTIQUE_FUZZ_REQUIRE(!frame.payload.empty());
+  return {};
+}
+
+// Every Envelope that parses must survive a trip through append_envelope and back
+// unchanged: that is what the peer at the other end will see.
+std::string check_envelope(const wire::Envelope& envelope) {
+  OPTIQUE_FUZZ_REQUIRE(envelope.body_case() != wire::Envelope::BODY_NOT_SET);
+  OPTIQUE_FUZZ_REQUIRE(std::string_view(net::body_name(envelope)) != "none");
+  Bytes framed;
+  net::append_envelope(framed, envelope);
+  const net::DecodedFrame frame = net::decode_frame(framed, net::kDefaultMaxPayloadBytes);
+  OPTIQUE_FUZZ_REQUIRE(frame.status == net::DecodeStatus::good);
+  OPTIQUE_FUZZ_REQUIRE(frame.consumed == framed.size());
+  auto again = net::parse_envelope(frame.payload);
+  OPTIQUE_FUZZ_REQUIRE(again.ok());
+  OPTIQUE_FUZZ_REQUIRE(again.value().body_case() == envelope.body_case());
+  const std::string reserialized = again.value().SerializeAsString();
+  OPTIQUE_FUZZ_REQUIRE(reserialized.size() == frame.payload.size());
+  OPTIQUE_FUZZ_REQUIRE(std::equal(reserialized.begin(), reserialized.end(), frame.payload.begin(),
+                                  [](char a, std::uint8_t b) { return static_cast<std::uint8_t>(a) == b; }));
+  return {};
+}
+
+std::string frames(std::span<const std::uint8_t> input, Outcome& out) {
+  if (input.empty()) return {};
+  const std::uint32_t piece = input[0];
+  const std::span<const std::uint8_t> stream = input.subspan(1);
+
+  // The reference: the whole stream decoded in place. Fragmentation must not
+  // change which frames come out, nor how the stream ends.
+  std::vector<Bytes> expected;
+  net::DecodedFrame expected_end;
+  std::size_t expected_left = 0;
+  for (std::size_t pos = 0;;) {
+    net::DecodedFrame frame = net::decode_frame(stream.subspan(pos), kMaxPayloadBytes);
+    if (frame.status != net::DecodeStatus::good) {
+      expected_end = std::move(frame);
+      expected_left = stream.size() - pos;
+      break;
+    }
+    if (auto broken = check_good_frame(frame); !broken.empty()) return broken;
+    expected.emplace_back(frame.payload.begin(), frame.payload.end());
+    pos += frame.consumed;
+  }
+  OPTIQUE_FUZZ_REQUIRE(expected_end.status != net::DecodeStatus::bad || !expected_end.error.empty());
+
+  net::FrameReader reader(kMaxPayloadBytes);
+  std::vector<Bytes> got;
+  net::DecodedFrame last;
+  // Payloads are views into the reader's buffer, valid only until the next
+  // append(): copy each one out before feeding more.
+  auto drain = [&]() -> std::string {
+    for (;;) {
+      last = reader.next();
+      if (last.status != net::DecodeStatus::good) return {};
+      if (auto broken = check_good_frame(last); !broken.empty()) return broken;
+      got.emplace_back(last.payload.begin(), last.payload.end());
+    }
+  };
+  std::uint32_t rng_state = piece * 0x9E3779B9u + 0x7F4A7C15u;
+  for (std::size_t pos = 0; pos < stream.size();) {
+    std::size_t size = stream.size() - pos;
+    if (piece != 0) size = std::min<std::size_t>(size, 1 + next_random(rng_state) % piece);
+    reader.append(stream.subspan(pos, size));
+    pos += size;
+    // Sometimes let several pieces pile up before asking for frames.
+    if ((next_random(rng_state) & 1u) != 0) {
+      if (auto broken = drain(); !broken.empty()) return broken;
+    }
+  }
+  if (auto broken = drain(); !broken.empty()) return broken;
+
+  OPTIQUE_FUZZ_REQUIRE(got == expected);
+  OPTIQUE_FUZZ_REQUIRE(last.status == expected_end.status);
+  if (last.status == net::DecodeStatus::bad) {
+    OPTIQUE_FUZZ_REQUIRE(last.error == expected_end.error);
+    OPTIQUE_FUZZ_REQUIRE(reader.buffered_bytes() == 0);
+    // A bad stream stays bad, whatever arrives after.
+    reader.append(input);
+    OPTIQUE_FUZZ_REQUIRE(reader.next().status == net::DecodeStatus::bad);
+  } else {
+    OPTIQUE_FUZZ_REQUIRE(reader.buffered_bytes() == expected_left);
+  }
+
+  out.good_frames += static_cast<int>(got.size());
+  for (const Bytes& payload : got) {
+    auto envelope = net::parse_envelope(payload);
+    if (!envelope.ok()) {
+      OPTIQUE_FUZZ_REQUIRE(!envelope.error().empty());
+      continue;
+    }
+    ++out.envelopes;
+    if (auto broken = check_envelope(envelope.value()); !broken.empty()) return broken;
+  }
+  return {};
+}
+
+bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+bool same_bits(const glm::dvec3& a, const glm::dvec3& b) {
+  return std::bit_cast<std::uint64_t>(a.x) == std::bit_cast<std::uint64_t>(b.x) &&
+         std::bit_cast<std::uint64_t>(a.y) == std::bit_cast<std::uint64_t>(b.y) &&
+         std::bit_cast<std::uint64_t>(a.z) == std::bit_cast<std::uint64_t>(b.z);
+}
+
+std::string check_pose(const scene::Pose& pose) {
+  OPTIQUE_FUZZ_REQUIRE(finite(pose.position));
+  OPTIQUE_FUZZ_REQUIRE(finite(pose.scale));
+  const glm::dquat& q = pose.rotation;
+  OPTIQUE_FUZZ_REQUIRE(std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z));
+  OPTIQUE_FUZZ_REQUIRE(std::abs(std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) - 1.0) <= 1e-6);
+  return {};
+}
+
+// What every state that made it past from_snapshot or apply_delta must satisfy.
+std::string check_state(const scene::SceneState& state) {
+  for (const auto& [id, object] : state.objects) {
+    if (auto broken = check_pose(object.now); !broken.empty()) return broken + " (object " + std::to_string(id) + ")";
+    if (auto broken = check_pose(object.next); !broken.empty()) return broken + " (object " + std::to_string(id) + ")";
+  }
+  OPTIQUE_FUZZ_REQUIRE(finite(state.eye_now));
+  OPTIQUE_FUZZ_REQUIRE(finite(state.eye_next));
+
+  const std::uint64_t hash = scene::state_hash(state);
+  OPTIQUE_FUZZ_REQUIRE(scene::state_hash(state) == hash);
+  const scene::SceneState copy = state;
+  OPTIQUE_FUZZ_REQUIRE(scene::state_hash(copy) == hash);
+
+  // Through a Snapshot, in memory and on the wire: what a joining node receives.
+  const wire::Snapshot snapshot = scene::to_snapshot(state);
+  auto back = scene::from_snapshot(snapshot);
+  OPTIQUE_FUZZ_REQUIRE(back.ok());
+  OPTIQUE_FUZZ_REQUIRE(back.value() == state);
+  OPTIQUE_FUZZ_REQUIRE(scene::state_hash(back.value()) == hash);
+  wire::Snapshot received;
+  OPTIQUE_FUZZ_REQUIRE(received.ParseFromString(snapshot.SerializeAsString()));
+  auto rebuilt = scene::from_snapshot(received);
+  OPTIQUE_FUZZ_REQUIRE(rebuilt.ok());
+  OPTIQUE_FUZZ_REQUIRE(rebuilt.value() == state);
+  OPTIQUE_FUZZ_REQUIRE(scene::state_hash(rebuilt.value()) == hash);
+
+  OPTIQUE_FUZZ_REQUIRE(scene::make_delta(state, state).ByteSizeLong() == 0);
+  return {};
+}
+
+// After an accepted delta: it did what it said, and make_delta reproduces it.
+std::string check_applied(const scene::SceneState& before, const scene::SceneState& after,
+                          const wire::StateDelta& delta) {
+  for (std::uint32_t id : delta.removed()) OPTIQUE_FUZZ_REQUIRE(!after.objects.contains(id));
+  for (const auto& changed : delta.changed()) {
+    bool removed = false;
+    for (std::uint32_t id : delta.removed()) removed = removed || id == changed.id();
+    OPTIQUE_FUZZ_REQUIRE(removed || after.objects.contains(changed.id()));
+  }
+  for (std::uint32_t light : delta.lights_off()) OPTIQUE_FUZZ_REQUIRE(after.lights_off.contains(light));
+  for (std::uint32_t light : delta.lights_on()) OPTIQUE_FUZZ_REQUIRE(!after.lights_off.contains(light));
+  if (!delta.has_viewer()) {
+    OPTIQUE_FUZZ_REQUIRE(same_bits(after.eye_now, before.eye_now));
+    OPTIQUE_FUZZ_REQUIRE(same_bits(after.eye_next, before.eye_next));
+  }
+
+  scene::SceneState replayed = before;
+  auto replay = scene::apply_delta(replayed, scene::make_delta(before, after));
+  OPTIQUE_FUZZ_REQUIRE(replay.ok());
+  OPTIQUE_FUZZ_REQUIRE(replayed == after);
+  OPTIQUE_FUZZ_REQUIRE(scene::state_hash(replayed) == scene::state_hash(after));
+  return {};
+}
+
+std::vector<std::span<const std::uint8_t>> split_chunks(std::span<const std::uint8_t> input) {
+  std::vector<std::span<const std::uint8_t>> chunks;
+  const auto* begin = input.data();
+  const auto* end = input.data() + input.size();
+  const auto* separator = reinterpret_cast<const std::uint8_t*>(kChunkSeparator.data());
+  for (;;) {
+    const auto* at = std::search(begin, end, separator, separator + kChunkSeparator.size());
+    chunks.emplace_back(begin, at);
+    if (at == end) return chunks;
+    begin = at + kChunkSeparator.size();
+  }
+}
+
+std::string deltas(std::span<const std::uint8_t> input, Outcome& out) {
+  const auto chunks = split_chunks(input);
+  scene::SceneState state;
+  wire::Snapshot snapshot;
+  if (snapshot.ParseFromArray(chunks[0].data(), static_cast<int>(chunks[0].size()))) {
+    auto accepted = scene::from_snapshot(snapshot);
+    if (accepted.ok()) {
+      out.snapshot_accepted = true;
+      state = std::move(accepted).value();
+    } else {
+      OPTIQUE_FUZZ_REQUIRE(!accepted.error().empty());
+    }
+  }
+  if (auto broken = check_state(state); !broken.empty()) return broken;
+
+  for (std::size_t i = 1; i < chunks.size(); ++i) {
+    wire::StateDelta delta;
+    if (!delta.ParseFromArray(chunks[i].data(), static_cast<int>(chunks[i].size()))) continue;
+    const scene::SceneState before = state;
+    const std::uint64_t before_hash = scene::state_hash(before);
+    auto applied = scene::apply_delta(state, delta);
+    if (!applied.ok()) {
+      ++out.deltas_refused;
+      OPTIQUE_FUZZ_REQUIRE(!applied.error().empty());
+      OPTIQUE_FUZZ_REQUIRE(state == before);
+      // operator== takes 0.0 for -0.0; the hash sees every bit.
+      OPTIQUE_FUZZ_REQUIRE(scene::state_hash(state) == before_hash);
+      continue;
+    }
+    ++out.deltas_applied;
+    if (auto broken = check_state(state); !broken.empty()) return broken + " (after delta " + std::to_string(i) + ")";
+    if (auto broken = check_applied(before, state, delta); !broken.empty()) {
+      return broken + " (after delta " + std::to_string(i) + ")";
+    }
+  }
+  return {};
+}
+
+// Protobuf logs an error for every string field that is not UTF-8: expected for
+// fuzz input, and enough of them to bury a real report.
+struct QuietProtobuf {
+#ifdef OPTIQUE_FUZZ_HAS_LOG_SILENCER
+  google::protobuf::LogSilencer silencer;
+#endif
+};
+
+}  // namespace
+
+Outcome run_frames(std::span<const std::uint8_t> input) {
+  const QuietProtobuf quiet;
+  Outcome out;
+  out.broken = frames(input, out);
+  return out;
+}
+
+Outcome run_deltas(std::span<const std::uint8_t> input) {
+  const QuietProtobuf quiet;
+  Outcome out;
+  out.broken = deltas(input, out);
+  return out;
+}
+
+}  // namespace optique::fuzz

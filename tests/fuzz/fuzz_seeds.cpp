@@ -1,0 +1,419 @@
+#include "fuzz_seeds.h"
+
+#include <algorithm>
+#include <limits>
+#include <stdexcept>
+#include <string_view>
+
+#include "fuzz_bodies.h"
+#include "net/envelope.h"
+#include "net/framing.h"
+
+namespace optique::fuzz {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Fixed, so that regenerating the corpus gives the same files.
+Bytes noise(std::size_t size, std::uint32_t state) {
+  Bytes out(size);
+  for (auto& b : out) {
+    state = state * 1664525u + 1013904223u;
+    b = static_cast<std::uint8_t>(state >> 24);
+  }
+  return out;
+}
+
+Bytes serialize(const google::protobuf::MessageLite& message) {
+  const std::string s = message.SerializeAsString();
+  return {s.begin(), s.end()};
+}
+
+// --- frames ---
+
+wire::Envelope envelope(std::uint64_t sequence) {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  e.set_sequence(sequence);
+  return e;
+}
+
+void set(wire::Vec3& v, double x, double y, double z) {
+  v.set_x(x);
+  v.set_y(y);
+  v.set_z(z);
+}
+
+wire::ObjectState object(std::uint32_t id, double x, double y, double z) {
+  wire::ObjectState o;
+  o.set_id(id);
+  for (wire::Pose* pose : {o.mutable_now(), o.mutable_next()}) {
+    set(*pose->mutable_position(), x, y, z);
+    pose->mutable_rotation()->set_w(1.0);
+    set(*pose->mutable_scale(), 1.0, 1.0, 1.0);
+  }
+  o.mutable_next()->mutable_position()->set_x(x + 0.01);
+  return o;
+}
+
+wire::StateDelta sample_delta() {
+  wire::StateDelta d;
+  *d.add_changed() = object(7, 1.25, 0.5, -2.0);
+  *d.add_changed() = object(8, -1.0, 0.0, 0.0);
+  d.add_removed(3);
+  set(*d.mutable_viewer()->mutable_eye_now(), 0.0, 1.6, 2.0);
+  set(*d.mutable_viewer()->mutable_eye_next(), 0.01, 1.6, 2.0);
+  d.add_lights_off(4);
+  d.add_lights_on(1);
+  return d;
+}
+
+std::vector<std::pair<std::string, wire::Envelope>> one_of_each_body() {
+  std::vector<std::pair<std::string, wire::Envelope>> out;
+  std::uint64_t sequence = 0;
+  auto add = [&](std::string name) -> wire::Envelope& {
+    out.emplace_back(std::move(name), envelope(++sequence));
+    return out.back().second;
+  };
+  {
+    const Bytes nonce = noise(32, 1);
+    add("challenge").mutable_challenge()->set_nonce(std::string(nonce.begin(), nonce.end()));
+  }
+  {
+    auto& hello = *add("hello").mutable_hello();
+    hello.set_node_id("wall-left");
+    hello.add_capabilities("headless");
+    hello.add_capabilities("window");
+    const Bytes mac = noise(32, 2);
+    hello.set_nonce_mac(std::string(mac.begin(), mac.end()));
+  }
+  {
+    auto& welcome = *add("welcome").mutable_welcome();
+    auto& projector = *welcome.mutable_projector();
+    projector.set_id("left");
+    projector.set_host("localhost");
+    projector.set_width(320);
+    projector.set_height(200);
+    projector.set_screen("wall");
+    for (double h : {1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0}) projector.add_homography(h);
+    *welcome.add_blend_group() = projector;
+    auto& screen = *welcome.mutable_screen();
+    screen.set_id("wall");
+    for (double v : {0.0, 0.0, 0.0}) screen.add_origin(v);
+    for (double v : {1.0, 0.0, 0.0}) screen.add_right(v);
+    for (double v : {0.0, 1.0, 0.0}) screen.add_up(v);
+    screen.set_width(2.0);
+    screen.set_height(1.25);
+    for (double v : {0.0, 1.6, 2.0}) welcome.mutable_viewer()->add_eye(v);
+    welcome.mutable_scene()->set_builtin("cubes");
+    welcome.set_frame_period_ns(16'666'667);
+    welcome.set_heartbeat_ms(250);
+    welcome.set_liveness_timeout_ms(3000);
+    welcome.set_scene_sha256(std::string(64, 'a'));
+    welcome.mutable_depth_of_field()->set_focal_depth(2.5);
+    welcome.mutable_lights()->add_lights(0);
+    welcome.mutable_lights()->add_lights(2);
+    welcome.mutable_lights()->set_ambient(true);
+  }
+  {
+    auto& refuse = *add("refuse").mutable_refuse();
+    refuse.set_reason("node id wall-left is already connected");
+    refuse.set_retriable(true);
+  }
+  add("configured").mutable_configured()->set_renderer("llvmpipe (LLVM 15.0.6, 256 bits), headless");
+  {
+    auto& resync = *add("resync").mutable_resync();
+    auto& snapshot = *resync.mutable_snapshot();
+    *snapshot.add_objects() = object(1, 0.0, 1.0, -0.5);
+    *snapshot.add_objects() = object(3, 2.0, 0.0, 0.0);
+    set(*snapshot.mutable_viewer()->mutable_eye_now(), 0.0, 1.6, 2.0);
+    set(*snapshot.mutable_viewer()->mutable_eye_next(), 0.0, 1.6, 2.0);
+    snapshot.add_lights_off(1);
+    resync.set_next_frame_id(42);
+    resync.set_state_hash(0x0123456789ABCDEFull);
+  }
+  {
+    auto& begin = *add("frame_begin").mutable_frame_begin();
+    begin.set_frame_id(42);
+    begin.set_simulation_time_ns(700'000'014);
+    begin.set_present_time_ns(-123'456'789);
+    *begin.mutable_delta() = sample_delta();
+    begin.set_state_hash(0xDEADBEEFCAFEF00Dull);
+    begin.set_capture(true);
+    begin.mutable_focus()->set_depth(1.5);
+    begin.mutable_focus()->set_gaze_x(0.25);
+    begin.mutable_focus()->set_gaze_y(-0.125);
+    begin.mutable_lights()->add_lights(1);
+  }
+  {
+    auto& ready = *add("frame_ready").mutable_frame_ready();
+    ready.set_frame_id(42);
+    ready.set_render_ns(3'000'000);
+    ready.set_state_hash(0xDEADBEEFCAFEF00Dull);
+  }
+  {
+    auto& swap = *add("swap").mutable_swap();
+    swap.set_frame_id(42);
+    swap.set_present_deadline_ns(716'666'681);
+  }
+  {
+    auto& presented = *add("presented").mutable_presented();
+    presented.set_frame_id(42);
+    presented.set_presented_ns(716'700'000);
+    presented.set_clock_offset_ns(-5'000);
+    presented.set_clock_rtt_ns(120'000);
+    presented.set_content_frame_id(41);
+  }
+  add("ping").mutable_ping()->set_t1(1'000);
+  {
+    auto& pong = *add("pong").mutable_pong();
+    pong.set_t1(1'000);
+    pong.set_t2(1'500);
+    pong.set_t3(1'600);
+  }
+  add("heartbeat").mutable_heartbeat()->set_sent_ns(std::numeric_limits<std::int64_t>::max());
+  add("goodbye").mutable_goodbye()->set_reason("master shutting down");
+  return out;
+}
+
+Bytes framed(const wire::Envelope& e) {
+  Bytes out;
+  net::append_envelope(out, e);
+  return out;
+}
+
+Bytes header(std::uint32_t length) {
+  Bytes out(net::kFrameHeaderBytes);
+  net::write_frame_header(out.data(), length);
+  return out;
+}
+
+Bytes concat(std::initializer_list<Bytes> parts) {
+  Bytes out;
+  for (const Bytes& p : parts) out.insert(out.end(), p.begin(), p.end());
+  return out;
+}
+
+// Byte 0 of a frames input picks the fragmentation.
+Seed frame_seed(std::string name, std::uint8_t piece, const Bytes& stream) {
+  Bytes bytes{piece};
+  bytes.insert(bytes.end(), stream.begin(), stream.end());
+  return {std::move(name), std::move(bytes)};
+}
+
+// --- deltas ---
+
+wire::Snapshot base_snapshot() {
+  wire::Snapshot s;
+  *s.add_objects() = object(1, 0.0, 1.0, -0.5);
+  *s.add_objects() = object(2, 1.0, 1.2, -0.7);
+  *s.add_objects() = object(5, -1.0, 0.3, 0.1);
+  set(*s.mutable_viewer()->mutable_eye_now(), 0.0, 1.6, 2.0);
+  set(*s.mutable_viewer()->mutable_eye_next(), 0.0, 1.6, 2.0);
+  s.add_lights_off(2);
+  s.add_lights_off(7);
+  return s;
+}
+
+Bytes join(const std::vector<Bytes>& chunks) {
+  Bytes out;
+  const auto* separator = reinterpret_cast<const std::uint8_t*>(kChunkSeparator.data());
+  for (std::size_t i = 0; i < chunks.size(); ++i) {
+    if (std::search(chunks[i].begin(), chunks[i].end(), separator, separator + kChunkSeparator.size()) !=
+        chunks[i].end()) {
+      throw std::logic_error("a seed chunk contains the chunk separator");
+    }
+    if (i > 0) out.insert(out.end(), separator, separator + kChunkSeparator.size());
+    out.insert(out.end(), chunks[i].begin(), chunks[i].end());
+  }
+  return out;
+}
+
+// A delta seed: base snapshot (unless given), then the deltas.
+Seed delta_seed(std::string name, const std::vector<wire::StateDelta>& deltas,
+                const wire::Snapshot& snapshot = base_snapshot()) {
+  std::vector<Bytes> chunks{serialize(snapshot)};
+  for (const auto& d : deltas) chunks.push_back(serialize(d));
+  return {std::move(name), join(chunks)};
+}
+
+wire::StateDelta change(const wire::ObjectState& o) {
+  wire::StateDelta d;
+  *d.add_changed() = o;
+  return d;
+}
+
+wire::StateDelta lights(std::initializer_list<std::uint32_t> off, std::initializer_list<std::uint32_t> on) {
+  wire::StateDelta d;
+  for (auto l : off) d.add_lights_off(l);
+  for (auto l : on) d.add_lights_on(l);
+  return d;
+}
+
+wire::StateDelta remove(std::initializer_list<std::uint32_t> ids) {
+  wire::StateDelta d;
+  for (auto id : ids) d.add_removed(id);
+  return d;
+}
+
+wire::ObjectState with_rotation(wire::ObjectState o, double w, double x, double y, double z) {
+  auto& q = *o.mutable_now()->mutable_rotation();
+  q.set_w(w);
+  q.set_x(x);
+  q.set_y(y);
+  q.set_z(z);
+  return o;
+}
+
+}  // namespace
+
+std::vector<Seed> frame_seeds() {
+  std::vector<Seed> seeds;
+  const auto bodies = one_of_each_body();
+  Bytes all;
+  for (const auto& [name, e] : bodies) {
+    const Bytes frame = framed(e);
+    seeds.push_back(frame_seed(name, 0, frame));
+    all.insert(all.end(), frame.begin(), frame.end());
+  }
+  seeds.push_back(frame_seed("all_bodies_whole", 0, all));
+  seeds.push_back(frame_seed("all_bodies_bytewise", 1, all));
+  seeds.push_back(frame_seed("all_bodies_pieces_of_7", 7, all));
+  seeds.push_back(frame_seed("all_bodies_pieces_of_200", 200, all));
+
+  const Bytes hello = framed(bodies[1].second);
+  wire::Envelope ping_envelope = envelope(99);
+  ping_envelope.mutable_ping()->set_t1(-1);
+  const Bytes ping = framed(ping_envelope);
+  seeds.push_back(frame_seed("empty_stream", 0, {}));
+  seeds.push_back(frame_seed("truncated_header", 0, {0x00, 0x00}));
+  seeds.push_back(frame_seed("header_only", 3, header(100)));
+  seeds.push_back(frame_seed("truncated_payload", 3, concat({header(100), noise(50, 3)})));
+  seeds.push_back(frame_seed("good_then_truncated", 5, concat({hello, Bytes(hello.begin(), hello.end() - 3)})));
+  seeds.push_back(frame_seed("oversized_header", 0, concat({header(0xFFFFFFFFu), noise(16, 4)})));
+  seeds.push_back(frame_seed("one_byte_over_max", 2, concat({header(kMaxPayloadBytes + 1), noise(16, 5)})));
+  seeds.push_back(frame_seed("zero_length", 0, header(0)));
+  seeds.push_back(frame_seed("good_bad_good", 1, concat({hello, header(0), ping})));
+  seeds.push_back(frame_seed("garbage_payload", 0, concat({header(32), noise(32, 6)})));
+  seeds.push_back(frame_seed("garbage_stream", 9, noise(64, 7)));
+  {
+    wire::Envelope no_body = envelope(5);
+    seeds.push_back(frame_seed("no_body", 0, framed(no_body)));
+  }
+  {
+    // A field from a newer protocol: kept as an unknown field, body still there.
+    Bytes payload = serialize(bodies[1].second);
+    payload.insert(payload.end(), {0x98, 0x06, 0x2A});  // field 99, varint 42
+    seeds.push_back(
+        frame_seed("unknown_field", 4, concat({header(static_cast<std::uint32_t>(payload.size())), payload})));
+  }
+  {
+    wire::Envelope old = bodies[1].second;
+    old.set_protocol_version(net::kProtocolVersion - 1);
+    seeds.push_back(frame_seed("old_protocol_version", 0, framed(old)));
+  }
+  return seeds;
+}
+
+std::vector<Seed> delta_seeds() {
+  std::vector<Seed> seeds;
+  seeds.push_back({"empty", {}});
+  seeds.push_back(delta_seed("snapshot_only", {}));
+  {
+    wire::StateDelta d = change(object(1, 0.5, 1.0, -0.5));
+    *d.add_changed() = object(9, 3.0, 0.0, 0.0);
+    d.add_removed(5);
+    set(*d.mutable_viewer()->mutable_eye_now(), 0.0, 1.6, 2.0);
+    set(*d.mutable_viewer()->mutable_eye_next(), 0.05, 1.6, 2.0);
+    seeds.push_back(delta_seed("move_add_remove_view", {d}));
+  }
+  seeds.push_back(delta_seed("lights_off_then_on", {lights({3}, {}), lights({}, {2}), lights({}, {3, 7})}));
+  seeds.push_back(delta_seed("light_off_twice", {lights({2}, {})}));
+  seeds.push_back(delta_seed("light_on_not_off", {lights({}, {4})}));
+  seeds.push_back(delta_seed("light_off_and_on_in_one_delta", {lights({4}, {4})}));
+  seeds.push_back(delta_seed("light_on_and_off_in_one_delta", {lights({2}, {2})}));
+  seeds.push_back(delta_seed("same_light_off_twice_in_one_delta", {lights({4, 4}, {})}));
+  seeds.push_back(delta_seed("all_lights_on", {lights({}, {2, 7}), lights({0, 1, 0xFFFFFFFFu}, {})}));
+  {
+    wire::ObjectState o = object(1, kNaN, 0.0, 0.0);
+    seeds.push_back(delta_seed("nan_position", {change(o), change(object(1, 0.0, 0.0, 0.0))}));
+  }
+  {
+    wire::ObjectState o = object(2, 0.0, 0.0, 0.0);
+    o.mutable_next()->mutable_scale()->set_y(kInf);
+    seeds.push_back(delta_seed("inf_scale", {change(o)}));
+  }
+  {
+    wire::StateDelta d;
+    set(*d.mutable_viewer()->mutable_eye_now(), 0.0, -kInf, 0.0);
+    set(*d.mutable_viewer()->mutable_eye_next(), kNaN, 0.0, 0.0);
+    seeds.push_back(delta_seed("nan_eye", {d}));
+  }
+  seeds.push_back(delta_seed("non_unit_quaternion", {change(with_rotation(object(1, 0, 0, 0), 2.0, 0.0, 0.0, 0.0))}));
+  seeds.push_back(delta_seed("zero_quaternion", {change(with_rotation(object(1, 0, 0, 0), 0.0, 0.0, 0.0, 0.0))}));
+  seeds.push_back(delta_seed("nan_quaternion", {change(with_rotation(object(1, 0, 0, 0), kNaN, 0.0, 0.0, 0.0))}));
+  seeds.push_back(
+      delta_seed("almost_unit_quaternion", {change(with_rotation(object(1, 0, 0, 0), 1.0 + 5e-7, 0, 0, 0)),
+                                            change(with_rotation(object(1, 0, 0, 0), 1.0 + 2e-6, 0, 0, 0))}));
+  seeds.push_back(delta_seed("rotated_quaternion", {change(with_rotation(object(1, 0, 0, 0), 0.5, 0.5, -0.5, 0.5)),
+                                                    change(with_rotation(object(2, 0, 0, 0), 0.0, 0.0, 0.0, -1.0))}));
+  seeds.push_back(delta_seed("remove_unknown_id", {remove({42}), remove({1, 42}), remove({1})}));
+  seeds.push_back(delta_seed("remove_twice", {remove({5, 5}), remove({5})}));
+  {
+    wire::StateDelta d = change(object(1, 4.0, 4.0, 4.0));
+    d.add_removed(1);
+    seeds.push_back(delta_seed("change_and_remove_same_id", {d}));
+  }
+  {
+    wire::StateDelta d = change(object(3, 1.0, 0.0, 0.0));
+    *d.add_changed() = object(3, 2.0, 0.0, 0.0);
+    seeds.push_back(delta_seed("same_id_changed_twice", {d}));
+  }
+  seeds.push_back(delta_seed("negative_zero", {change(object(1, -0.0, 0.0, -0.0)), change(object(1, 0.0, 0.0, 0.0))}));
+  seeds.push_back(delta_seed("extreme_values", {change(object(1, 1e308, -1e308, 4.9e-324)),
+                                                change(object(1, std::numeric_limits<double>::max(), 0.0, 0.0))}));
+  {
+    wire::ObjectState bare;
+    bare.set_id(11);
+    seeds.push_back(delta_seed("no_rotation_no_scale", {change(bare)}));
+  }
+  {
+    const Bytes noise_chunk = noise(24, 8);
+    std::vector<Bytes> chunks{serialize(base_snapshot()), serialize(lights({5}, {})), noise_chunk,
+                              serialize(lights({}, {5}))};
+    seeds.push_back({"garbage_between_deltas", join(chunks)});
+  }
+  seeds.push_back({"empty_deltas", join({serialize(base_snapshot()), {}, {}, {}})});
+  {
+    std::vector<wire::StateDelta> frames;
+    for (int i = 0; i < 10; ++i) {
+      wire::StateDelta d = change(object(1, 0.1 * i, 1.0, -0.5));
+      if (i % 3 == 0) d.add_lights_off(10 + static_cast<std::uint32_t>(i));
+      if (i % 3 == 1 && i > 1) d.add_lights_on(10 + static_cast<std::uint32_t>(i) - 4);
+      frames.push_back(d);
+    }
+    seeds.push_back(delta_seed("ten_frames", frames));
+  }
+  {
+    wire::Snapshot twice = base_snapshot();
+    *twice.add_objects() = object(1, 9.0, 9.0, 9.0);
+    seeds.push_back(delta_seed("snapshot_object_twice", {lights({1}, {})}, twice));
+  }
+  {
+    wire::Snapshot twice = base_snapshot();
+    twice.add_lights_off(2);
+    seeds.push_back(delta_seed("snapshot_light_twice", {lights({1}, {})}, twice));
+  }
+  {
+    wire::Snapshot nan = base_snapshot();
+    nan.mutable_viewer()->mutable_eye_next()->set_z(kNaN);
+    seeds.push_back(delta_seed("snapshot_nan_eye", {remove({1})}, nan));
+  }
+  seeds.push_back(delta_seed("empty_snapshot", {change(object(4, 1.0, 2.0, 3.0)), remove({4})}, wire::Snapshot{}));
+  return seeds;
+}
+
+}  // namespace optique::fuzz
