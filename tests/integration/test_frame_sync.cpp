@@ -33,26 +33,43 @@ using namespace std::chrono_literals;
 
 const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
 
+// One null-render node per projector of `config`, in config order; `extra(i)`
+// adds arguments for the i-th.
+struct NullNodes {
+  std::vector<std::string> ids;
+  std::vector<std::unique_ptr<Process>> processes;
+};
+
+NullNodes start_null_nodes(const ExternalMaster& master, const std::string& config,
+                           const std::function<std::vector<std::string>(std::size_t)>& extra = {}) {
+  NullNodes nodes;
+  auto loaded = config::load_installation(config);
+  EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
+  if (!loaded) return nodes;
+  for (const auto& p : loaded.value().installation.projectors()) {
+    std::vector<std::string> arguments{"--renderer", "null"};
+    if (extra) {
+      const std::vector<std::string> more = extra(nodes.ids.size());
+      arguments.insert(arguments.end(), more.begin(), more.end());
+    }
+    nodes.ids.push_back(p.id());
+    nodes.processes.push_back(master.node(p.id(), arguments));
+  }
+  return nodes;
+}
+
 // Four null-render nodes at 60 Hz; two with clocks 50 ms off that drift ±200 ppm.
 TEST(FrameSync, SkewedAndDriftingClocksAreEstimatedWithin50MicrosecondsAfterTwoSeconds) {
   const std::string config = kConfigs + "/powerwall-2x2.json";
   ExternalMaster master(config, {"--frames", "300"});
   ASSERT_FALSE(master.port.empty()) << master.process->output();
-  auto loaded = config::load_installation(config);
-  ASSERT_TRUE(loaded) << loaded.error();
-  std::vector<std::string> ids;
-  for (const auto& p : loaded.value().installation.projectors()) ids.push_back(p.id());
-  ASSERT_EQ(ids.size(), 4u);
   const std::vector<std::vector<std::string>> skews{{"--clock-offset-ns", "50000000", "--clock-drift-ppm", "200"},
                                                     {"--clock-offset-ns", "-50000000", "--clock-drift-ppm", "-200"},
                                                     {},
                                                     {}};
-  std::vector<std::unique_ptr<Process>> nodes;
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    std::vector<std::string> extra{"--renderer", "null"};
-    extra.insert(extra.end(), skews[i].begin(), skews[i].end());
-    nodes.push_back(master.node(ids[i], extra));
-  }
+  const NullNodes nodes = start_null_nodes(master, config, [&](std::size_t i) { return skews.at(i); });
+  const std::vector<std::string>& ids = nodes.ids;
+  ASSERT_EQ(ids.size(), 4u);
   ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
   const ClusterRun run = read_cluster_run(master.dir + "/out");
   ASSERT_TRUE(run.error.empty()) << run.error;
@@ -98,14 +115,8 @@ TEST(FrameSync, EightNodesPresentTogetherAt60HzFor10Seconds) {
       dir + "/eight.json");
   ExternalMaster master(config, {"--frames", "600"});
   ASSERT_FALSE(master.port.empty()) << master.process->output();
-  auto loaded = config::load_installation(config);
-  ASSERT_TRUE(loaded) << loaded.error();
-  std::vector<std::unique_ptr<Process>> nodes;
-  std::vector<std::string> ids;
-  for (const auto& p : loaded.value().installation.projectors()) {
-    ids.push_back(p.id());
-    nodes.push_back(master.node(p.id(), {"--renderer", "null"}));
-  }
+  const NullNodes started = start_null_nodes(master, config);
+  const std::vector<std::string>& ids = started.ids;
   ASSERT_EQ(ids.size(), 8u);
   ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
   const ClusterRun run = read_cluster_run(master.dir + "/out");
@@ -128,16 +139,11 @@ TEST(FrameSync, AStateHashMismatchIsRepairedWithinOneFrame) {
   const std::string config = kConfigs + "/powerwall-2x2.json";
   ExternalMaster master(config, {"--frames", "90"});
   ASSERT_FALSE(master.port.empty()) << master.process->output();
-  auto loaded = config::load_installation(config);
-  ASSERT_TRUE(loaded) << loaded.error();
-  std::vector<std::unique_ptr<Process>> nodes;
-  std::vector<std::string> ids;
-  for (const auto& p : loaded.value().installation.projectors()) {
-    ids.push_back(p.id());
-    std::vector<std::string> extra{"--renderer", "null"};
-    if (ids.size() == 1) extra.insert(extra.end(), {"--corrupt-state-at-frame", "30"});
-    nodes.push_back(master.node(p.id(), extra));
-  }
+  const NullNodes started = start_null_nodes(master, config, [](std::size_t i) {
+    return i == 0 ? std::vector<std::string>{"--corrupt-state-at-frame", "30"} : std::vector<std::string>{};
+  });
+  const std::vector<std::string>& ids = started.ids;
+  const auto& nodes = started.processes;
   ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
   const ClusterRun run = read_cluster_run(master.dir + "/out");
   ASSERT_TRUE(run.error.empty()) << run.error;
@@ -166,14 +172,9 @@ TEST(FrameSync, AStragglerIsWaitedForThenItsFrameIsDroppedEverywhere) {
       dir + "/drop.json");
   ExternalMaster master(config, {"--frames", "240"});
   ASSERT_FALSE(master.port.empty()) << master.process->output();
-  auto loaded = config::load_installation(config);
-  ASSERT_TRUE(loaded) << loaded.error();
-  std::vector<std::unique_ptr<Process>> nodes;
-  std::vector<std::string> ids;
-  for (const auto& p : loaded.value().installation.projectors()) {
-    ids.push_back(p.id());
-    nodes.push_back(master.node(p.id(), {"--renderer", "null"}));
-  }
+  const NullNodes started = start_null_nodes(master, config);
+  const std::vector<std::string>& ids = started.ids;
+  const auto& nodes = started.processes;
   ASSERT_TRUE(master.process->wait_for_output("starting frames", 20s)) << master.process->output();
   std::this_thread::sleep_for(1s);
   nodes.back()->signal(SIGSTOP);
