@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <fstream>
@@ -56,6 +57,15 @@ NullNodes start_null_nodes(const ExternalMaster& master, const std::string& conf
     nodes.processes.push_back(master.node(p.id(), arguments));
   }
   return nodes;
+}
+
+// How many times the master's log says node `id` joined.
+std::size_t times_joined(const Process& master, const std::string& id) {
+  const std::string log = master.output();
+  const std::string line = "node '" + id + "' joined";
+  std::size_t count = 0;
+  for (auto at = log.find(line); at != std::string::npos; at = log.find(line, at + 1)) ++count;
+  return count;
 }
 
 // Four null-render nodes at 60 Hz; two with clocks 50 ms off that drift ±200 ppm.
@@ -248,6 +258,67 @@ TEST(FrameSync, NodesShowBlackWhileTheMasterIsGoneAndARestartedMasterTakesThemBa
   for (const auto& node : nodes) EXPECT_EQ(node->wait(10s).value_or(-1), 0) << node->output();
 }
 
+// A node SIGKILLed mid-run and started again: the others never wait for it; it
+// rejoins at a frame boundary with a fresh snapshot, its state hash matches the
+// master's from its first frame back, and from there it shows every frame once,
+// in order, to the end.
+TEST(FrameSync, AKilledNodeRestartedRejoinsAndShowsEveryFrameFromThere) {
+  const std::string config = kConfigs + "/powerwall-2x2.json";
+  constexpr std::uint64_t kFrames = 360;  // 6 s at 60 Hz
+  ExternalMaster master(config, {"--frames", std::to_string(kFrames), "--log-level", "info"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  NullNodes started = start_null_nodes(master, config);
+  const std::vector<std::string>& ids = started.ids;
+  ASSERT_EQ(ids.size(), 4u);
+  const std::string victim = ids.back();
+  ASSERT_TRUE(master.process->wait_for_output("starting frames", 20s)) << master.process->output();
+  std::this_thread::sleep_for(1s);
+  started.processes.back()->signal(SIGKILL);
+  ASSERT_EQ(started.processes.back()->wait(10s).value_or(-1), 128 + SIGKILL);
+  ASSERT_TRUE(master.process->wait_for_output("node '" + victim + "' left", 5s)) << master.process->output();
+  started.processes.back() = master.node(victim, {"--renderer", "null"});
+  const auto joins = [&] { return times_joined(*master.process, victim); };
+  ASSERT_TRUE(poll_until([&] { return joins() == 2; }, 10s)) << master.process->output();
+  ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
+  for (const auto& node : started.processes) EXPECT_EQ(node->wait(10s).value_or(-1), 0) << node->output();
+
+  const ClusterRun run = read_cluster_run(master.dir + "/out");
+  ASSERT_TRUE(run.error.empty()) << run.error;
+  const std::vector<std::string> survivors(ids.begin(), ids.end() - 1);
+  for (const auto& id : survivors) EXPECT_EQ(find_node(run.report, id)->frames_presented(), kFrames) << id;
+  const std::vector<std::string> problems = sync_problems(run, survivors, kFrames);
+  EXPECT_TRUE(problems.empty()) << problems.front();
+  const report::NodeReport* restarted = find_node(run.report, victim);
+  ASSERT_NE(restarted, nullptr);
+  EXPECT_EQ(restarted->joins(), 2u);
+  EXPECT_EQ(restarted->hash_mismatches(), 0u) << "its hash matched from its first frame back";
+
+  // The frames it showed: a run before the kill, a gap, then every frame to the end.
+  std::vector<std::uint64_t> shown;
+  for (const auto& row : run.rows) {
+    if (row.node == victim && row.presented != 0) shown.push_back(row.frame);
+  }
+  std::sort(shown.begin(), shown.end());
+  EXPECT_EQ(std::adjacent_find(shown.begin(), shown.end()), shown.end()) << "no frame shown twice";
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> runs;  // [first, last] of each contiguous stretch
+  for (const std::uint64_t frame : shown) {
+    if (runs.empty() || frame != runs.back().second + 1) {
+      runs.emplace_back(frame, frame);
+    } else {
+      runs.back().second = frame;
+    }
+  }
+  ASSERT_EQ(runs.size(), 2u) << "shown before the kill, then from the rejoin on";
+  EXPECT_EQ(runs.front().first, 0u);
+  EXPECT_EQ(runs.back().second, kFrames - 1);
+  EXPECT_GT(runs.back().first, runs.front().second + 1);
+  const std::string node_log = started.processes.back()->output();
+  EXPECT_EQ(node_log.find("frame ids jumped"), std::string::npos) << node_log;
+  EXPECT_EQ(node_log.find("differs from the master's"), std::string::npos) << node_log;
+  std::cout << "killed after frame " << runs.front().second << ", back from frame " << runs.back().first << " of "
+            << kFrames << "\n";
+}
+
 // One node reaches the master through the fault proxy, which resets its
 // connection 100 times: it rejoins every time with a fresh snapshot, its state
 // hash always matches, and its frame ids never repeat or skip.
@@ -273,15 +344,7 @@ TEST(FrameSync, AHundredConnectionResetsAllResync) {
     }
   }
   ASSERT_TRUE(master.process->wait_for_output("starting frames", 20s)) << master.process->output();
-  const auto joins = [&] {
-    const std::string log = master.process->output();
-    std::size_t count = 0;
-    for (auto at = log.find("node '" + through_proxy + "' joined"); at != std::string::npos;
-         at = log.find("node '" + through_proxy + "' joined", at + 1)) {
-      ++count;
-    }
-    return count;
-  };
+  const auto joins = [&] { return times_joined(*master.process, through_proxy); };
   for (int reset = 1; reset <= 100; ++reset) {
     ASSERT_TRUE(poll_until([&] { return joins() == static_cast<std::size_t>(reset); }, 10s))
         << "rejoin " << reset << ":\n"
