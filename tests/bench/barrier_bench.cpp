@@ -1,10 +1,12 @@
 // Barrier benchmark: optique's frame barrier (null renderer, real master and node
-// processes on loopback) for 1, 2, 4, 8, 16 nodes, side by side in one run with a
-// plain ready/go barrier at the same pacing. Writes a Markdown table and a CSV.
+// processes on loopback) for 1 … 64 nodes, side by side in one run with a plain
+// ready/go barrier at the same pacing. Writes a Markdown table, a CSV and a plot
+// (barrier.png: barrier round and present skew against the node count).
 //
 //   optique-bench-barrier [--out DIR] [--frames N] [--rate HZ] [--repeats R] [--nodes 1,2,4]
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -12,7 +14,9 @@
 
 #include "../integration/cluster_run.h"
 #include "../integration/process.h"
+#include "image/image_io.h"
 #include "metrics/distribution.h"
+#include "plot.h"
 #include "ready_go_baseline.h"
 #include "spread.h"
 
@@ -41,7 +45,18 @@ struct Sample {
   double barrier_median = 0, barrier_p99 = 0, skew_median = 0, skew_p99 = 0;
   double baseline_median = 0, baseline_p99 = 0;
   std::uint64_t missing = 0;
+  double presented_by_all = 0;  // fraction of the frames every node presented
 };
+
+// The fraction of frames [0, frames) that all `nodes` of the run presented.
+double presented_by_all(const testing::ClusterRun& run, std::size_t nodes, std::size_t frames) {
+  std::vector<std::size_t> presenters(frames, 0);
+  for (const auto& row : run.rows) {
+    if (row.presented != 0 && row.frame < frames) ++presenters[row.frame];
+  }
+  const auto complete = std::count(presenters.begin(), presenters.end(), nodes);
+  return static_cast<double>(complete) / static_cast<double>(frames);
+}
 
 Sample run_once(const std::string& master_bin, const std::string& work, std::size_t nodes, std::size_t frames,
                 double rate) {
@@ -63,6 +78,7 @@ Sample run_once(const std::string& master_bin, const std::string& work, std::siz
   s.skew_median = sync.present_skew_us().median();
   s.skew_p99 = sync.present_skew_us().p99();
   s.missing = sync.frames_with_missing_node();
+  s.presented_by_all = presented_by_all(run, nodes, frames);
   auto baseline = bench::ready_go_rounds(nodes, frames, rate);
   const auto summary = metrics::summarize(std::move(baseline));
   s.baseline_median = summary.median();
@@ -75,12 +91,12 @@ Sample run_once(const std::string& master_bin, const std::string& work, std::siz
 int main(int argc, char** argv) {
   CLI::App app{"optique barrier benchmark"};
   std::string out = "docs/bench";
-  std::size_t frames = 300;
+  std::size_t frames = 600;  // 10 s at 60 Hz
   double rate = 60.0;
   std::size_t repeats = 3;
-  std::vector<std::size_t> node_counts{1, 2, 4, 8, 16};
+  std::vector<std::size_t> node_counts{1, 2, 4, 8, 16, 32, 64};
   std::string master_bin = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
-  app.add_option("--out", out, "folder for barrier.md and barrier.csv");
+  app.add_option("--out", out, "folder for barrier.md, barrier.csv and barrier.png");
   app.add_option("--frames", frames, "frames (and baseline rounds) per run");
   app.add_option("--rate", rate, "frame rate in Hz (both barriers are paced at it)");
   app.add_option("--repeats", repeats, "runs per node count; the table shows the median and the min–max");
@@ -92,18 +108,24 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(out);
   std::ofstream csv(out + "/barrier.csv");
   csv << "nodes,repeat,frames,rate_hz,barrier_median_us,barrier_p99_us,present_skew_median_us,present_skew_p99_us,"
-         "ready_go_median_us,ready_go_p99_us,frames_with_missing_node\n";
+         "ready_go_median_us,ready_go_p99_us,frames_with_missing_node,presented_by_all\n";
   std::ostringstream table;
   table << "| nodes | optique barrier round median µs | p99 µs | present skew median µs | p99 µs | "
-           "ready/go baseline median µs | p99 µs | optique / baseline (median) |\n"
-        << "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+           "ready/go baseline median µs | p99 µs | optique / baseline (median) | frames presented by all nodes % |\n"
+        << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  // One point per node count for each curve of the plot: median over the repeats.
+  struct Point {
+    double nodes, barrier_median, barrier_p99, skew_median, skew_p99;
+  };
+  std::vector<Point> points;
   for (std::size_t nodes : node_counts) {
-    std::vector<double> bm, bp, sm, sp, gm, gp, ratio;
+    std::vector<double> bm, bp, sm, sp, gm, gp, ratio, all;
     for (std::size_t r = 0; r < repeats; ++r) {
       const Sample s = run_once(master_bin, work, nodes, frames, rate);
       csv << nodes << ',' << r << ',' << frames << ',' << rate << ',' << s.barrier_median << ',' << s.barrier_p99 << ','
           << s.skew_median << ',' << s.skew_p99 << ',' << s.baseline_median << ',' << s.baseline_p99 << ',' << s.missing
-          << '\n';
+          << ',' << s.presented_by_all << '\n'
+          << std::flush;
       bm.push_back(s.barrier_median);
       bp.push_back(s.barrier_p99);
       sm.push_back(s.skew_median);
@@ -111,19 +133,54 @@ int main(int argc, char** argv) {
       gm.push_back(s.baseline_median);
       gp.push_back(s.baseline_p99);
       ratio.push_back(s.barrier_median / s.baseline_median);
+      all.push_back(100.0 * s.presented_by_all);
       std::cerr << "nodes " << nodes << " repeat " << r << ": barrier " << s.barrier_median << " µs, skew "
-                << s.skew_median << " µs, ready/go " << s.baseline_median << " µs\n";
+                << s.skew_median << " µs, ready/go " << s.baseline_median << " µs, presented by all "
+                << 100.0 * s.presented_by_all << " %\n";
     }
     using bench::cell;
     using bench::spread;
     table << "| " << nodes << " | " << cell(spread(bm), 0) << " | " << cell(spread(bp), 0) << " | "
           << cell(spread(sm), 0) << " | " << cell(spread(sp), 0) << " | " << cell(spread(gm), 0) << " | "
-          << cell(spread(gp), 0) << " | " << cell(spread(ratio), 2) << " |\n";
+          << cell(spread(gp), 0) << " | " << cell(spread(ratio), 2) << " | " << cell(spread(all), 1) << " |\n";
+    points.push_back(
+        {static_cast<double>(nodes), spread(bm).median, spread(bp).median, spread(sm).median, spread(sp).median});
+  }
+
+  // Left: barrier round, right: present skew; both µs on log axes (10 µs – 100 ms)
+  // against the node count (log). Dark: median, light: p99.
+  using bench::Plot;
+  Plot plot(960, 400);
+  const double max_nodes = static_cast<double>(std::max<std::size_t>(2, node_counts.back())) * 1.3;
+  const Plot::Panel barrier_panel{50, 30, 400, 330, 0.8, max_nodes, 10.0, 1e5};
+  const Plot::Panel skew_panel{530, 30, 400, 330, 0.8, max_nodes, 10.0, 1e5};
+  std::vector<double> ticks;
+  for (const std::size_t n : node_counts) ticks.push_back(static_cast<double>(n));
+  plot.frame(barrier_panel, ticks);
+  plot.frame(skew_panel, ticks);
+  const auto draw = [&](const Plot::Panel& panel, double Point::*value, glm::u8vec3 colour) {
+    const auto at = [&](const Point& p) { return panel.at(p.nodes, std::clamp(p.*value, panel.y_lo, panel.y_hi)); };
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      plot.dot(at(points[i]), colour, 4);
+      if (i > 0) plot.line(at(points[i - 1]), at(points[i]), colour, 1);
+    }
+  };
+  draw(barrier_panel, &Point::barrier_median, {20, 60, 160});
+  draw(barrier_panel, &Point::barrier_p99, {130, 170, 230});
+  draw(skew_panel, &Point::skew_median, {170, 40, 30});
+  draw(skew_panel, &Point::skew_p99, {240, 150, 130});
+  if (auto written = image::write_png(out + "/barrier.png", plot.image()); !written) {
+    std::cerr << "optique-bench-barrier: " << written.error() << "\n";
+    return 1;
   }
   std::ofstream md(out + "/barrier.md");
   md << "Barrier benchmark: " << frames << " frames at " << rate << " Hz, " << repeats
-     << " runs per row; each cell is the median over runs with the min–max in brackets.\n\n"
-     << table.str();
+     << " runs per row; each cell is the median over runs with the min–max in brackets. "
+        "Null-render nodes, all on this machine; a frame counts as presented by all nodes when every node reported "
+        "its present.\n\n"
+     << table.str()
+     << "\n![barrier round (left, blue) and present skew (right, red) against the node count, log axes "
+        "10 µs – 100 ms; dark: median, light: p99](barrier.png)\n";
   std::cout << table.str();
   std::filesystem::remove_all(work);
   return 0;
