@@ -20,6 +20,7 @@ packages=(
   xvfb xauth                         # a virtual display for the window tests
   libssl-dev                         # SHA-256 of configs, HMAC (libcrypto)
   python3                            # bench plots and helper scripts
+  clang libclang-rt-14-dev llvm      # libFuzzer targets (scripts/fuzz.sh), llvm-symbolizer for stacks
 )
 
 missing=()

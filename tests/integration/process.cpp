@@ -6,8 +6,10 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <random>
 #include <sstream>
 #include <stdexcept>
@@ -66,6 +68,18 @@ std::string Process::output() const { return read_file(log_path_); }
 
 bool Process::wait_for_output(const std::string& needle, std::chrono::milliseconds timeout) const {
   return poll_until([&] { return output().find(needle) != std::string::npos; }, timeout);
+}
+
+double timing_scale() {
+  const char* text = std::getenv("OPTIQUE_TEST_TIME_SCALE");
+  if (text == nullptr || *text == '\0') return 1.0;
+  char* end = nullptr;
+  const double scale = std::strtod(text, &end);
+  if (*end != '\0' || !(scale >= 1.0 && scale <= 100.0)) {
+    std::cerr << "OPTIQUE_TEST_TIME_SCALE='" << text << "' is not a number in [1, 100]; using 1\n";
+    return 1.0;
+  }
+  return scale;
 }
 
 std::string make_temp_dir(const std::string& prefix) {

@@ -43,6 +43,10 @@ class Process {
 [[nodiscard]] bool poll_until(const std::function<bool()>& done, std::chrono::milliseconds timeout);
 // Polls until `path` exists and is non-empty, or the timeout passes.
 [[nodiscard]] bool wait_for_file(const std::string& path, std::chrono::milliseconds timeout);
+// How many times slower than a plain build the processes under test run:
+// OPTIQUE_TEST_TIME_SCALE (scripts/sanitize.sh sets it), else 1. Bounds on how
+// late something may be are multiplied by it; bounds on what happened are not.
+[[nodiscard]] double timing_scale();
 // Processes whose command line contains `needle` (from /proc), excluding this one.
 [[nodiscard]] std::vector<pid_t> processes_matching(const std::string& needle);
 
