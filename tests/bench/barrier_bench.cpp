@@ -36,7 +36,10 @@ std::string installation_json(std::size_t nodes, double rate) {
          << width * static_cast<double>(i) / static_cast<double>(nodes) << R"(, "y": 0, "width": )"
          << width / static_cast<double>(nodes) << R"(, "height": 2.25}})";
   }
+  // All nodes start at once: let every one through the handshake together rather
+  // than refusing those past the default 16 and timing their reconnects.
   json << R"(], "viewer": {"eye": [0, 1.6, 2]}, "master": {"frame_rate": )" << rate
+       << R"(, "max_pending_connections": )" << std::max<std::size_t>(16, nodes + 1)
        << R"(}, "scene": {"builtin": "cubes"}})";
   return json.str();
 }
@@ -102,7 +105,15 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "runs per node count; the table shows the median and the min–max");
   app.add_option("--nodes", node_counts, "node counts")->delimiter(',');
   app.add_option("--master", master_bin, "optique-master binary");
+  app.get_option("--frames")->check(CLI::PositiveNumber);
+  app.get_option("--repeats")->check(CLI::PositiveNumber);
+  app.get_option("--rate")->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
+  if (node_counts.empty() || std::find(node_counts.begin(), node_counts.end(), 0u) != node_counts.end()) {
+    std::cerr << "optique-bench-barrier: --nodes needs one or more node counts, each at least 1\n";
+    return 2;
+  }
+  std::sort(node_counts.begin(), node_counts.end());
 
   const std::string work = testing::make_temp_dir("optique-bench");
   std::filesystem::create_directories(out);
