@@ -37,10 +37,12 @@ std::string installation_json(std::size_t nodes, double rate) {
          << width / static_cast<double>(nodes) << R"(, "height": 2.25}})";
   }
   // All nodes start at once: let every one through the handshake together rather
-  // than refusing those past the default 16 and timing their reconnects.
+  // than refusing those past the default 16, and wait for all of them (64 node
+  // processes take ~18 s to start on 2 cores), so the run measures steady frames,
+  // not late joins.
   json << R"(], "viewer": {"eye": [0, 1.6, 2]}, "master": {"frame_rate": )" << rate
        << R"(, "max_pending_connections": )" << std::max<std::size_t>(16, nodes + 1)
-       << R"(}, "scene": {"builtin": "cubes"}})";
+       << R"(, "startup_timeout_ms": 120000}, "scene": {"builtin": "cubes"}})";
   return json.str();
 }
 
