@@ -9,7 +9,7 @@
 #   FUZZ_JOBS      build parallelism (default: nproc)
 #   FUZZ_KEEP=1    keep the work folder (new corpus entries) even when nothing crashed
 #
-# Installs nothing. On Debian 12 it needs the packages clang and libclang-rt-14-dev
+# Installs nothing (scripts/install-deps.sh --fuzz does). On Debian 12 it needs the packages clang and libclang-rt-14-dev
 # (libFuzzer and the sanitizer runtimes), and llvm for readable stacks
 # (llvm-symbolizer). Exits non-zero if any target crashed, leaked, timed out or ran
 # out of memory; the input that did it is copied to build-fuzz/crashes/.
@@ -19,7 +19,7 @@ root="$PWD"
 
 if ! command -v clang >/dev/null 2>&1 || ! command -v clang++ >/dev/null 2>&1; then
   echo "fuzz: clang and clang++ are needed (libFuzzer comes with clang only)." >&2
-  echo "fuzz: on Debian 12: apt-get install clang libclang-rt-14-dev llvm" >&2
+  echo "fuzz: on Debian 12: scripts/install-deps.sh --fuzz (clang libclang-rt-14-dev llvm)" >&2
   exit 1
 fi
 

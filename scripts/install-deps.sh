@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs everything optique needs to build and test, from Debian 12 packages.
+# Installs everything optique needs to build and test, from Debian 12 packages
+# (with --fuzz, clang for the libFuzzer targets too).
 # Idempotent: when every package is already installed it changes nothing and
 # does not touch the network.
 set -euo pipefail
@@ -20,8 +21,14 @@ packages=(
   xvfb xauth                         # a virtual display for the window tests
   libssl-dev                         # SHA-256 of configs, HMAC (libcrypto)
   python3                            # bench plots and helper scripts
-  clang libclang-rt-14-dev llvm      # libFuzzer targets (scripts/fuzz.sh), llvm-symbolizer for stacks
 )
+# scripts/install-deps.sh --fuzz: also what scripts/fuzz.sh needs (CI runs it).
+if [ "${1:-}" = --fuzz ]; then
+  packages+=(clang libclang-rt-14-dev llvm)  # libFuzzer and its sanitizer runtimes, llvm-symbolizer for stacks
+elif [ -n "${1:-}" ]; then
+  echo "install-deps: unknown argument '$1' (the only one is --fuzz)" >&2
+  exit 2
+fi
 
 missing=()
 for p in "${packages[@]}"; do
