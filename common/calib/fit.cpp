@@ -9,6 +9,7 @@
 #include "calib/dlt.h"
 #include "calib/point_checks.h"
 #include "calib/refine.h"
+#include "util/finite.h"
 
 namespace optique::calib {
 namespace {
@@ -29,15 +30,6 @@ double frobenius(const glm::dmat3& h) {
     for (int r = 0; r < 3; ++r) sum += h[c][r] * h[c][r];
   }
   return std::sqrt(sum);
-}
-
-bool all_finite(const glm::dmat3& h) {
-  for (int c = 0; c < 3; ++c) {
-    for (int r = 0; r < 3; ++r) {
-      if (!std::isfinite(h[c][r])) return false;
-    }
-  }
-  return true;
 }
 
 // h33 = 1 when that is a sound scale. When the screen origin is on the
@@ -158,7 +150,7 @@ Result<HomographyFit> fit_homography(std::span<const Correspondence> points, con
     }
   }
   h = normalize_scale(h, subset.front(), fit.warnings);
-  if (!all_finite(h)) return Error{"the fit is degenerate: H has non-finite entries"};
+  if (!util::finite(h)) return Error{"the fit is degenerate: H has non-finite entries"};
   fit.homography = h;
   fit.inliers = used;
 

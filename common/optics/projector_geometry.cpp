@@ -9,20 +9,12 @@
 #include <glm/matrix.hpp>
 
 #include "calib/homography.h"
+#include "util/finite.h"
 
 namespace optique::optics {
 namespace {
 
 using calib::apply;
-
-bool all_finite(const glm::dmat3& m) {
-  for (int c = 0; c < 3; ++c) {
-    for (int r = 0; r < 3; ++r) {
-      if (!std::isfinite(m[c][r])) return false;
-    }
-  }
-  return true;
-}
 
 std::array<glm::dvec2, 4> pixel_corners(int width, int height) {
   const double w = width;
@@ -112,7 +104,7 @@ ProjectorGeometry::ProjectorGeometry(const glm::dmat3& screen_to_pixel, const gl
 
 Result<ProjectorGeometry> ProjectorGeometry::make(const glm::dmat3& screen_to_pixel, int width, int height) {
   if (width <= 0 || height <= 0) return Error{"the projector has no pixels"};
-  if (!all_finite(screen_to_pixel)) return Error{"the homography has a non-finite entry"};
+  if (!util::finite(screen_to_pixel)) return Error{"the homography has a non-finite entry"};
   double scale = 0.0;
   for (int c = 0; c < 3; ++c) {
     for (int r = 0; r < 3; ++r) scale = std::max(scale, std::abs(screen_to_pixel[c][r]));
@@ -120,7 +112,7 @@ Result<ProjectorGeometry> ProjectorGeometry::make(const glm::dmat3& screen_to_pi
   if (scale == 0.0) return Error{"the homography is all zeros"};
   const glm::dmat3 normalized = screen_to_pixel / scale;
   const glm::dmat3 inverse = glm::inverse(normalized);
-  if (std::abs(glm::determinant(normalized)) < 1e-14 || !all_finite(inverse)) {
+  if (std::abs(glm::determinant(normalized)) < 1e-14 || !util::finite(inverse)) {
     return Error{"the homography is singular: it does not map the screen plane onto the image"};
   }
   // w of H⁻¹ is affine over the image, so its corners bound its sign.

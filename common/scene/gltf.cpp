@@ -29,6 +29,7 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include "util/finite.h"
 #include "util/sha256.h"
 
 // TinyGLTF's implementation lives here (Debian ships a shared library too, but
@@ -284,21 +285,9 @@ double read_component(const unsigned char* p, int component_type, bool normalize
   }
 }
 
-bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+using util::finite;
 
-bool finite(const glm::dmat4& m) {
-  for (int c = 0; c < 4; ++c) {
-    for (int r = 0; r < 4; ++r) {
-      if (!std::isfinite(m[c][r])) return false;
-    }
-  }
-  return true;
-}
-
-bool finite(const Pose& pose) {
-  return finite(pose.position) && finite(pose.scale) && std::isfinite(pose.rotation.w) &&
-         std::isfinite(pose.rotation.x) && std::isfinite(pose.rotation.y) && std::isfinite(pose.rotation.z);
-}
+bool finite(const Pose& pose) { return finite(pose.position) && finite(pose.scale) && finite(pose.rotation); }
 
 glm::dquat canonical(glm::dquat q) {
   q = glm::normalize(q);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <utility>
+#include "util/finite.h"
 
 #include <glm/geometric.hpp>
 #include <glm/mat4x4.hpp>
@@ -17,7 +18,7 @@ namespace {
 // enough that the boxes cost little next to the triangles.
 constexpr std::size_t kChunkTriangles = 64;
 
-bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+using util::finite;
 
 // Whether the ray meets `lo`..`hi` somewhere in (0, t_max]. The slab test, with
 // axis-parallel rays handled apart so that 0·∞ never makes a NaN.

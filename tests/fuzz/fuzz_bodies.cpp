@@ -13,6 +13,7 @@
 #include "net/envelope.h"
 #include "net/framing.h"
 #include "scene/state.h"
+#include "util/finite.h"
 
 // A failed invariant returns its own text and line from the checking function, so
 // a crash report (or a replay failure) says which one without a debugger.
@@ -136,7 +137,7 @@ std::string frames(std::span<const std::uint8_t> input, Outcome& out) {
   return {};
 }
 
-bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+using util::finite;
 
 bool same_bits(const glm::dvec3& a, const glm::dvec3& b) {
   return std::bit_cast<std::uint64_t>(a.x) == std::bit_cast<std::uint64_t>(b.x) &&
@@ -147,8 +148,8 @@ bool same_bits(const glm::dvec3& a, const glm::dvec3& b) {
 std::string check_pose(const scene::Pose& pose) {
   OPTIQUE_FUZZ_REQUIRE(finite(pose.position));
   OPTIQUE_FUZZ_REQUIRE(finite(pose.scale));
+  OPTIQUE_FUZZ_REQUIRE(finite(pose.rotation));
   const glm::dquat& q = pose.rotation;
-  OPTIQUE_FUZZ_REQUIRE(std::isfinite(q.w) && std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z));
   OPTIQUE_FUZZ_REQUIRE(std::abs(std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) - 1.0) <= 1e-6);
   return {};
 }

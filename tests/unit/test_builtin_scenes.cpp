@@ -17,6 +17,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "scene/builtin.h"
+#include "util/finite.h"
 
 namespace optique::scene {
 namespace {
@@ -27,8 +28,8 @@ const std::vector<double> kTimes{0.0, 0.37, 5.0};
 
 // The seed-001 set: the test scenes of the frame-rate up-conversion paper.
 const std::vector<std::string> kSeedScenes{
-    "cube-fast-rotation", "cube-slow-rotation", "cube-zoom",  "pyramid-fast-rotation", "pyramid-slow-rotation",
-    "wheel-rotation",     "wheel-in-out",       "falling-ring",
+    "cube-fast-rotation",    "cube-slow-rotation", "cube-zoom",    "pyramid-fast-rotation",
+    "pyramid-slow-rotation", "wheel-rotation",     "wheel-in-out", "falling-ring",
 };
 
 std::vector<std::string> all_names() {
@@ -42,11 +43,8 @@ SceneDefinition load(const std::string& name) {
   return scene.ok() ? std::move(scene).value() : SceneDefinition{};
 }
 
-bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-bool finite(const Pose& p) {
-  return finite(p.position) && finite(p.scale) && std::isfinite(p.rotation.w) && std::isfinite(p.rotation.x) &&
-         std::isfinite(p.rotation.y) && std::isfinite(p.rotation.z);
-}
+using util::finite;
+bool finite(const Pose& p) { return finite(p.position) && finite(p.scale) && finite(p.rotation); }
 
 // The angle turned from `a` to `b`, whatever the axis.
 double angle_between(const glm::dquat& a, const glm::dquat& b) {

@@ -17,13 +17,14 @@
 #include "scene/builtin.h"
 #include "scene/meshes.h"
 #include "scene/raycast.h"
+#include "util/finite.h"
 
 namespace optique::scene {
 namespace {
 
 constexpr double kTolerance = 1e-9;
 
-bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+using util::finite;
 
 void expect_near(const glm::dvec3& actual, const glm::dvec3& expected, double tolerance = kTolerance) {
   EXPECT_NEAR(actual.x, expected.x, tolerance);
