@@ -153,11 +153,13 @@ int main(int argc, char** argv) {
     }
     using bench::cell;
     using bench::spread;
-    table << "| " << nodes << " | " << cell(spread(bm), 0) << " | " << cell(spread(bp), 0) << " | "
-          << cell(spread(sm), 0) << " | " << cell(spread(sp), 0) << " | " << cell(spread(gm), 0) << " | "
+    const bench::Spread barrier_median = spread(bm), barrier_p99 = spread(bp);
+    const bench::Spread skew_median = spread(sm), skew_p99 = spread(sp);
+    table << "| " << nodes << " | " << cell(barrier_median, 0) << " | " << cell(barrier_p99, 0) << " | "
+          << cell(skew_median, 0) << " | " << cell(skew_p99, 0) << " | " << cell(spread(gm), 0) << " | "
           << cell(spread(gp), 0) << " | " << cell(spread(ratio), 2) << " | " << cell(spread(all), 1) << " |\n";
     points.push_back(
-        {static_cast<double>(nodes), spread(bm).median, spread(bp).median, spread(sm).median, spread(sp).median});
+        {static_cast<double>(nodes), barrier_median.median, barrier_p99.median, skew_median.median, skew_p99.median});
   }
 
   // Left: barrier round, right: present skew; both µs on log axes (10 µs – 100 ms)
@@ -173,10 +175,9 @@ int main(int argc, char** argv) {
   plot.frame(skew_panel, ticks);
   const auto draw = [&](const Plot::Panel& panel, double Point::*value, glm::u8vec3 colour) {
     const auto at = [&](const Point& p) { return panel.at(p.nodes, std::clamp(p.*value, panel.y_lo, panel.y_hi)); };
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      plot.dot(at(points[i]), colour, 4);
-      if (i > 0) plot.line(at(points[i - 1]), at(points[i]), colour, 1);
-    }
+    std::vector<glm::dvec2> pixels;
+    for (const Point& p : points) pixels.push_back(at(p));
+    plot.curve(pixels, colour);
   };
   draw(barrier_panel, &Point::barrier_median, {20, 60, 160});
   draw(barrier_panel, &Point::barrier_p99, {130, 170, 230});

@@ -213,10 +213,9 @@ int main(int argc, char** argv) {
     const auto at = [&](const Point& p) {
       return panel.at(p.n, time ? p.time : std::clamp(p.ratio, panel.y_lo, panel.y_hi));
     };
-    for (std::size_t i = 0; i < curve.size(); ++i) {
-      plot.dot(at(curve[i]), colour, 4);
-      if (i > 0) plot.line(at(curve[i - 1]), at(curve[i]), colour, 1);
-    }
+    std::vector<glm::dvec2> pixels;
+    for (const Point& p : curve) pixels.push_back(at(p));
+    plot.curve(pixels, colour);
   };
   for (const Method m : kMethods) {
     draw(time_panel, clean_curves[static_cast<std::size_t>(m)], true, colour_of(m));

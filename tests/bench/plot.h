@@ -53,6 +53,14 @@ class Plot {
     line({p.x0, p.y0 + p.h}, {p.x0 + p.w, p.y0 + p.h}, black, 1);
   }
 
+  // One series of a line chart: a dot at each point (pixels), joined in order.
+  void curve(const std::vector<glm::dvec2>& points, glm::u8vec3 colour) {
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      dot(points[i], colour, 4);
+      if (i > 0) line(points[i - 1], points[i], colour, 1);
+    }
+  }
+
   void line(glm::dvec2 a, glm::dvec2 b, glm::u8vec3 colour, int thickness) {
     const int steps = static_cast<int>(std::ceil(std::max(std::abs(b.x - a.x), std::abs(b.y - a.y)))) + 1;
     for (int i = 0; i <= steps; ++i) dot(a + (b - a) * (static_cast<double>(i) / steps), colour, thickness);
