@@ -84,12 +84,17 @@ CC=gcc CXX=g++ cmake -S . -B "$build_dir" "${generator[@]}" \
   -DCMAKE_SHARED_LINKER_FLAGS="$sanitize_flags" >/dev/null
 t1=$(stamp)
 
-# The test executables whose label matches, read from the optique_test() calls;
-# their add_dependencies pull in optique-master and optique-node where they run them.
+# The test executables whose label matches regex $1, read from the optique_test()
+# calls in tests/*/CMakeLists.txt.
+tests_labelled() {
+  grep -hoE 'optique_test\([A-Za-z0-9_]+ [a-z]+' tests/*/CMakeLists.txt |
+    awk -v re="^($1)\$" '{ sub(/optique_test\(/, ""); if ($2 ~ re) print $1 }' | sort -u
+}
+
+# The tests' add_dependencies pull in optique-master and optique-node where they run them.
 targets=()
 if [ "${SANITIZE_ALL:-0}" != 1 ]; then
-  mapfile -t targets < <(grep -hoE 'optique_test\([A-Za-z0-9_]+ [a-z]+' tests/*/CMakeLists.txt |
-    awk -v re="^(${labels})\$" '{ sub(/optique_test\(/, ""); if ($2 ~ re) print $1 }' | sort -u)
+  mapfile -t targets < <(tests_labelled "$labels")
   if [ ${#targets[@]} -eq 0 ]; then
     echo "sanitize: no test matches the labels '$labels'" >&2
     exit 1
@@ -145,8 +150,7 @@ if [[ unit =~ ^(${labels})$ ]]; then
   unit_logs="$root/$build_dir/unit-logs"
   rm -rf "$unit_logs"
   mkdir -p "$unit_logs"
-  mapfile -t unit_tests < <(grep -hoE 'optique_test\([A-Za-z0-9_]+ unit' tests/*/CMakeLists.txt |
-    awk '{ sub(/optique_test\(/, ""); print $1 }' | sort -u)
+  mapfile -t unit_tests < <(tests_labelled unit)
   run_unit() {
     local exe
     exe=$(find "$2/tests" -mindepth 2 -maxdepth 2 -type f -executable -name "$1" | head -n 1)

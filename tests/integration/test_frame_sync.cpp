@@ -277,8 +277,7 @@ TEST(FrameSync, AKilledNodeRestartedRejoinsAndShowsEveryFrameFromThere) {
   ASSERT_EQ(started.processes.back()->wait(10s).value_or(-1), 128 + SIGKILL);
   ASSERT_TRUE(master.process->wait_for_output("node '" + victim + "' left", 5s)) << master.process->output();
   started.processes.back() = master.node(victim, {"--renderer", "null"});
-  const auto joins = [&] { return times_joined(*master.process, victim); };
-  ASSERT_TRUE(poll_until([&] { return joins() == 2; }, 10s)) << master.process->output();
+  ASSERT_TRUE(poll_until([&] { return times_joined(*master.process, victim) == 2; }, 10s)) << master.process->output();
   ASSERT_EQ(master.process->wait(60s).value_or(-1), 0) << master.process->output();
   for (const auto& node : started.processes) EXPECT_EQ(node->wait(10s).value_or(-1), 0) << node->output();
 
