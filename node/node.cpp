@@ -303,14 +303,18 @@ void Node::handle_swap(const wire::FrameSwap& swap) {
               static_cast<double>(deadline - now) / 1e6, static_cast<double>(longest) / 1e6);
     deadline = now + longest;
   }
-  if (now > deadline + frame_period_) {
-    // Held up past the next frame's time (the process was stopped, the machine
-    // stalled): showing it now would put an old frame beside its partners' new one.
+  // Held up past the next frame's time (the process was stopped, the machine
+  // stalled): showing it now would put an old frame beside its partners' new one.
+  // Checked again after the wait, which a stop can stretch as well.
+  const auto stale = [&](clock::Nanos at) {
+    if (at <= deadline + frame_period_) return false;
     log_.warn("frame {}'s present deadline passed {:.1f} ms ago: not showing a stale frame", swap.frame_id(),
-              static_cast<double>(now - deadline) / 1e6);
-    return;
-  }
+              static_cast<double>(at - deadline) / 1e6);
+    return true;
+  };
+  if (stale(now)) return;
   clock::sleep_until_monotonic(deadline, options_.present_spin.count() * clock::kNanosPerMicro);
+  if (stale(clock::monotonic_now())) return;
   renderer_.present();
   const clock::Nanos monotonic = clock::monotonic_now();
   const clock::Nanos local = options_.clock.to_local(monotonic);
