@@ -1,4 +1,4 @@
-#include "barrier.h"
+#include "master/barrier.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "cli.h"
+#include "master/cli.h"
 
 #include <unistd.h>
 
@@ -11,77 +11,28 @@
 #include <iostream>
 
 #include <spdlog/sinks/sink.h>
-#include "calibrate.h"
-#include "check_config.h"
-#include "compose.h"
 
-#include "light_switches.h"
 #include "log/logger.h"
-#include "master.h"
-#include "render_reference.h"
-#include "shared_secret.h"
-#include "stacked_groups.h"
+#include "master/master.h"
+#include "master/run_config.h"
+#include "master/shared_secret.h"
+#include "util/program.h"
 
 namespace optique::master {
 namespace {
 
-// The config and the scene it names: both must load before anything starts.
-Result<std::pair<config::LoadedConfig, scene::LoadedScene>> load_config_and_scene(const std::string& path) {
-  auto loaded = config::load_installation(path);
-  if (!loaded) return Error{loaded.error()};
-  auto scene = scene::load_scene(loaded.value().installation.scene(), loaded.value().directory);
-  if (!scene) return Error{path + ": scene: " + scene.error()};
-  const std::size_t light_count = scene.value().definition.lights.size();
-  auto problems = check_lighting_groups(loaded.value().installation, light_count);
-  for (config::Problem& problem : LightSwitches::check(loaded.value().installation.scene(), light_count)) {
-    problems.push_back(std::move(problem));
-  }
-  if (!problems.empty()) return Error{config::describe_problems(problems, path)};
-  // A refused secret file is a config problem: check-config says so too.
-  if (auto secret = load_installation_secret(loaded.value()); !secret) {
-    return Error{config::describe_problems({{"master.secret_file", secret.error()}}, path)};
-  }
-  return std::pair{std::move(loaded).value(), std::move(scene).value()};
-}
-
-int check_config(const std::vector<std::string>& files) {
-  int status = kExitOk;
-  for (const auto& file : files) {
-    auto loaded = load_config_and_scene(file);
-    if (!loaded) {
-      std::cerr << loaded.error() << "\n";
-      status = kExitUsage;
-      continue;
-    }
-    std::cout << summarize(loaded.value().first);
-    for (const auto& warning : loaded.value().second.warnings) std::cout << "  scene warning: " << warning << "\n";
-  }
-  return status;
-}
-
-// Composes every frame that all projectors captured; a frame some node missed
-// (it left the barrier) is skipped with a warning.
-void compose_local_captures(const config::LoadedConfig& config, const std::string& out_dir, spdlog::logger& log) {
-  const auto& projectors = config.installation.projectors();
-  if (projectors.empty()) return;
-  const std::filesystem::path first = std::filesystem::path(out_dir) / "nodes" / projectors.Get(0).id();
-  std::error_code ec;
-  std::vector<std::uint64_t> frames;
-  for (const auto& entry : std::filesystem::directory_iterator(first, ec)) {
-    const std::string name = entry.path().filename().string();
-    std::uint64_t frame = 0;
-    if (std::sscanf(name.c_str(), "frame-%" SCNu64 ".exr", &frame) == 1 && name.ends_with(".exr")) {
-      frames.push_back(frame);
-    }
-  }
-  std::sort(frames.begin(), frames.end());
-  for (std::uint64_t frame : frames) {
-    if (auto composed = compose_frame(config, frame, (std::filesystem::path(out_dir) / "nodes").string(), out_dir, log);
-        !composed) {
-      log.warn("frame {} not composed: {}", frame, composed.error());
-    }
-  }
-}
+// Subcommands that draw, read images or fit calibrations live in optique-tools,
+// so that the process running the frame loop loads no image or GL library.
+struct Tool {
+  const char* name;
+  const char* description;
+};
+constexpr Tool kTools[] = {
+    {"check-config", "validate installation files and print a summary of each"},
+    {"render-reference", "draw what a viewer should see on each screen at one frame"},
+    {"compose", "what each screen receives at one frame, from the nodes' captures"},
+    {"calibrate", "fit a projector's homography (screen → pixels) from measured points"},
+};
 
 }  // namespace
 
@@ -115,43 +66,14 @@ int run_cli(int argc, char** argv) {
   app.add_option("--capture-every", options.capture_every,
                  "nodes write every K-th frame (frame 0, K, 2K, ...); with --local into OUT/nodes/<projector-id>/");
 
-  std::vector<std::string> check_files;
-  auto* check = app.add_subcommand("check-config", "validate installation files and print a summary of each");
-  check->add_option("files", check_files, "installation files")->required();
-
-  std::string reference_config;
-  std::uint64_t reference_frame = 0;
-  std::string reference_out;
-  auto* reference = app.add_subcommand("render-reference", "draw what a viewer should see on each screen at one frame");
-  reference->add_option("--config", reference_config, "installation file")->required();
-  reference->add_option("--frame", reference_frame, "frame number (simulation time = frame / frame rate)");
-  reference->add_option("--out", reference_out, "writes OUT/reference/<screen-id>/frame-NNNNNN.exr and .png")
-      ->required();
-  ReferenceOptions reference_options;
-  reference
-      ->add_option("--supersample", reference_options.supersample,
-                   "S×S samples per pixel, box-filtered (compare with composites, which integrate each pixel)")
-      ->check(CLI::Range(1, 8));
-
-  std::string compose_config;
-  std::uint64_t compose_frame_number = 0;
-  std::string compose_out;
-  std::string compose_captures;
-  auto* compose = app.add_subcommand("compose", "what each screen receives at one frame, from the nodes' captures");
-  compose->add_option("--config", compose_config, "installation file")->required();
-  compose->add_option("--frame", compose_frame_number, "a captured frame number")->required();
-  compose->add_option("--out", compose_out, "writes OUT/screens/<screen-id>/frame-NNNNNN.exr and .png")->required();
-  compose->add_option("--captures", compose_captures,
-                      "folder with <projector-id>/frame-NNNNNN.png (default: OUT/nodes, where --local runs put them)");
-
-  CalibrateOptions calibrate_options;
-  auto* calibrate_command =
-      app.add_subcommand("calibrate", "fit a projector's homography (screen → pixels) from measured points");
-  calibrate_command
-      ->add_option("--points", calibrate_options.points_path, "points file (JSON: pixel ↔ screen or tracker)")
-      ->required();
-  calibrate_command->add_option("--out", calibrate_options.out_path, "calibration file to write (JSON)")->required();
-  calibrate_command->add_flag("--robust", calibrate_options.robust, "RANSAC: leave gross outliers out of the fit");
+  std::vector<CLI::App*> tools;
+  for (const Tool& tool : kTools) {
+    CLI::App* sub = app.add_subcommand(tool.name, tool.description);
+    // Everything after the name, --help included, is optique-tools' to read.
+    sub->prefix_command();
+    sub->set_help_flag();
+    tools.push_back(sub);
+  }
 
   try {
     app.parse(argc, argv);
@@ -160,50 +82,27 @@ int run_cli(int argc, char** argv) {
     return status == 0 ? kExitOk : kExitUsage;
   }
 
-  if (check->parsed()) return check_config(check_files);
-  if (calibrate_command->parsed()) return calibrate(calibrate_options, std::cout, std::cerr);
-  if (compose->parsed()) {
-    auto loaded = config::load_installation(compose_config);
-    if (!loaded) {
-      std::cerr << loaded.error() << "\n";
-      return kExitUsage;
-    }
-    auto logger = log::make_logger("master", log_level);
-    const std::string captures = compose_captures.empty() ? compose_out + "/nodes" : compose_captures;
-    if (auto composed = compose_frame(loaded.value(), compose_frame_number, captures, compose_out, *logger);
-        !composed) {
-      logger->error("{}", composed.error());
-      return kExitUsage;
-    }
-    return kExitOk;
-  }
-  if (reference->parsed()) {
-    auto loaded = load_config_and_scene(reference_config);
-    if (!loaded) {
-      std::cerr << loaded.error() << "\n";
-      return kExitUsage;
-    }
-    auto logger = log::make_logger("master", log_level);
-    if (auto done = render_reference(loaded.value().first, loaded.value().second, reference_frame, reference_out,
-                                     *logger, reference_options);
-        !done) {
-      logger->error("{}", done.error());
-      return kExitFailed;
-    }
-    return kExitOk;
+  for (CLI::App* tool : tools) {
+    if (!tool->parsed()) continue;
+    std::vector<std::string> args{"--log-level", log_level, tool->get_name()};
+    for (const std::string& arg : tool->remaining()) args.push_back(arg);
+    const Error failed = util::replace_process(util::sibling_program("optique-tools"), "optique-master", args);
+    std::cerr << "optique-master " << tool->get_name() << ": " << failed.message << "\n";
+    return kExitFailed;
   }
 
   if (config_path.empty()) {
     std::cerr << "optique-master: --config FILE is required (see --help)\n";
     return kExitUsage;
   }
-  auto loaded = load_config_and_scene(config_path);
+  // The master animates the scene but never draws it: its images stay unread.
+  auto loaded = load_run_config(config_path, {});
   if (!loaded) {
     std::cerr << loaded.error() << "\n";
     return kExitUsage;
   }
-  options.config = std::move(loaded.value().first);
-  options.scene = std::move(loaded.value().second);
+  options.config = std::move(loaded.value().config);
+  options.scene = std::move(loaded.value().scene);
   auto secret = load_installation_secret(options.config);
   if (!secret) {
     std::cerr << config::describe_problems({{"master.secret_file", secret.error()}}, config_path) << "\n";
@@ -218,7 +117,7 @@ int run_cli(int argc, char** argv) {
   }
   if (!listen.empty()) settings.set_listen(listen);
   if (port >= 0) settings.set_port(static_cast<std::uint32_t>(port));
-  if (options.node_binary.empty()) options.node_binary = LocalLauncher::sibling_binary("optique-node");
+  if (options.node_binary.empty()) options.node_binary = util::sibling_program("optique-node");
 
   std::string log_file;
   if (!out_dir.empty()) {
@@ -237,7 +136,6 @@ int run_cli(int argc, char** argv) {
   options.out_dir = out_dir;
   // A --local run that captured frames also shows what the screens received.
   const bool local_captures = options.local && options.capture_every != 0;
-  const config::LoadedConfig config_for_composites = options.config;
   options.status_line = !no_status && isatty(STDERR_FILENO) == 1;
   auto logger = log::make_logger("master", log_level, log_file);
   // On a terminal, each log line first clears the status line (stderr only, not the log file).
@@ -251,7 +149,19 @@ int run_cli(int argc, char** argv) {
   }
   io.run();
   const int status = master.exit_code();
-  if (status == kExitOk && local_captures) compose_local_captures(config_for_composites, out_dir, *logger);
+  if (status == kExitOk && local_captures) {
+    // Every frame all projectors captured, into OUT/screens/, logged into master.log too.
+    logger->flush();
+    const std::vector<std::string> args{"--log-level", log_level,  "--log-file", log_file,
+                                        "compose",     "--config", config_path,  "--every-captured-frame",
+                                        "--out",       out_dir};
+    auto composed = util::run_program(util::sibling_program("optique-tools"), args);
+    if (!composed) {
+      logger->error("composites not made: {}", composed.error());
+    } else if (composed.value() != 0) {
+      logger->error("composites not made: optique-tools compose exited with status {}", composed.value());
+    }
+  }
   return status;
 }
 

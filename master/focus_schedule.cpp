@@ -1,4 +1,4 @@
-#include "focus_schedule.h"
+#include "master/focus_schedule.h"
 
 #include <algorithm>
 #include <cmath>

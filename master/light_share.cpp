@@ -1,4 +1,4 @@
-#include "light_share.h"
+#include "master/light_share.h"
 
 #include <algorithm>
 #include <cassert>

@@ -1,11 +1,11 @@
-#include "light_switches.h"
+#include "master/light_switches.h"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <string>
 
-#include "light_share.h"
+#include "master/light_share.h"
 #include "util/number_text.h"
 
 namespace optique::master {

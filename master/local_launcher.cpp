@@ -1,4 +1,4 @@
-#include "local_launcher.h"
+#include "master/local_launcher.h"
 
 #include <fcntl.h>
 #include <sys/prctl.h>
@@ -8,7 +8,6 @@
 #include <cerrno>
 #include <csignal>
 #include <cstring>
-#include <filesystem>
 
 namespace optique::master {
 
@@ -89,13 +88,6 @@ std::vector<ChildExit> LocalLauncher::reap() {
 
 void LocalLauncher::signal_all(int signal) const {
   for (const Child& c : children_) kill(c.pid, signal);
-}
-
-std::string LocalLauncher::sibling_binary(const std::string& name) {
-  std::error_code ec;
-  const auto self = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (ec) return name;
-  return (self.parent_path() / name).string();
 }
 
 }  // namespace optique::master

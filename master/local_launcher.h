@@ -37,9 +37,6 @@ class LocalLauncher {
   void signal_all(int signal) const;
   [[nodiscard]] std::size_t running() const { return children_.size(); }
 
-  // The default node binary: optique-node next to the running executable.
-  [[nodiscard]] static std::string sibling_binary(const std::string& name);
-
  private:
   struct Child {
     std::string id;

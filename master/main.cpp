@@ -1,7 +1,7 @@
 #include <exception>
 #include <iostream>
 
-#include "cli.h"
+#include "master/cli.h"
 
 int main(int argc, char** argv) {
   try {

@@ -1,4 +1,4 @@
-#include "master.h"
+#include "master/master.h"
 
 #include <google/protobuf/util/json_util.h>
 

@@ -15,17 +15,18 @@
 #include <string>
 #include <vector>
 
-#include "barrier.h"
 #include "config/load.h"
-#include "focus_schedule.h"
-#include "local_launcher.h"
+#include "master/barrier.h"
+#include "master/exit_codes.h"
+#include "master/focus_schedule.h"
+#include "master/local_launcher.h"
+#include "master/run_recorder.h"
+#include "master/scene_authority.h"
+#include "master/stacked_groups.h"
+#include "master/status_line.h"
 #include "net/auth.h"
 #include "net/connection.h"
-#include "run_recorder.h"
 #include "scene/load_scene.h"
-#include "scene_authority.h"
-#include "stacked_groups.h"
-#include "status_line.h"
 #include "util/result.h"
 
 namespace optique::master {
@@ -48,11 +49,6 @@ struct MasterOptions {
   std::optional<net::Secret> secret;
   std::string secret_path;  // handed to local nodes
 };
-
-// Process exit statuses, shared by main and the tests.
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitUsage = 2;   // bad config or command line: nothing started
-inline constexpr int kExitFailed = 3;  // could not run: no nodes, cannot listen, ...
 
 // The largest frame a peer may send before its hello is accepted.
 inline constexpr std::uint32_t kMaxHelloBytes = 4096;

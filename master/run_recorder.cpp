@@ -1,4 +1,4 @@
-#include "run_recorder.h"
+#include "master/run_recorder.h"
 
 #include <algorithm>
 #include <cmath>

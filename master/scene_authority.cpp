@@ -1,4 +1,4 @@
-#include "scene_authority.h"
+#include "master/scene_authority.h"
 
 #include "scene/viewer_path.h"
 

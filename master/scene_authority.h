@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "clock/clock.h"
-#include "light_switches.h"
+#include "master/light_switches.h"
 #include "optique/config.pb.h"
 #include "scene/definition.h"
 #include "scene/state.h"

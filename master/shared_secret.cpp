@@ -1,4 +1,4 @@
-#include "shared_secret.h"
+#include "master/shared_secret.h"
 
 #include <filesystem>
 

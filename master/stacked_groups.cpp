@@ -1,4 +1,4 @@
-#include "stacked_groups.h"
+#include "master/stacked_groups.h"
 
 #include <algorithm>
 #include <cassert>
@@ -144,8 +144,8 @@ std::vector<double> group_light_costs(const config::Installation& inst, const St
     if (s.id() == group.screen) screen = &s;
   }
   assert(screen != nullptr);
-  optics::ScreenRect area{{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()},
-                          {std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()}};
+  geometry::ScreenRect area{{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()},
+                            {std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()}};
   for (std::size_t member : group.members) {
     auto geometry = config::projector_geometry(inst.projectors(static_cast<int>(member)));
     if (!geometry) continue;
@@ -154,7 +154,7 @@ std::vector<double> group_light_costs(const config::Installation& inst, const St
       area.max = glm::max(area.max, corner);
     }
   }
-  const optics::ScreenRect usable = config::usable_area(*screen);
+  const geometry::ScreenRect usable = config::usable_area(*screen);
   area.min = glm::clamp(area.min, usable.min, usable.max);
   area.max = glm::clamp(area.max, usable.min, usable.max);
   const glm::dvec3 origin(screen->origin(0), screen->origin(1), screen->origin(2));

@@ -1,4 +1,4 @@
-#include "status_line.h"
+#include "master/status_line.h"
 
 namespace optique::master {
 

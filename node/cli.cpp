@@ -1,4 +1,4 @@
-#include "cli.h"
+#include "node/cli.h"
 
 #include <sys/prctl.h>
 
@@ -6,14 +6,14 @@
 #include <boost/asio/io_context.hpp>
 #include <iostream>
 
-#include "gl_renderer.h"
 #include "log/logger.h"
-#include "node.h"
-#include "null_renderer.h"
+#include "node/node.h"
+#include "node/null_renderer.h"
+#include "util/program.h"
 
 namespace optique::node {
 
-int run_cli(int argc, char** argv) {
+int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
   CLI::App app{"optique-node: renders one projector's share of the picture in sync with the master"};
   NodeOptions options;
   std::string master = "127.0.0.1:7400";
@@ -84,6 +84,13 @@ int run_cli(int argc, char** argv) {
     options.secret = std::move(secret).value();
   }
 
+  if (renderer_kind == "gl" && !make_gl) {
+    const std::vector<std::string> args(argv + 1, argv + argc);
+    const Error failed = util::replace_process(util::sibling_program("optique-node-gl"), argv[0], args);
+    std::cerr << "optique-node: the GL renderer: " << failed.message << " (or run with --renderer null)\n";
+    return kExitRefused;
+  }
+
   // The kernel may wake a sleeper up to its timer slack late (50 µs by default);
   // presents are timed to tens of microseconds.
   prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
@@ -94,7 +101,7 @@ int run_cli(int argc, char** argv) {
   if (renderer_kind == "null") {
     renderer = std::make_unique<NullRenderer>();
   } else {
-    renderer = std::make_unique<GlRenderer>(*logger, capture_dir);
+    renderer = make_gl(*logger, capture_dir);
   }
   Node node(io, std::move(options), *renderer, *logger);
   node.start();

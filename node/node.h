@@ -20,7 +20,7 @@
 #include "net/auth.h"
 #include "net/connection.h"
 #include "net/envelope.h"
-#include "renderer.h"
+#include "node/renderer.h"
 #include "scene/state.h"
 
 namespace optique::node {

@@ -1,4 +1,4 @@
-#include "null_renderer.h"
+#include "node/null_renderer.h"
 
 #include <cassert>
 

@@ -2,7 +2,7 @@
 // Draws nothing: for runs that measure the cluster's own costs (barrier, clock,
 // network) without any rendering in the way.
 
-#include "renderer.h"
+#include "node/renderer.h"
 
 namespace optique::node {
 

@@ -22,9 +22,9 @@ struct TrackerSummary {
 };
 
 struct Calibration {
-  HomographyFit fit;                            // its warnings include the file's and the tracker's
-  std::vector<Correspondence> correspondences;  // in the screen frame
-  std::optional<TrackerSummary> tracker;        // tracker input only
+  HomographyFit fit;                                      // its warnings include the file's and the tracker's
+  std::vector<geometry::Correspondence> correspondences;  // in the screen frame
+  std::optional<TrackerSummary> tracker;                  // tracker input only
 };
 
 // A given frame whose z = 0 misses this projector's readings by more than this

@@ -10,7 +10,7 @@
 
 namespace optique::calib {
 
-Result<Orientation> check_orientation(const glm::dmat3& h, std::span<const Correspondence> points,
+Result<Orientation> check_orientation(const glm::dmat3& h, std::span<const geometry::Correspondence> points,
                                       std::span<const std::size_t> used) {
   const double det = glm::determinant(h);
   Orientation o;
@@ -21,7 +21,7 @@ Result<Orientation> check_orientation(const glm::dmat3& h, std::span<const Corre
   bool any_positive = false;
   bool any_negative = false;
   for (const std::size_t i : used) {
-    const double w = homogeneous_w(h, points[i].screen);
+    const double w = geometry::homogeneous_w(h, points[i].screen);
     if (w > 0.0 && !any_positive) positive = i, any_positive = true;
     if (w <= 0.0 && !any_negative) negative = i, any_negative = true;
     const double j = det / (w * w * w);
@@ -31,8 +31,8 @@ Result<Orientation> check_orientation(const glm::dmat3& h, std::span<const Corre
   if (any_positive && any_negative) {
     const std::size_t first = std::min(positive, negative);
     const std::size_t second = std::max(positive, negative);
-    const double w1 = homogeneous_w(h, points[first].screen);
-    const double w2 = homogeneous_w(h, points[second].screen);
+    const double w1 = geometry::homogeneous_w(h, points[first].screen);
+    const double w2 = geometry::homogeneous_w(h, points[second].screen);
     const double scale = std::max(std::abs(w1), std::abs(w2));
     return Error{fmt::format(
         "the fit flips orientation: points[{}] and points[{}] land on opposite sides of the projector's horizon "
@@ -43,14 +43,14 @@ Result<Orientation> check_orientation(const glm::dmat3& h, std::span<const Corre
   return o;
 }
 
-Result<void> check_horizon_outside_image(const glm::dmat3& h, ImageSize image, double points_w_sign) {
+Result<void> check_horizon_outside_image(const glm::dmat3& h, geometry::ImageSize image, double points_w_sign) {
   const glm::dmat3 inverse = glm::inverse(h);
   const std::array<glm::dvec2, 4> corners{glm::dvec2(0.0, 0.0), glm::dvec2(image.width, 0.0),
                                           glm::dvec2(image.width, image.height), glm::dvec2(0.0, image.height)};
   // The screen point of pixel p is H⁻¹p = s/w: its w has the sign of the w the
   // points have when the pixel is on their side of the horizon.
   for (const auto& corner : corners) {
-    const double w = homogeneous_w(inverse, corner);
+    const double w = geometry::homogeneous_w(inverse, corner);
     if (!(w * points_w_sign > 0.0)) {
       return Error{fmt::format(
           "the projector's horizon crosses its image: pixel corner ({:g}, {:g}) of the {}×{} image maps beyond "
@@ -62,7 +62,8 @@ Result<void> check_horizon_outside_image(const glm::dmat3& h, ImageSize image, d
   return {};
 }
 
-double pixel_coverage(std::span<const Correspondence> points, std::span<const std::size_t> used, ImageSize image) {
+double pixel_coverage(std::span<const geometry::Correspondence> points, std::span<const std::size_t> used,
+                      geometry::ImageSize image) {
   glm::dvec2 low = points[used.front()].pixel;
   glm::dvec2 high = low;
   for (const std::size_t i : used) {

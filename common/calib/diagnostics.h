@@ -10,7 +10,7 @@
 
 #include <glm/mat3x3.hpp>
 
-#include "calib/homography.h"
+#include "geometry/homography.h"
 #include "util/result.h"
 
 namespace optique::calib {
@@ -27,16 +27,18 @@ struct Orientation {
 // Fails ("the fit flips orientation") when the points in `used` are on both
 // sides of the projector's horizon: w = (H·[X Y 1]ᵀ)_z, and with it the sign of
 // the Jacobian determinant det(H)/w³, differs among them.
-[[nodiscard]] Result<Orientation> check_orientation(const glm::dmat3& h, std::span<const Correspondence> points,
+[[nodiscard]] Result<Orientation> check_orientation(const glm::dmat3& h,
+                                                    std::span<const geometry::Correspondence> points,
                                                     std::span<const std::size_t> used);
 
 // Fails when the horizon (the pixels whose screen point is at infinity) crosses
 // the image: some pixel corner maps to the other side of it than the points do.
-[[nodiscard]] Result<void> check_horizon_outside_image(const glm::dmat3& h, ImageSize image, double points_w_sign);
+[[nodiscard]] Result<void> check_horizon_outside_image(const glm::dmat3& h, geometry::ImageSize image,
+                                                       double points_w_sign);
 
 // The bounding box of the used points' pixels as a fraction of the image area.
-[[nodiscard]] double pixel_coverage(std::span<const Correspondence> points, std::span<const std::size_t> used,
-                                    ImageSize image);
+[[nodiscard]] double pixel_coverage(std::span<const geometry::Correspondence> points, std::span<const std::size_t> used,
+                                    geometry::ImageSize image);
 // Below this the fit extrapolates over most of the image.
 inline constexpr double kLowCoverage = 0.25;
 

@@ -9,7 +9,7 @@
 
 namespace optique::calib {
 
-std::optional<DltSolution> solve_dlt(std::span<const Correspondence> points) {
+std::optional<DltSolution> solve_dlt(std::span<const geometry::Correspondence> points) {
   if (points.size() < 4) return std::nullopt;
   std::vector<glm::dvec2> screen;
   std::vector<glm::dvec2> pixel;

@@ -9,7 +9,7 @@
 
 #include <glm/mat3x3.hpp>
 
-#include "calib/homography.h"
+#include "geometry/homography.h"
 
 namespace optique::calib {
 
@@ -20,6 +20,6 @@ struct DltSolution {
 
 // Does not validate the points (calib/point_checks.h does); nullopt when fewer
 // than 4 are given or the SVD gives non-finite numbers.
-[[nodiscard]] std::optional<DltSolution> solve_dlt(std::span<const Correspondence> points);
+[[nodiscard]] std::optional<DltSolution> solve_dlt(std::span<const geometry::Correspondence> points);
 
 }  // namespace optique::calib

@@ -17,8 +17,9 @@ namespace {
 // How many points a warning names before it says "and N more".
 constexpr std::size_t kNamedOutliers = 8;
 
-std::vector<Correspondence> select(std::span<const Correspondence> points, std::span<const std::size_t> indices) {
-  std::vector<Correspondence> subset;
+std::vector<geometry::Correspondence> select(std::span<const geometry::Correspondence> points,
+                                             std::span<const std::size_t> indices) {
+  std::vector<geometry::Correspondence> subset;
   subset.reserve(indices.size());
   for (const std::size_t i : indices) subset.push_back(points[i]);
   return subset;
@@ -35,10 +36,11 @@ double frobenius(const glm::dmat3& h) {
 // h33 = 1 when that is a sound scale. When the screen origin is on the
 // projector's horizon h33 → 0 and dividing by it would blow the other entries
 // up (or divide by zero): then unit norm, with w > 0 at the points.
-glm::dmat3 normalize_scale(const glm::dmat3& h, const Correspondence& reference, std::vector<std::string>& warnings) {
+glm::dmat3 normalize_scale(const glm::dmat3& h, const geometry::Correspondence& reference,
+                           std::vector<std::string>& warnings) {
   const double norm = frobenius(h);
   if (std::abs(h[2][2]) >= kTinyH33 * norm) return h / h[2][2];
-  const double sign = homogeneous_w(h, reference.screen) < 0.0 ? -1.0 : 1.0;
+  const double sign = geometry::homogeneous_w(h, reference.screen) < 0.0 ? -1.0 : 1.0;
   warnings.push_back(fmt::format(
       "h33 ≈ 0 (|h33| = {:.2g} ‖H‖): the screen origin lies on the projector's horizon (a33 → 0), so H is scaled to "
       "unit norm instead of h33 = 1; the fit is sound, but an origin inside the lit area makes a better-scaled file",
@@ -46,10 +48,10 @@ glm::dmat3 normalize_scale(const glm::dmat3& h, const Correspondence& reference,
   return h * (sign / norm);
 }
 
-double rms_over(const glm::dmat3& h, std::span<const Correspondence> points) {
+double rms_over(const glm::dmat3& h, std::span<const geometry::Correspondence> points) {
   double sum = 0.0;
   for (const auto& c : points) {
-    const double e = reprojection_error(h, c);
+    const double e = geometry::reprojection_error(h, c);
     sum += e * e;
   }
   return std::sqrt(sum / static_cast<double>(points.size()));
@@ -64,7 +66,8 @@ std::string outlier_list(std::span<const Outlier> outliers) {
   return text;
 }
 
-void add_image_diagnostics(HomographyFit& fit, std::span<const Correspondence> points, ImageSize image) {
+void add_image_diagnostics(HomographyFit& fit, std::span<const geometry::Correspondence> points,
+                           geometry::ImageSize image) {
   const double coverage = pixel_coverage(points, fit.inliers, image);
   fit.coverage = coverage;
   if (coverage < kLowCoverage) {
@@ -79,7 +82,7 @@ void add_image_diagnostics(HomographyFit& fit, std::span<const Correspondence> p
         "({:.0f}, {:.0f})): the fit extrapolates over the rest of the image; spread the points over all of it",
         100.0 * coverage, image.width, image.height, high.x - low.x, high.y - low.y, low.x, low.y, high.x, high.y));
   }
-  auto oblique = oblique_depth(fit.homography, image);
+  auto oblique = geometry::oblique_depth(fit.homography, image);
   if (!oblique) {
     fit.warnings.push_back("no single-pass oblique projection for this projector: " + oblique.error());
     return;
@@ -87,19 +90,19 @@ void add_image_diagnostics(HomographyFit& fit, std::span<const Correspondence> p
   const double f = oblique.value().factor;
   fit.oblique = oblique.value();
   const double k = oblique.value().depth_scale;
-  if (f >= kDepthFactorWarning) {
+  if (f >= geometry::kDepthFactorWarning) {
     fit.warnings.push_back(fmt::format(
         "the oblique depth factor |a31| + |a32| is {:.3f} (≥ {}): Raskar's approximated depth (eq. 5) would keep "
         "1 − |a31| − |a32| = {:.3f} of the depth range{}; optique bounds depth over the lit area instead and keeps "
         "{:.3f} of it{}",
-        f, kDepthFactorWarning, 1.0 - f, f >= 1.0 ? " (nothing: single-pass depth would fail)" : "", k,
+        f, geometry::kDepthFactorWarning, 1.0 - f, f >= 1.0 ? " (nothing: single-pass depth would fail)" : "", k,
         k < 0.1 ? ", so depth precision drops: a less oblique projector helps" : ""));
   }
 }
 
 }  // namespace
 
-Result<HomographyFit> fit_homography(std::span<const Correspondence> points, const FitOptions& options) {
+Result<HomographyFit> fit_homography(std::span<const geometry::Correspondence> points, const FitOptions& options) {
   if (auto checked = check_points(points); !checked) return Error{checked.error()};
   HomographyFit fit;
   fit.warnings = near_line_warnings(points);
@@ -126,7 +129,7 @@ Result<HomographyFit> fit_homography(std::span<const Correspondence> points, con
       dlt_of_used.reset();
     }
   }
-  std::vector<Correspondence> subset = select(points, used);
+  std::vector<geometry::Correspondence> subset = select(points, used);
   const auto dlt = dlt_of_used ? dlt_of_used : solve_dlt(subset);
   if (!dlt || !std::isfinite(dlt->condition)) {
     return Error{"the points fix no homography (the DLT system has a second null vector: condition ∞)"};
@@ -156,7 +159,7 @@ Result<HomographyFit> fit_homography(std::span<const Correspondence> points, con
 
   double sum = 0.0;
   fit.residuals_px.reserve(points.size());
-  for (const auto& c : points) fit.residuals_px.push_back(reprojection_error(h, c));
+  for (const auto& c : points) fit.residuals_px.push_back(geometry::reprojection_error(h, c));
   for (const std::size_t i : used) {
     const double e = fit.residuals_px[i];
     sum += e * e;
@@ -204,7 +207,7 @@ Result<HomographyFit> fit_homography(std::span<const Correspondence> points, con
   }
 
   if (options.image) {
-    const double w_sign = homogeneous_w(h, points[used.front()].screen) > 0.0 ? 1.0 : -1.0;
+    const double w_sign = geometry::homogeneous_w(h, points[used.front()].screen) > 0.0 ? 1.0 : -1.0;
     if (auto horizon = check_horizon_outside_image(h, *options.image, w_sign); !horizon) {
       return Error{horizon.error()};
     }

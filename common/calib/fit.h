@@ -14,9 +14,9 @@
 #include <glm/mat3x3.hpp>
 
 #include "calib/diagnostics.h"
-#include "calib/homography.h"
-#include "calib/oblique_depth.h"
 #include "calib/robust.h"
+#include "geometry/homography.h"
+#include "geometry/oblique_depth.h"
 #include "util/result.h"
 
 namespace optique::calib {
@@ -29,7 +29,7 @@ struct FitOptions {
   RansacOptions ransac;
   // The projector's image size, when known: enables the checks on coverage, on
   // the horizon crossing the image, and on the oblique depth factor.
-  std::optional<ImageSize> image;
+  std::optional<geometry::ImageSize> image;
 };
 
 // |h33| below this fraction of ‖H‖ (the screen origin on the projector's
@@ -51,12 +51,12 @@ struct HomographyFit {
   // above the median (kept in the fit, and warned about). Worst first.
   std::vector<Outlier> outliers;
   Orientation orientation;
-  std::optional<double> coverage;       // with an image size: pixels' bounding box / image area
-  std::optional<ObliqueDepth> oblique;  // with an image size: A and |a31| + |a32|
+  std::optional<double> coverage;                 // with an image size: pixels' bounding box / image area
+  std::optional<geometry::ObliqueDepth> oblique;  // with an image size: A and |a31| + |a32|
   std::vector<std::string> warnings;
 };
 
-[[nodiscard]] Result<HomographyFit> fit_homography(std::span<const Correspondence> points,
+[[nodiscard]] Result<HomographyFit> fit_homography(std::span<const geometry::Correspondence> points,
                                                    const FitOptions& options = {});
 
 }  // namespace optique::calib

@@ -16,7 +16,7 @@ enum class Side { kScreen, kPixel };
 
 const char* side_name(Side side) { return side == Side::kScreen ? "screen" : "pixel"; }
 const char* unit(Side side) { return side == Side::kScreen ? "m" : "px"; }
-glm::dvec2 at(const Correspondence& c, Side side) { return side == Side::kScreen ? c.screen : c.pixel; }
+glm::dvec2 at(const geometry::Correspondence& c, Side side) { return side == Side::kScreen ? c.screen : c.pixel; }
 
 double cross(const glm::dvec2& a, const glm::dvec2& b) { return a.x * b.y - a.y * b.x; }
 
@@ -26,7 +26,7 @@ double distance_from_line(const glm::dvec2& p, const glm::dvec2& q, const glm::d
   return std::abs(cross(d, x - p)) / std::hypot(d.x, d.y);
 }
 
-double extent(std::span<const Correspondence> points, Side side) {
+double extent(std::span<const geometry::Correspondence> points, Side side) {
   glm::dvec2 low = at(points.front(), side);
   glm::dvec2 high = low;
   for (const auto& c : points) {
@@ -44,7 +44,7 @@ struct Triple {
   double span = 0.0;
 };
 
-Triple measure_triple(std::span<const Correspondence> points, std::array<std::size_t, 3> idx, Side side) {
+Triple measure_triple(std::span<const geometry::Correspondence> points, std::array<std::size_t, 3> idx, Side side) {
   const auto p = [&](std::size_t k) { return at(points[idx[k]], side); };
   const std::array<std::array<std::size_t, 3>, 3> orders{{{0, 1, 2}, {0, 2, 1}, {1, 2, 0}}};
   Triple best;
@@ -69,7 +69,7 @@ struct OnLine {
   double distance = 0.0;
 };
 
-std::optional<OnLine> all_but_one_on_a_line(std::span<const Correspondence> points, Side side) {
+std::optional<OnLine> all_but_one_on_a_line(std::span<const geometry::Correspondence> points, Side side) {
   const double tolerance = kOnLineRelative * extent(points, side);
   const std::array<std::array<std::size_t, 2>, 3> pairs{{{0, 1}, {0, 2}, {1, 2}}};
   for (const auto& pair : pairs) {
@@ -103,7 +103,7 @@ std::string names(std::span<const std::size_t> indices) {
 
 }  // namespace
 
-Result<void> check_points(std::span<const Correspondence> points) {
+Result<void> check_points(std::span<const geometry::Correspondence> points) {
   if (points.size() < 4) {
     return Error{fmt::format("a homography needs at least 4 correspondences (got {})", points.size())};
   }
@@ -157,7 +157,7 @@ Result<void> check_points(std::span<const Correspondence> points) {
   return {};
 }
 
-std::vector<std::string> near_line_warnings(std::span<const Correspondence> points) {
+std::vector<std::string> near_line_warnings(std::span<const geometry::Correspondence> points) {
   std::vector<std::string> warnings;
   if (points.size() > kNearLineMaxPoints) return warnings;
   for (std::size_t a = 0; a < points.size(); ++a) {
@@ -181,7 +181,7 @@ std::vector<std::string> near_line_warnings(std::span<const Correspondence> poin
   return warnings;
 }
 
-bool has_three_on_a_line(std::span<const Correspondence> points, double relative) {
+bool has_three_on_a_line(std::span<const geometry::Correspondence> points, double relative) {
   for (std::size_t a = 0; a < points.size(); ++a) {
     for (std::size_t b = a + 1; b < points.size(); ++b) {
       for (std::size_t c = b + 1; c < points.size(); ++c) {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "calib/homography.h"
+#include "geometry/homography.h"
 #include "util/result.h"
 
 namespace optique::calib {
@@ -24,14 +24,14 @@ inline constexpr std::size_t kNearLineMaxPoints = 6;
 // Errors: fewer than 4 points, a non-finite coordinate, a repeated point, all
 // points or all but one on one line (on the screen or in the pixels): then no 4
 // of them are in general position and they fix no homography.
-[[nodiscard]] Result<void> check_points(std::span<const Correspondence> points);
+[[nodiscard]] Result<void> check_points(std::span<const geometry::Correspondence> points);
 
 // Warnings for three points nearly on one line (screen or pixel side), checked
 // when the set is small (kNearLineMaxPoints) so that the three are a large part of it.
-[[nodiscard]] std::vector<std::string> near_line_warnings(std::span<const Correspondence> points);
+[[nodiscard]] std::vector<std::string> near_line_warnings(std::span<const geometry::Correspondence> points);
 
 // Whether three of these points are on one line within `relative` of their span
 // on either side: RANSAC skips such minimal samples.
-[[nodiscard]] bool has_three_on_a_line(std::span<const Correspondence> points, double relative);
+[[nodiscard]] bool has_three_on_a_line(std::span<const geometry::Correspondence> points, double relative);
 
 }  // namespace optique::calib

@@ -19,7 +19,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "calib/homography.h"
+#include "geometry/homography.h"
 #include "util/result.h"
 
 namespace optique::calib {
@@ -27,7 +27,7 @@ namespace optique::calib {
 enum class PointKind { kScreen, kTracker };
 
 struct PointsFile {
-  ImageSize projector;
+  geometry::ImageSize projector;
   PointKind kind = PointKind::kScreen;
   std::vector<glm::dvec2> pixels;
   std::vector<glm::dvec2> screen;   // kind == kScreen: one per pixel

@@ -85,7 +85,7 @@ double rms(const Eigen::VectorXd& residuals, double to_pixels) {
 
 }  // namespace
 
-Refinement refine_homography(const glm::dmat3& initial, std::span<const Correspondence> points) {
+Refinement refine_homography(const glm::dmat3& initial, std::span<const geometry::Correspondence> points) {
   std::vector<glm::dvec2> screen_points;
   std::vector<glm::dvec2> pixel_points;
   for (const auto& c : points) {

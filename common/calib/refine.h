@@ -9,7 +9,7 @@
 
 #include <glm/mat3x3.hpp>
 
-#include "calib/homography.h"
+#include "geometry/homography.h"
 
 namespace optique::calib {
 
@@ -24,6 +24,6 @@ struct Refinement {
 // with 8 parameters (the entry of the normalized H largest at the start stays
 // fixed), so it is well conditioned for metres against 8K pixels and for any
 // entry, h33 included, going to 0. Never returns a worse fit than `initial`.
-[[nodiscard]] Refinement refine_homography(const glm::dmat3& initial, std::span<const Correspondence> points);
+[[nodiscard]] Refinement refine_homography(const glm::dmat3& initial, std::span<const geometry::Correspondence> points);
 
 }  // namespace optique::calib

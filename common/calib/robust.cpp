@@ -23,18 +23,19 @@ constexpr int kMinSamples = 10;
 // The four sample points all on one side of the sample's horizon: a sample whose
 // quadrilateral is twisted (a bow tie) on one side fits an H that flips
 // orientation between them, which no projector does.
-bool keeps_orientation(const glm::dmat3& h, std::span<const Correspondence> sample) {
-  const double first = homogeneous_w(h, sample.front().screen);
-  return std::all_of(sample.begin(), sample.end(),
-                     [&](const Correspondence& c) { return homogeneous_w(h, c.screen) * first > 0.0; });
+bool keeps_orientation(const glm::dmat3& h, std::span<const geometry::Correspondence> sample) {
+  const double first = geometry::homogeneous_w(h, sample.front().screen);
+  return std::all_of(sample.begin(), sample.end(), [&](const geometry::Correspondence& c) {
+    return geometry::homogeneous_w(h, c.screen) * first > 0.0;
+  });
 }
 
 // MSAC cost: inliers pay their squared error, others the squared threshold, so
 // that among samples with as many inliers the tighter fit wins.
-double msac_cost(const glm::dmat3& h, std::span<const Correspondence> points, double threshold) {
+double msac_cost(const glm::dmat3& h, std::span<const geometry::Correspondence> points, double threshold) {
   double cost = 0.0;
   for (const auto& c : points) {
-    const double e = reprojection_error(h, c);
+    const double e = geometry::reprojection_error(h, c);
     cost += std::isfinite(e) ? std::min(e * e, threshold * threshold) : threshold * threshold;
   }
   return cost;
@@ -52,15 +53,16 @@ int samples_needed(double inlier_ratio, double confidence, int cap) {
 
 }  // namespace
 
-std::vector<std::size_t> inliers_of(const glm::dmat3& h, std::span<const Correspondence> points, double threshold_px) {
+std::vector<std::size_t> inliers_of(const glm::dmat3& h, std::span<const geometry::Correspondence> points,
+                                    double threshold_px) {
   std::vector<std::size_t> inliers;
   for (std::size_t i = 0; i < points.size(); ++i) {
-    if (reprojection_error(h, points[i]) <= threshold_px) inliers.push_back(i);
+    if (geometry::reprojection_error(h, points[i]) <= threshold_px) inliers.push_back(i);
   }
   return inliers;
 }
 
-Result<Consensus> find_consensus(std::span<const Correspondence> points, const RansacOptions& options) {
+Result<Consensus> find_consensus(std::span<const geometry::Correspondence> points, const RansacOptions& options) {
   if (points.size() < 4) {
     return Error{fmt::format("robust mode needs at least 4 correspondences (got {})", points.size())};
   }
@@ -78,7 +80,7 @@ Result<Consensus> find_consensus(std::span<const Correspondence> points, const R
       } while (std::find(index.begin(), index.begin() + static_cast<std::ptrdiff_t>(k), index[k]) !=
                index.begin() + static_cast<std::ptrdiff_t>(k));
     }
-    std::array<Correspondence, 4> sample{};
+    std::array<geometry::Correspondence, 4> sample{};
     for (std::size_t k = 0; k < 4; ++k) sample[k] = points[index[k]];
     if (has_three_on_a_line(sample, kSampleLineRelative)) {
       ++best.degenerate_samples;

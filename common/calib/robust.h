@@ -9,7 +9,7 @@
 
 #include <glm/mat3x3.hpp>
 
-#include "calib/homography.h"
+#include "geometry/homography.h"
 #include "util/result.h"
 
 namespace optique::calib {
@@ -29,10 +29,12 @@ struct Consensus {
 };
 
 // Fails when no sample of 4 gives a usable H or fewer than 4 points agree with it.
-[[nodiscard]] Result<Consensus> find_consensus(std::span<const Correspondence> points, const RansacOptions& options);
+[[nodiscard]] Result<Consensus> find_consensus(std::span<const geometry::Correspondence> points,
+                                               const RansacOptions& options);
 
 // Indices of the points within `threshold_px` of `homography`, ascending.
-[[nodiscard]] std::vector<std::size_t> inliers_of(const glm::dmat3& homography, std::span<const Correspondence> points,
+[[nodiscard]] std::vector<std::size_t> inliers_of(const glm::dmat3& homography,
+                                                  std::span<const geometry::Correspondence> points,
                                                   double threshold_px);
 
 }  // namespace optique::calib

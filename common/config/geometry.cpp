@@ -2,20 +2,21 @@
 
 #include <filesystem>
 
+#include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 
-#include "calib/calibration_file.h"
+#include "config/calibration_file.h"
 
 namespace optique::config {
 namespace {
 
 glm::dmat3 matrix_of(const google::protobuf::RepeatedField<double>& nine) {
-  return optics::homography_from_rows(std::span<const double, 9>(nine.data(), 9));
+  return geometry::homography_from_rows(std::span<const double, 9>(nine.data(), 9));
 }
 
 void store(Projector& projector, const glm::dmat3& homography) {
   projector.clear_homography();
-  for (double v : optics::homography_rows(homography)) projector.add_homography(v);
+  for (double v : geometry::homography_rows(homography)) projector.add_homography(v);
 }
 
 const Screen* screen_of(const Installation& installation, const Projector& projector) {
@@ -26,6 +27,24 @@ const Screen* screen_of(const Installation& installation, const Projector& proje
 }
 
 }  // namespace
+
+geometry::WorldRect screen_region(const Screen& screen, const Region& region) {
+  geometry::WorldRect rect;
+  const glm::dvec3 origin(screen.origin(0), screen.origin(1), screen.origin(2));
+  rect.right = glm::normalize(glm::dvec3(screen.right(0), screen.right(1), screen.right(2)));
+  rect.up = glm::normalize(glm::dvec3(screen.up(0), screen.up(1), screen.up(2)));
+  rect.lower_left = origin + rect.right * region.x() + rect.up * region.y();
+  rect.width = region.width();
+  rect.height = region.height();
+  return rect;
+}
+
+geometry::WorldRect whole_screen(const Screen& screen) {
+  Region region;
+  region.set_width(screen.width());
+  region.set_height(screen.height());
+  return screen_region(screen, region);
+}
 
 bool same_screen_image(const Projector& a, const Projector& b) {
   return a.screen() == b.screen() && a.eye() == b.eye();
@@ -42,21 +61,21 @@ bool same_blend_group(const Projector& a, const Projector& b) {
   return same_screen_image(a, b) && (a.id() == b.id() || same_layer(a, b));
 }
 
-optics::ScreenRect usable_area(const Screen& screen) {
-  return optics::ScreenRect{glm::dvec2(0.0), glm::dvec2(screen.width(), screen.height())};
+geometry::ScreenRect usable_area(const Screen& screen) {
+  return geometry::ScreenRect{glm::dvec2(0.0), glm::dvec2(screen.width(), screen.height())};
 }
 
-Result<optics::ProjectorGeometry> projector_geometry(const Projector& projector) {
+Result<geometry::ProjectorGeometry> projector_geometry(const Projector& projector) {
   const int width = static_cast<int>(projector.width());
   const int height = static_cast<int>(projector.height());
   if (projector.homography_size() == 9) {
-    return optics::ProjectorGeometry::make(matrix_of(projector.homography()), width, height);
+    return geometry::ProjectorGeometry::make(matrix_of(projector.homography()), width, height);
   }
   if (!projector.has_region())
     return Error{"projector '" + projector.id() + "' has no geometry (load the config first)"};
   const Region& r = projector.region();
-  const optics::ScreenRect rect{glm::dvec2(r.x(), r.y()), glm::dvec2(r.x() + r.width(), r.y() + r.height())};
-  return optics::ProjectorGeometry::make(optics::aligned_homography(rect, width, height), width, height);
+  const geometry::ScreenRect rect{glm::dvec2(r.x(), r.y()), glm::dvec2(r.x() + r.width(), r.y() + r.height())};
+  return geometry::ProjectorGeometry::make(geometry::aligned_homography(rect, width, height), width, height);
 }
 
 std::vector<Problem> resolve_geometry(Installation& installation, const std::string& config_dir) {
@@ -66,7 +85,7 @@ std::vector<Problem> resolve_geometry(Installation& installation, const std::str
   for (int i = 0; i < installation.projectors_size(); ++i) {
     Projector& p = *installation.mutable_projectors(i);
     if (!p.calibration().empty()) {
-      auto h = calib::read_calibration_homography((std::filesystem::path(config_dir) / p.calibration()).string());
+      auto h = config::read_calibration_homography((std::filesystem::path(config_dir) / p.calibration()).string());
       if (!h) {
         problems.push_back({at(i) + ".calibration", h.error()});
         continue;
@@ -109,7 +128,7 @@ std::vector<Problem> resolve_geometry(Installation& installation, const std::str
       problems.push_back({at(i) + ".homography", geometry.error()});
       continue;
     }
-    if (auto oblique = optics::oblique_projection(geometry.value(), usable_area(*screen)); !oblique) {
+    if (auto oblique = geometry::oblique_projection(geometry.value(), usable_area(*screen)); !oblique) {
       problems.push_back({at(i), oblique.error() + " (screen '" + screen->id() + "')"});
     }
   }

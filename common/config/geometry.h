@@ -9,7 +9,8 @@
 #include <vector>
 
 #include "config/validate.h"
-#include "optics/projector_geometry.h"
+#include "geometry/projection.h"
+#include "geometry/projector_geometry.h"
 #include "optique/config.pb.h"
 #include "util/result.h"
 
@@ -33,10 +34,15 @@ namespace optique::config {
 // light is meant to add.
 [[nodiscard]] bool same_blend_group(const Projector& a, const Projector& b);
 
+// The part of `screen` that `region` (metres in the screen's frame) covers, in
+// world space; and the whole screen.
+[[nodiscard]] geometry::WorldRect screen_region(const Screen& screen, const Region& region);
+[[nodiscard]] geometry::WorldRect whole_screen(const Screen& screen);
+
 // The screen area that is shown: the whole screen rectangle.
-[[nodiscard]] optics::ScreenRect usable_area(const Screen& screen);
+[[nodiscard]] geometry::ScreenRect usable_area(const Screen& screen);
 
 // The geometry of a resolved projector: from its homography, or its region.
-[[nodiscard]] Result<optics::ProjectorGeometry> projector_geometry(const Projector& projector);
+[[nodiscard]] Result<geometry::ProjectorGeometry> projector_geometry(const Projector& projector);
 
 }  // namespace optique::config

@@ -7,7 +7,7 @@
 #include <set>
 
 #include "config/defaults.h"
-#include "optics/projector_model.h"
+#include "config/response.h"
 #include "scene/builtin.h"
 #include "util/number_text.h"
 
@@ -304,7 +304,7 @@ void check_projectors(Checker& check, const Installation& inst, const std::strin
     check.one_of(at + ".eye", p.eye(), {"mono", "left", "right"});
     check.one_of(at + ".rendering", p.rendering(), {"single-pass", "two-pass"});
     check.non_negative(at + ".blend_ramp", p.blend_ramp());
-    if (auto model = optics::ProjectorModel::from_config(p); !model) {
+    if (auto model = parse_response(p); !model) {
       // The model's messages start with the field ("response.table[3]: …").
       const std::string& e = model.error();
       const auto colon = e.find(": ");

@@ -47,18 +47,19 @@ double blend_rolloff(double distance, double ramp) {
   return t * t * (3.0 - 2.0 * t);
 }
 
-BlendField::BlendField(std::span<const ProjectorGeometry> group, const ScreenRect& usable, double ramp)
+BlendField::BlendField(std::span<const geometry::ProjectorGeometry> group, const geometry::ScreenRect& usable,
+                       double ramp)
     : ramps_(group.size(), ramp), usable_(usable) {
   distances_.reserve(group.size());
-  for (const ProjectorGeometry& g : group) distances_.emplace_back(g.lit_quad());
+  for (const geometry::ProjectorGeometry& g : group) distances_.emplace_back(g.lit_quad());
 }
 
-BlendField::BlendField(std::span<const ProjectorGeometry> group, const ScreenRect& usable,
+BlendField::BlendField(std::span<const geometry::ProjectorGeometry> group, const geometry::ScreenRect& usable,
                        std::span<const double> ramps)
     : ramps_(ramps.begin(), ramps.end()), usable_(usable) {
   assert(ramps.size() == group.size());
   distances_.reserve(group.size());
-  for (const ProjectorGeometry& g : group) distances_.emplace_back(g.lit_quad());
+  for (const geometry::ProjectorGeometry& g : group) distances_.emplace_back(g.lit_quad());
 }
 
 double BlendField::weight(std::size_t self, const glm::dvec2& screen) const {
@@ -90,7 +91,8 @@ bool BlendField::covered(const glm::dvec2& screen) const {
   return false;
 }
 
-image::FloatImage blend_weights(const BlendField& field, const ProjectorGeometry& geometry, std::size_t self) {
+image::FloatImage blend_weights(const BlendField& field, const geometry::ProjectorGeometry& geometry,
+                                std::size_t self) {
   image::FloatImage weights(geometry.width(), geometry.height(), 1);
   const glm::dmat3& to_screen = geometry.pixel_to_screen();
   for (int y = 0; y < geometry.height(); ++y) {
@@ -106,14 +108,14 @@ image::FloatImage blend_weights(const BlendField& field, const ProjectorGeometry
   return weights;
 }
 
-image::FloatImage blend_weights(std::span<const ProjectorGeometry> group, std::size_t self, const ScreenRect& usable,
-                                double ramp) {
+image::FloatImage blend_weights(std::span<const geometry::ProjectorGeometry> group, std::size_t self,
+                                const geometry::ScreenRect& usable, double ramp) {
   assert(self < group.size());
   return blend_weights(BlendField(group, usable, ramp), group[self], self);
 }
 
-double blend_weight(std::span<const ProjectorGeometry> group, std::size_t self, const ScreenRect& usable, double ramp,
-                    const glm::dvec2& screen) {
+double blend_weight(std::span<const geometry::ProjectorGeometry> group, std::size_t self,
+                    const geometry::ScreenRect& usable, double ramp, const glm::dvec2& screen) {
   return BlendField(group, usable, ramp).weight(self, screen);
 }
 

@@ -24,8 +24,8 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "geometry/projector_geometry.h"
 #include "image/image.h"
-#include "optics/projector_geometry.h"
 
 namespace optique::optics {
 
@@ -59,9 +59,10 @@ class QuadDistance {
 class BlendField {
  public:
   // One ramp for every projector of the group (metres, 0 = default d²).
-  BlendField(std::span<const ProjectorGeometry> group, const ScreenRect& usable, double ramp);
+  BlendField(std::span<const geometry::ProjectorGeometry> group, const geometry::ScreenRect& usable, double ramp);
   // One ramp per projector (`ramps.size() == group.size()`).
-  BlendField(std::span<const ProjectorGeometry> group, const ScreenRect& usable, std::span<const double> ramps);
+  BlendField(std::span<const geometry::ProjectorGeometry> group, const geometry::ScreenRect& usable,
+             std::span<const double> ramps);
 
   [[nodiscard]] std::size_t size() const { return distances_.size(); }
   // Weight of projector `self` at screen point `screen` (metres, screen frame).
@@ -76,19 +77,19 @@ class BlendField {
  private:
   std::vector<QuadDistance> distances_;
   std::vector<double> ramps_;
-  ScreenRect usable_;
+  geometry::ScreenRect usable_;
 };
 
 // The weight image of projector `self` of `group`: one channel, the projector's
 // width × height, evaluated at its pixel centres s = H⁻¹(x + ½, y + ½).
-[[nodiscard]] image::FloatImage blend_weights(std::span<const ProjectorGeometry> group, std::size_t self,
-                                              const ScreenRect& usable, double ramp);
-[[nodiscard]] image::FloatImage blend_weights(const BlendField& field, const ProjectorGeometry& geometry,
+[[nodiscard]] image::FloatImage blend_weights(std::span<const geometry::ProjectorGeometry> group, std::size_t self,
+                                              const geometry::ScreenRect& usable, double ramp);
+[[nodiscard]] image::FloatImage blend_weights(const BlendField& field, const geometry::ProjectorGeometry& geometry,
                                               std::size_t self);
 
 // The weight of projector `self` at one screen point (same as BlendField::weight;
 // convenient for one-off checks, it rebuilds the field each call).
-[[nodiscard]] double blend_weight(std::span<const ProjectorGeometry> group, std::size_t self, const ScreenRect& usable,
-                                  double ramp, const glm::dvec2& screen);
+[[nodiscard]] double blend_weight(std::span<const geometry::ProjectorGeometry> group, std::size_t self,
+                                  const geometry::ScreenRect& usable, double ramp, const glm::dvec2& screen);
 
 }  // namespace optique::optics

@@ -53,7 +53,7 @@ inline void add_bilinear(const image::FloatImage& image, double px, double py, f
 
 void add_projector(const ProjectedImage& projector, double height, const ComposeOptions& options,
                    image::FloatImage& out) {
-  const ProjectorGeometry& geometry = *projector.geometry;
+  const geometry::ProjectorGeometry& geometry = *projector.geometry;
   const image::FloatImage& image = *projector.image;
   assert(image.width == geometry.width() && image.height == geometry.height() && image.channels >= 3);
   const double ppm = options.pixels_per_metre;
@@ -132,7 +132,7 @@ int screen_pixels(double metres, double pixels_per_metre) {
   return static_cast<int>(std::lround(metres * pixels_per_metre));
 }
 
-int subsamples_for(const ProjectorGeometry& geometry, double pixels_per_metre) {
+int subsamples_for(const geometry::ProjectorGeometry& geometry, double pixels_per_metre) {
   const double ratio = geometry.max_pixels_per_metre() / pixels_per_metre;
   if (!std::isfinite(ratio)) return 16;
   return std::clamp(static_cast<int>(std::ceil(2.0 * ratio)), 1, 16);

@@ -13,8 +13,8 @@
 
 #include <span>
 
+#include "geometry/projector_geometry.h"
 #include "image/image.h"
-#include "optics/projector_geometry.h"
 
 namespace optique::optics {
 
@@ -22,7 +22,7 @@ namespace optique::optics {
 // linear; alpha is ignored). Both must outlive the call; the image must be the
 // geometry's width × height.
 struct ProjectedImage {
-  const ProjectorGeometry* geometry = nullptr;
+  const geometry::ProjectorGeometry* geometry = nullptr;
   const image::FloatImage* image = nullptr;
 };
 
@@ -38,7 +38,7 @@ struct ComposeOptions {
 
 // Enough subsamples per axis to see every projector pixel about twice across an
 // output pixel, at the projector's densest: ceil(2 · density / ppm), in [1, 16].
-[[nodiscard]] int subsamples_for(const ProjectorGeometry& geometry, double pixels_per_metre);
+[[nodiscard]] int subsamples_for(const geometry::ProjectorGeometry& geometry, double pixels_per_metre);
 
 // The light a screen of `width` × `height` metres receives, RGBA (alpha 1),
 // linear. Projectors may be empty (a black screen).

@@ -15,19 +15,20 @@
 #include <string>
 #include <vector>
 
+#include "config/response.h"
 #include "image/image.h"
-#include "optique/config.pb.h"
 #include "util/result.h"
 
 namespace optique::optics {
 
 class ProjectorModel {
  public:
-  enum class Curve { srgb, gamma, table };
+  using Curve = config::ResponseCurve;
 
   // The sRGB curve, 8 bits, no black, brightness 1: what a projector without
   // response settings is taken to be.
   ProjectorModel() = default;
+  explicit ProjectorModel(const config::ProjectorResponse& response);
   // Fails, naming the field, on a gamma ≤ 0, a table that is too short, not
   // finite, not from 0 to 1 or decreasing, bits outside 1…16, a black level
   // outside [0, 1) or a brightness < 0. Paths are relative to the projector

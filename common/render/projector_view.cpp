@@ -19,20 +19,20 @@ FocusRole parse_focus_role(const std::string& role) {
   return FocusRole::none;
 }
 
-Result<ProjectorView> ProjectorView::make(const config::Screen& screen, const optics::ProjectorGeometry& geometry,
+Result<ProjectorView> ProjectorView::make(const config::Screen& screen, const geometry::ProjectorGeometry& geometry,
                                           RenderMethod method, double two_pass_pixels_per_metre) {
-  auto oblique = optics::oblique_projection(geometry, config::usable_area(screen));
+  auto oblique = geometry::oblique_projection(geometry, config::usable_area(screen));
   if (!oblique) return Error{oblique.error()};
   ProjectorView view;
   view.method_ = method;
   view.oblique_ = oblique.value();
-  const optics::ScreenRect& r = view.oblique_.bounds;
+  const geometry::ScreenRect& r = view.oblique_.bounds;
   config::Region region;
   region.set_x(r.min.x);
   region.set_y(r.min.y);
   region.set_width(r.width());
   region.set_height(r.height());
-  view.bounds_ = screen_region(screen, region);
+  view.bounds_ = config::screen_region(screen, region);
   view.width_ = geometry.width();
   view.height_ = geometry.height();
   view.pixel_to_screen_ = geometry.pixel_to_screen();
@@ -50,8 +50,8 @@ Result<ProjectorView> ProjectorView::make(const config::Screen& screen, const op
   return view;
 }
 
-Result<Frustum> ProjectorView::frustum(const glm::dvec3& eye, double near, double far) const {
-  auto frustum = off_axis_frustum(bounds_, eye, near, far);
+Result<geometry::Frustum> ProjectorView::frustum(const glm::dvec3& eye, double near, double far) const {
+  auto frustum = geometry::off_axis_frustum(bounds_, eye, near, far);
   if (!frustum) return frustum;
   if (method_ == RenderMethod::single_pass) frustum.value().projection = oblique_.matrix() * frustum.value().projection;
   return frustum;

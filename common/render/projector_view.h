@@ -7,9 +7,9 @@
 
 #include <glm/vec3.hpp>
 
-#include "optics/projector_geometry.h"
+#include "geometry/projection.h"
+#include "geometry/projector_geometry.h"
 #include "optique/config.pb.h"
-#include "render/projection.h"
 #include "render/scene_renderer.h"
 #include "util/result.h"
 
@@ -25,12 +25,12 @@ class ProjectorView {
   // Fails when the projector lights none of the screen's usable area. A two-pass
   // view renders R at `two_pass_pixels_per_metre`; 0: the projector's densest.
   [[nodiscard]] static Result<ProjectorView> make(const config::Screen& screen,
-                                                  const optics::ProjectorGeometry& geometry, RenderMethod method,
+                                                  const geometry::ProjectorGeometry& geometry, RenderMethod method,
                                                   double two_pass_pixels_per_metre = 0.0);
 
   // The frustum to draw the scene with, for an eye. Fails when the eye is not in
   // front of the screen.
-  [[nodiscard]] Result<Frustum> frustum(const glm::dvec3& eye, double near, double far) const;
+  [[nodiscard]] Result<geometry::Frustum> frustum(const glm::dvec3& eye, double near, double far) const;
 
   // The size of the image the scene is drawn into: the projector's for a single
   // pass; for two passes, R at the projector's densest pixel pitch by default (so
@@ -41,15 +41,15 @@ class ProjectorView {
   // share of the depth of field a focus/defocus projector shows.
   [[nodiscard]] OutputStage output_stage(image::FloatImage weights, FocusRole role = FocusRole::none) const;
 
-  [[nodiscard]] const optics::ObliqueProjection& oblique() const { return oblique_; }
-  [[nodiscard]] const WorldRect& bounds() const { return bounds_; }
+  [[nodiscard]] const geometry::ObliqueProjection& oblique() const { return oblique_; }
+  [[nodiscard]] const geometry::WorldRect& bounds() const { return bounds_; }
   [[nodiscard]] RenderMethod method() const { return method_; }
 
  private:
   ProjectorView() = default;
   RenderMethod method_ = RenderMethod::single_pass;
-  optics::ObliqueProjection oblique_;
-  WorldRect bounds_;
+  geometry::ObliqueProjection oblique_;
+  geometry::WorldRect bounds_;
   glm::dmat3 pixel_to_screen_{1.0};
   double max_pixels_per_metre_ = 1.0;
   int width_ = 0;

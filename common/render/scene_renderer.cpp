@@ -554,8 +554,8 @@ void SceneRenderer::set_focus(const FocusFrame& frame) {
                      static_cast<float>(frame.gaze.y), static_cast<float>(frame.inset_radius));
 }
 
-void SceneRenderer::draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye, const Frustum& frustum,
-                         const LightTerms& terms) {
+void SceneRenderer::draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                         const geometry::Frustum& frustum, const LightTerms& terms) {
   Gl& gl = *gl_;
   glBindFramebuffer(GL_FRAMEBUFFER, gl.linear_framebuffer);
   glViewport(0, 0, gl.width, gl.height);

@@ -11,10 +11,10 @@
 
 #include <glm/mat3x3.hpp>
 
+#include "geometry/projection.h"
 #include "image/image.h"
 #include "optics/defocus.h"
 #include "optics/projector_model.h"
-#include "render/projection.h"
 #include "scene/definition.h"
 #include "scene/state.h"
 #include "util/result.h"
@@ -84,7 +84,7 @@ class SceneRenderer {
 
   // Draws the scene with animated objects at `fraction` between their two frame
   // poses, seen from `eye` through `frustum`; returns when the GPU is done.
-  void draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye, const Frustum& frustum,
+  void draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye, const geometry::Frustum& frustum,
             const LightTerms& terms = {});
 
   // Fails when the weights do not match the output size.

@@ -26,16 +26,14 @@
 #include <glm/mat3x3.hpp>
 #include <glm/vec4.hpp>
 
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
-
 #include "util/finite.h"
+#include "util/message_text.h"
 #include "util/sha256.h"
 
 // TinyGLTF's implementation lives here (Debian ships a shared library too, but
 // building it in keeps the link line as it is). It uses nlohmann/json; tinygltf
-// decodes no images itself (no stb_image; base colour images are decoded here
-// with OpenImageIO) and reads no external image files.
+// decodes no images itself (no stb_image: base colour images go to the caller's
+// ImageDecoder) and reads no external image files.
 #define TINYGLTF_IMPLEMENTATION
 #define TINYGLTF_NO_STB_IMAGE
 #define TINYGLTF_NO_STB_IMAGE_WRITE
@@ -125,30 +123,8 @@ bool keep_encoded_image(tinygltf::Image* image, const int, std::string*, std::st
 // ---------------------------------------------------------------------------
 // Small helpers.
 
-// tinygltf's messages on one line, and not too long (they may quote a whole
-// base64 data URI).
-constexpr std::size_t kMaxMessage = 400;
-
-std::string shortened(std::string text) {
-  if (text.size() > kMaxMessage) {
-    text.resize(kMaxMessage);
-    text += "...";
-  }
-  return text;
-}
-
-std::string one_line(std::string text) {
-  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) text.pop_back();
-  std::string out;
-  for (char c : text) {
-    if (c == '\n') {
-      out += "; ";
-    } else if (c != '\r') {
-      out += c;
-    }
-  }
-  return shortened(std::move(out));
-}
+using util::one_line;
+using util::shortened;
 
 std::vector<std::string> lines_of(const std::string& text) {
   std::vector<std::string> lines;
@@ -369,64 +345,6 @@ bool reproduces(const Pose& pose, const glm::dmat4& m) {
 }
 
 // ---------------------------------------------------------------------------
-// Images.
-
-// A file name extension for OpenImageIO to pick its reader by: from the MIME type
-// tinygltf records (or the data URI's), else ".png" (OpenImageIO then still
-// checks the bytes' signature).
-std::string extension_for(const std::string& mime_type) {
-  if (mime_type == "image/jpeg") return ".jpg";
-  if (mime_type == "image/bmp") return ".bmp";
-  if (mime_type == "image/gif") return ".gif";
-  if (mime_type == "image/webp") return ".webp";
-  return ".png";
-}
-
-// Decodes an encoded image (PNG, JPEG, ... as OpenImageIO reads them) from
-// memory to 8-bit RGBA: grey becomes RGB, a missing alpha 255. Colour values are
-// kept as stored (sRGB-encoded), alpha unassociated.
-Result<Texture> decode_image(const std::vector<unsigned char>& bytes, const std::string& mime_type) {
-  if (bytes.empty()) return Error{"no image data"};
-  OIIO::Filesystem::IOMemReader memory(bytes.data(), bytes.size());
-  OIIO::Filesystem::IOProxy* proxy = &memory;
-  OIIO::ImageSpec config;
-  config.attribute("oiio:UnassociatedAlpha", 1);  // PNG: no premultiplication on read
-  // OpenImageIO 2.4 ignores open()'s ioproxy argument when a config is given; the
-  // config attribute works.
-  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  auto input = OIIO::ImageInput::open("image" + extension_for(mime_type), &config);
-  if (!input) return Error{one_line(OIIO::geterror())};
-  const OIIO::ImageSpec& spec = input->spec();
-  constexpr int kMaxSide = 16384;
-  if (spec.width <= 0 || spec.height <= 0 || spec.width > kMaxSide || spec.height > kMaxSide || spec.depth > 1 ||
-      spec.nchannels <= 0) {
-    return Error{"unsupported image size " + std::to_string(spec.width) + "x" + std::to_string(spec.height)};
-  }
-  const int channels = std::min(spec.nchannels, 4);
-  const auto pixels = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
-  std::vector<std::uint8_t> stored(pixels * static_cast<std::size_t>(channels));
-  if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, stored.data())) {
-    return Error{one_line(input->geterror())};
-  }
-  Texture out;
-  out.width = spec.width;
-  out.height = spec.height;
-  out.rgba.resize(pixels * 4);
-  // Grey, grey + alpha, RGB or RGBA (first four channels).
-  const bool grey = channels <= 2;
-  const bool alpha = channels == 2 || channels == 4;
-  for (std::size_t i = 0; i < pixels; ++i) {
-    const std::uint8_t* in = stored.data() + i * static_cast<std::size_t>(channels);
-    std::uint8_t* to = out.rgba.data() + i * 4;
-    to[0] = in[0];
-    to[1] = grey ? in[0] : in[1];
-    to[2] = grey ? in[0] : in[2];
-    to[3] = alpha ? in[channels - 1] : std::uint8_t{255};
-  }
-  return out;
-}
-
-// ---------------------------------------------------------------------------
 // Animation data, self-contained so that pose_at can own a copy.
 
 enum class Interpolation { kStep, kLinear, kCubicSpline };
@@ -551,8 +469,8 @@ struct Track {
 
 class Loader {
  public:
-  Loader(std::string path, const tinygltf::Model& model, std::vector<std::string>& warnings)
-      : path_(std::move(path)), model_(model), warnings_(warnings) {}
+  Loader(std::string path, const tinygltf::Model& model, const ImageDecoder& decode, std::vector<std::string>& warnings)
+      : path_(std::move(path)), model_(model), decode_(decode), warnings_(warnings) {}
 
   SceneDefinition build() {
     check_version();
@@ -1244,7 +1162,8 @@ class Loader {
       warn(what + ": " + image_label + " is an external file, which is not supported (embed it); ignored");
       return std::nullopt;
     }
-    auto decoded = decode_image(*encoded, image.mimeType);
+    if (!decode_) return std::nullopt;  // not drawn here: the image is not needed
+    auto decoded = decode_(std::span<const std::uint8_t>(encoded->data(), encoded->size()), image.mimeType);
     if (!decoded) {
       warn(what + ": " + image_label + " cannot be decoded (" + decoded.error() + "); ignored");
       return std::nullopt;
@@ -1352,6 +1271,7 @@ class Loader {
 
   std::string path_;
   const tinygltf::Model& model_;
+  const ImageDecoder& decode_;
   std::vector<std::string>& warnings_;
 
   std::map<std::size_t, NodeTracks> channels_;  // by node
@@ -1372,7 +1292,7 @@ class Loader {
   std::optional<std::uint32_t> default_material_;
 };
 
-Result<LoadedGltf> load(const std::string& path) {
+Result<LoadedGltf> load(const std::string& path, const ImageDecoder& decode) {
   std::error_code error;
   const auto status = std::filesystem::status(path, error);
   if (!std::filesystem::exists(status)) return Error{path + ": no such file"};
@@ -1409,7 +1329,7 @@ Result<LoadedGltf> load(const std::string& path) {
 
   LoadedGltf loaded_gltf;
   for (const auto& line : lines_of(load_warning)) loaded_gltf.warnings.push_back(path + ": " + line);
-  Loader loader(path, model, loaded_gltf.warnings);
+  Loader loader(path, model, decode, loaded_gltf.warnings);
   loaded_gltf.scene = loader.build();
   loaded_gltf.content_sha256 = util::sha256_hex(bytes + context.bytes);
   return loaded_gltf;
@@ -1417,9 +1337,9 @@ Result<LoadedGltf> load(const std::string& path) {
 
 }  // namespace
 
-Result<LoadedGltf> load_gltf(const std::string& path) {
+Result<LoadedGltf> load_gltf(const std::string& path, const ImageDecoder& decode) {
   try {
-    return load(path);
+    return load(path, decode);
   } catch (const GltfError& e) {
     return Error{e.what()};
   } catch (const std::exception& e) {

@@ -8,7 +8,7 @@
 // or, where drawing without it is still honest, is left out with a warning: spot
 // and directional lights; metallic-roughness, normal, occlusion and emissive
 // textures; base colour textures on other texture coordinate sets, in external
-// image files, or whose image OpenImageIO cannot decode. Texture samplers are
+// image files, or whose image the decoder cannot read. Texture samplers are
 // not read (the renderer filters linearly and repeats).
 //
 // Animated nodes become animated objects: every node that is the target of an
@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "scene/definition.h"
+#include "scene/image_decoder.h"
 #include "util/result.h"
 
 namespace optique::scene {
@@ -35,7 +36,9 @@ struct LoadedGltf {
   std::vector<std::string> warnings;
 };
 
-// Loads the glTF file at `path`. Every error message starts with `path`.
-[[nodiscard]] Result<LoadedGltf> load_gltf(const std::string& path);
+// Loads the glTF file at `path`, its base colour images read by `decode` (an
+// empty decoder: none are read, the materials get no textures). Every error
+// message starts with `path`.
+[[nodiscard]] Result<LoadedGltf> load_gltf(const std::string& path, const ImageDecoder& decode);
 
 }  // namespace optique::scene

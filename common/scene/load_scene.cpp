@@ -13,7 +13,7 @@ std::string resolve_asset(const std::string& path, const std::string& config_dir
   return std::filesystem::absolute(std::filesystem::path(config_dir) / asset).lexically_normal().string();
 }
 
-Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& config_dir) {
+Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& config_dir, const ImageDecoder& decode) {
   LoadedScene loaded;
   if (!scene.builtin().empty()) {
     auto definition = builtin_scene(scene.builtin());
@@ -23,7 +23,7 @@ Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& co
     return loaded;
   }
   const std::string path = resolve_asset(scene.gltf(), config_dir);
-  auto gltf = load_gltf(path);
+  auto gltf = load_gltf(path, decode);
   if (!gltf) return Error{gltf.error()};
   loaded.definition = std::move(gltf.value().scene);
   loaded.content_sha256 = gltf.value().content_sha256;

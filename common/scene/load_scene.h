@@ -7,6 +7,7 @@
 
 #include "optique/config.pb.h"
 #include "scene/definition.h"
+#include "scene/image_decoder.h"
 #include "util/result.h"
 
 namespace optique::scene {
@@ -22,6 +23,8 @@ struct LoadedScene {
 // elsewhere load the same file.
 [[nodiscard]] std::string resolve_asset(const std::string& path, const std::string& config_dir);
 
-[[nodiscard]] Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& config_dir);
+// `decode` reads a glTF file's images (empty: none are read; see scene/image_decoder.h).
+[[nodiscard]] Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& config_dir,
+                                             const ImageDecoder& decode);
 
 }  // namespace optique::scene

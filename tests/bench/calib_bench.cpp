@@ -56,7 +56,7 @@ struct Case {
 // The points of one trial: noisy pixels, and gross outliers (60–300 px off) at
 // random indices.
 struct Trial {
-  std::vector<calib::Correspondence> points;
+  std::vector<geometry::Correspondence> points;
   std::vector<bool> outlier;
 };
 
@@ -110,7 +110,7 @@ Sample run_repeat(const testing::PinholeProjector& p, const Case& c, Method m, i
       ++s.failures;
       continue;
     }
-    std::vector<calib::Correspondence> inliers;
+    std::vector<geometry::Correspondence> inliers;
     for (std::size_t i = 0; i < exact.size(); ++i) {
       if (!data[t].outlier[i]) inliers.push_back(exact[i]);
     }

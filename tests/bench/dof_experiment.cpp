@@ -1,4 +1,5 @@
 #include "dof_experiment.h"
+#include "image/texture_decode.h"
 
 #include <algorithm>
 #include <cmath>
@@ -100,7 +101,7 @@ Result<PairSetup> load_setup(const std::string& config_path, int divisor) {
     p->set_width(p->width() / static_cast<std::uint32_t>(divisor));
     p->set_height(p->height() / static_cast<std::uint32_t>(divisor));
   }
-  auto scene = scene::load_scene(inst.scene(), loaded.value().directory);
+  auto scene = scene::load_scene(inst.scene(), loaded.value().directory, image::decode_texture);
   if (!scene) return Error{scene.error()};
   setup.scene = std::move(scene).value().definition;
   for (const auto& object : setup.scene.objects) {
@@ -186,7 +187,7 @@ double psnr_against(const image::FloatImage& image, const FocalFrame& frame, boo
                                 [&](int x, int y) { return !away || frame.coc.at(x, y, 0) > kAwayFromFocus; });
 }
 
-Result<render::Frustum> pair_frustum(const PairSetup& setup, double frustum_near, double frustum_far) {
+Result<geometry::Frustum> pair_frustum(const PairSetup& setup, double frustum_near, double frustum_far) {
   auto geometry = config::projector_geometry(setup.focus);
   if (!geometry) return Error{geometry.error()};
   auto view = render::ProjectorView::make(setup.screen, geometry.value(), render::RenderMethod::single_pass);

@@ -17,10 +17,10 @@
 
 #include <glm/vec3.hpp>
 
+#include "geometry/projection.h"
 #include "image/image.h"
 #include "optics/defocus.h"
 #include "optique/config.pb.h"
-#include "render/projection.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
 #include "scene/state.h"
@@ -93,7 +93,7 @@ struct FocalFrame {
 [[nodiscard]] double psnr_against(const image::FloatImage& image, const FocalFrame& frame, bool away);
 
 // A frustum of the pair: the viewer's eye through the focus projector's region.
-[[nodiscard]] Result<render::Frustum> pair_frustum(const PairSetup& setup, double frustum_near, double frustum_far);
+[[nodiscard]] Result<geometry::Frustum> pair_frustum(const PairSetup& setup, double frustum_near, double frustum_far);
 
 // The pair's two nodes and a plain one, each a SceneRenderer as the node sets it
 // up (node/gl_renderer.cpp), on the current GL context.
@@ -115,14 +115,14 @@ class Pair {
   void draw_focus(double b);
   void draw_defocus(double b);
   [[nodiscard]] render::SceneRenderer& plain() { return *plain_; }
-  [[nodiscard]] const render::Frustum& frustum() const { return frustum_; }
+  [[nodiscard]] const geometry::Frustum& frustum() const { return frustum_; }
   // The output pass's c_r mapping for focal depth b with this pair's frustum.
   [[nodiscard]] optics::CocFromWindowDepth mapping(double b) const;
 
  private:
-  Pair(const PairSetup& setup, render::Frustum frustum) : setup_(setup), frustum_(std::move(frustum)) {}
+  Pair(const PairSetup& setup, geometry::Frustum frustum) : setup_(setup), frustum_(std::move(frustum)) {}
   const PairSetup& setup_;
-  render::Frustum frustum_;
+  geometry::Frustum frustum_;
   std::unique_ptr<render::SceneRenderer> plain_;
   std::unique_ptr<render::SceneRenderer> focus_;
   std::unique_ptr<render::SceneRenderer> defocus_;

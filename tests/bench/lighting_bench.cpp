@@ -37,7 +37,8 @@
 #include "config/load.h"
 #include "image/compare.h"
 #include "image/image_io.h"
-#include "light_share.h"
+#include "master/light_share.h"
+#include "master/stacked_groups.h"
 #include "plot.h"
 #include "render/gl_context.h"
 #include "render/projector_view.h"
@@ -45,7 +46,6 @@
 #include "scene/builtin.h"
 #include "scene/light_coverage.h"
 #include "spread.h"
-#include "stacked_groups.h"
 
 namespace {
 

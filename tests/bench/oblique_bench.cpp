@@ -23,6 +23,7 @@
 #include "image/compare.h"
 #include "image/convert.h"
 #include "image/image_io.h"
+#include "image/texture_decode.h"
 #include "metrics/distribution.h"
 #include "plot.h"
 #include "render/gl_context.h"
@@ -43,7 +44,8 @@ struct Method {
 };
 
 Method make_method(const scene::SceneDefinition& scene, const config::Screen& screen,
-                   const optics::ProjectorGeometry& geometry, render::RenderMethod how, double texture_density = 0.0) {
+                   const geometry::ProjectorGeometry& geometry, render::RenderMethod how,
+                   double texture_density = 0.0) {
   auto view = render::ProjectorView::make(screen, geometry, how, texture_density);
   if (!view) throw std::runtime_error(view.error());
   auto renderer = render::SceneRenderer::create(scene, view.value().render_width(), view.value().render_height());
@@ -68,7 +70,7 @@ double draw(Method& m, const scene::SceneState& state, const config::Viewer& vie
 
 // The pixels whose centre lands in the screen's usable area: outside it the
 // projector is masked, and the methods differ by construction.
-std::vector<bool> usable_pixels(const optics::ProjectorGeometry& geometry, const optics::ScreenRect& usable) {
+std::vector<bool> usable_pixels(const geometry::ProjectorGeometry& geometry, const geometry::ScreenRect& usable) {
   std::vector<bool> inside;
   for (int y = 0; y < geometry.height(); ++y) {
     for (int x = 0; x < geometry.width(); ++x) {
@@ -110,7 +112,7 @@ int main(int argc, char** argv) {
     if (!loaded) throw std::runtime_error(loaded.error());
     const auto& installation = loaded.value().installation;
     if (installation.viewer().eye().empty()) throw std::runtime_error("the bench needs a fixed viewer eye");
-    auto scene = scene::load_scene(installation.scene(), loaded.value().directory);
+    auto scene = scene::load_scene(installation.scene(), loaded.value().directory, image::decode_texture);
     if (!scene) throw std::runtime_error(scene.error());
     const auto& definition = scene.value().definition;
     auto context = render::make_headless_context();
@@ -132,20 +134,20 @@ int main(int argc, char** argv) {
       }
       auto geometry = config::projector_geometry(projector);
       if (!geometry || screen == nullptr) throw std::runtime_error(projector.id() + ": no geometry");
-      const optics::ScreenRect usable = config::usable_area(*screen);
+      const geometry::ScreenRect usable = config::usable_area(*screen);
       Method single = make_method(definition, *screen, geometry.value(), render::RenderMethod::single_pass);
       Method two = make_method(definition, *screen, geometry.value(), render::RenderMethod::two_pass);
       // Two passes with as many texels as the projector has pixels: less work, more blur.
-      const optics::ScreenRect& r = two.view.oblique().bounds;
+      const geometry::ScreenRect& r = two.view.oblique().bounds;
       const double equal_density = std::sqrt(static_cast<double>(geometry.value().width()) * geometry.value().height() /
                                              (r.width() * r.height()));
       Method two_equal =
           make_method(definition, *screen, geometry.value(), render::RenderMethod::two_pass, equal_density);
       const std::vector<bool> inside = usable_pixels(geometry.value(), usable);
       const glm::dmat3 scale(kSupersample, 0.0, 0.0, 0.0, kSupersample, 0.0, 0.0, 0.0, 1.0);
-      auto fine_geometry = optics::ProjectorGeometry::make(scale * geometry.value().screen_to_pixel(),
-                                                           kSupersample * geometry.value().width(),
-                                                           kSupersample * geometry.value().height());
+      auto fine_geometry = geometry::ProjectorGeometry::make(scale * geometry.value().screen_to_pixel(),
+                                                             kSupersample * geometry.value().width(),
+                                                             kSupersample * geometry.value().height());
       if (!fine_geometry) throw std::runtime_error(fine_geometry.error());
       Method reference = make_method(definition, *screen, fine_geometry.value(), render::RenderMethod::single_pass);
 

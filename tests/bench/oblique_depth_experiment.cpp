@@ -299,7 +299,7 @@ Result<Projector> make_projector(const Installation& inst, const Placement& plac
     (middle_row_length(ph, placement, std::exp(mid)) > placement.lit_width ? lo : hi) = mid;
   }
   const glm::dmat3 h = homography_of(ph, placement, std::exp(hi));
-  auto geometry = optics::ProjectorGeometry::make(h, placement.width, placement.height);
+  auto geometry = geometry::ProjectorGeometry::make(h, placement.width, placement.height);
   if (!geometry) return Error{geometry.error()};
   auto view = render::ProjectorView::make(inst.screen, geometry.value(), render::RenderMethod::single_pass);
   if (!view) return Error{view.error()};
@@ -307,7 +307,7 @@ Result<Projector> make_projector(const Installation& inst, const Placement& plac
   p.placement = placement;
   p.throw_ratio = std::exp(hi);
   p.screen_to_pixel = h;
-  const optics::ObliqueProjection& oblique = p.view.oblique();
+  const geometry::ObliqueProjection& oblique = p.view.oblique();
   p.k = oblique.depth_scale;
   // Eq. 5 needs a33 = 1; a33 is w at R's centre, positive for the lit quad's own
   // sign of w unless R's centre is at or beyond the projector's horizon.
@@ -366,14 +366,14 @@ Result<Count> Experiment::measure(const Projector& projector, double delta, Meth
   }
 
   const render::ProjectorView& view = projector.view;
-  const optics::ObliqueProjection& ours = view.oblique();
+  const geometry::ObliqueProjection& ours = view.oblique();
   const DepthModel model = depth_model(projector, method);
   // Ours goes through ProjectorView itself, so the test checks what nodes draw.
   auto frustum = method == Method::ours ? view.frustum(inst_.eye, inst_.near, inst_.far)
-                                        : render::off_axis_frustum(view.bounds(), inst_.eye, inst_.near, inst_.far);
+                                        : geometry::off_axis_frustum(view.bounds(), inst_.eye, inst_.near, inst_.far);
   if (!frustum) return Error{frustum.error()};
   if (model.oblique && method != Method::ours) {
-    const optics::ObliqueProjection drawn{ours.bounds, model.a, model.scale};
+    const geometry::ObliqueProjection drawn{ours.bounds, model.a, model.scale};
     frustum.value().projection = drawn.matrix() * frustum.value().projection;
   }
   renderer->draw(scene::SceneState{}, 0.0, inst_.eye, frustum.value());
@@ -381,7 +381,7 @@ Result<Count> Experiment::measure(const Projector& projector, double delta, Meth
 
   // The wall point of a pixel centre (x, y may be one outside the image).
   const glm::dmat3 pixel_to_screen = glm::inverse(projector.screen_to_pixel);
-  const optics::ScreenRect& r = ours.bounds;
+  const geometry::ScreenRect& r = ours.bounds;
   auto wall_point = [&](int x, int y) {
     const glm::dvec2 centre(x + 0.5, y + 0.5);
     if (model.oblique) return apply(pixel_to_screen, centre);

@@ -16,7 +16,7 @@
 #include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
-#include "optics/projector_geometry.h"
+#include "geometry/projector_geometry.h"
 #include "optique/config.pb.h"
 #include "render/projector_view.h"
 #include "render/scene_renderer.h"

@@ -11,9 +11,9 @@
 #include <iostream>
 
 #include "clock/clock.h"
+#include "geometry/projection.h"
 #include "metrics/distribution.h"
 #include "render/gl_context.h"
-#include "render/projection.h"
 #include "render/scene_renderer.h"
 #include "scene/builtin.h"
 #include "spread.h"
@@ -36,12 +36,12 @@ std::vector<double> frame_times(const Case& c, int frames) {
   if (!definition) throw std::runtime_error(definition.error());
   auto renderer = render::SceneRenderer::create(definition.value(), c.width, c.height);
   if (!renderer) throw std::runtime_error(renderer.error());
-  render::WorldRect wall;
+  geometry::WorldRect wall;
   wall.lower_left = {-2.0, 0.0, 0.0};
   wall.width = 4.0;
   wall.height = 2.25;
   const glm::dvec3 eye(0.0, 1.6, 2.0);
-  const auto frustum = render::off_axis_frustum(wall, eye, 0.05, 100.0).value();
+  const auto frustum = geometry::off_axis_frustum(wall, eye, 0.05, 100.0).value();
   std::vector<double> times;
   for (int k = -3; k < frames; ++k) {  // three unmeasured frames first
     scene::SceneState state;

@@ -10,7 +10,7 @@
 #include <random>
 
 #include "../unit/pinhole_projector.h"
-#include "calib/calibration_file.h"
+#include "config/calibration_file.h"
 #include "process.h"
 
 namespace optique::testing {
@@ -35,7 +35,7 @@ CliRun calibrate(const std::string& dir, const std::vector<std::string>& args) {
   return {status.value_or(-1), process.output()};
 }
 
-json points_json(const std::vector<calib::Correspondence>& points, int width, int height) {
+json points_json(const std::vector<geometry::Correspondence>& points, int width, int height) {
   json doc;
   doc["projector"] = {{"width", width}, {"height", height}};
   doc["points"] = json::array();
@@ -55,7 +55,7 @@ class CalibrateCli : public ::testing::Test {
   std::string dir = make_temp_dir("optique-calibrate");
   PinholeProjector projector = projector_cases()[1];  // strong oblique
   glm::dmat3 truth = projector.homography();
-  std::vector<calib::Correspondence> noisy() const {
+  std::vector<geometry::Correspondence> noisy() const {
     std::mt19937_64 random(17);
     return with_pixel_noise(grid_points(truth, projector.width, projector.height, 5, 4), 0.5, random);
   }
@@ -86,7 +86,7 @@ TEST_F(CalibrateCli, GoodInputWritesTheCalibrationFile) {
   EXPECT_FALSE(doc.contains("tracker_to_screen"));
 
   // Read back as a config reads it: close to the true H.
-  auto h = calib::read_calibration_homography(out);
+  auto h = config::read_calibration_homography(out);
   ASSERT_TRUE(h.ok()) << h.error();
   EXPECT_LT(transfer_error(h.value(), truth, grid_points(truth, 1920, 1080, 5, 4)), 0.5);
 }
@@ -138,7 +138,7 @@ TEST_F(CalibrateCli, TrackerInputWritesTheScreenFrame) {
 
 TEST_F(CalibrateCli, DegenerateInputExitsTwoNamingTheProblem) {
   const auto points = grid_points(truth, 1920, 1080, 5, 4);
-  std::vector<calib::Correspondence> three_on_a_line{points[0], points[2], points[4], points[12]};
+  std::vector<geometry::Correspondence> three_on_a_line{points[0], points[2], points[4], points[12]};
   const std::string in = write(dir + "/line.json", points_json(three_on_a_line, 1920, 1080).dump());
   const std::string out = dir + "/never.json";
   const CliRun run = calibrate(dir, {"--points", in, "--out", out});

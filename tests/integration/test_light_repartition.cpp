@@ -16,7 +16,7 @@
 #include <sstream>
 
 #include "image/frame_files.h"
-#include "light_share.h"
+#include "master/light_share.h"
 #include "process.h"
 #include "screen_check.h"
 

@@ -11,7 +11,6 @@
 #include <filesystem>
 #include <fstream>
 
-#include "compose.h"
 #include "config/geometry.h"
 #include "config/load.h"
 #include "image/compare.h"
@@ -20,6 +19,7 @@
 #include "image/image_io.h"
 #include "log/logger.h"
 #include "process.h"
+#include "tools/compose.h"
 
 namespace optique::testing {
 namespace {
@@ -44,7 +44,7 @@ WallResult measure(const config::Installation& installation, const image::FloatI
                    const image::FloatImage& reference) {
   const auto& screen = installation.screens(0);
   const double ppm = screen.pixels_per_metre();
-  std::vector<optics::ProjectorGeometry> geometries;
+  std::vector<geometry::ProjectorGeometry> geometries;
   for (const auto& p : installation.projectors()) geometries.push_back(config::projector_geometry(p).value());
   // Projectors lighting each output pixel's centre.
   const int w = composite.width;
@@ -159,7 +159,7 @@ TEST(ObliqueWall, ComposedScreenMatchesTheReferenceWithoutSeams) {
   ASSERT_EQ(centre.homography_size(), 9);
   for (int c = 0; c < 3; ++c) centre.set_homography(c, centre.homography(c) + 3.0 * centre.homography(6 + c));
   auto logger = log::make_logger("test", "warn");
-  auto composed = master::compose_frame(wrong, 0, out + "/nodes", dir + "/wrong", *logger);
+  auto composed = tools::compose_frame(wrong, 0, out + "/nodes", dir + "/wrong", *logger);
   ASSERT_TRUE(composed.ok()) << composed.error();
   const WallResult off =
       measure(installation, read(image::frame_path(dir + "/wrong/screens/front", 0, "exr")), reference);

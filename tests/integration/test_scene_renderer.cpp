@@ -11,8 +11,9 @@
 #include <string>
 #include <vector>
 
+#include "geometry/projection.h"
+#include "image/texture_decode.h"
 #include "render/gl_context.h"
-#include "render/projection.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
 #include "scene/gltf.h"
@@ -39,14 +40,14 @@ float srgb_to_linear(std::uint8_t encoded) {
 }
 
 // The viewer 2 m in front of a 2 m × 2 m screen in the z = 0 plane.
-Frustum view_of_unit_square() {
-  WorldRect rect;
+geometry::Frustum view_of_unit_square() {
+  geometry::WorldRect rect;
   rect.lower_left = {-1.0, -1.0, 0.0};
   rect.width = 2.0;
   rect.height = 2.0;
-  auto frustum = off_axis_frustum(rect, kEye, 0.1, 10.0);
+  auto frustum = geometry::off_axis_frustum(rect, kEye, 0.1, 10.0);
   EXPECT_TRUE(frustum.ok());
-  return frustum.ok() ? frustum.value() : Frustum{};
+  return frustum.ok() ? frustum.value() : geometry::Frustum{};
 }
 
 // The quad that exactly fills that screen, uv (0, 0) top left, facing the viewer.
@@ -140,7 +141,7 @@ TEST_F(SceneRendererTest, BaseColourFactorMultipliesTheTexture) {
 }
 
 TEST_F(SceneRendererTest, TexturedQuadFromGltf) {
-  auto loaded = scene::load_gltf(OPTIQUE_SOURCE_DIR "/tests/data/gltf/textured-quad.gltf");
+  auto loaded = scene::load_gltf(OPTIQUE_SOURCE_DIR "/tests/data/gltf/textured-quad.gltf", image::decode_texture);
   ASSERT_TRUE(loaded.ok()) << loaded.error();
   scene::SceneDefinition scene = std::move(loaded).value().scene;
   ASSERT_EQ(scene.textures.size(), 1u);

@@ -11,12 +11,13 @@
 
 #include "config/geometry.h"
 #include "config/load.h"
+#include "image/texture_decode.h"
+#include "master/stacked_groups.h"
 #include "optics/projector_model.h"
 #include "render/gl_context.h"
 #include "render/projector_view.h"
 #include "render/scene_renderer.h"
 #include "scene/load_scene.h"
-#include "stacked_groups.h"
 
 namespace optique {
 namespace {
@@ -37,7 +38,7 @@ class StackedLighting : public ::testing::Test {
     auto loaded = config::load_installation(kConfig);
     ASSERT_TRUE(loaded) << loaded.error();
     config_ = std::move(loaded).value();
-    auto scene = scene::load_scene(config_.installation.scene(), config_.directory);
+    auto scene = scene::load_scene(config_.installation.scene(), config_.directory, image::decode_texture);
     ASSERT_TRUE(scene) << scene.error();
     scene_ = std::move(scene).value().definition;
     for (const auto& object : scene_.objects) {

@@ -11,7 +11,7 @@
 #include <glm/matrix.hpp>
 #include <glm/vec2.hpp>
 
-#include "optics/projector_geometry.h"
+#include "geometry/projector_geometry.h"
 
 namespace optique::testing {
 
@@ -50,14 +50,14 @@ inline std::vector<std::array<glm::dvec2, 4>> keystoned_quads() {
   };
 }
 
-inline std::vector<optics::ProjectorGeometry> keystoned_wall(int width, int height) {
-  std::vector<optics::ProjectorGeometry> group;
+inline std::vector<geometry::ProjectorGeometry> keystoned_wall(int width, int height) {
+  std::vector<geometry::ProjectorGeometry> group;
   for (const auto& quad : keystoned_quads()) {
-    group.push_back(optics::ProjectorGeometry::make(homography_onto(quad, width, height), width, height).value());
+    group.push_back(geometry::ProjectorGeometry::make(homography_onto(quad, width, height), width, height).value());
   }
   return group;
 }
 
-inline optics::ScreenRect wall_area() { return {glm::dvec2(0.0), glm::dvec2(kWallWidth, kWallHeight)}; }
+inline geometry::ScreenRect wall_area() { return {glm::dvec2(0.0), glm::dvec2(kWallWidth, kWallHeight)}; }
 
 }  // namespace optique::testing

@@ -19,7 +19,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "calib/homography.h"
+#include "geometry/homography.h"
 
 namespace optique::testing {
 
@@ -92,22 +92,22 @@ inline std::vector<PinholeProjector> projector_cases() {
 
 // `columns` × `rows` pixels spread over the image (5 % margins), with their
 // exact screen points.
-inline std::vector<calib::Correspondence> grid_points(const glm::dmat3& h, int width, int height, int columns,
-                                                      int rows) {
+inline std::vector<geometry::Correspondence> grid_points(const glm::dmat3& h, int width, int height, int columns,
+                                                         int rows) {
   const glm::dmat3 inverse = glm::inverse(h);
-  std::vector<calib::Correspondence> points;
+  std::vector<geometry::Correspondence> points;
   for (int j = 0; j < rows; ++j) {
     for (int i = 0; i < columns; ++i) {
       const glm::dvec2 pixel(width * (0.05 + 0.9 * i / (columns - 1)), height * (0.05 + 0.9 * j / (rows - 1)));
-      points.push_back({calib::apply(inverse, pixel), pixel});
+      points.push_back({geometry::apply(inverse, pixel), pixel});
     }
   }
   return points;
 }
 
 // Adds N(0, σ²) to each pixel coordinate.
-inline std::vector<calib::Correspondence> with_pixel_noise(std::vector<calib::Correspondence> points, double sigma,
-                                                           std::mt19937_64& random) {
+inline std::vector<geometry::Correspondence> with_pixel_noise(std::vector<geometry::Correspondence> points,
+                                                              double sigma, std::mt19937_64& random) {
   std::normal_distribution<double> noise(0.0, sigma);
   for (auto& p : points) {
     const double dx = noise(random);
@@ -121,10 +121,10 @@ inline std::vector<calib::Correspondence> with_pixel_noise(std::vector<calib::Co
 // it: √(Σᵢ |Ĥ(sᵢ) − H(sᵢ)|² / 2n). The ML estimate's expected value is
 // σ·√(d / 2n), d = 8, for noise in one image only.
 inline double transfer_error(const glm::dmat3& estimate, const glm::dmat3& truth,
-                             const std::vector<calib::Correspondence>& points) {
+                             const std::vector<geometry::Correspondence>& points) {
   double sum = 0.0;
   for (const auto& p : points) {
-    const glm::dvec2 d = calib::apply(estimate, p.screen) - calib::apply(truth, p.screen);
+    const glm::dvec2 d = geometry::apply(estimate, p.screen) - geometry::apply(truth, p.screen);
     sum += glm::dot(d, d);
   }
   return std::sqrt(sum / (2.0 * static_cast<double>(points.size())));

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "barrier.h"
+#include "master/barrier.h"
 
 namespace optique::master {
 namespace {

@@ -61,11 +61,13 @@ TEST(BlendRolloff, IsSmoothstepOrSquare) {
 // Two aligned projectors on a 2 m × 1 m screen, [0, 1.2] and [0.8, 2] wide: the
 // weights are known in closed form.
 TEST(BlendField, AlignedOverlapHasTheClosedFormWeights) {
-  const ScreenRect screen{glm::dvec2(0.0), glm::dvec2(2.0, 1.0)};
-  const std::vector<ProjectorGeometry> group = {
-      ProjectorGeometry::make(aligned_homography({glm::dvec2(0.0, 0.0), glm::dvec2(1.2, 1.0)}, 1200, 1000), 1200, 1000)
+  const geometry::ScreenRect screen{glm::dvec2(0.0), glm::dvec2(2.0, 1.0)};
+  const std::vector<geometry::ProjectorGeometry> group = {
+      geometry::ProjectorGeometry::make(
+          geometry::aligned_homography({glm::dvec2(0.0, 0.0), glm::dvec2(1.2, 1.0)}, 1200, 1000), 1200, 1000)
           .value(),
-      ProjectorGeometry::make(aligned_homography({glm::dvec2(0.8, 0.0), glm::dvec2(2.0, 1.0)}, 1200, 1000), 1200, 1000)
+      geometry::ProjectorGeometry::make(
+          geometry::aligned_homography({glm::dvec2(0.8, 0.0), glm::dvec2(2.0, 1.0)}, 1200, 1000), 1200, 1000)
           .value()};
   // Middle of the overlap: equal shares.
   EXPECT_NEAR(blend_weight(group, 0, screen, 0.0, glm::dvec2(1.0, 0.5)), 0.5, 1e-12);

@@ -34,15 +34,15 @@ std::string all_warnings(const HomographyFit& fit) {
 
 FitOptions with_image(const PinholeProjector& p, bool robust = false) {
   FitOptions options;
-  options.image = ImageSize{p.width, p.height};
+  options.image = geometry::ImageSize{p.width, p.height};
   options.robust = robust;
   return options;
 }
 
 // Points at the given pixels, with their exact screen points.
-std::vector<Correspondence> at_pixels(const glm::dmat3& h, const std::vector<glm::dvec2>& pixels) {
-  std::vector<Correspondence> points;
-  for (const auto& p : pixels) points.push_back({apply(glm::inverse(h), p), p});
+std::vector<geometry::Correspondence> at_pixels(const glm::dmat3& h, const std::vector<glm::dvec2>& pixels) {
+  std::vector<geometry::Correspondence> points;
+  for (const auto& p : pixels) points.push_back({geometry::apply(glm::inverse(h), p), p});
   return points;
 }
 
@@ -227,8 +227,8 @@ TEST(CalibrationDiagnostics, ObliqueDepthFactorNearOneWarns) {
       fit_homography(testing::grid_points(steep.homography(), steep.width, steep.height, 5, 4), with_image(steep));
   ASSERT_TRUE(fit.ok()) << fit.error();
   ASSERT_TRUE(fit.value().oblique.has_value());
-  const ObliqueDepth& d = *fit.value().oblique;
-  EXPECT_GE(d.factor, kDepthFactorWarning);
+  const geometry::ObliqueDepth& d = *fit.value().oblique;
+  EXPECT_GE(d.factor, geometry::kDepthFactorWarning);
   EXPECT_LT(d.factor, 1.0);
   const std::string warning = warning_with(fit.value(), "|a31| + |a32| is 0.9");
   EXPECT_FALSE(warning.empty()) << all_warnings(fit.value());
@@ -237,9 +237,9 @@ TEST(CalibrationDiagnostics, ObliqueDepthFactorNearOneWarns) {
   // user NDC through R, to that corner in projector NDC.
   const glm::dmat3 inverse = glm::inverse(fit.value().homography);
   for (const glm::dvec2 corner : {glm::dvec2(0, 0), glm::dvec2(1920, 0), glm::dvec2(1920, 1080), glm::dvec2(0, 1080)}) {
-    const glm::dvec2 s = apply(inverse, corner);
+    const glm::dvec2 s = geometry::apply(inverse, corner);
     const glm::dvec2 user = 2.0 * (s - d.rect_min) / (d.rect_max - d.rect_min) - 1.0;
-    const glm::dvec2 ndc = apply(d.a, user);
+    const glm::dvec2 ndc = geometry::apply(d.a, user);
     EXPECT_NEAR(ndc.x, 2.0 * corner.x / 1920.0 - 1.0, 1e-9);
     EXPECT_NEAR(ndc.y, 1.0 - 2.0 * corner.y / 1080.0, 1e-9);
   }
@@ -292,7 +292,7 @@ TEST(CalibrationDiagnostics, HorizonAcrossTheImageIsAnError) {
     for (int i = 0; i < 5; ++i) pixels.emplace_back(100.0 + 200.0 * i, 100.0 + 280.0 * j);
   }
   const auto points = at_pixels(truth, pixels);
-  for (const auto& c : points) ASSERT_GT(homogeneous_w(truth, c.screen), 0.0);  // in front of the projector
+  for (const auto& c : points) ASSERT_GT(geometry::homogeneous_w(truth, c.screen), 0.0);  // in front of the projector
   auto fit = fit_homography(points, with_image(p));
   ASSERT_FALSE(fit.ok());
   EXPECT_TRUE(contains(fit.error(), "the projector's horizon crosses its image")) << fit.error();

@@ -100,7 +100,7 @@ TEST(CalibrationTracker, DerivedFrameFollowsThePixelsAndTheHomographyFitsToTheNo
   const auto exact = testing::grid_points(p.homography(), p.width, p.height, 6, 5);
   for (const auto& c : exact) {
     const glm::dvec3 s = transform_point(screen_to_derived, glm::dvec3(c.screen, 0.0));
-    const glm::dvec2 d = apply(fit.homography, {s.x, s.y}) - c.pixel;
+    const glm::dvec2 d = geometry::apply(fit.homography, {s.x, s.y}) - c.pixel;
     sum += glm::dot(d, d);
   }
   EXPECT_LT(std::sqrt(sum / (2.0 * static_cast<double>(exact.size()))), 0.3);
@@ -143,8 +143,8 @@ TEST(CalibrationTracker, GivenFrameIsSharedByASecondProjector) {
   const glm::dvec3 shared = transform_point(screen_to_shared, glm::dvec3(wall_point, 0.0));
   for (const auto& [projector, fit] :
        {std::pair{first_projector, first.value().fit}, std::pair{second_projector, second.value().fit}}) {
-    const glm::dvec2 expected = apply(projector.homography(), wall_point);
-    const glm::dvec2 got = apply(fit.homography, {shared.x, shared.y});
+    const glm::dvec2 expected = geometry::apply(projector.homography(), wall_point);
+    const glm::dvec2 got = geometry::apply(fit.homography, {shared.x, shared.y});
     EXPECT_LT(glm::length(got - expected), 1.0) << projector.name;
   }
 

@@ -29,7 +29,7 @@ glm::dvec2 output_centre(int u, int v, double ppm, double height) {
 
 // What each projector emits to show `pattern`: the pattern at its pixel centres
 // (mapped to the screen through H⁻¹) times its blend weight.
-std::vector<image::FloatImage> projector_images(const std::vector<ProjectorGeometry>& group, double ramp,
+std::vector<image::FloatImage> projector_images(const std::vector<geometry::ProjectorGeometry>& group, double ramp,
                                                 const Pattern& pattern) {
   std::vector<image::FloatImage> images;
   const BlendField field(group, wall_area(), ramp);
@@ -49,8 +49,8 @@ std::vector<image::FloatImage> projector_images(const std::vector<ProjectorGeome
   return images;
 }
 
-image::FloatImage compose(const std::vector<ProjectorGeometry>& group, const std::vector<image::FloatImage>& images,
-                          double ppm, int subsamples = 0) {
+image::FloatImage compose(const std::vector<geometry::ProjectorGeometry>& group,
+                          const std::vector<image::FloatImage>& images, double ppm, int subsamples = 0) {
   std::vector<ProjectedImage> projected;
   for (std::size_t i = 0; i < group.size(); ++i) projected.push_back({&group[i], &images[i]});
   ComposeOptions options;
@@ -80,7 +80,7 @@ image::FloatImage rasterize(const Pattern& pattern, double ppm, int n) {
 
 // Where two lit quads' outlines cross inside the usable area: the corners of an
 // unlit gap (the fixture has one at the bottom, near x = 1.78 m).
-std::vector<glm::dvec2> outline_crossings(const std::vector<ProjectorGeometry>& group) {
+std::vector<glm::dvec2> outline_crossings(const std::vector<geometry::ProjectorGeometry>& group) {
   std::vector<glm::dvec2> found;
   for (std::size_t i = 0; i < group.size(); ++i) {
     for (std::size_t j = i + 1; j < group.size(); ++j) {
@@ -111,7 +111,8 @@ std::vector<glm::dvec2> outline_crossings(const std::vector<ProjectorGeometry>& 
 // optics/blend.h), faster than a projector's pixel grid can follow, so the sum of
 // interpolated weights strays from 1 there: `corner_margin` metres around such
 // corners are left out.
-std::vector<bool> well_covered(const std::vector<ProjectorGeometry>& group, double ppm, double corner_margin) {
+std::vector<bool> well_covered(const std::vector<geometry::ProjectorGeometry>& group, double ppm,
+                               double corner_margin) {
   const int width = screen_pixels(kWallWidth, ppm);
   const int height = screen_pixels(kWallHeight, ppm);
   const BlendField field(group, wall_area(), 0.0);
@@ -160,8 +161,9 @@ TEST(ScreenSize, MatchesRenderReference) {
 }
 
 TEST(Subsamples, FollowTheProjectorsPixelDensity) {
-  const auto aligned =
-      ProjectorGeometry::make(aligned_homography({glm::dvec2(0.0), glm::dvec2(3.0, 1.0)}, 300, 100), 300, 100).value();
+  const auto aligned = geometry::ProjectorGeometry::make(
+                           geometry::aligned_homography({glm::dvec2(0.0), glm::dvec2(3.0, 1.0)}, 300, 100), 300, 100)
+                           .value();
   EXPECT_EQ(subsamples_for(aligned, 100.0), 2);
   EXPECT_EQ(subsamples_for(aligned, 400.0), 1);
   EXPECT_EQ(subsamples_for(aligned, 10.0), 16);
@@ -174,8 +176,8 @@ TEST(Subsamples, FollowTheProjectorsPixelDensity) {
 // the image itself. Any half-pixel or flipped-axis slip breaks this.
 TEST(ComposeScreen, AlignedProjectorWithTheScreensPixelsGivesTheImageBack) {
   const auto geometry =
-      ProjectorGeometry::make(aligned_homography({glm::dvec2(0.0), glm::dvec2(kWallWidth, kWallHeight)}, 300, 100), 300,
-                              100)
+      geometry::ProjectorGeometry::make(
+          geometry::aligned_homography({glm::dvec2(0.0), glm::dvec2(kWallWidth, kWallHeight)}, 300, 100), 300, 100)
           .value();
   image::FloatImage image(300, 100, 3);
   for (int y = 0; y < 100; ++y) {
@@ -201,7 +203,7 @@ TEST(ComposeScreen, AlignedProjectorWithTheScreensPixelsGivesTheImageBack) {
 // hundredths of an output pixel, and keeps its light (the composite integrates).
 TEST(ComposeScreen, BlobLandsWhereTheHomographySays) {
   const auto group = keystoned_wall(1280, 800);
-  const ProjectorGeometry& g = group[0];
+  const geometry::ProjectorGeometry& g = group[0];
   const glm::dvec2 centre(640.3, 400.7);
   image::FloatImage image(1280, 800, 4);
   for (int y = 0; y < 800; ++y) {

@@ -1,4 +1,4 @@
-#include "compose.h"
+#include "tools/compose.h"
 
 #include <gtest/gtest.h>
 #include <spdlog/sinks/ostream_sink.h>
@@ -16,7 +16,7 @@
 #include "optics/blend.h"
 #include "optics/compose.h"
 
-namespace optique::master {
+namespace optique::tools {
 namespace {
 
 namespace fs = std::filesystem;
@@ -31,7 +31,7 @@ std::string make_temp_dir() {
 }
 
 void add_homography(config::Projector& p, const glm::dmat3& h) {
-  for (double v : optics::homography_rows(h)) p.add_homography(v);
+  for (double v : geometry::homography_rows(h)) p.add_homography(v);
 }
 
 // A 3 m × 1 m wall lit by two keystoned mono projectors (160 × 100 px), and a
@@ -79,7 +79,7 @@ config::LoadedConfig installation() {
 // What the nodes would capture: `level` × the projector's blend weight.
 void write_captures(const config::LoadedConfig& loaded, const std::string& captures) {
   const auto& inst = loaded.installation;
-  std::vector<optics::ProjectorGeometry> wall;
+  std::vector<geometry::ProjectorGeometry> wall;
   for (int i = 0; i < 2; ++i) wall.push_back(config::projector_geometry(inst.projectors(i)).value());
   for (int i = 0; i < inst.projectors_size(); ++i) {
     const config::Projector& p = inst.projectors(i);
@@ -205,4 +205,4 @@ TEST(CompositeFolder, NamesEyes) {
 }
 
 }  // namespace
-}  // namespace optique::master
+}  // namespace optique::tools

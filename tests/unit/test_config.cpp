@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "calib/homography.h"
 #include "config/geometry.h"
 #include "config/load.h"
 #include "config/validate.h"
+#include "geometry/homography.h"
 
 namespace optique::config {
 namespace {
@@ -469,7 +469,7 @@ std::string two_through_a_camera(const std::string& second_extra = "") {
 }
 
 glm::dmat3 rows(const std::vector<double>& nine) {
-  return optics::homography_from_rows(std::span<const double, 9>(nine.data(), 9));
+  return geometry::homography_from_rows(std::span<const double, 9>(nine.data(), 9));
 }
 
 TEST(ProjectorGeometry, ACameraViewRelatesAPartnerToTheScreen) {
@@ -486,8 +486,8 @@ TEST(ProjectorGeometry, ACameraViewRelatesAPartnerToTheScreen) {
   // A screen point seen by the camera through either projector is the same
   // camera pixel: A2c · H2 ≅ A1c · H1.
   for (const glm::dvec2 s : {glm::dvec2(0.5, 0.5), glm::dvec2(1.5, 1.2), glm::dvec2(1.0, 0.2)}) {
-    const glm::dvec2 via_first = calib::apply(a1c, calib::apply(h1, s));
-    const glm::dvec2 via_second = calib::apply(a2c, calib::apply(h2, s));
+    const glm::dvec2 via_first = geometry::apply(a1c, geometry::apply(h1, s));
+    const glm::dvec2 via_second = geometry::apply(a2c, geometry::apply(h2, s));
     EXPECT_NEAR(via_first.x, via_second.x, 1e-9);
     EXPECT_NEAR(via_first.y, via_second.y, 1e-9);
   }

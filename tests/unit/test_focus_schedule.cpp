@@ -1,13 +1,13 @@
 // The focal depth of each frame (master/focus_schedule.h): fixed, scripted, or
 // ray cast under the gaze point.
 
-#include "focus_schedule.h"
+#include "master/focus_schedule.h"
 
 #include <gtest/gtest.h>
 
 #include "config/load.h"
+#include "master/scene_authority.h"
 #include "scene/builtin.h"
-#include "scene_authority.h"
 
 namespace optique::master {
 namespace {

@@ -23,6 +23,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 
+#include "image/texture_decode.h"
 #include "scene/gltf.h"
 #include "util/sha256.h"
 
@@ -74,7 +75,7 @@ json read_json(const std::string& path) { return json::parse(read_bytes(path)); 
 void write_json(const std::string& path, const json& doc) { write_bytes(path, doc.dump(1)); }
 
 LoadedGltf load_ok(const std::string& path) {
-  auto loaded = load_gltf(path);
+  auto loaded = load_gltf(path, image::decode_texture);
   EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error());
   if (!loaded.ok()) return {};
   return std::move(loaded).value();
@@ -83,7 +84,7 @@ LoadedGltf load_ok(const std::string& path) {
 // Loads `path`, expecting an error that starts with the path and contains every
 // one of `words`.
 void expect_error(const std::string& path, std::initializer_list<std::string> words) {
-  const auto loaded = load_gltf(path);
+  const auto loaded = load_gltf(path, image::decode_texture);
   ASSERT_FALSE(loaded.ok()) << path << " loaded";
   const std::string& message = loaded.error();
   EXPECT_EQ(message.rfind(path + ": ", 0), 0u) << message;

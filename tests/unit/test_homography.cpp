@@ -26,7 +26,7 @@ TEST(FitHomography, ExactPointsGiveTheHomographyBack) {
       ASSERT_TRUE(fit.ok()) << projector.name << ": " << fit.error();
       EXPECT_LE(fit.value().max_px, 1e-6) << projector.name << (refine ? " refined" : " DLT");
       for (const auto& p : points) {
-        const glm::dvec2 q = apply(fit.value().homography, p.screen);
+        const glm::dvec2 q = geometry::apply(fit.value().homography, p.screen);
         EXPECT_NEAR(q.x, p.pixel.x, 1e-6) << projector.name;
         EXPECT_NEAR(q.y, p.pixel.y, 1e-6) << projector.name;
       }
@@ -42,8 +42,8 @@ TEST(FitHomography, ExactMinimalSetGivesTheHomographyBack) {
   auto fit = fit_homography(points);
   ASSERT_TRUE(fit.ok()) << fit.error();
   EXPECT_LE(fit.value().max_px, 1e-6);
-  const glm::dvec2 centre = apply(glm::inverse(truth), {960.0, 540.0});
-  const glm::dvec2 q = apply(fit.value().homography, centre);
+  const glm::dvec2 centre = geometry::apply(glm::inverse(truth), {960.0, 540.0});
+  const glm::dvec2 q = geometry::apply(fit.value().homography, centre);
   EXPECT_NEAR(q.x, 960.0, 1e-6);
   EXPECT_NEAR(q.y, 540.0, 1e-6);
 }
@@ -75,8 +75,8 @@ TEST(FitHomography, DegenerateInputIsRefusedWithAReason) {
   EXPECT_NE(result.error().find("at least 4"), std::string::npos) << result.error();
   EXPECT_NE(result.error().find("got 3"), std::string::npos) << result.error();
 
-  std::vector<Correspondence> line;
-  for (int i = 0; i < 6; ++i) line.push_back({{0.5 * i, 0.25 * i}, apply(h, {0.5 * i, 0.25 * i})});
+  std::vector<geometry::Correspondence> line;
+  for (int i = 0; i < 6; ++i) line.push_back({{0.5 * i, 0.25 * i}, geometry::apply(h, {0.5 * i, 0.25 * i})});
   result = fit_homography(line);
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.error().find("all lie on one line"), std::string::npos) << result.error();
@@ -84,7 +84,7 @@ TEST(FitHomography, DegenerateInputIsRefusedWithAReason) {
   // All but one on a line: no 4 of them in general position.
   auto almost_line = line;
   almost_line[3].screen.y += 0.5;
-  almost_line[3].pixel = apply(h, almost_line[3].screen);
+  almost_line[3].pixel = geometry::apply(h, almost_line[3].screen);
   result = fit_homography(almost_line);
   ASSERT_FALSE(result.ok());
   EXPECT_NE(result.error().find("all points but points[3] lie on one line"), std::string::npos) << result.error();

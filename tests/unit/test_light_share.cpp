@@ -13,11 +13,11 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "light_share.h"
+#include "master/light_share.h"
+#include "master/scene_authority.h"
 #include "scene/builtin.h"
 #include "scene/light_coverage.h"
 #include "scene/meshes.h"
-#include "scene_authority.h"
 
 namespace optique::master {
 namespace {

@@ -1,7 +1,7 @@
 // Lights switched on and off over a show (master/light_switches.h): what
 // check-config refuses, and which lights are off when.
 
-#include "light_switches.h"
+#include "master/light_switches.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,8 @@
 // render-reference with a supersample factor: the same raster, each pixel the
 // average of S × S samples. Needs GL (headless; llvmpipe in CI): label `gpu`.
 
-#include "render_reference.h"
+#include "image/texture_decode.h"
+#include "tools/render_reference.h"
 
 #include <gtest/gtest.h>
 #include <spdlog/sinks/null_sink.h>
@@ -15,7 +16,7 @@
 #include "image/image_io.h"
 #include "optics/compose.h"
 
-namespace optique::master {
+namespace optique::tools {
 namespace {
 
 namespace fs = std::filesystem;
@@ -28,7 +29,7 @@ struct Rendered {
 Rendered render(int supersample) {
   auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
   EXPECT_TRUE(config.ok()) << config.error();
-  auto scene = scene::load_scene(config.value().installation.scene(), config.value().directory);
+  auto scene = scene::load_scene(config.value().installation.scene(), config.value().directory, image::decode_texture);
   EXPECT_TRUE(scene.ok()) << scene.error();
   std::string dir = (fs::temp_directory_path() / "optique-reference-XXXXXX").string();
   EXPECT_NE(mkdtemp(dir.data()), nullptr);
@@ -80,7 +81,7 @@ TEST(RenderReference, SupersampledHasTheScreensPixelsAndAveragesThem) {
 TEST(RenderReference, RefusesAZeroFactor) {
   auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
   ASSERT_TRUE(config.ok()) << config.error();
-  auto scene = scene::load_scene(config.value().installation.scene(), config.value().directory);
+  auto scene = scene::load_scene(config.value().installation.scene(), config.value().directory, image::decode_texture);
   ASSERT_TRUE(scene.ok()) << scene.error();
   spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
   auto written = render_reference(config.value(), scene.value(), 0, "/nonexistent", log, ReferenceOptions{0});
@@ -89,4 +90,4 @@ TEST(RenderReference, RefusesAZeroFactor) {
 }
 
 }  // namespace
-}  // namespace optique::master
+}  // namespace optique::tools

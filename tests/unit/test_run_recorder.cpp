@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "run_recorder.h"
+#include "master/run_recorder.h"
 
 namespace optique::master {
 namespace {

@@ -1,7 +1,7 @@
 // Stacked groups: the checks check-config makes on lights and focus pairs
 // (master/stacked_groups.h, common/config/validate.cpp) and the light plan.
 
-#include "stacked_groups.h"
+#include "master/stacked_groups.h"
 
 #include <gtest/gtest.h>
 
@@ -10,8 +10,8 @@
 
 #include "config/load.h"
 #include "config/validate.h"
+#include "master/scene_authority.h"
 #include "scene/builtin.h"
-#include "scene_authority.h"
 
 namespace optique::master {
 namespace {

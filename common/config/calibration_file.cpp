@@ -1,0 +1,39 @@
+#include "config/calibration_file.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace optique::config {
+
+Result<glm::dmat3> read_calibration_homography(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Error{path + ": cannot open the calibration file"};
+  std::ostringstream text;
+  text << in.rdbuf();
+  const auto document = nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+  if (document.is_discarded()) return Error{path + ": not valid JSON"};
+  const auto found = document.find("homography");
+  if (found == document.end()) return Error{path + ": no \"homography\" (write it with optique-master calibrate)"};
+  const auto& rows = *found;
+  if (!rows.is_array() || rows.size() != 3) return Error{path + ": homography: needs 3 rows of 3 numbers"};
+  glm::dmat3 h(0.0);
+  for (int r = 0; r < 3; ++r) {
+    const auto& row = rows[static_cast<std::size_t>(r)];
+    if (!row.is_array() || row.size() != 3) {
+      return Error{path + ": homography[" + std::to_string(r) + "]: needs 3 numbers"};
+    }
+    for (int c = 0; c < 3; ++c) {
+      const auto& value = row[static_cast<std::size_t>(c)];
+      if (!value.is_number() || !std::isfinite(value.get<double>())) {
+        return Error{path + ": homography[" + std::to_string(r) + "][" + std::to_string(c) + "]: not a finite number"};
+      }
+      h[c][r] = value.get<double>();
+    }
+  }
+  return h;
+}
+
+}  // namespace optique::config

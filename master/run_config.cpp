@@ -1,0 +1,27 @@
+#include "master/run_config.h"
+
+#include "master/light_switches.h"
+#include "master/shared_secret.h"
+#include "master/stacked_groups.h"
+
+namespace optique::master {
+
+Result<RunConfig> load_run_config(const std::string& path, const scene::ImageDecoder& decode) {
+  auto loaded = config::load_installation(path);
+  if (!loaded) return Error{loaded.error()};
+  auto scene = scene::load_scene(loaded.value().installation.scene(), loaded.value().directory, decode);
+  if (!scene) return Error{path + ": scene: " + scene.error()};
+  const std::size_t light_count = scene.value().definition.lights.size();
+  auto problems = check_lighting_groups(loaded.value().installation, light_count);
+  for (config::Problem& problem : LightSwitches::check(loaded.value().installation.scene(), light_count)) {
+    problems.push_back(std::move(problem));
+  }
+  if (!problems.empty()) return Error{config::describe_problems(problems, path)};
+  // A refused secret file is a config problem: check-config says so too.
+  if (auto secret = load_installation_secret(loaded.value()); !secret) {
+    return Error{config::describe_problems({{"master.secret_file", secret.error()}}, path)};
+  }
+  return RunConfig{std::move(loaded).value(), std::move(scene).value()};
+}
+
+}  // namespace optique::master
