@@ -110,13 +110,13 @@ int run_cli(int argc, char** argv) {
   }
   options.secret = std::move(secret).value();
   options.secret_path = secret_path(options.config);
-  auto& settings = *options.config.installation.mutable_master();
+  config::MasterSettings& settings = options.config.installation.master;
   if (options.local) {
-    settings.set_listen("127.0.0.1");
-    settings.set_port(0);
+    settings.listen = "127.0.0.1";
+    settings.port = 0;
   }
-  if (!listen.empty()) settings.set_listen(listen);
-  if (port >= 0) settings.set_port(static_cast<std::uint32_t>(port));
+  if (!listen.empty()) settings.listen = listen;
+  if (port >= 0) settings.port = static_cast<std::uint16_t>(port);
   if (options.node_binary.empty()) options.node_binary = util::sibling_program("optique-node");
 
   std::string log_file;

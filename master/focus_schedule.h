@@ -10,8 +10,8 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
-#include "optique/config.pb.h"
-#include "optique/wire.pb.h"
+#include "config/installation.h"
+#include "protocol/focus.h"
 #include "scene/definition.h"
 #include "scene/state.h"
 
@@ -27,14 +27,12 @@ class FocusSchedule {
   [[nodiscard]] glm::dvec2 gaze_at(double seconds) const;
   // The frame's focus: its focal depth (clamped to the depth of field's near and
   // far) and gaze point. The scene and state are those of the frame.
-  [[nodiscard]] wire::Focus at(double seconds, const scene::SceneDefinition& scene, const scene::SceneState& state,
-                               const glm::dvec3& eye) const;
+  [[nodiscard]] protocol::Focus at(double seconds, const scene::SceneDefinition& scene, const scene::SceneState& state,
+                                   const glm::dvec3& eye) const;
 
  private:
   config::DepthOfField settings_;
-  glm::dvec3 origin_{0.0};  // the gaze screen's frame
-  glm::dvec3 right_{1.0, 0.0, 0.0};
-  glm::dvec3 up_{0.0, 1.0, 0.0};
+  config::Screen screen_;  // the gaze's
 };
 
 }  // namespace optique::master

@@ -1,8 +1,8 @@
 #pragma once
 // The automatic light split of a stacked group (DESIGN.md, "Lighting split"):
 // each light drawn by exactly one node, the ambient and emissive terms by exactly
-// one, so that the projectors' optical sum is the full render. Pure partitioning
-// and the role-"lights" list syntax; no IO.
+// one, so that the projectors' optical sum is the full render. Pure partitioning;
+// no IO. (The lists configs write are config/light_list.h.)
 
 #include <cstddef>
 #include <cstdint>
@@ -11,16 +11,12 @@
 #include <string_view>
 #include <vector>
 
+#include "protocol/light_share.h"
 #include "util/result.h"
 
 namespace optique::master {
 
-struct LightShare {
-  std::vector<std::uint32_t> lights;  // indices into the scene's lights, ascending
-  bool ambient = false;               // also draws the ambient and emissive terms
-
-  friend bool operator==(const LightShare&, const LightShare&) = default;
-};
+using protocol::LightShare;
 
 // The least cost a light counts for, whatever its coverage: a light that reaches
 // none of a node's pixels still costs each of them a turn of the shader's light
@@ -49,16 +45,5 @@ inline constexpr double kLightCostFloor = 0.1;
 [[nodiscard]] std::vector<double> modelled_times(std::span<const double> light_costs,
                                                  std::span<const double> node_pixels, double base_cost,
                                                  double ambient_cost, std::span<const LightShare> shares);
-
-// Parses a role-"lights" list of indices and ranges, "0-6" or "0, 3, 7-9"
-// (whitespace allowed around items and dashes), into ascending unique indices.
-// Blank text is the empty list. Each error names the offending item: an empty
-// item, one that is not a number or range, a reversed range ("6-2"), an index the
-// scene does not have, an index listed twice.
-[[nodiscard]] Result<std::vector<std::uint32_t>> parse_light_list(std::string_view text, std::size_t light_count);
-
-// Formats ascending unique indices compactly, runs as ranges: "0-6, 9"; the empty
-// list as "". parse_light_list reads it back.
-[[nodiscard]] std::string format_light_list(std::span<const std::uint32_t> lights);
 
 }  // namespace optique::master

@@ -10,6 +10,7 @@
 #include <set>
 #include <vector>
 
+#include "config/installation.h"
 #include "config/validate.h"
 #include "optique/config.pb.h"
 
@@ -19,15 +20,13 @@ class LightSwitches {
  public:
   LightSwitches() = default;  // no switches: every light shines all the time
 
-  // Every problem with the scene's switches, naming the field
-  // ("scene.light_switches[2].off"): a time that is not finite, negative, or
-  // before the switch above it; a list that does not parse or names a light the
-  // scene lacks; a switch that changes nothing (a light switched off while off,
-  // or on while on).
-  [[nodiscard]] static std::vector<config::Problem> check(const config::Scene& scene, std::size_t light_count);
+  // The lights the scene's switches name that the scene does not have, naming
+  // the field ("scene.light_switches[2].off"). (The rest — times in order, lists
+  // that parse, no switch that changes nothing — is checked with the config.)
+  [[nodiscard]] static std::vector<config::Problem> check(const config::SceneSource& scene, std::size_t light_count);
 
-  // The switches of a scene that `check` accepts (asserted).
-  [[nodiscard]] static LightSwitches from_config(const config::Scene& scene, std::size_t light_count);
+  // The switches of a scene that `check` accepts.
+  [[nodiscard]] static LightSwitches from_config(const config::SceneSource& scene);
 
   // The lights that are off at simulation time `seconds`: a switch at time t
   // applies from t on (to within half a microsecond, so that a switch at 2 s
@@ -37,12 +36,7 @@ class LightSwitches {
   [[nodiscard]] bool empty() const { return switches_.empty(); }
 
  private:
-  struct Switch {
-    double time = 0.0;
-    std::vector<std::uint32_t> off;
-    std::vector<std::uint32_t> on;
-  };
-  std::vector<Switch> switches_;
+  std::vector<config::LightSwitch> switches_;
 };
 
 }  // namespace optique::master

@@ -7,8 +7,9 @@
 #include <fstream>
 #include <random>
 
-#include "config/geometry.h"
+#include "config/light_list.h"
 #include "net/envelope.h"
+#include "protocol/welcome.h"
 
 namespace optique::master {
 namespace {
@@ -20,13 +21,6 @@ bool is_loopback(const asio::ip::address& address) {
     return asio::ip::make_address_v4(asio::ip::v4_mapped, address.to_v6()).is_loopback();
   }
   return address.is_loopback();
-}
-
-wire::LightShare to_wire(const LightShare& share) {
-  wire::LightShare out;
-  out.mutable_lights()->Add(share.lights.begin(), share.lights.end());
-  out.set_ambient(share.ambient);
-  return out;
 }
 
 std::string format_us(double us) {
@@ -41,7 +35,7 @@ Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
     : io_(io),
       options_(std::move(options)),
       log_(log),
-      settings_(options_.config.installation.master()),
+      settings_(options_.config.installation.master),
       acceptor_(io),
       accept_retry_timer_(io),
       signals_(io, SIGINT, SIGTERM),
@@ -51,7 +45,7 @@ Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
       housekeeping_timer_(io),
       heartbeat_timer_(io),
       status_(options_.status_line) {
-  for (const auto& projector : options_.config.installation.projectors())
+  for (const auto& projector : options_.config.installation.projectors)
     slots_.push_back({&projector, nullptr, std::nullopt});
 }
 
@@ -60,11 +54,11 @@ Master::~Master() = default;
 Result<void> Master::start() {
   const auto& installation = options_.config.installation;
   const std::size_t light_count = options_.scene.definition.lights.size();
-  if (auto problems = LightSwitches::check(installation.scene(), light_count); !problems.empty()) {
+  if (auto problems = LightSwitches::check(installation.scene, light_count); !problems.empty()) {
     return Error{config::describe_problems(problems, options_.config.path)};
   }
-  authority_.emplace(options_.scene.definition.objects, installation.viewer(), settings_.frame_rate(),
-                     LightSwitches::from_config(installation.scene(), light_count));
+  authority_.emplace(options_.scene.definition.objects, installation.viewer, settings_.frame_rate,
+                     LightSwitches::from_config(installation.scene));
   frame_period_ = authority_->frame_period();
   current_state_ = authority_->state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
@@ -75,7 +69,7 @@ Result<void> Master::start() {
   focus_ = FocusSchedule::make(installation);
 
   std::vector<std::string> ids;
-  for (const Slot& s : slots_) ids.push_back(s.projector->id());
+  for (const Slot& s : slots_) ids.push_back(s.projector->id);
   if (!options_.out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(std::filesystem::path(options_.out_dir) / "logs", ec);
@@ -88,16 +82,15 @@ Result<void> Master::start() {
 
   // Listen.
   boost::system::error_code ec;
-  const auto address = asio::ip::make_address(settings_.listen(), ec);
-  if (ec) return Error{"master.listen: '" + settings_.listen() + "' is not an address"};
-  const asio::ip::tcp::endpoint endpoint(address, static_cast<std::uint16_t>(settings_.port()));
+  const auto address = asio::ip::make_address(settings_.listen, ec);
+  if (ec) return Error{"master.listen: '" + settings_.listen + "' is not an address"};
+  const asio::ip::tcp::endpoint endpoint(address, static_cast<std::uint16_t>(settings_.port));
   acceptor_.open(endpoint.protocol(), ec);
   if (!ec) acceptor_.set_option(asio::ip::tcp::acceptor::reuse_address(true), ec);
   if (!ec) acceptor_.bind(endpoint, ec);
   if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
   if (ec) {
-    return Error{"cannot listen on " + settings_.listen() + ":" + std::to_string(settings_.port()) + ": " +
-                 ec.message()};
+    return Error{"cannot listen on " + settings_.listen + ":" + std::to_string(settings_.port) + ": " + ec.message()};
   }
   port_ = acceptor_.local_endpoint().port();
   if (!options_.port_file.empty()) {
@@ -109,7 +102,7 @@ Result<void> Master::start() {
   }
   std::string id_list;
   for (const auto& id : ids) id_list += (id_list.empty() ? "" : ", ") + id;
-  log_.info("listening on {}:{}; waiting for {} node(s): {}", settings_.listen(), port_, slots_.size(), id_list);
+  log_.info("listening on {}:{}; waiting for {} node(s): {}", settings_.listen, port_, slots_.size(), id_list);
   if (options_.secret) {
     log_.info("nodes must prove they hold the shared secret in {}", options_.secret_path);
   } else {
@@ -120,7 +113,7 @@ Result<void> Master::start() {
     launcher_.emplace(options_.node_binary);
     for (const Slot& s : slots_) {
       std::vector<std::string> args{"--master",    "127.0.0.1:" + std::to_string(port_),
-                                    "--id",        s.projector->id(),
+                                    "--id",        s.projector->id,
                                     "--log-level", options_.node_log_level};
       if (!options_.secret_path.empty()) {
         args.push_back("--secret-file");
@@ -128,12 +121,12 @@ Result<void> Master::start() {
       }
       if (!options_.out_dir.empty()) {
         args.push_back("--capture-dir");
-        args.push_back((std::filesystem::path(options_.out_dir) / "nodes" / s.projector->id()).string());
+        args.push_back((std::filesystem::path(options_.out_dir) / "nodes" / s.projector->id).string());
       }
       args.insert(args.end(), options_.node_args.begin(), options_.node_args.end());
-      auto pid = launcher_->spawn(s.projector->id(), args, node_log_path(s.projector->id()));
-      if (!pid) return Error{"cannot start the node for projector '" + s.projector->id() + "': " + pid.error()};
-      log_.debug("started node '{}' as pid {}", s.projector->id(), pid.value());
+      auto pid = launcher_->spawn(s.projector->id, args, node_log_path(s.projector->id));
+      if (!pid) return Error{"cannot start the node for projector '" + s.projector->id + "': " + pid.error()};
+      log_.debug("started node '{}' as pid {}", s.projector->id, pid.value());
     }
   }
 
@@ -143,19 +136,19 @@ Result<void> Master::start() {
   accept_next();
   housekeeping();
   send_heartbeats();
-  phase_timer_.expires_after(milliseconds(settings_.startup_timeout_ms()));
+  phase_timer_.expires_after(settings_.startup_timeout);
   phase_timer_.async_wait([this](const boost::system::error_code& error) {
     if (error || state_ != RunState::starting) return;
     if (nodes_up() == 0) {
-      fail("no node connected within " + std::to_string(settings_.startup_timeout_ms()) + " ms");
+      fail("no node connected within " + std::to_string(settings_.startup_timeout.count()) + " ms");
       return;
     }
     std::string missing;
     for (const Slot& s : slots_) {
-      if (!s.session) missing += (missing.empty() ? "" : ", ") + s.projector->id();
+      if (!s.session) missing += (missing.empty() ? "" : ", ") + s.projector->id;
     }
     log_.warn("starting without {} (not connected after {} ms); they join when they come", missing,
-              settings_.startup_timeout_ms());
+              settings_.startup_timeout.count());
     start_frames();
   });
   return {};
@@ -199,7 +192,7 @@ void Master::on_connection(asio::ip::tcp::socket socket) {
   }
   const auto pending = static_cast<std::size_t>(
       std::count_if(sessions_.begin(), sessions_.end(), [](const auto& s) { return s->phase == Phase::handshake; }));
-  if (pending >= settings_.max_pending_connections()) {
+  if (pending >= settings_.max_pending_connections) {
     log_.warn(
         "refused connection from {}: {} connections are already waiting to authenticate "
         "(master.max_pending_connections)",
@@ -222,8 +215,8 @@ void Master::on_connection(asio::ip::tcp::socket socket) {
       },
   });
   session->connection->set_deadline(
-      milliseconds(settings_.handshake_timeout_ms()),
-      "no valid hello within " + std::to_string(settings_.handshake_timeout_ms()) + " ms");
+      settings_.handshake_timeout,
+      "no valid hello within " + std::to_string(settings_.handshake_timeout.count()) + " ms");
   wire::Envelope challenge;
   session->nonce = net::random_nonce();
   challenge.mutable_challenge()->set_nonce(session->nonce.data(), session->nonce.size());
@@ -318,8 +311,8 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
   std::optional<std::size_t> slot;
   std::string known;
   for (std::size_t i = 0; i < slots_.size(); ++i) {
-    if (slots_[i].projector->id() == hello.node_id()) slot = i;
-    known += (known.empty() ? "" : ", ") + slots_[i].projector->id();
+    if (slots_[i].projector->id == hello.node_id()) slot = i;
+    known += (known.empty() ? "" : ", ") + slots_[i].projector->id;
   }
   if (!slot) {
     refuse(*session, hello.node_id(),
@@ -337,39 +330,20 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
   target.session = session;
   session->slot = slot;
   session->phase = Phase::configuring;
-  session->connection->set_max_payload_bytes(settings_.max_message_bytes());
+  session->connection->set_max_payload_bytes(settings_.max_message_bytes);
   // Setting up a GL context and compiling shaders can take seconds on a loaded
   // machine; the node is silent meanwhile.
   session->connection->set_deadline(
       kConfigureTimeout, "node did not finish configuring within " + std::to_string(kConfigureTimeout.count()) + " s");
 
-  const auto& installation = options_.config.installation;
+  const LightShare* share = light_plan_->share(*slot);
   wire::Envelope envelope;
-  auto& welcome = *envelope.mutable_welcome();
-  *welcome.mutable_projector() = *target.projector;
-  for (const auto& screen : installation.screens()) {
-    if (screen.id() == target.projector->screen()) *welcome.mutable_screen() = screen;
-  }
-  for (const auto& other : installation.projectors()) {
-    if (config::same_blend_group(other, *target.projector)) *welcome.add_blend_group() = other;
-  }
-  *welcome.mutable_viewer() = installation.viewer();
-  *welcome.mutable_scene() = installation.scene();
-  if (!installation.scene().gltf().empty()) {
-    // The node loads the same file, at the path the master resolved.
-    welcome.mutable_scene()->set_gltf(options_.scene.source);
-    welcome.set_scene_sha256(options_.scene.content_sha256);
-  }
-  if (const LightShare* share = light_plan_->share(*slot)) {
-    *welcome.mutable_lights() = to_wire(*share);
-    // Its first frame repeats the share, so the log tells from which frame each
-    // node draws what (and a share changed while it set itself up still reaches it).
-    target.sent_share.reset();
-  }
-  if (installation.has_depth_of_field()) *welcome.mutable_depth_of_field() = installation.depth_of_field();
-  welcome.set_frame_period_ns(frame_period_);
-  welcome.set_heartbeat_ms(settings_.heartbeat_ms());
-  welcome.set_liveness_timeout_ms(settings_.liveness_timeout_ms());
+  *envelope.mutable_welcome() = protocol::encode_welcome(
+      options_.config.installation, *slot, options_.scene.content_sha256,
+      static_cast<std::uint32_t>(options_.scene.definition.lights.size()), frame_period_, share);
+  // Its first frame repeats the share, so the log tells from which frame each node
+  // draws what (and a share changed while it set itself up still reaches it).
+  if (share != nullptr) target.sent_share.reset();
   session->connection->send(envelope);
   log_.debug("node '{}' from {} is configuring", hello.node_id(), session->connection->peer());
 }
@@ -377,8 +351,7 @@ void Master::handle_hello(const std::shared_ptr<Session>& session, wire::Envelop
 void Master::handle_configured(Session& session, const wire::Configured& configured) {
   session.connection->cancel_deadline();
   session.connection->set_liveness_timeout(
-      milliseconds(settings_.liveness_timeout_ms()),
-      "node silent for " + std::to_string(settings_.liveness_timeout_ms()) + " ms");
+      settings_.liveness_timeout, "node silent for " + std::to_string(settings_.liveness_timeout.count()) + " ms");
   send_resync(session);
   session.phase = Phase::joined;
   recorder_->node_joined(*session.slot);
@@ -429,7 +402,7 @@ void Master::start_frames() {
   if (state_ != RunState::starting) return;
   state_ = RunState::running;
   phase_timer_.cancel();
-  log_.info("starting frames at {} Hz with {}/{} node(s){}", settings_.frame_rate(), nodes_up(), slots_.size(),
+  log_.info("starting frames at {} Hz with {}/{} node(s){}", settings_.frame_rate, nodes_up(), slots_.size(),
             options_.frames ? " for " + std::to_string(options_.frames) + " frames" : std::string());
   schedule_origin_ = clock::monotonic_now();
   schedule_origin_frame_ = next_frame_;
@@ -458,12 +431,13 @@ void Master::begin_frame() {
   begin.set_present_time_ns(schedule_origin_ +
                             static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_);
   if (focus_) {
-    *begin.mutable_focus() = focus_->at(static_cast<double>(begin.simulation_time_ns()) / 1e9,
-                                        options_.scene.definition, current_state_, current_state_.eye_now);
+    *begin.mutable_focus() =
+        protocol::to_wire(focus_->at(static_cast<double>(begin.simulation_time_ns()) / 1e9, options_.scene.definition,
+                                     current_state_, current_state_.eye_now));
   }
   // The scene moves: about once a second, see whether another split of the
   // automatic groups' lights would finish clearly sooner.
-  const auto frames_per_second = static_cast<std::uint64_t>(std::max(1.0, settings_.frame_rate()));
+  const auto frames_per_second = static_cast<std::uint64_t>(std::max(1.0, settings_.frame_rate));
   if (lights_switched) {
     rebalance_lights(true);
   } else if (frame % frames_per_second == 0) {
@@ -481,10 +455,10 @@ void Master::begin_frame() {
     if (share != nullptr && slots_[i].sent_share != *share) {
       // A new share applies from this frame on, on every node of the group at once.
       wire::Envelope with_share = envelope;
-      *with_share.mutable_frame_begin()->mutable_lights() = to_wire(*share);
+      *with_share.mutable_frame_begin()->mutable_lights() = protocol::to_wire(*share);
       session->connection->send(with_share);
       slots_[i].sent_share = *share;
-      log_.info("node '{}' draws lights [{}]{} from frame {}", slot_id(i), format_light_list(share->lights),
+      log_.info("node '{}' draws lights [{}]{} from frame {}", slot_id(i), config::format_light_list(share->lights),
                 share->ambient ? " and ambient" : "", frame);
     } else {
       session->connection->send(envelope);
@@ -501,7 +475,7 @@ void Master::begin_frame() {
     swap();
     return;
   }
-  barrier_timer_.expires_after(milliseconds(settings_.frame_timeout_ms()));
+  barrier_timer_.expires_after(settings_.frame_timeout);
   barrier_timer_.async_wait([this](const boost::system::error_code& error) {
     if (!error) on_barrier_timeout();
   });
@@ -533,12 +507,12 @@ void Master::handle_ready(Session& session, const wire::FrameReady& ready, clock
 
 void Master::on_barrier_timeout() {
   if (!barrier_.active()) return;
-  const bool drop = settings_.straggler_policy() == "drop";
+  const bool drop = settings_.straggler_policy == config::StragglerPolicy::drop;
   for (std::size_t slot : barrier_.waiting_for()) {
     recorder_->node_missed_barrier(slot);
     if (Session* session = slots_[slot].session.get()) session->phase = Phase::out_of_barrier;
     log_.warn("node '{}' was not ready for frame {} within {} ms: taken out of the barrier; {}", slot_id(slot),
-              barrier_.frame(), settings_.frame_timeout_ms(),
+              barrier_.frame(), settings_.frame_timeout.count(),
               drop ? "the frame is dropped everywhere" : "the others show the frame");
   }
   if (drop) {
@@ -556,7 +530,7 @@ void Master::swap() {
   auto& swap = *envelope.mutable_swap();
   swap.set_frame_id(frame);
   const clock::Nanos sent = clock::monotonic_now();
-  swap.set_present_deadline_ns(sent + static_cast<clock::Nanos>(settings_.present_lead_us()) * clock::kNanosPerMicro);
+  swap.set_present_deadline_ns(sent + std::chrono::nanoseconds(settings_.present_lead).count());
   for (std::size_t slot : ready_for_swap_) {
     if (Session* session = slots_[slot].session.get()) session->connection->send(envelope);
   }
@@ -612,7 +586,8 @@ void Master::drain(const std::string& reason) {
 
 void Master::wait_for_last_presents(bool frames_ran) {
   // The last swap's Presented arrive after its present deadline.
-  const auto wait = frames_ran ? milliseconds(settings_.present_lead_us() / 1000 + 250) : milliseconds(0);
+  const auto wait = frames_ran ? std::chrono::duration_cast<milliseconds>(settings_.present_lead) + milliseconds(250)
+                               : milliseconds(0);
   phase_timer_.expires_after(wait);
   phase_timer_.async_wait([this](const boost::system::error_code& error) {
     if (!error) say_goodbye();
@@ -681,7 +656,7 @@ void Master::write_outputs() {
   report::RunReport report = recorder_->report();
   report.set_config_file(options_.config.path);
   report.set_config_sha256(options_.config.sha256);
-  report.set_frame_rate(settings_.frame_rate());
+  report.set_frame_rate(settings_.frame_rate);
   report.set_stopped_because(stopped_because_);
   report.set_connections_refused(refused_connections_);
   const auto& sync = report.sync();
@@ -722,7 +697,7 @@ void Master::rebalance_lights(bool force) {
 
 void Master::log_light_switches(std::uint64_t frame, const wire::StateDelta& delta, const scene::SceneState& state) {
   const auto list = [](const auto& lights) {
-    return format_light_list(std::vector<std::uint32_t>(lights.begin(), lights.end()));
+    return config::format_light_list(std::vector<std::uint32_t>(lights.begin(), lights.end()));
   };
   std::string what;
   if (delta.lights_off_size() > 0) what = "lights [" + list(delta.lights_off()) + "] go dark";
@@ -768,7 +743,7 @@ void Master::send_heartbeats() {
       slot.session->connection->send(envelope);
     }
   }
-  heartbeat_timer_.expires_after(milliseconds(settings_.heartbeat_ms()));
+  heartbeat_timer_.expires_after(settings_.heartbeat);
   heartbeat_timer_.async_wait([this](const boost::system::error_code& error) {
     if (!error) send_heartbeats();
   });
@@ -818,7 +793,7 @@ std::size_t Master::nodes_up() const {
   return up;
 }
 
-std::string Master::slot_id(std::size_t slot) const { return slots_[slot].projector->id(); }
+std::string Master::slot_id(std::size_t slot) const { return slots_[slot].projector->id; }
 
 std::string Master::node_log_path(const std::string& id) const {
   if (options_.out_dir.empty()) return {};

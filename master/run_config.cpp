@@ -9,11 +9,12 @@ namespace optique::master {
 Result<RunConfig> load_run_config(const std::string& path, const scene::ImageDecoder& decode) {
   auto loaded = config::load_installation(path);
   if (!loaded) return Error{loaded.error()};
-  auto scene = scene::load_scene(loaded.value().installation.scene(), loaded.value().directory, decode);
+  const config::SceneSource& source = loaded.value().installation.scene;
+  auto scene = scene::load_scene(source.builtin, source.gltf, decode);
   if (!scene) return Error{path + ": scene: " + scene.error()};
   const std::size_t light_count = scene.value().definition.lights.size();
   auto problems = check_lighting_groups(loaded.value().installation, light_count);
-  for (config::Problem& problem : LightSwitches::check(loaded.value().installation.scene(), light_count)) {
+  for (config::Problem& problem : LightSwitches::check(source, light_count)) {
     problems.push_back(std::move(problem));
   }
   if (!problems.empty()) return Error{config::describe_problems(problems, path)};

@@ -1,7 +1,5 @@
 #include "master/scene_authority.h"
 
-#include "scene/viewer_path.h"
-
 namespace optique::master {
 
 SceneAuthority::SceneAuthority(std::vector<scene::AnimatedObject> objects, config::Viewer viewer, double frame_rate,
@@ -22,8 +20,8 @@ scene::SceneState SceneAuthority::state_at_frame(std::uint64_t frame) const {
   for (const auto& object : objects_) {
     state.objects.emplace(object.id, scene::ObjectState{object.pose_at(now), object.pose_at(next)});
   }
-  state.eye_now = scene::eye_at(viewer_, now);
-  state.eye_next = scene::eye_at(viewer_, next);
+  state.eye_now = viewer_.eye_at(now);
+  state.eye_next = viewer_.eye_at(next);
   state.lights_off = switches_.off_at(now);
   return state;
 }

@@ -6,8 +6,8 @@
 #include <cstdint>
 
 #include "clock/clock.h"
+#include "config/installation.h"
 #include "master/light_switches.h"
-#include "optique/config.pb.h"
 #include "scene/definition.h"
 #include "scene/state.h"
 

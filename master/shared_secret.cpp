@@ -5,7 +5,7 @@
 namespace optique::master {
 
 std::string secret_path(const config::LoadedConfig& config) {
-  const std::string& file = config.installation.master().secret_file();
+  const std::string& file = config.installation.master.secret_file;
   if (file.empty()) return {};
   const std::filesystem::path path(file);
   return path.is_absolute() ? path.string() : (std::filesystem::path(config.directory) / path).string();

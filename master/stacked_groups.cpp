@@ -5,14 +5,16 @@
 #include <limits>
 #include <set>
 
-#include "config/geometry.h"
+#include "config/light_list.h"
+#include "config/projector_groups.h"
 #include "scene/light_coverage.h"
 
 namespace optique::master {
 namespace {
 
-std::string group_name(const StackedGroup& group) {
-  return "stacked group on screen '" + group.screen + "' (eye " + group.eye + ")";
+std::string group_name(const config::Installation& inst, const StackedGroup& group) {
+  return "stacked group on screen '" + inst.screens[group.screen].id + "' (eye " +
+         std::string(config::to_string(group.eye)) + ")";
 }
 
 std::string lights_path(std::size_t projector) {
@@ -24,8 +26,7 @@ std::vector<std::vector<std::size_t>> layers_of(const config::Installation& inst
   std::vector<std::vector<std::size_t>> layers;
   for (std::size_t member : group.members) {
     auto layer = std::find_if(layers.begin(), layers.end(), [&](const std::vector<std::size_t>& l) {
-      return config::same_layer(inst.projectors(static_cast<int>(l.front())),
-                                inst.projectors(static_cast<int>(member)));
+      return config::same_layer(inst.projectors[l.front()], inst.projectors[member]);
     });
     if (layer != layers.end()) {
       layer->push_back(member);
@@ -40,17 +41,17 @@ std::vector<std::vector<std::size_t>> layers_of(const config::Installation& inst
 
 std::vector<StackedGroup> lighting_groups(const config::Installation& inst) {
   std::vector<StackedGroup> groups;
-  for (int i = 0; i < inst.projectors_size(); ++i) {
-    const config::Projector& p = inst.projectors(i);
-    if (p.content().role() != "lights") continue;
+  for (std::size_t i = 0; i < inst.projectors.size(); ++i) {
+    const config::Projector& p = inst.projectors[i];
+    if (p.content.role != config::ContentRole::lights) continue;
     auto group = std::find_if(groups.begin(), groups.end(), [&](const StackedGroup& g) {
-      return config::same_screen_image(inst.projectors(static_cast<int>(g.members.front())), p);
+      return config::same_screen_image(inst.projectors[g.members.front()], p);
     });
     if (group == groups.end()) {
-      groups.push_back({p.screen(), p.eye(), {}, p.content().lights() == "auto"});
+      groups.push_back({p.screen, p.eye, {}, p.content.automatic});
       group = std::prev(groups.end());
     }
-    group->members.push_back(static_cast<std::size_t>(i));
+    group->members.push_back(i);
   }
   return groups;
 }
@@ -58,16 +59,14 @@ std::vector<StackedGroup> lighting_groups(const config::Installation& inst) {
 std::vector<config::Problem> check_lighting_groups(const config::Installation& inst, std::size_t light_count) {
   std::vector<config::Problem> problems;
   for (const StackedGroup& group : lighting_groups(inst)) {
-    const auto projector = [&](std::size_t i) -> const config::Projector& {
-      return inst.projectors(static_cast<int>(i));
-    };
+    const auto projector = [&](std::size_t i) -> const config::Projector& { return inst.projectors[i]; };
     bool mixed = false;
     for (std::size_t member : group.members) {
-      if ((projector(member).content().lights() == "auto") != group.automatic) mixed = true;
+      if (projector(member).content.automatic != group.automatic) mixed = true;
     }
     if (mixed) {
       problems.push_back({lights_path(group.members.front()),
-                          "the " + group_name(group) +
+                          "the " + group_name(inst, group) +
                               " mixes \"auto\" with listed lights: use \"auto\" for all its projectors, or list "
                               "the lights of each"});
       continue;
@@ -79,23 +78,22 @@ std::vector<config::Problem> check_lighting_groups(const config::Installation& i
     bool parsed = true;
     for (const std::vector<std::size_t>& layer : layers_of(inst, group)) {
       const config::Projector& first = projector(layer.front());
-      auto lights = parse_light_list(first.content().lights(), light_count);
-      if (!lights) {
-        problems.push_back({lights_path(layer.front()), lights.error()});
+      if (auto beyond = config::lights_beyond(first.content.lights, light_count)) {
+        problems.push_back({lights_path(layer.front()), *beyond});
         parsed = false;
         continue;
       }
-      for (std::uint32_t light : lights.value()) {
+      for (std::uint32_t light : first.content.lights) {
         if (!drawn_by[light].empty()) {
           problems.push_back({lights_path(layer.front()), "light " + std::to_string(light) + " is drawn twice in the " +
-                                                              group_name(group) + ", by '" + drawn_by[light] +
-                                                              "' and '" + first.id() +
+                                                              group_name(inst, group) + ", by '" + drawn_by[light] +
+                                                              "' and '" + first.id +
                                                               "': give each light to exactly one projector"});
         } else {
-          drawn_by[light] = first.id();
+          drawn_by[light] = first.id;
         }
       }
-      if (first.content().ambient()) ambient_carriers.push_back(first.id());
+      if (first.content.ambient) ambient_carriers.push_back(first.id);
     }
     if (parsed) {
       std::vector<std::uint32_t> missing;
@@ -103,20 +101,20 @@ std::vector<config::Problem> check_lighting_groups(const config::Installation& i
         if (drawn_by[light].empty()) missing.push_back(static_cast<std::uint32_t>(light));
       }
       if (!missing.empty()) {
-        problems.push_back({lights_path(group.members.front()), "the " + group_name(group) + " draws no light " +
-                                                                    format_light_list(missing) + " of the scene's " +
-                                                                    std::to_string(light_count) +
+        problems.push_back({lights_path(group.members.front()), "the " + group_name(inst, group) + " draws no light " +
+                                                                    config::format_light_list(missing) +
+                                                                    " of the scene's " + std::to_string(light_count) +
                                                                     ": give each light to exactly one projector"});
       }
     }
     const std::string ambient_path = "projectors[" + std::to_string(group.members.front()) + "].content.ambient";
     if (ambient_carriers.empty()) {
-      problems.push_back({ambient_path, "no projector of the " + group_name(group) +
+      problems.push_back({ambient_path, "no projector of the " + group_name(inst, group) +
                                             " carries ambient and emissive light: set ambient on exactly one"});
     } else if (ambient_carriers.size() > 1) {
-      problems.push_back({ambient_path, "ambient and emissive light are carried twice in the " + group_name(group) +
-                                            ", by '" + ambient_carriers[0] + "' and '" + ambient_carriers[1] +
-                                            "': set ambient on exactly one projector"});
+      problems.push_back({ambient_path, "ambient and emissive light are carried twice in the " +
+                                            group_name(inst, group) + ", by '" + ambient_carriers[0] + "' and '" +
+                                            ambient_carriers[1] + "': set ambient on exactly one projector"});
     }
   }
   return problems;
@@ -127,10 +125,10 @@ std::map<std::size_t, LightShare> listed_shares(const config::Installation& inst
   for (const StackedGroup& group : lighting_groups(inst)) {
     if (group.automatic) continue;
     for (std::size_t member : group.members) {
-      const config::Content& content = inst.projectors(static_cast<int>(member)).content();
-      auto lights = parse_light_list(content.lights(), light_count);
-      assert(lights);
-      shares[member] = {lights ? std::move(lights).value() : std::vector<std::uint32_t>{}, content.ambient()};
+      const config::Content& content = inst.projectors[member].content;
+      assert(!config::lights_beyond(content.lights, light_count));
+      (void)light_count;
+      shares[member] = {content.lights, content.ambient};
     }
   }
   return shares;
@@ -139,32 +137,23 @@ std::map<std::size_t, LightShare> listed_shares(const config::Installation& inst
 std::vector<double> group_light_costs(const config::Installation& inst, const StackedGroup& group,
                                       const scene::SceneDefinition& scene, const scene::SceneState& state,
                                       const glm::dvec3& eye) {
-  const config::Screen* screen = nullptr;
-  for (const config::Screen& s : inst.screens()) {
-    if (s.id() == group.screen) screen = &s;
-  }
-  assert(screen != nullptr);
+  const config::Screen& screen = inst.screens[group.screen];
   geometry::ScreenRect area{{std::numeric_limits<double>::max(), std::numeric_limits<double>::max()},
                             {std::numeric_limits<double>::lowest(), std::numeric_limits<double>::lowest()}};
   for (std::size_t member : group.members) {
-    auto geometry = config::projector_geometry(inst.projectors(static_cast<int>(member)));
-    if (!geometry) continue;
-    for (const glm::dvec2& corner : geometry.value().lit_quad()) {
+    for (const glm::dvec2& corner : inst.projectors[member].geometry().lit_quad()) {
       area.min = glm::min(area.min, corner);
       area.max = glm::max(area.max, corner);
     }
   }
-  const geometry::ScreenRect usable = config::usable_area(*screen);
+  const geometry::ScreenRect usable = screen.area();
   area.min = glm::clamp(area.min, usable.min, usable.max);
   area.max = glm::clamp(area.max, usable.min, usable.max);
-  const glm::dvec3 origin(screen->origin(0), screen->origin(1), screen->origin(2));
-  const glm::dvec3 right(screen->right(0), screen->right(1), screen->right(2));
-  const glm::dvec3 up(screen->up(0), screen->up(1), screen->up(2));
   scene::CoverageGrid grid;
   grid.eye = eye;
-  grid.corner = origin + area.min.x * right + area.min.y * up;
-  grid.across = area.width() * right;
-  grid.up = area.height() * up;
+  grid.corner = screen.point(area.min);
+  grid.across = area.width() * screen.right;
+  grid.up = area.height() * screen.up;
   return scene::light_coverage(scene, state, grid);
 }
 
@@ -181,9 +170,9 @@ LiveMembers live_members(const config::Installation& inst, const StackedGroup& g
   LiveMembers members;
   for (std::size_t k = 0; k < group.members.size(); ++k) {
     if (!live[k]) continue;
-    const config::Projector& p = inst.projectors(static_cast<int>(group.members[k]));
+    const config::Projector& p = inst.projectors[group.members[k]];
     members.places.push_back(k);
-    members.pixels.push_back(static_cast<double>(p.width()) * p.height());
+    members.pixels.push_back(static_cast<double>(p.width) * p.height);
   }
   return members;
 }

@@ -13,6 +13,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "config/installation.h"
 #include "config/validate.h"
 #include "master/light_share.h"
 #include "optique/config.pb.h"
@@ -22,8 +23,8 @@
 namespace optique::master {
 
 struct StackedGroup {
-  std::string screen;
-  std::string eye;
+  std::size_t screen = 0;  // index into Installation.screens
+  config::Eye eye = config::Eye::mono;
   std::vector<std::size_t> members;  // indices into Installation.projectors, config order
   bool automatic = false;            // lights "auto": the master shares them out
 };
@@ -31,8 +32,8 @@ struct StackedGroup {
 [[nodiscard]] std::vector<StackedGroup> lighting_groups(const config::Installation& installation);
 
 // Every problem with the groups' light lists, naming the field or the group: a
-// list that does not parse or names a light the scene lacks, "auto" mixed with
-// lists, a light drawn by no layer or by two, no ambient carrier or two.
+// list that names a light the scene lacks, "auto" mixed with lists, a light
+// drawn by no layer or by two, no ambient carrier or two.
 [[nodiscard]] std::vector<config::Problem> check_lighting_groups(const config::Installation& installation,
                                                                  std::size_t light_count);
 

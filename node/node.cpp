@@ -189,21 +189,28 @@ void Node::handle_challenge(wire::Envelope& message) {
 }
 
 void Node::handle_welcome(const wire::Welcome& welcome) {
-  if (auto configured = renderer_.configure(welcome); !configured) {
+  auto job = protocol::decode_welcome(welcome, options_.id);
+  if (!job) {
+    stop(kExitRefused, "the master's welcome cannot be used: " + job.error());
+    return;
+  }
+  if (auto configured = renderer_.configure(job.value()); !configured) {
     stop(kExitRefused, "cannot drive projector '" + options_.id + "': " + configured.error());
     return;
   }
-  frame_period_ = welcome.frame_period_ns();
-  heartbeat_ = milliseconds(std::max<std::uint32_t>(welcome.heartbeat_ms(), 10));
-  liveness_timeout_ = milliseconds(welcome.liveness_timeout_ms());
+  frame_period_ = job.value().frame_period;
+  heartbeat_ = std::max(job.value().heartbeat, milliseconds(10));
+  liveness_timeout_ = job.value().liveness_timeout;
+  light_count_ = job.value().light_count;
   wire::Envelope envelope;
   envelope.mutable_configured()->set_renderer(renderer_.description());
   connection_->send(envelope);
   phase_ = Phase::awaiting_state;
   connection_->set_deadline(kHandshakeTimeout, "no state from the master within 5 s of being configured");
-  const auto& p = welcome.projector();
-  log_.info("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}", p.id(), p.width(), p.height(),
-            p.screen(), p.eye(), static_cast<double>(frame_period_) / 1e6, renderer_.description());
+  const config::Projector& p = job.value().job.self();
+  log_.info("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}", p.id, p.width, p.height,
+            job.value().job.screen().id, config::to_string(p.eye), static_cast<double>(frame_period_) / 1e6,
+            renderer_.description());
 }
 
 void Node::handle_resync(const wire::Resync& resync) {
@@ -266,10 +273,31 @@ void Node::handle_frame_begin(const wire::FrameBegin& begin) {
     shown = &past_frames_.front().begin;
     shown_state = &past_frames_.front().state;
   }
-  FrameInput input{begin.frame_id(), shown->simulation_time_ns(), shown->present_time_ns(), frame_period_, shown_state,
-                   begin.capture()};
-  if (shown->has_focus()) input.focus = &shown->focus();
-  if (begin.has_lights()) input.lights = &begin.lights();
+  FrameInput input;
+  input.frame_id = begin.frame_id();
+  input.simulation_time = shown->simulation_time_ns();
+  input.present_time = shown->present_time_ns();
+  input.frame_period = frame_period_;
+  input.state = shown_state;
+  input.capture = begin.capture();
+  if (shown->has_focus()) {
+    auto focus = protocol::decode_focus(shown->focus());
+    if (!focus) {
+      connection_->close("frame " + std::to_string(begin.frame_id()) + ": " + focus.error());
+      return;
+    }
+    input.focus = focus.value();
+  }
+  std::optional<protocol::LightShare> share;
+  if (begin.has_lights()) {
+    auto decoded = protocol::decode_light_share(begin.lights(), light_count_);
+    if (!decoded) {
+      connection_->close("frame " + std::to_string(begin.frame_id()) + ": lights: " + decoded.error());
+      return;
+    }
+    share = std::move(decoded).value();
+    input.lights = &*share;
+  }
   const clock::Nanos started = clock::monotonic_now();
   renderer_.render(input);
   const clock::Nanos render_time = clock::monotonic_now() - started;

@@ -108,6 +108,7 @@ class Node {
   std::uint64_t last_rendered_ = 0;
   bool rendered_any_ = false;
   clock::Nanos frame_period_ = 0;
+  std::uint32_t light_count_ = 0;  // the scene's, from the welcome: shares name fewer
   std::chrono::milliseconds heartbeat_{250};
   std::chrono::milliseconds liveness_timeout_{3000};
   int pings_in_burst_ = 0;

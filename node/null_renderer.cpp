@@ -4,12 +4,7 @@
 
 namespace optique::node {
 
-Result<void> NullRenderer::configure(const wire::Welcome& welcome) {
-  if (welcome.projector().width() == 0 || welcome.projector().height() == 0) {
-    return Error{"the welcome names a projector without a resolution"};
-  }
-  return {};
-}
+Result<void> NullRenderer::configure(const protocol::NodeJob&) { return {}; }
 
 void NullRenderer::render(const FrameInput& frame) {
   assert(frame.state != nullptr);

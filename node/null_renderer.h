@@ -8,7 +8,7 @@ namespace optique::node {
 
 class NullRenderer final : public Renderer {
  public:
-  [[nodiscard]] Result<void> configure(const wire::Welcome& welcome) override;
+  [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
   [[nodiscard]] std::string description() const override { return "null renderer (draws nothing)"; }
   void render(const FrameInput& frame) override;
   void present() override;

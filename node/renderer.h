@@ -1,11 +1,16 @@
 #pragma once
-// What a node does with a frame. The null renderer implements it now; the GL
-// renderer (windowed or headless) implements the same interface.
+// What a node does with its job and its frames: plain, checked values (the
+// protocol decoded and checked them). The null renderer and the GL renderer
+// (node/gl) implement it.
 
 #include <cstdint>
+#include <optional>
+#include <string>
 
 #include "clock/clock.h"
-#include "optique/wire.pb.h"
+#include "protocol/focus.h"
+#include "protocol/light_share.h"
+#include "protocol/welcome.h"
 #include "scene/state.h"
 #include "util/result.h"
 
@@ -17,16 +22,16 @@ struct FrameInput {
   clock::Nanos present_time = 0;  // predicted, master clock
   clock::Nanos frame_period = 0;
   const scene::SceneState* state = nullptr;
-  bool capture = false;                      // also write this frame to the capture folder
-  const wire::Focus* focus = nullptr;        // the frame's focal depth and gaze (focus/defocus nodes)
-  const wire::LightShare* lights = nullptr;  // a new share of the lights from this frame on, if any
+  bool capture = false;                          // also write this frame to the capture folder
+  std::optional<protocol::Focus> focus;          // the frame's focal depth and gaze (focus/defocus nodes)
+  const protocol::LightShare* lights = nullptr;  // a new share of the lights from this frame on, if any
 };
 
 class Renderer {
  public:
   virtual ~Renderer() = default;
   // The projector, its screen, the viewer and the scene, from the master's welcome.
-  [[nodiscard]] virtual Result<void> configure(const wire::Welcome& welcome) = 0;
+  [[nodiscard]] virtual Result<void> configure(const protocol::NodeJob& job) = 0;
   // What draws, for the master's log ("llvmpipe (...), headless").
   [[nodiscard]] virtual std::string description() const = 0;
   // Draws the frame into the back buffer; returns when it is ready to show.

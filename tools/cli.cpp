@@ -47,11 +47,11 @@ int check_config(const std::vector<std::string>& files) {
 // warning, a frame that another node missed).
 std::vector<std::uint64_t> captured_frames(const config::LoadedConfig& config, const std::string& captures) {
   std::vector<std::uint64_t> frames;
-  const auto& projectors = config.installation.projectors();
+  const auto& projectors = config.installation.projectors;
   if (projectors.empty()) return frames;
   std::error_code ec;
   for (const auto& entry :
-       std::filesystem::directory_iterator(std::filesystem::path(captures) / projectors.Get(0).id(), ec)) {
+       std::filesystem::directory_iterator(std::filesystem::path(captures) / projectors.front().id, ec)) {
     const std::string name = entry.path().filename().string();
     std::uint64_t frame = 0;
     if (std::sscanf(name.c_str(), "frame-%" SCNu64 ".exr", &frame) == 1 && name.ends_with(".exr")) {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "config/geometry.h"
+#include "config/projector_groups.h"
 #include "image/convert.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
@@ -17,22 +17,20 @@ namespace {
 
 struct Group {
   const config::Screen* screen = nullptr;
-  std::string eye;
+  config::Eye eye = config::Eye::mono;
   std::vector<const config::Projector*> projectors;
 };
 
 // The screen images (screen and eye), in the order their first projector appears.
 std::vector<Group> groups_of(const config::Installation& installation) {
   std::vector<Group> groups;
-  for (const config::Projector& p : installation.projectors()) {
+  for (const config::Projector& p : installation.projectors) {
     auto group = std::find_if(groups.begin(), groups.end(),
                               [&](const Group& g) { return config::same_screen_image(*g.projectors.front(), p); });
     if (group != groups.end()) {
       group->projectors.push_back(&p);
-      continue;
-    }
-    for (const config::Screen& screen : installation.screens()) {
-      if (screen.id() == p.screen()) groups.push_back({&screen, p.eye(), {&p}});
+    } else {
+      groups.push_back({&installation.screen_of(p), p.eye, {&p}});
     }
   }
   return groups;
@@ -41,37 +39,35 @@ std::vector<Group> groups_of(const config::Installation& installation) {
 // The signal the node sent its projector: the simulator turns it into light with
 // the projector's model, as the projector would.
 std::string capture_path(const std::string& captures_dir, const config::Projector& projector, std::uint64_t frame) {
-  return image::frame_path((std::filesystem::path(captures_dir) / projector.id()).string(), frame, "png");
+  return image::frame_path((std::filesystem::path(captures_dir) / projector.id).string(), frame, "png");
 }
 
 Result<image::FloatImage> read_capture(const std::string& path, const config::Projector& projector) {
   auto read = image::read_image(path);
-  if (!read) return Error{"projector '" + projector.id() + "': " + read.error()};
+  if (!read) return Error{"projector '" + projector.id + "': " + read.error()};
   image::FloatImage capture = std::move(read).value();
-  if (capture.width != static_cast<int>(projector.width()) || capture.height != static_cast<int>(projector.height())) {
-    return Error{"projector '" + projector.id() + "': capture " + path + " is " + std::to_string(capture.width) + "×" +
-                 std::to_string(capture.height) + " px, but the projector is " + std::to_string(projector.width()) +
-                 "×" + std::to_string(projector.height()) + " px (captures from another config?)"};
+  if (capture.width != projector.width || capture.height != projector.height) {
+    return Error{"projector '" + projector.id + "': capture " + path + " is " + std::to_string(capture.width) + "×" +
+                 std::to_string(capture.height) + " px, but the projector is " + std::to_string(projector.width) + "×" +
+                 std::to_string(projector.height) + " px (captures from another config?)"};
   }
   if (capture.channels < 3) {
-    return Error{"projector '" + projector.id() + "': capture " + path + " has " + std::to_string(capture.channels) +
+    return Error{"projector '" + projector.id + "': capture " + path + " has " + std::to_string(capture.channels) +
                  " channel(s); expected RGB or RGBA"};
   }
-  auto model = optics::ProjectorModel::from_config(projector);
-  if (!model) return Error{"projector '" + projector.id() + "': " + model.error()};
-  return optics::emitted_image(capture, model.value());
+  return optics::emitted_image(capture, optics::ProjectorModel(projector.response));
 }
 
 // Share of the raster's pixel centres inside some projector's lit quad.
 double covered_share(const std::vector<geometry::ProjectorGeometry>& geometries, const config::Screen& screen,
                      int width, int height) {
   if (width <= 0 || height <= 0) return 0.0;
-  const optics::BlendField field(geometries, config::usable_area(screen), 0.0);
-  const double ppm = screen.pixels_per_metre();
+  const optics::BlendField field(geometries, screen.area(), 0.0);
+  const double ppm = screen.pixels_per_metre;
   std::size_t lit = 0;
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) {
-      if (field.covered(glm::dvec2((u + 0.5) / ppm, screen.height() - (v + 0.5) / ppm))) ++lit;
+      if (field.covered(glm::dvec2((u + 0.5) / ppm, screen.height - (v + 0.5) / ppm))) ++lit;
     }
   }
   return static_cast<double>(lit) / (static_cast<double>(width) * height);
@@ -79,8 +75,8 @@ double covered_share(const std::vector<geometry::ProjectorGeometry>& geometries,
 
 }  // namespace
 
-std::string composite_folder(const std::string& screen_id, const std::string& eye) {
-  return eye == "mono" || eye.empty() ? screen_id : screen_id + "." + eye;
+std::string composite_folder(const std::string& screen_id, config::Eye eye) {
+  return eye == config::Eye::mono ? screen_id : screen_id + "." + std::string(config::to_string(eye));
 }
 
 Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::uint64_t frame,
@@ -113,17 +109,15 @@ Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::ui
     std::vector<geometry::ProjectorGeometry> geometries;
     std::vector<image::FloatImage> captures;
     ComposedScreen composed;
-    composed.folder = composite_folder(screen.id(), group.eye);
-    composed.screen = screen.id();
+    composed.folder = composite_folder(screen.id, group.eye);
+    composed.screen = screen.id;
     composed.eye = group.eye;
     for (const config::Projector* p : group.projectors) {
-      auto geometry = config::projector_geometry(*p);
-      if (!geometry) return Error{"projector '" + p->id() + "': " + geometry.error()};
       auto capture = read_capture(capture_path(captures_dir, *p, frame), *p);
       if (!capture) return Error{capture.error()};
-      geometries.push_back(std::move(geometry).value());
+      geometries.push_back(p->geometry());
       captures.push_back(std::move(capture).value());
-      composed.projectors.push_back(p->id());
+      composed.projectors.push_back(p->id);
     }
     // Sharp projectors land together; a defocused one lands alone and its optics
     // blur what it throws by its circle of confusion, in screen pixels.
@@ -131,20 +125,20 @@ Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::ui
     std::vector<std::pair<optics::ProjectedImage, double>> blurred;
     for (std::size_t i = 0; i < geometries.size(); ++i) {
       const optics::ProjectedImage projected{&geometries[i], &captures[i]};
-      if (group.projectors[i]->content().role() == "defocus") {
-        blurred.emplace_back(projected, group.projectors[i]->content().blur_radius());
+      if (group.projectors[i]->content.role == config::ContentRole::defocus) {
+        blurred.emplace_back(projected, group.projectors[i]->content.blur_radius);
       } else {
         sharp.push_back(projected);
       }
       composed.subsamples =
-          std::max(composed.subsamples, optics::subsamples_for(geometries[i], screen.pixels_per_metre()));
+          std::max(composed.subsamples, optics::subsamples_for(geometries[i], screen.pixels_per_metre));
     }
     optics::ComposeOptions options;
-    options.pixels_per_metre = screen.pixels_per_metre();
-    image::FloatImage linear = optics::compose_screen(sharp, screen.width(), screen.height(), options);
+    options.pixels_per_metre = screen.pixels_per_metre;
+    image::FloatImage linear = optics::compose_screen(sharp, screen.width, screen.height, options);
     for (const auto& [projected, radius] : blurred) {
       const image::FloatImage thrown = optics::disc_blur(
-          optics::compose_screen(std::span(&projected, 1), screen.width(), screen.height(), options), radius);
+          optics::compose_screen(std::span(&projected, 1), screen.width, screen.height, options), radius);
       for (std::size_t k = 0; k < linear.pixels.size(); ++k) {
         if (k % 4 != 3) linear.pixels[k] += thrown.pixels[k];
       }
@@ -155,15 +149,15 @@ Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::ui
 
     const std::string folder = (std::filesystem::path(out_dir) / "screens" / composed.folder).string();
     if (auto written = image::write_frame(folder, frame, linear, image::encode_srgb(linear)); !written) {
-      return Error{"screen '" + screen.id() + "': " + written.error()};
+      return Error{"screen '" + screen.id + "': " + written.error()};
     }
     composed.exr_path = image::frame_path(folder, frame, "exr");
     composed.png_path = image::frame_path(folder, frame, "png");
     std::string names;
     for (const std::string& id : composed.projectors) names += (names.empty() ? "" : ", ") + id;
-    log.info("screen '{}' ({}): {}×{} px from {} projector(s) [{}], {}×{} subsamples, {:.1f}% lit → {}", screen.id(),
-             group.eye, composed.width, composed.height, composed.projectors.size(), names, composed.subsamples,
-             composed.subsamples, 100.0 * composed.covered, composed.png_path);
+    log.info("screen '{}' ({}): {}×{} px from {} projector(s) [{}], {}×{} subsamples, {:.1f}% lit → {}", screen.id,
+             config::to_string(group.eye), composed.width, composed.height, composed.projectors.size(), names,
+             composed.subsamples, composed.subsamples, 100.0 * composed.covered, composed.png_path);
     summary.screens.push_back(std::move(composed));
   }
   return summary;

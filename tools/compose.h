@@ -19,9 +19,9 @@
 namespace optique::tools {
 
 struct ComposedScreen {
-  std::string folder;                   // <screen-id>, or <screen-id>.left / .right
-  std::string screen;                   // screen id
-  std::string eye;                      // "mono", "left" or "right"
+  std::string folder;  // <screen-id>, or <screen-id>.left / .right
+  std::string screen;  // screen id
+  config::Eye eye = config::Eye::mono;
   std::vector<std::string> projectors;  // the captures that went into it
   int width = 0;                        // pixels
   int height = 0;
@@ -36,8 +36,8 @@ struct ComposeSummary {
   std::vector<ComposedScreen> screens;
 };
 
-// The folder name of a screen's composite for one eye ("mono" → the screen id).
-[[nodiscard]] std::string composite_folder(const std::string& screen_id, const std::string& eye);
+// The folder name of a screen's composite for one eye (mono: the screen id).
+[[nodiscard]] std::string composite_folder(const std::string& screen_id, config::Eye eye);
 
 // Reads CAPTURES/<projector-id>/frame-NNNNNN.png (the signal) for every projector (as the
 // nodes write them under OUT/nodes), composes each screen × eye group and writes

@@ -1,7 +1,5 @@
 #include "tools/render_reference.h"
 
-#include "config/geometry.h"
-
 #include <cmath>
 #include <filesystem>
 
@@ -22,25 +20,23 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
   }
   const int s = options.supersample;
   const auto& installation = config.installation;
-  const master::SceneAuthority authority(
-      scene.definition.objects, installation.viewer(), installation.master().frame_rate(),
-      master::LightSwitches::from_config(installation.scene(), scene.definition.lights.size()));
+  const master::SceneAuthority authority(scene.definition.objects, installation.viewer, installation.master.frame_rate,
+                                         master::LightSwitches::from_config(installation.scene));
   const scene::SceneState state = authority.state_at_frame(frame);
 
   auto context = render::make_headless_context();
   if (!context) return Error{"cannot render: " + context.error()};
-  const auto& viewer = installation.viewer();
-  for (const auto& screen : installation.screens()) {
+  const config::Viewer& viewer = installation.viewer;
+  for (const config::Screen& screen : installation.screens) {
     // The composite's raster, so the two compare pixel for pixel.
-    const int width = optics::screen_pixels(screen.width(), screen.pixels_per_metre());
-    const int height = optics::screen_pixels(screen.height(), screen.pixels_per_metre());
+    const int width = optics::screen_pixels(screen.width, screen.pixels_per_metre);
+    const int height = optics::screen_pixels(screen.height, screen.pixels_per_metre);
     auto renderer = render::SceneRenderer::create(scene.definition, width * s, height * s);
-    if (!renderer) return Error{"screen '" + screen.id() + "': " + renderer.error()};
-    auto frustum = geometry::off_axis_frustum(config::whole_screen(screen), state.eye_now, viewer.near(), viewer.far());
-    if (!frustum)
-      return Error{"screen '" + screen.id() + "' at frame " + std::to_string(frame) + ": " + frustum.error()};
+    if (!renderer) return Error{"screen '" + screen.id + "': " + renderer.error()};
+    auto frustum = geometry::off_axis_frustum(screen.world(), state.eye_now, viewer.near, viewer.far);
+    if (!frustum) return Error{"screen '" + screen.id + "' at frame " + std::to_string(frame) + ": " + frustum.error()};
     renderer.value()->draw(state, 0.0, state.eye_now, frustum.value());
-    const std::string folder = (std::filesystem::path(out_dir) / "reference" / screen.id()).string();
+    const std::string folder = (std::filesystem::path(out_dir) / "reference" / screen.id).string();
     Result<void> written;
     if (s == 1) {
       written = image::write_frame(folder, frame, renderer.value()->read_rendered(), renderer.value()->read_encoded());
@@ -49,7 +45,7 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
       written = image::write_frame(folder, frame, linear, image::encode_srgb(linear));
     }
     if (!written) return written;
-    log.info("screen '{}': {}×{} px ({}×{} samples per pixel) → {}", screen.id(), width, height, s, s,
+    log.info("screen '{}': {}×{} px ({}×{} samples per pixel) → {}", screen.id, width, height, s, s,
              image::frame_path(folder, frame, "png"));
   }
   return {};

@@ -8,15 +8,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "config/defaults.h"
-#include "config/geometry.h"
-#include "config/validate.h"
+#include "config/parse.h"
 #include "util/sha256.h"
 
 namespace optique::config {
 
-Result<Installation> parse_installation(const std::string& json, const std::string& origin,
-                                        const std::string& directory) {
+Result<schema::Installation> read_schema(const std::string& json, const std::string& origin) {
   // Protobuf's parser says what is wrong with JSON syntax but not where; a user
   // with a missing comma in a long file needs the line and column.
   try {
@@ -37,19 +34,21 @@ Result<Installation> parse_installation(const std::string& json, const std::stri
     }
     return Error{origin + ":" + std::to_string(line) + ":" + std::to_string(column) + ": not valid JSON: " + what};
   }
-  Installation installation;
+  schema::Installation installation;
   google::protobuf::util::JsonParseOptions options;
   options.ignore_unknown_fields = false;
   const auto status = google::protobuf::util::JsonStringToMessage(json, &installation, options);
   if (!status.ok()) {
     return Error{origin + ": not a valid installation: " + std::string(status.message())};
   }
-  const std::vector<Problem> problems = validate(installation, directory);
-  if (!problems.empty()) return Error{describe_problems(problems, origin)};
-  apply_defaults(installation);
-  const std::vector<Problem> geometry = resolve_geometry(installation, directory);
-  if (!geometry.empty()) return Error{describe_problems(geometry, origin)};
   return installation;
+}
+
+Result<Installation> parse_installation(const std::string& json, const std::string& origin,
+                                        const std::string& directory) {
+  auto schema = read_schema(json, origin);
+  if (!schema) return Error{schema.error()};
+  return parse_installation(schema.value(), directory, origin);
 }
 
 Result<LoadedConfig> load_installation(const std::string& path) {
@@ -68,63 +67,6 @@ Result<LoadedConfig> load_installation(const std::string& path) {
   loaded.installation = std::move(installation).value();
   loaded.sha256 = util::sha256_hex(text.str());
   return loaded;
-}
-
-void apply_defaults(Installation& installation) {
-  MasterSettings& m = *installation.mutable_master();
-  if (m.listen().empty()) m.set_listen("0.0.0.0");
-  if (m.frame_rate() == 0.0) m.set_frame_rate(defaults::kFrameRate);
-  if (m.frame_timeout_ms() == 0) m.set_frame_timeout_ms(defaults::kFrameTimeoutMs);
-  if (m.startup_timeout_ms() == 0) m.set_startup_timeout_ms(defaults::kStartupTimeoutMs);
-  if (m.handshake_timeout_ms() == 0) m.set_handshake_timeout_ms(defaults::kHandshakeTimeoutMs);
-  if (m.heartbeat_ms() == 0) m.set_heartbeat_ms(defaults::kHeartbeatMs);
-  if (m.liveness_timeout_ms() == 0)
-    m.set_liveness_timeout_ms(std::max(defaults::kMinLivenessTimeoutMs, 3 * m.heartbeat_ms()));
-  if (m.present_lead_us() == 0) m.set_present_lead_us(defaults::kPresentLeadUs);
-  if (m.max_message_bytes() == 0) m.set_max_message_bytes(defaults::kMaxMessageBytes);
-  if (m.max_pending_connections() == 0) m.set_max_pending_connections(defaults::kMaxPendingConnections);
-  if (m.straggler_policy().empty()) m.set_straggler_policy("present");
-
-  Viewer& v = *installation.mutable_viewer();
-  if (v.eye_separation() == 0.0) v.set_eye_separation(defaults::kEyeSeparation);
-  if (v.near() == 0.0) v.set_near(defaults::kNear);
-  if (v.far() == 0.0) v.set_far(defaults::kFar);
-  if (v.head_right().empty()) {
-    v.add_head_right(1.0);
-    v.add_head_right(0.0);
-    v.add_head_right(0.0);
-  }
-
-  if (installation.has_depth_of_field()) {
-    DepthOfField& d = *installation.mutable_depth_of_field();
-    if (d.near() == 0.0) d.set_near(v.near());
-    if (d.far() == 0.0) d.set_far(v.far());
-  }
-
-  for (Screen& s : *installation.mutable_screens()) {
-    if (s.pixels_per_metre() == 0.0) s.set_pixels_per_metre(defaults::kPixelsPerMetre);
-  }
-  for (Projector& p : *installation.mutable_projectors()) {
-    if (p.host().empty()) p.set_host("localhost");
-    if (p.output().kind().empty()) p.mutable_output()->set_kind("headless");
-    if (p.eye().empty()) p.set_eye("mono");
-    if (p.content().role().empty()) p.mutable_content()->set_role("full");
-    if (p.content().role() == "defocus" && p.content().blur_radius() == 0.0) {
-      p.mutable_content()->set_blur_radius(defaults::kBlurRadius);
-    }
-    if (p.brightness() == 0.0) p.set_brightness(1.0);
-    const bool other_geometry = !p.homography().empty() || !p.calibration().empty() || p.has_camera();
-    if (!p.has_region() && !other_geometry) {
-      for (const Screen& s : installation.screens()) {
-        if (s.id() != p.screen()) continue;
-        Region& r = *p.mutable_region();
-        r.set_x(0.0);
-        r.set_y(0.0);
-        r.set_width(s.width());
-        r.set_height(s.height());
-      }
-    }
-  }
 }
 
 }  // namespace optique::config

@@ -9,9 +9,9 @@ namespace optique::config {
 
 using util::number_text;
 
-Result<ProjectorResponse> parse_response(const Projector& projector) {
+Result<ProjectorResponse> parse_response(const schema::Projector& projector) {
   ProjectorResponse model;
-  const Response& r = projector.response();
+  const schema::Response& r = projector.response();
   if (r.gamma() != 0.0 && !r.table().empty()) {
     return Error{"response: give either gamma or table, not both"};
   }

@@ -24,6 +24,6 @@ struct ProjectorResponse {
 // not finite, not from 0 to 1 or decreasing, bits outside 1…16, a black level
 // outside [0, 1) or a brightness < 0. Paths are relative to the projector
 // ("response.table[3]: …").
-[[nodiscard]] Result<ProjectorResponse> parse_response(const Projector& projector);
+[[nodiscard]] Result<ProjectorResponse> parse_response(const schema::Projector& projector);
 
 }  // namespace optique::config

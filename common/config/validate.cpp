@@ -2,11 +2,13 @@
 
 #include <arpa/inet.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
 
 #include "config/defaults.h"
+#include "config/light_list.h"
 #include "config/response.h"
 #include "scene/builtin.h"
 #include "util/number_text.h"
@@ -87,10 +89,10 @@ double dot(const google::protobuf::RepeatedField<double>& a, const google::proto
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 }
 
-void check_screens(Checker& check, const Installation& inst, std::set<std::string>& ids) {
+void check_screens(Checker& check, const schema::Installation& inst, std::set<std::string>& ids) {
   if (inst.screens().empty()) check.fail("screens", "at least one screen is needed");
   for (int i = 0; i < inst.screens_size(); ++i) {
-    const Screen& s = inst.screens(i);
+    const schema::Screen& s = inst.screens(i);
     const std::string at = "screens[" + std::to_string(i) + "]";
     check_id(check, at + ".id", s.id(), ids, "screen");
     check.vec3(at + ".origin", s.origin());
@@ -114,7 +116,7 @@ void check_screens(Checker& check, const Installation& inst, std::set<std::strin
   }
 }
 
-void check_region(Checker& check, const std::string& at, const Region& r, const Screen* screen) {
+void check_region(Checker& check, const std::string& at, const schema::Region& r, const schema::Screen* screen) {
   check.non_negative(at + ".x", r.x());
   check.non_negative(at + ".y", r.y());
   check.positive(at + ".width", r.width());
@@ -142,7 +144,8 @@ void check_matrix3(Checker& check, const std::string& path, const google::protob
 
 // At most one way to say where the projector's pixels land (a camera view may
 // accompany a direct one: it then relates partners to this projector).
-void check_geometry_source(Checker& check, const std::string& at, const Projector& p, const std::string& config_dir) {
+void check_geometry_source(Checker& check, const std::string& at, const schema::Projector& p,
+                           const std::string& config_dir) {
   if (!p.homography().empty() && !p.calibration().empty()) {
     check.fail(at, "give either homography or calibration, not both");
   }
@@ -161,13 +164,16 @@ void check_geometry_source(Checker& check, const std::string& at, const Projecto
   }
 }
 
-void check_content(Checker& check, const std::string& at, const Content& c) {
+void check_content(Checker& check, const std::string& at, const schema::Content& c) {
   check.one_of(at + ".role", c.role(), {"full", "lights", "focus", "defocus"});
   const bool lights = c.role() == "lights";
   if (lights && c.lights().empty()) {
     check.fail(at + ".lights",
                "role 'lights' needs its lights: indices and ranges of the scene's lights (\"0-6\", "
                "\"0, 3, 7-9\") or \"auto\"");
+  }
+  if (lights && !c.lights().empty() && c.lights() != "auto") {
+    if (auto list = parse_light_list(c.lights()); !list) check.fail(at + ".lights", list.error());
   }
   if (!lights && !c.lights().empty()) check.fail(at + ".lights", "only a projector of role 'lights' takes lights");
   if (!lights && c.ambient()) check.fail(at + ".ambient", "only a projector of role 'lights' takes ambient");
@@ -180,14 +186,14 @@ void check_content(Checker& check, const std::string& at, const Content& c) {
 // A defocus projector shows only the blurred share of the image: without a focus
 // partner on the same screen for the same eye, the sharp share is missing, and
 // the other way round.
-void check_stacked_pairs(Checker& check, const Installation& inst) {
+void check_stacked_pairs(Checker& check, const schema::Installation& inst) {
   for (int i = 0; i < inst.projectors_size(); ++i) {
-    const Projector& p = inst.projectors(i);
+    const schema::Projector& p = inst.projectors(i);
     const std::string& role = p.content().role();
     if (role != "focus" && role != "defocus") continue;
     const std::string wanted = role == "focus" ? "defocus" : "focus";
     bool partnered = false;
-    for (const Projector& other : inst.projectors()) {
+    for (const schema::Projector& other : inst.projectors()) {
       partnered = partnered || (other.content().role() == wanted && other.screen() == p.screen() &&
                                 (other.eye().empty() ? "mono" : other.eye()) == (p.eye().empty() ? "mono" : p.eye()));
     }
@@ -199,12 +205,22 @@ void check_stacked_pairs(Checker& check, const Installation& inst) {
   }
 }
 
-void check_depth_of_field(Checker& check, const Installation& inst) {
+void check_depth_range(Checker& check, const schema::DepthOfField& d) {
+  check.non_negative("depth_of_field.near", d.near());
+  check.non_negative("depth_of_field.far", d.far());
+  if (d.near() != 0.0 && d.far() != 0.0 && std::isfinite(d.near()) && std::isfinite(d.far()) && !(d.far() > d.near())) {
+    check.fail("depth_of_field.far",
+               "must be greater than near (" + number_text(d.far()) + " m <= " + number_text(d.near()) + " m)");
+  }
+  check.non_negative("depth_of_field.inset_radius", d.inset_radius());
+}
+
+void check_depth_of_field(Checker& check, const schema::Installation& inst) {
   bool needed = false;
-  for (const Projector& p : inst.projectors()) {
+  for (const schema::Projector& p : inst.projectors()) {
     needed = needed || p.content().role() == "focus" || p.content().role() == "defocus";
   }
-  const DepthOfField& d = inst.depth_of_field();
+  const schema::DepthOfField& d = inst.depth_of_field();
   const bool given = inst.has_depth_of_field();
   if (!needed) {
     if (given) check.fail("depth_of_field", "set, but no projector has role 'focus' or 'defocus'");
@@ -227,9 +243,9 @@ void check_depth_of_field(Checker& check, const Installation& inst) {
     }
   }
   if (d.has_gaze()) {
-    const Gaze& g = d.gaze();
-    const Screen* screen = nullptr;
-    for (const Screen& s : inst.screens()) {
+    const schema::Gaze& g = d.gaze();
+    const schema::Screen* screen = nullptr;
+    for (const schema::Screen& s : inst.screens()) {
       if (s.id() == g.screen()) screen = &s;
     }
     if (screen == nullptr) check.fail("depth_of_field.gaze.screen", "unknown screen '" + g.screen() + "'");
@@ -259,24 +275,18 @@ void check_depth_of_field(Checker& check, const Installation& inst) {
       }
     }
   }
-  check.non_negative("depth_of_field.near", d.near());
-  check.non_negative("depth_of_field.far", d.far());
-  if (d.near() != 0.0 && d.far() != 0.0 && std::isfinite(d.near()) && std::isfinite(d.far()) && !(d.far() > d.near())) {
-    check.fail("depth_of_field.far",
-               "must be greater than near (" + number_text(d.far()) + " m <= " + number_text(d.near()) + " m)");
-  }
-  check.non_negative("depth_of_field.inset_radius", d.inset_radius());
+  check_depth_range(check, d);
   if (d.inset_radius() > 0.0 && !d.has_gaze()) {
     check.fail("depth_of_field.inset_radius", "the focused inset follows the gaze point: give gaze too");
   }
 }
 
-void check_projectors(Checker& check, const Installation& inst, const std::string& config_dir) {
+void check_projectors(Checker& check, const schema::Installation& inst, const std::string& config_dir, Scope scope) {
   if (inst.projectors().empty()) check.fail("projectors", "at least one projector is needed");
   std::set<std::string> ids;
   constexpr std::uint32_t kMaxPixels = 16384;
   for (int i = 0; i < inst.projectors_size(); ++i) {
-    const Projector& p = inst.projectors(i);
+    const schema::Projector& p = inst.projectors(i);
     const std::string at = "projectors[" + std::to_string(i) + "]";
     check_id(check, at + ".id", p.id(), ids, "projector");
     if (p.width() == 0 || p.width() > kMaxPixels) {
@@ -287,15 +297,15 @@ void check_projectors(Checker& check, const Installation& inst, const std::strin
       check.fail(at + ".height",
                  "must be 1.." + std::to_string(kMaxPixels) + " pixels (got " + std::to_string(p.height()) + ")");
     }
-    const Screen* screen = nullptr;
-    for (const Screen& s : inst.screens()) {
+    const schema::Screen* screen = nullptr;
+    for (const schema::Screen& s : inst.screens()) {
       if (s.id() == p.screen()) screen = &s;
     }
     if (p.screen().empty()) {
       check.fail(at + ".screen", "must name the screen this projector lights");
     } else if (screen == nullptr) {
       std::string known;
-      for (const Screen& s : inst.screens()) known += (known.empty() ? "" : ", ") + s.id();
+      for (const schema::Screen& s : inst.screens()) known += (known.empty() ? "" : ", ") + s.id();
       check.fail(at + ".screen", "unknown screen '" + p.screen() + "' (screens are: " + known + ")");
     }
     if (p.has_region()) check_region(check, at + ".region", p.region(), screen);
@@ -312,10 +322,10 @@ void check_projectors(Checker& check, const Installation& inst, const std::strin
     }
     check_content(check, at + ".content", p.content());
   }
-  check_stacked_pairs(check, inst);
+  if (scope == Scope::installation) check_stacked_pairs(check, inst);
 }
 
-void check_viewer(Checker& check, const Viewer& v) {
+void check_viewer(Checker& check, const schema::Viewer& v) {
   const bool has_eye = !v.eye().empty();
   const bool has_path = !v.path().empty();
   if (has_eye == has_path) {
@@ -350,7 +360,7 @@ void check_viewer(Checker& check, const Viewer& v) {
                "is in metres; " + number_text(v.eye_separation()) + " m is not an eye separation");
 }
 
-void check_master(Checker& check, const MasterSettings& m) {
+void check_master(Checker& check, const schema::MasterSettings& m) {
   if (!m.listen().empty()) {
     in6_addr buffer{};
     if (inet_pton(AF_INET, m.listen().c_str(), &buffer) != 1 && inet_pton(AF_INET6, m.listen().c_str(), &buffer) != 1) {
@@ -377,7 +387,53 @@ void check_master(Checker& check, const MasterSettings& m) {
   }
 }
 
-void check_scene(Checker& check, const Scene& s, const std::string& config_dir) {
+// Switch times in order, lists that parse, and no switch that changes nothing (a
+// light switched off while off, or on while on). Whether the scene has those
+// lights is checked once it is loaded.
+void check_light_switches(Checker& check, const schema::Scene& scene) {
+  std::set<std::uint32_t> off;
+  double previous_time = 0.0;
+  for (int i = 0; i < scene.light_switches_size(); ++i) {
+    const schema::LightSwitch& entry = scene.light_switches(i);
+    const std::string path = "scene.light_switches[" + std::to_string(i) + "]";
+    if (!std::isfinite(entry.time()) || entry.time() < 0.0) {
+      check.fail(path + ".time", "must be a finite number of seconds ≥ 0 (got " + number_text(entry.time()) + ")");
+    } else if (entry.time() < previous_time) {
+      check.fail(path + ".time", "switches must be in time order: " + number_text(entry.time()) +
+                                     " s comes before the switch above it at " + number_text(previous_time) + " s");
+    } else {
+      previous_time = entry.time();
+    }
+    if (entry.off().empty() && entry.on().empty()) {
+      check.fail(path, "switches nothing: give the lights that go \"off\" or come \"on\"");
+    }
+    auto going_off = parse_light_list(entry.off());
+    if (!going_off) check.fail(path + ".off", going_off.error());
+    auto coming_on = parse_light_list(entry.on());
+    if (!coming_on) check.fail(path + ".on", coming_on.error());
+    if (!going_off || !coming_on) continue;
+    std::vector<std::uint32_t> already_off;
+    for (std::uint32_t light : going_off.value()) {
+      if (!off.insert(light).second) already_off.push_back(light);
+    }
+    if (!already_off.empty()) {
+      check.fail(path + ".off", "light " + format_light_list(already_off) +
+                                    " is off already: a switch that changes nothing is probably a typo");
+    }
+    std::vector<std::uint32_t> not_off;
+    for (std::uint32_t light : coming_on.value()) {
+      const bool switched_off_here =
+          std::find(going_off.value().begin(), going_off.value().end(), light) != going_off.value().end();
+      if (switched_off_here || off.erase(light) == 0) not_off.push_back(light);
+    }
+    if (!not_off.empty()) {
+      check.fail(path + ".on", "light " + format_light_list(not_off) +
+                                   " is not off: a switch that changes nothing is probably a typo");
+    }
+  }
+}
+
+void check_scene(Checker& check, const schema::Scene& s, const std::string& config_dir, Scope scope) {
   const bool builtin = !s.builtin().empty();
   const bool gltf = !s.gltf().empty();
   if (builtin == gltf) {
@@ -389,7 +445,8 @@ void check_scene(Checker& check, const Scene& s, const std::string& config_dir) 
     for (const auto& name : scene::builtin_scene_names()) known += (known.empty() ? "" : ", ") + std::string(name);
     check.fail("scene.builtin", "unknown scene '" + s.builtin() + "' (built-in scenes are: " + known + ")");
   }
-  if (gltf) {
+  check_light_switches(check, s);
+  if (gltf && scope == Scope::installation) {
     const std::filesystem::path file = std::filesystem::path(config_dir) / s.gltf();
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec)) check.fail("scene.gltf", "no such file: " + file.string());
@@ -405,16 +462,20 @@ std::string describe_problems(const std::vector<Problem>& problems, const std::s
   return message;
 }
 
-std::vector<Problem> validate(const Installation& installation, const std::string& config_dir) {
+std::vector<Problem> validate(const schema::Installation& installation, const std::string& config_dir, Scope scope) {
   std::vector<Problem> problems;
   Checker check(problems);
   std::set<std::string> screen_ids;
   check_screens(check, installation, screen_ids);
-  check_projectors(check, installation, config_dir);
+  check_projectors(check, installation, config_dir, scope);
   check_viewer(check, installation.viewer());
   check_master(check, installation.master());
-  check_scene(check, installation.scene(), config_dir);
-  check_depth_of_field(check, installation);
+  check_scene(check, installation.scene(), config_dir, scope);
+  if (scope == Scope::installation) {
+    check_depth_of_field(check, installation);
+  } else if (installation.has_depth_of_field()) {
+    check_depth_range(check, installation.depth_of_field());
+  }
   return problems;
 }
 

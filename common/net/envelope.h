@@ -11,7 +11,7 @@
 namespace optique::net {
 
 // Bumped whenever a message changes meaning; master and node must agree exactly.
-inline constexpr std::uint32_t kProtocolVersion = 4;  // 4: lights switched on and off in the scene state
+inline constexpr std::uint32_t kProtocolVersion = 5;  // 5: the welcome says how many lights the scene has
 
 // Serializes `envelope` and appends it as one frame to `out`.
 void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envelope);

@@ -20,12 +20,6 @@ ProjectorModel::ProjectorModel(const config::ProjectorResponse& response)
       black_level_(response.black_level),
       brightness_(response.brightness) {}
 
-Result<ProjectorModel> ProjectorModel::from_config(const config::Projector& projector) {
-  auto response = config::parse_response(projector);
-  if (!response) return Error{response.error()};
-  return ProjectorModel(response.value());
-}
-
 double ProjectorModel::response(double signal) const {
   const double v = std::clamp(signal, 0.0, 1.0);
   switch (curve_) {

@@ -28,12 +28,8 @@ class ProjectorModel {
   // The sRGB curve, 8 bits, no black, brightness 1: what a projector without
   // response settings is taken to be.
   ProjectorModel() = default;
+  // A projector's response as its config states it (checked when parsed).
   explicit ProjectorModel(const config::ProjectorResponse& response);
-  // Fails, naming the field, on a gamma ≤ 0, a table that is too short, not
-  // finite, not from 0 to 1 or decreasing, bits outside 1…16, a black level
-  // outside [0, 1) or a brightness < 0. Paths are relative to the projector
-  // ("response.table[3]").
-  [[nodiscard]] static Result<ProjectorModel> from_config(const config::Projector& projector);
 
   // Normalized response: light in [0, 1] for a signal in [0, 1], non-decreasing.
   [[nodiscard]] double response(double signal) const;

@@ -5,34 +5,23 @@
 
 #include <glm/matrix.hpp>
 
-#include "config/geometry.h"
-
 namespace optique::render {
 
-RenderMethod parse_render_method(const std::string& name) {
-  return name == "two-pass" ? RenderMethod::two_pass : RenderMethod::single_pass;
-}
-
-FocusRole parse_focus_role(const std::string& role) {
-  if (role == "focus") return FocusRole::focus;
-  if (role == "defocus") return FocusRole::defocus;
+FocusRole focus_role(config::ContentRole role) {
+  if (role == config::ContentRole::focus) return FocusRole::focus;
+  if (role == config::ContentRole::defocus) return FocusRole::defocus;
   return FocusRole::none;
 }
 
 Result<ProjectorView> ProjectorView::make(const config::Screen& screen, const geometry::ProjectorGeometry& geometry,
                                           RenderMethod method, double two_pass_pixels_per_metre) {
-  auto oblique = geometry::oblique_projection(geometry, config::usable_area(screen));
+  auto oblique = geometry::oblique_projection(geometry, screen.area());
   if (!oblique) return Error{oblique.error()};
   ProjectorView view;
   view.method_ = method;
   view.oblique_ = oblique.value();
   const geometry::ScreenRect& r = view.oblique_.bounds;
-  config::Region region;
-  region.set_x(r.min.x);
-  region.set_y(r.min.y);
-  region.set_width(r.width());
-  region.set_height(r.height());
-  view.bounds_ = config::screen_region(screen, region);
+  view.bounds_ = screen.world(r);
   view.width_ = geometry.width();
   view.height_ = geometry.height();
   view.pixel_to_screen_ = geometry.pixel_to_screen();

@@ -7,18 +7,17 @@
 
 #include <glm/vec3.hpp>
 
+#include "config/installation.h"
 #include "geometry/projection.h"
 #include "geometry/projector_geometry.h"
-#include "optique/config.pb.h"
 #include "render/scene_renderer.h"
 #include "util/result.h"
 
 namespace optique::render {
 
-enum class RenderMethod { single_pass, two_pass };
-[[nodiscard]] RenderMethod parse_render_method(const std::string& name);  // "two-pass", anything else single
-// A content role's share of the depth of field: "focus", "defocus", anything else none.
-[[nodiscard]] FocusRole parse_focus_role(const std::string& role);
+using config::RenderMethod;
+// A content role's share of the depth of field: focus, defocus, or none.
+[[nodiscard]] FocusRole focus_role(config::ContentRole role);
 
 class ProjectorView {
  public:

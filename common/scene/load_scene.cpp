@@ -13,16 +13,15 @@ std::string resolve_asset(const std::string& path, const std::string& config_dir
   return std::filesystem::absolute(std::filesystem::path(config_dir) / asset).lexically_normal().string();
 }
 
-Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& config_dir, const ImageDecoder& decode) {
+Result<LoadedScene> load_scene(const std::string& builtin, const std::string& path, const ImageDecoder& decode) {
   LoadedScene loaded;
-  if (!scene.builtin().empty()) {
-    auto definition = builtin_scene(scene.builtin());
+  if (!builtin.empty()) {
+    auto definition = builtin_scene(builtin);
     if (!definition) return Error{definition.error()};
     loaded.definition = std::move(definition).value();
-    loaded.source = "builtin " + scene.builtin();
+    loaded.source = "builtin " + builtin;
     return loaded;
   }
-  const std::string path = resolve_asset(scene.gltf(), config_dir);
   auto gltf = load_gltf(path, decode);
   if (!gltf) return Error{gltf.error()};
   loaded.definition = std::move(gltf.value().scene);

@@ -5,7 +5,6 @@
 #include <string>
 #include <vector>
 
-#include "optique/config.pb.h"
 #include "scene/definition.h"
 #include "scene/image_decoder.h"
 #include "util/result.h"
@@ -23,8 +22,10 @@ struct LoadedScene {
 // elsewhere load the same file.
 [[nodiscard]] std::string resolve_asset(const std::string& path, const std::string& config_dir);
 
-// `decode` reads a glTF file's images (empty: none are read; see scene/image_decoder.h).
-[[nodiscard]] Result<LoadedScene> load_scene(const config::Scene& scene, const std::string& config_dir,
+// The built-in scene `builtin`, or else the glTF file at `gltf` (absolute, or
+// relative to the working folder); `decode` reads its images (empty: none are
+// read; see scene/image_decoder.h).
+[[nodiscard]] Result<LoadedScene> load_scene(const std::string& builtin, const std::string& gltf,
                                              const ImageDecoder& decode);
 
 }  // namespace optique::scene

@@ -1,18 +1,21 @@
 #include "dof_experiment.h"
-#include "image/texture_decode.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
+#include <optional>
+#include <sstream>
 #include <utility>
 
 #include <glm/geometric.hpp>
 
-#include "config/geometry.h"
 #include "config/load.h"
+#include "config/parse.h"
 #include "image/compare.h"
-#include "optics/projector_model.h"
-#include "render/projector_view.h"
+#include "image/texture_decode.h"
 #include "scene/load_scene.h"
 #include "scene/raycast.h"
 
@@ -24,43 +27,19 @@ constexpr double kStep24 = 1.0 / 16777216.0;  // 2⁻²⁴: one step of a 24-bit
 // 16-bit signal's step, not by c_r.
 constexpr double kLeastLight = 1e-3;
 
-glm::dvec3 vec3_of(const google::protobuf::RepeatedField<double>& v) { return {v.Get(0), v.Get(1), v.Get(2)}; }
-
-struct ScreenFrame {
-  glm::dvec3 origin;
-  glm::dvec3 right;
-  glm::dvec3 up;
-  glm::dvec3 normal;  // towards the viewer
-  [[nodiscard]] glm::dvec3 world(const glm::dvec2& s) const { return origin + right * s.x + up * s.y; }
-};
-
-ScreenFrame frame_of(const config::Screen& screen) {
-  ScreenFrame f{
-      vec3_of(screen.origin()), glm::normalize(vec3_of(screen.right())), glm::normalize(vec3_of(screen.up())), {}};
-  f.normal = glm::normalize(glm::cross(f.right, f.up));
-  return f;
-}
-
-// One node of the pair (or a plain one for FocusRole::none), set up as
-// GlRenderer::configure does for an aligned single-pass projector.
-Result<std::unique_ptr<render::SceneRenderer>> make_node(const PairSetup& setup, render::FocusRole role, int bits,
-                                                         render::DepthFormat format) {
-  config::Projector projector = role == render::FocusRole::defocus ? setup.defocus : setup.focus;
-  projector.mutable_response()->set_bits(static_cast<std::uint32_t>(bits));
-  auto geometry = config::projector_geometry(projector);
-  if (!geometry) return Error{geometry.error()};
-  auto view = render::ProjectorView::make(setup.screen, geometry.value(), render::RenderMethod::single_pass);
-  if (!view) return Error{view.error()};
-  auto renderer =
-      render::SceneRenderer::create(setup.scene, view.value().render_width(), view.value().render_height(), format);
-  if (!renderer) return Error{renderer.error()};
-  // One projector per layer: no blend partner, so no weights.
-  render::OutputStage stage = view.value().output_stage({}, role);
-  auto model = optics::ProjectorModel::from_config(projector);
-  if (!model) return Error{model.error()};
-  stage.projector = std::move(model).value();
-  if (auto output = renderer.value()->set_output(stage); !output) return Error{output.error()};
-  return std::move(renderer).value();
+// One node of the pair (or a plain one for FocusRole::none, drawing the whole
+// image), its pipeline built as its node builds it, with `bits` of signal and
+// the viewer's frustum at `frustum_near` … `frustum_far`.
+Result<std::unique_ptr<render::ProjectorPipeline>> make_node(const PairSetup& setup, render::FocusRole role, int bits,
+                                                             render::DepthFormat format, double frustum_near,
+                                                             double frustum_far) {
+  config::ProjectorJob job = role == render::FocusRole::defocus ? setup.defocus : setup.focus;
+  config::Projector& projector = job.installation.projectors[job.projector];
+  projector.response.bits = bits;
+  if (role == render::FocusRole::none) projector.content = {};
+  job.installation.viewer.near = frustum_near;
+  job.installation.viewer.far = frustum_far;
+  return render::ProjectorPipeline::make(job, setup.scene, {.depth = format});
 }
 
 // c_r of an exact depth; a ray that meets nothing is as far as the range's far end.
@@ -72,54 +51,52 @@ double exact_coc(float depth, double b, const optics::CocRange& range) {
 
 Result<PairSetup> load_setup(const std::string& config_path, int divisor) {
   if (divisor < 1) return Error{"the divisor must be at least 1"};
-  auto loaded = config::load_installation(config_path);
-  if (!loaded) return Error{loaded.error()};
-  const config::Installation& inst = loaded.value().installation;
+  // Smaller projectors for quicker runs: divided before the config is parsed, so
+  // that their geometry (a region) follows.
+  std::ifstream file(config_path);
+  std::ostringstream text;
+  text << file.rdbuf();
+  auto schema = config::read_schema(text.str(), config_path);
+  if (!schema) return Error{schema.error()};
+  for (schema::Projector& p : *schema.value().mutable_projectors()) {
+    p.set_width(p.width() / static_cast<std::uint32_t>(divisor));
+    p.set_height(p.height() / static_cast<std::uint32_t>(divisor));
+  }
+  const std::string directory = std::filesystem::path(config_path).parent_path().string();
+  auto parsed = config::parse_installation(schema.value(), directory, config_path);
+  if (!parsed) return Error{parsed.error()};
+  const config::Installation& inst = parsed.value();
   PairSetup setup;
-  bool has_focus = false;
-  bool has_defocus = false;
-  for (const auto& p : inst.projectors()) {
-    if (p.content().role() == "focus" && !has_focus) {
-      setup.focus = p;
-      has_focus = true;
-    } else if (p.content().role() == "defocus" && !has_defocus) {
-      setup.defocus = p;
-      has_defocus = true;
-    }
+  std::optional<std::size_t> focus;
+  std::optional<std::size_t> defocus;
+  for (std::size_t i = 0; i < inst.projectors.size(); ++i) {
+    const config::ContentRole role = inst.projectors[i].content.role;
+    if (role == config::ContentRole::focus && !focus) focus = i;
+    if (role == config::ContentRole::defocus && !defocus) defocus = i;
   }
-  if (!has_focus || !has_defocus) return Error{config_path + ": needs a projector of role focus and one of defocus"};
-  if (!inst.has_depth_of_field()) return Error{config_path + ": has no depth_of_field"};
-  bool has_screen = false;
-  for (const auto& s : inst.screens()) {
-    if (s.id() == setup.focus.screen()) {
-      setup.screen = s;
-      has_screen = true;
-    }
-  }
-  if (!has_screen) return Error{config_path + ": no screen '" + setup.focus.screen() + "'"};
-  for (config::Projector* p : {&setup.focus, &setup.defocus}) {
-    p->set_width(p->width() / static_cast<std::uint32_t>(divisor));
-    p->set_height(p->height() / static_cast<std::uint32_t>(divisor));
-  }
-  auto scene = scene::load_scene(inst.scene(), loaded.value().directory, image::decode_texture);
+  if (!focus || !defocus) return Error{config_path + ": needs a projector of role focus and one of defocus"};
+  if (!inst.depth_of_field) return Error{config_path + ": has no depth_of_field"};
+  setup.focus = config::job_for(inst, *focus);
+  setup.defocus = config::job_for(inst, *defocus);
+  auto scene = scene::load_scene(inst.scene.builtin, inst.scene.gltf, image::decode_texture);
   if (!scene) return Error{scene.error()};
   setup.scene = std::move(scene).value().definition;
   for (const auto& object : setup.scene.objects) {
     const scene::Pose pose = object.pose_at(0.0);
     setup.state.objects[object.id] = {pose, pose};
   }
-  setup.eye = vec3_of(inst.viewer().eye());
-  setup.frustum_near = inst.viewer().near();
-  setup.frustum_far = inst.viewer().far();
-  setup.range = {inst.depth_of_field().near(), inst.depth_of_field().far()};
+  setup.eye = inst.viewer.eye_at(0.0);
+  setup.state.eye_now = setup.state.eye_next = setup.eye;
+  setup.frustum_near = inst.viewer.near;
+  setup.frustum_far = inst.viewer.far;
+  setup.range = {inst.depth_of_field->near, inst.depth_of_field->far};
   // blur_radius is in screen pixels; the pair's pixels may be finer or coarser.
-  auto geometry = config::projector_geometry(setup.defocus);
-  if (!geometry) return Error{geometry.error()};
-  setup.c_max =
-      setup.defocus.content().blur_radius() * geometry.value().max_pixels_per_metre() / setup.screen.pixels_per_metre();
-  const ScreenFrame frame = frame_of(setup.screen);
+  const config::Projector& defocused = setup.defocus.self();
+  setup.c_max = defocused.content.blur_radius * defocused.geometry().max_pixels_per_metre() /
+                setup.defocus.screen().pixels_per_metre;
+  const glm::dvec3 normal = setup.focus.screen().world().normal();
   for (const auto& [id, object] : setup.state.objects) {
-    setup.object_depths.push_back(glm::dot(setup.eye - object.now.position, frame.normal));
+    setup.object_depths.push_back(glm::dot(setup.eye - object.now.position, normal));
   }
   std::sort(setup.object_depths.begin(), setup.object_depths.end());
   return setup;
@@ -143,23 +120,23 @@ std::vector<double> focal_sweep(const PairSetup& setup) {
 }
 
 Result<ExactDepth> exact_depth(const PairSetup& setup) {
-  auto geometry = config::projector_geometry(setup.focus);
-  if (!geometry) return Error{geometry.error()};
-  const int width = geometry.value().width();
-  const int height = geometry.value().height();
-  const ScreenFrame frame = frame_of(setup.screen);
+  const geometry::ProjectorGeometry geometry = setup.focus.self().geometry();
+  const int width = geometry.width();
+  const int height = geometry.height();
+  const config::Screen& screen = setup.focus.screen();
+  const glm::dvec3 normal = screen.world().normal();
   const scene::RayCaster caster(setup.scene, setup.state, 0.0);
   ExactDepth exact;
   exact.depth = image::FloatImage(width, height, 1);
   std::vector<int> seen(static_cast<std::size_t>(width) * height, -1);  // instance, −1: nothing
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
-      const glm::dvec3 through = frame.world(geometry.value().to_screen({x + 0.5, y + 0.5}));
+      const glm::dvec3 through = screen.point(geometry.to_screen({x + 0.5, y + 0.5}));
       const auto hit = caster.cast({setup.eye, through - setup.eye});
       float& depth = exact.depth.at(x, y, 0);
       depth = std::numeric_limits<float>::infinity();
       if (hit) {
-        depth = static_cast<float>(glm::dot(setup.eye - hit->point, frame.normal));
+        depth = static_cast<float>(glm::dot(setup.eye - hit->point, normal));
         seen[static_cast<std::size_t>(y) * width + x] = static_cast<int>(hit->instance);
       }
     }
@@ -187,22 +164,12 @@ double psnr_against(const image::FloatImage& image, const FocalFrame& frame, boo
                                 [&](int x, int y) { return !away || frame.coc.at(x, y, 0) > kAwayFromFocus; });
 }
 
-Result<geometry::Frustum> pair_frustum(const PairSetup& setup, double frustum_near, double frustum_far) {
-  auto geometry = config::projector_geometry(setup.focus);
-  if (!geometry) return Error{geometry.error()};
-  auto view = render::ProjectorView::make(setup.screen, geometry.value(), render::RenderMethod::single_pass);
-  if (!view) return Error{view.error()};
-  return view.value().frustum(setup.eye, frustum_near, frustum_far);
-}
-
 Result<std::unique_ptr<Pair>> Pair::create(const PairSetup& setup, int bits, render::DepthFormat depth) {
-  auto frustum = pair_frustum(setup, setup.frustum_near, setup.frustum_far);
-  if (!frustum) return Error{frustum.error()};
-  std::unique_ptr<Pair> pair(new Pair(setup, std::move(frustum).value()));
+  std::unique_ptr<Pair> pair(new Pair(setup));
   for (auto [role, slot] :
        {std::pair{render::FocusRole::none, &pair->plain_}, std::pair{render::FocusRole::focus, &pair->focus_},
         std::pair{render::FocusRole::defocus, &pair->defocus_}}) {
-    auto node = make_node(setup, role, bits, depth);
+    auto node = make_node(setup, role, bits, depth, setup.frustum_near, setup.frustum_far);
     if (!node) return Error{node.error()};
     *slot = std::move(node).value();
   }
@@ -210,30 +177,40 @@ Result<std::unique_ptr<Pair>> Pair::create(const PairSetup& setup, int bits, ren
 }
 
 optics::CocFromWindowDepth Pair::mapping(double b) const {
-  return optics::coc_from_window_depth(b, setup_.range, frustum_.near, frustum_.far);
+  return optics::coc_from_window_depth(b, setup_.range, setup_.frustum_near, setup_.frustum_far);
 }
 
-void Pair::draw_plain() { plain_->draw(setup_.state, 0.0, setup_.eye, frustum_); }
+namespace {
+
+// The pair's frames are always drawable: the eye is in front of the screen.
+void draw(render::ProjectorPipeline& node, const scene::SceneState& state) {
+  [[maybe_unused]] const auto drawn = node.draw(state);
+  assert(drawn);
+}
+
+}  // namespace
+
+void Pair::draw_plain() { draw(*plain_, setup_.state); }
 
 void Pair::draw_focus(double b) {
-  focus_->set_focus({mapping(b)});
-  focus_->draw(setup_.state, 0.0, setup_.eye, frustum_);
+  focus_->set_focus({b, {}});
+  draw(*focus_, setup_.state);
 }
 
 void Pair::draw_defocus(double b) {
-  defocus_->set_focus({mapping(b)});
-  defocus_->draw(setup_.state, 0.0, setup_.eye, frustum_);
+  defocus_->set_focus({b, {}});
+  draw(*defocus_, setup_.state);
 }
 
 Result<FocalFrame> Pair::frame(double b, const ExactDepth& exact) {
   FocalFrame f;
   f.focal_depth = b;
   draw_plain();
-  f.rendered = plain_->read_rendered();
+  f.rendered = plain_->renderer().read_rendered();
   draw_focus(b);
-  f.focus = focus_->read_linear();
+  f.focus = focus_->renderer().read_linear();
   draw_defocus(b);
-  f.defocus = defocus_->read_linear();
+  f.defocus = defocus_->renderer().read_linear();
   if (exact.depth.width != f.rendered.width || exact.depth.height != f.rendered.height) {
     return Error{"the exact depth map is not the rendered image's size"};
   }
@@ -265,11 +242,10 @@ Result<FocalFrame> Pair::frame(double b, const ExactDepth& exact) {
 
 Result<Precision> measure_precision(const PairSetup& setup, const ExactDepth& exact, render::DepthFormat format,
                                     double frustum_near, double frustum_far, std::span<const double> focal_depths) {
-  auto frustum = pair_frustum(setup, frustum_near, frustum_far);
-  if (!frustum) return Error{frustum.error()};
-  auto node = make_node(setup, render::FocusRole::focus, 16, format);
+  auto node = make_node(setup, render::FocusRole::focus, 16, format, frustum_near, frustum_far);
   if (!node) return Error{node.error()};
-  render::SceneRenderer& renderer = *node.value();
+  render::ProjectorPipeline& pipeline = *node.value();
+  render::SceneRenderer& renderer = pipeline.renderer();
 
   Precision p;
   double buffer_sum = 0.0;
@@ -279,8 +255,8 @@ Result<Precision> measure_precision(const PairSetup& setup, const ExactDepth& ex
   image::FloatImage rendered;
   for (const double b : focal_depths) {
     const optics::CocFromWindowDepth mapping = optics::coc_from_window_depth(b, setup.range, frustum_near, frustum_far);
-    renderer.set_focus({mapping});
-    renderer.draw(setup.state, 0.0, setup.eye, frustum.value());
+    pipeline.set_focus({b, {}});
+    draw(pipeline, setup.state);
     if (depth.empty()) {
       depth = renderer.read_depth();
       rendered = renderer.read_rendered();

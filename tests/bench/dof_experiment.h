@@ -17,10 +17,10 @@
 
 #include <glm/vec3.hpp>
 
-#include "geometry/projection.h"
+#include "config/job.h"
 #include "image/image.h"
 #include "optics/defocus.h"
-#include "optique/config.pb.h"
+#include "render/projector_pipeline.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
 #include "scene/state.h"
@@ -36,10 +36,9 @@ inline constexpr double kAwayFromFocus = 0.05;
 // The installation as the pair's nodes see it, from the config file.
 struct PairSetup {
   scene::SceneDefinition scene;
-  scene::SceneState state;  // every object at t = 0 (depth-stack does not move)
-  config::Screen screen;
-  config::Projector focus;  // as loaded, its size divided by the divisor
-  config::Projector defocus;
+  scene::SceneState state;     // every object at t = 0 (depth-stack does not move), the eye at t = 0
+  config::ProjectorJob focus;  // as loaded, the projectors' sizes divided by the divisor
+  config::ProjectorJob defocus;
   glm::dvec3 eye{0.0};
   double frustum_near = 0.0;  // the viewer's clip planes, as a node draws with them
   double frustum_far = 0.0;
@@ -93,8 +92,6 @@ struct FocalFrame {
 [[nodiscard]] double psnr_against(const image::FloatImage& image, const FocalFrame& frame, bool away);
 
 // A frustum of the pair: the viewer's eye through the focus projector's region.
-[[nodiscard]] Result<geometry::Frustum> pair_frustum(const PairSetup& setup, double frustum_near, double frustum_far);
-
 // The pair's two nodes and a plain one, each a SceneRenderer as the node sets it
 // up (node/gl_renderer.cpp), on the current GL context.
 class Pair {
@@ -114,18 +111,16 @@ class Pair {
   void draw_plain();
   void draw_focus(double b);
   void draw_defocus(double b);
-  [[nodiscard]] render::SceneRenderer& plain() { return *plain_; }
-  [[nodiscard]] const geometry::Frustum& frustum() const { return frustum_; }
-  // The output pass's c_r mapping for focal depth b with this pair's frustum.
+  // The output pass's c_r mapping for focal depth b with the viewer's frustum.
   [[nodiscard]] optics::CocFromWindowDepth mapping(double b) const;
 
  private:
-  Pair(const PairSetup& setup, geometry::Frustum frustum) : setup_(setup), frustum_(std::move(frustum)) {}
+  explicit Pair(const PairSetup& setup) : setup_(setup) {}
   const PairSetup& setup_;
-  geometry::Frustum frustum_;
-  std::unique_ptr<render::SceneRenderer> plain_;
-  std::unique_ptr<render::SceneRenderer> focus_;
-  std::unique_ptr<render::SceneRenderer> defocus_;
+  // Each built as its node would build it (render::ProjectorPipeline).
+  std::unique_ptr<render::ProjectorPipeline> plain_;
+  std::unique_ptr<render::ProjectorPipeline> focus_;
+  std::unique_ptr<render::ProjectorPipeline> defocus_;
 };
 
 // How far c_r from the depth buffer is from c_r of the exact depth, over the

@@ -33,16 +33,17 @@
 #include <sstream>
 
 #include "clock/clock.h"
-#include "config/geometry.h"
+#include "config/job.h"
+#include "config/light_list.h"
 #include "config/load.h"
 #include "image/compare.h"
 #include "image/image_io.h"
 #include "master/light_share.h"
+#include "master/scene_authority.h"
 #include "master/stacked_groups.h"
 #include "plot.h"
 #include "render/gl_context.h"
-#include "render/projector_view.h"
-#include "render/scene_renderer.h"
+#include "render/projector_pipeline.h"
 #include "scene/builtin.h"
 #include "scene/light_coverage.h"
 #include "spread.h"
@@ -66,9 +67,9 @@ constexpr double kFrameSpacing = 1.0;
 constexpr const char* kReadingHeading = "## What it shows";
 
 struct Node {
-  render::ProjectorView view;
-  std::unique_ptr<render::SceneRenderer> renderer;
+  std::unique_ptr<render::ProjectorPipeline> pipeline;
   master::LightShare share;
+  [[nodiscard]] const render::SceneRenderer& renderer() const { return pipeline->renderer(); }
 };
 
 // One way of drawing a frame: one node drawing everything, or a stacked group
@@ -94,30 +95,24 @@ struct Accuracy {
   double clipped = 0.0;       // the share of its pixels above 1
 };
 
-Node make_node(const scene::SceneDefinition& scene, const config::Screen& screen, const config::Projector& projector,
+// Projector `projector` of `installation` drawing `share`, its pipeline built as
+// its node builds it, but as an ideal projector (8-bit sRGB, no black: the
+// model's default) without blend weights, so that the error measured is the
+// split's and the 8-bit steps', not a calibration's.
+Node make_node(const scene::SceneDefinition& scene, const config::Installation& installation, std::size_t projector,
                master::LightShare share) {
-  auto geometry = config::projector_geometry(projector);
-  if (!geometry) throw std::runtime_error(projector.id() + ": " + geometry.error());
-  auto view = render::ProjectorView::make(screen, geometry.value(), render::RenderMethod::single_pass);
-  if (!view) throw std::runtime_error(projector.id() + ": " + view.error());
-  auto renderer = render::SceneRenderer::create(scene, view.value().render_width(), view.value().render_height());
-  if (!renderer) throw std::runtime_error(renderer.error());
-  // Identical ideal projectors (8-bit sRGB, no black: the model's default), so the
-  // error measured is the split's and the 8-bit steps', not a calibration's.
-  render::OutputStage stage = view.value().output_stage({});
-  stage.projector = optics::ProjectorModel{};
-  if (auto output = renderer.value()->set_output(stage); !output) throw std::runtime_error(output.error());
-  renderer.value()->set_lights(share.lights);
-  return {std::move(view).value(), std::move(renderer).value(), std::move(share)};
+  config::ProjectorJob job = config::job_for(installation, projector);
+  job.installation.projectors[job.projector].response = {};
+  auto pipeline = render::ProjectorPipeline::make(job, scene, {.blend = false});
+  if (!pipeline) throw std::runtime_error(pipeline.error());
+  pipeline.value()->set_share(share);
+  return {std::move(pipeline).value(), std::move(share)};
 }
 
 // Draws one node's share of a frame; returns the time to a finished image, in ms.
-double draw(Node& node, const scene::SceneState& state, const config::Viewer& viewer) {
-  auto frustum = node.view.frustum(state.eye_now, viewer.near(), viewer.far());
-  if (!frustum) throw std::runtime_error(frustum.error());
-  const render::LightTerms terms{node.share.ambient, node.share.ambient};
+double draw(Node& node, const scene::SceneState& state) {
   const clock::Nanos start = clock::monotonic_now();
-  node.renderer->draw(state, 0.0, state.eye_now, frustum.value(), terms);
+  if (auto drawn = node.pipeline->draw(state); !drawn) throw std::runtime_error(drawn.error());
   return static_cast<double>(clock::monotonic_now() - start) / 1e6;
 }
 
@@ -134,19 +129,10 @@ std::vector<master::LightShare> naive_split(int lights, int nodes) {
   return shares;
 }
 
-scene::SceneState state_at(const scene::SceneDefinition& scene, const config::Viewer& viewer, double t) {
-  scene::SceneState state;
-  for (const auto& object : scene.objects) state.objects[object.id] = {object.pose_at(t), object.pose_at(t)};
-  state.eye_now = glm::dvec3(viewer.eye(0), viewer.eye(1), viewer.eye(2));
-  state.eye_next = state.eye_now;
-  return state;
-}
-
-const config::Screen& screen_of(const config::Installation& inst, const config::Projector& projector) {
-  for (const auto& s : inst.screens()) {
-    if (s.id() == projector.screen()) return s;
-  }
-  throw std::runtime_error(projector.id() + ": no screen '" + projector.screen() + "'");
+// The master's state of `scene` at frame k, frames kFrameSpacing apart.
+scene::SceneState state_at(const scene::SceneDefinition& scene, const config::Viewer& viewer, int k) {
+  return master::SceneAuthority(scene.objects, viewer, 1.0 / kFrameSpacing)
+      .state_at_frame(static_cast<std::uint64_t>(k));
 }
 
 void add(image::FloatImage& sum, const image::FloatImage& term) {
@@ -267,15 +253,14 @@ int main(int argc, char** argv) {
     if (!loaded_auto) throw std::runtime_error(loaded_auto.error());
     const config::Installation& mixed = loaded_auto.value().installation;
     for (const auto* inst : {&uniform, &mixed}) {
-      if (inst->viewer().eye().empty()) throw std::runtime_error("the bench needs a fixed viewer eye");
+      if (inst->viewer.moves()) throw std::runtime_error("the bench needs a fixed viewer eye");
     }
     const std::vector<master::StackedGroup> groups = master::lighting_groups(mixed);
     if (groups.size() != 1 || !groups.front().automatic) {
       throw std::runtime_error(auto_config_path + ": needs exactly one stacked group with lights \"auto\"");
     }
     const master::StackedGroup& group = groups.front();
-    const config::Projector& node_projector = uniform.projectors(0);
-    const config::Screen& node_screen = screen_of(uniform, node_projector);
+    const config::Projector& node_projector = uniform.projectors[0];
 
     std::vector<scene::SceneDefinition> scenes;
     for (int lights : kLightCounts) {
@@ -293,8 +278,8 @@ int main(int argc, char** argv) {
     std::vector<Stack> stacks;
     std::vector<double> mixed_pixels;
     for (std::size_t member : group.members) {
-      const config::Projector& p = mixed.projectors(static_cast<int>(member));
-      mixed_pixels.push_back(static_cast<double>(p.width()) * p.height());
+      const config::Projector& p = mixed.projectors[member];
+      mixed_pixels.push_back(static_cast<double>(p.width) * p.height);
     }
     std::vector<std::vector<double>> costs(scenes.size());  // at the first frame's state
     std::vector<int> auto_changes(scenes.size(), 0);        // frames at which automatic_shares would differ
@@ -303,11 +288,11 @@ int main(int argc, char** argv) {
       for (int n = 1; n <= kMaxNodes; ++n) {
         Stack stack{s, false, n == 1 ? "full" : "naive", {}, {}};
         for (auto& share : naive_split(lights, n)) {
-          stack.nodes.push_back(make_node(scenes[s], node_screen, node_projector, std::move(share)));
+          stack.nodes.push_back(make_node(scenes[s], uniform, 0, std::move(share)));
         }
         stacks.push_back(std::move(stack));
       }
-      const scene::SceneState start = state_at(scenes[s], mixed.viewer(), 0.0);
+      const scene::SceneState start = state_at(scenes[s], mixed.viewer, 0);
       const std::vector<bool> live(group.members.size(), true);
       const std::vector<master::LightShare> automatic =
           master::automatic_shares(mixed, group, live, scenes[s], start, start.eye_now);
@@ -320,7 +305,7 @@ int main(int argc, char** argv) {
         }
       }
       for (int k = 1; k < frames; ++k) {
-        const scene::SceneState later = state_at(scenes[s], mixed.viewer(), kFrameSpacing * k);
+        const scene::SceneState later = state_at(scenes[s], mixed.viewer, k);
         const auto again = master::automatic_shares(mixed, group, live, scenes[s], later, later.eye_now);
         bool differs = false;
         for (std::size_t m = 0; m < again.size(); ++m) differs = differs || again[m].lights != automatic[m].lights;
@@ -330,8 +315,7 @@ int main(int argc, char** argv) {
       for (const auto* split : {&naive, &automatic}) {
         Stack stack{s, true, split == &naive ? "naive" : "auto", {}, {}};
         for (std::size_t k = 0; k < group.members.size(); ++k) {
-          const config::Projector& p = mixed.projectors(static_cast<int>(group.members[k]));
-          stack.nodes.push_back(make_node(scenes[s], screen_of(mixed, p), p, (*split)[k]));
+          stack.nodes.push_back(make_node(scenes[s], mixed, group.members[k], (*split)[k]));
         }
         stacks.push_back(std::move(stack));
       }
@@ -351,7 +335,7 @@ int main(int argc, char** argv) {
     };
     // [stack] → per frame of the first run; only stacks of identical nodes.
     std::vector<std::vector<Accuracy>> accuracy(stacks.size());
-    const int row = node_projector.height() / 10;  // high on the wall, above the statue
+    const int row = node_projector.height / 10;  // high on the wall, above the statue
 
     const clock::Nanos bench_start = clock::monotonic_now();
     for (int run = 0; run < repeats; ++run) {
@@ -360,7 +344,7 @@ int main(int argc, char** argv) {
       }
       for (int k = -2; k < frames; ++k) {  // two unmeasured frames first
         for (std::size_t s = 0; s < scenes.size(); ++s) {
-          const scene::SceneState state = state_at(scenes[s], uniform.viewer(), kFrameSpacing * std::max(k, 0));
+          const scene::SceneState state = state_at(scenes[s], uniform.viewer, std::max(k, 0));
           std::vector<std::size_t> order;
           for (std::size_t i = 0; i < stacks.size(); ++i) {
             if (stacks[i].scene == s) order.push_back(i);
@@ -369,9 +353,8 @@ int main(int argc, char** argv) {
           std::rotate(order.begin(), order.begin() + (k + 2 + run) % static_cast<int>(order.size()), order.end());
           for (std::size_t i : order) {
             Stack& stack = stacks[i];
-            const config::Viewer& viewer = stack.mixed ? mixed.viewer() : uniform.viewer();
             for (std::size_t n = 0; n < stack.nodes.size(); ++n) {
-              const double ms = draw(stack.nodes[n], state, viewer);
+              const double ms = draw(stack.nodes[n], state);
               if (k < 0) continue;
               stack.ms.back()[n].push_back(ms);
               csv_row(stack, run, k, std::to_string(n), "ms", ms);
@@ -381,8 +364,8 @@ int main(int argc, char** argv) {
           // Accuracy: each stack's images read back now, while every renderer
           // still holds this frame.
           const Stack& full = full_of(s);
-          const image::FloatImage full_rendered = full.nodes.front().renderer->read_rendered();
-          const image::FloatImage full_linear = full.nodes.front().renderer->read_linear();
+          const image::FloatImage full_rendered = full.nodes.front().renderer().read_rendered();
+          const image::FloatImage full_linear = full.nodes.front().renderer().read_linear();
           // Where the full render is brighter than one projector can show, one
           // clips and several clip less: a matter of headroom, not of the split
           // or of 8-bit steps, so the comparisons leave those pixels out.
@@ -398,11 +381,11 @@ int main(int argc, char** argv) {
           for (std::size_t i : order) {
             const Stack& stack = stacks[i];
             if (stack.mixed) continue;
-            image::FloatImage sum_rendered = stack.nodes.front().renderer->read_rendered();
-            image::FloatImage sum_linear = stack.nodes.front().renderer->read_linear();
+            image::FloatImage sum_rendered = stack.nodes.front().renderer().read_rendered();
+            image::FloatImage sum_linear = stack.nodes.front().renderer().read_linear();
             for (std::size_t n = 1; n < stack.nodes.size(); ++n) {
-              add(sum_rendered, stack.nodes[n].renderer->read_rendered());
-              add(sum_linear, stack.nodes[n].renderer->read_linear());
+              add(sum_rendered, stack.nodes[n].renderer().read_rendered());
+              add(sum_linear, stack.nodes[n].renderer().read_linear());
             }
             Accuracy a;
             a.split_max_abs = max_abs_rgb(sum_rendered, full_rendered, everywhere);
@@ -446,7 +429,8 @@ int main(int argc, char** argv) {
       const RunTimes times = run_times(stack);
       for (std::size_t n = 0; n < stack.nodes.size(); ++n) {
         const double t = median(times.node[n]);
-        const double pixels = static_cast<double>(stack.nodes[n].renderer->width()) * stack.nodes[n].renderer->height();
+        const double pixels =
+            static_cast<double>(stack.nodes[n].renderer().width()) * stack.nodes[n].renderer().height();
         const double a = pixels / t;
         const double b = pixels * units(stack.scene, stack.nodes[n].share) / t;
         saa += a * a;
@@ -564,15 +548,15 @@ int main(int argc, char** argv) {
       std::string counts;
       double fitted_slowest = 0.0;
       for (std::size_t n = 0; n < stack.nodes.size(); ++n) {
-        const config::Projector& p = mixed.projectors(static_cast<int>(group.members[n]));
+        const config::Projector& p = mixed.projectors[group.members[n]];
         const double fitted = fitted_ms(stack.scene, stack.nodes[n].share, mixed_pixels[n]);
         fitted_slowest = std::max(fitted_slowest, fitted);
         counts += (n ? " / " : "") + std::to_string(stack.nodes[n].share.lights.size());
-        mixed_table << "| " << kLightCounts[stack.scene] << " | " << stack.split << " | " << p.id() << " | "
-                    << p.width() << "×" << p.height() << " | " << master::format_light_list(stack.nodes[n].share.lights)
-                    << " (" << stack.nodes[n].share.lights.size() << ") | "
-                    << (stack.nodes[n].share.ambient ? "yes" : "") << " | " << cell(r.times.node[n], 1) << " | "
-                    << fixed(ms_per_unit * r.modelled[n], 1) << " | " << fixed(fitted, 1) << " |\n";
+        mixed_table << "| " << kLightCounts[stack.scene] << " | " << stack.split << " | " << p.id << " | " << p.width
+                    << "×" << p.height << " | " << config::format_light_list(stack.nodes[n].share.lights) << " ("
+                    << stack.nodes[n].share.lights.size() << ") | " << (stack.nodes[n].share.ambient ? "yes" : "")
+                    << " | " << cell(r.times.node[n], 1) << " | " << fixed(ms_per_unit * r.modelled[n], 1) << " | "
+                    << fixed(fitted, 1) << " |\n";
       }
       const double modelled_slowest = *std::max_element(r.modelled.begin(), r.modelled.end());
       mixed_summary << "| " << kLightCounts[stack.scene] << " | " << stack.split << " | " << counts << " | "
@@ -680,8 +664,8 @@ int main(int argc, char** argv) {
           "slowest node's; speed-up = full render's time / slowest node's, per run. Σ nodes / full is the work the "
           "split adds in all (each node rasterizes the whole scene and runs the output pass).\n"
        << "- Times: median over frames per run, then median (min–max) over runs; per-node columns are medians.\n"
-       << "- Identical nodes: " << node_projector.width() << "×" << node_projector.height() << ", projector '"
-       << node_projector.id() << "' of " << config_path.substr(config_path.rfind('/') + 1)
+       << "- Identical nodes: " << node_projector.width << "×" << node_projector.height << ", projector '"
+       << node_projector.id << "' of " << config_path.substr(config_path.rfind('/') + 1)
        << " (same screen and eye), 1 to " << kMaxNodes
        << " of them; 1 is the full render. Naive split: contiguous runs of equal length by index (the first "
           "lights % nodes one longer), ambient and emissive on the first node.\n"

@@ -18,17 +18,17 @@
 #include <map>
 
 #include "clock/clock.h"
-#include "config/geometry.h"
+#include "config/job.h"
 #include "config/load.h"
 #include "image/compare.h"
 #include "image/convert.h"
 #include "image/image_io.h"
 #include "image/texture_decode.h"
+#include "master/scene_authority.h"
 #include "metrics/distribution.h"
 #include "plot.h"
 #include "render/gl_context.h"
-#include "render/projector_view.h"
-#include "render/scene_renderer.h"
+#include "render/projector_pipeline.h"
 #include "scene/load_scene.h"
 #include "spread.h"
 
@@ -38,33 +38,31 @@ using namespace optique;
 
 constexpr int kSupersample = 4;
 
+// One way to draw a projector: its pipeline, built as its node builds it but for
+// the method and without blend weights (the comparison is of methods), as a
+// 16-bit projector (of methods, not of 8-bit steps).
 struct Method {
-  render::ProjectorView view;
-  std::unique_ptr<render::SceneRenderer> renderer;
+  std::unique_ptr<render::ProjectorPipeline> pipeline;
+  [[nodiscard]] const render::ProjectorView& view() const { return pipeline->view(); }
+  [[nodiscard]] image::FloatImage light() const { return pipeline->renderer().read_linear(); }
 };
 
-Method make_method(const scene::SceneDefinition& scene, const config::Screen& screen,
-                   const geometry::ProjectorGeometry& geometry, render::RenderMethod how,
+Method make_method(config::ProjectorJob job, const scene::SceneDefinition& scene, render::RenderMethod how,
                    double texture_density = 0.0) {
-  auto view = render::ProjectorView::make(screen, geometry, how, texture_density);
-  if (!view) throw std::runtime_error(view.error());
-  auto renderer = render::SceneRenderer::create(scene, view.value().render_width(), view.value().render_height());
-  if (!renderer) throw std::runtime_error(renderer.error());
-  // A 16-bit projector: the comparison is of rendering methods, not of 8-bit steps.
-  render::OutputStage stage = view.value().output_stage({});
-  config::Projector deep;
-  deep.mutable_response()->set_bits(16);
-  stage.projector = optics::ProjectorModel::from_config(deep).value();
-  if (auto output = renderer.value()->set_output(stage); !output) throw std::runtime_error(output.error());
-  return {std::move(view).value(), std::move(renderer).value()};
+  config::Projector& projector = job.installation.projectors[job.projector];
+  projector.rendering = how;
+  projector.response = {};
+  projector.response.bits = 16;
+  auto pipeline =
+      render::ProjectorPipeline::make(job, scene, {.two_pass_pixels_per_metre = texture_density, .blend = false});
+  if (!pipeline) throw std::runtime_error(pipeline.error());
+  return {std::move(pipeline).value()};
 }
 
 // Draws one frame; returns the time to a finished image, in ms.
-double draw(Method& m, const scene::SceneState& state, const config::Viewer& viewer) {
-  auto frustum = m.view.frustum(state.eye_now, viewer.near(), viewer.far());
-  if (!frustum) throw std::runtime_error(frustum.error());
+double draw(Method& m, const scene::SceneState& state) {
   const clock::Nanos start = clock::monotonic_now();
-  m.renderer->draw(state, 0.0, state.eye_now, frustum.value());
+  if (auto drawn = m.pipeline->draw(state); !drawn) throw std::runtime_error(drawn.error());
   return static_cast<double>(clock::monotonic_now() - start) / 1e6;
 }
 
@@ -85,14 +83,6 @@ double psnr_luma(const image::FloatImage& a, const image::FloatImage& b, const s
   return image::psnr_luma_where(a, b, [&](int x, int y) { return inside[static_cast<std::size_t>(y) * a.width + x]; });
 }
 
-scene::SceneState state_at(const scene::SceneDefinition& scene, const config::Viewer& viewer, double t) {
-  scene::SceneState state;
-  for (const auto& object : scene.objects) state.objects[object.id] = {object.pose_at(t), object.pose_at(t)};
-  state.eye_now = glm::dvec3(viewer.eye(0), viewer.eye(1), viewer.eye(2));
-  state.eye_next = state.eye_now;
-  return state;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -110,11 +100,13 @@ int main(int argc, char** argv) {
   try {
     auto loaded = config::load_installation(config_path);
     if (!loaded) throw std::runtime_error(loaded.error());
-    const auto& installation = loaded.value().installation;
-    if (installation.viewer().eye().empty()) throw std::runtime_error("the bench needs a fixed viewer eye");
-    auto scene = scene::load_scene(installation.scene(), loaded.value().directory, image::decode_texture);
+    const config::Installation& installation = loaded.value().installation;
+    if (installation.viewer.moves()) throw std::runtime_error("the bench needs a fixed viewer eye");
+    auto scene = scene::load_scene(installation.scene.builtin, installation.scene.gltf, image::decode_texture);
     if (!scene) throw std::runtime_error(scene.error());
     const auto& definition = scene.value().definition;
+    // Frames 0.25 s of animation apart, as the master would step them at 4 Hz.
+    const master::SceneAuthority authority(definition.objects, installation.viewer, 4.0);
     auto context = render::make_headless_context();
     if (!context) throw std::runtime_error(context.error());
     const std::string gl = context.value()->renderer_name();
@@ -127,57 +119,54 @@ int main(int argc, char** argv) {
           << "|---|---:|---|---|---:|---:|---:|\n";
     // One point per (projector, method): median frame time, median PSNR.
     std::vector<std::array<glm::dvec2, 3>> points;
-    for (const auto& projector : installation.projectors()) {
-      const config::Screen* screen = nullptr;
-      for (const auto& s : installation.screens()) {
-        if (s.id() == projector.screen()) screen = &s;
-      }
-      auto geometry = config::projector_geometry(projector);
-      if (!geometry || screen == nullptr) throw std::runtime_error(projector.id() + ": no geometry");
-      const geometry::ScreenRect usable = config::usable_area(*screen);
-      Method single = make_method(definition, *screen, geometry.value(), render::RenderMethod::single_pass);
-      Method two = make_method(definition, *screen, geometry.value(), render::RenderMethod::two_pass);
+    for (std::size_t index = 0; index < installation.projectors.size(); ++index) {
+      const config::Projector& projector = installation.projectors[index];
+      const config::ProjectorJob job = config::job_for(installation, index);
+      const geometry::ProjectorGeometry geometry = projector.geometry();
+      Method single = make_method(job, definition, render::RenderMethod::single_pass);
+      Method two = make_method(job, definition, render::RenderMethod::two_pass);
       // Two passes with as many texels as the projector has pixels: less work, more blur.
-      const geometry::ScreenRect& r = two.view.oblique().bounds;
-      const double equal_density = std::sqrt(static_cast<double>(geometry.value().width()) * geometry.value().height() /
-                                             (r.width() * r.height()));
-      Method two_equal =
-          make_method(definition, *screen, geometry.value(), render::RenderMethod::two_pass, equal_density);
-      const std::vector<bool> inside = usable_pixels(geometry.value(), usable);
+      const geometry::ScreenRect& r = two.view().oblique().bounds;
+      const double equal_density =
+          std::sqrt(static_cast<double>(geometry.width()) * geometry.height() / (r.width() * r.height()));
+      Method two_equal = make_method(job, definition, render::RenderMethod::two_pass, equal_density);
+      const std::vector<bool> inside = usable_pixels(geometry, job.screen().area());
+      // The reference: the same projector with kSupersample² as many pixels.
+      config::ProjectorJob fine = job;
+      config::Projector& fine_projector = fine.installation.projectors[fine.projector];
       const glm::dmat3 scale(kSupersample, 0.0, 0.0, 0.0, kSupersample, 0.0, 0.0, 0.0, 1.0);
-      auto fine_geometry = geometry::ProjectorGeometry::make(scale * geometry.value().screen_to_pixel(),
-                                                             kSupersample * geometry.value().width(),
-                                                             kSupersample * geometry.value().height());
-      if (!fine_geometry) throw std::runtime_error(fine_geometry.error());
-      Method reference = make_method(definition, *screen, fine_geometry.value(), render::RenderMethod::single_pass);
+      fine_projector.homography = scale * fine_projector.homography;
+      fine_projector.width *= kSupersample;
+      fine_projector.height *= kSupersample;
+      fine_projector.region.reset();
+      Method reference = make_method(fine, definition, render::RenderMethod::single_pass);
 
       std::vector<double> single_medians, two_medians, equal_medians, ratios, equal_ratios, single_psnrs, two_psnrs,
           equal_psnrs;
       for (int run = 0; run < repeats; ++run) {
         std::vector<double> single_ms, two_ms, equal_ms;
         for (int k = -2; k < frames; ++k) {  // two unmeasured frames first
-          const auto state = state_at(definition, installation.viewer(), 0.25 * std::max(k, 0));
+          const scene::SceneState state = authority.state_at_frame(static_cast<std::uint64_t>(std::max(k, 0)));
           // Rotate which goes first, so none always follows another.
           std::array<Method*, 3> order{&single, &two, &two_equal};
           std::rotate(order.begin(), order.begin() + (k + 3) % 3, order.end());
           std::map<Method*, double> ms;
-          for (Method* m : order) ms[m] = draw(*m, state, installation.viewer());
+          for (Method* m : order) ms[m] = draw(*m, state);
           if (k < 0) continue;
           single_ms.push_back(ms[&single]);
           two_ms.push_back(ms[&two]);
           equal_ms.push_back(ms[&two_equal]);
           std::array<double, 3> psnr{};
           if (run == 0) {  // the images do not change between runs
-            draw(reference, state, installation.viewer());
-            const image::FloatImage ideal = image::box_downsample(reference.renderer->read_linear(), kSupersample);
-            psnr = {psnr_luma(single.renderer->read_linear(), ideal, inside),
-                    psnr_luma(two.renderer->read_linear(), ideal, inside),
-                    psnr_luma(two_equal.renderer->read_linear(), ideal, inside)};
+            draw(reference, state);
+            const image::FloatImage ideal = image::box_downsample(reference.light(), kSupersample);
+            psnr = {psnr_luma(single.light(), ideal, inside), psnr_luma(two.light(), ideal, inside),
+                    psnr_luma(two_equal.light(), ideal, inside)};
             single_psnrs.push_back(psnr[0]);
             two_psnrs.push_back(psnr[1]);
             equal_psnrs.push_back(psnr[2]);
           }
-          csv << '"' << gl << "\"," << projector.id() << ',' << run << ',' << k << ',' << ms[&single] << ',' << ms[&two]
+          csv << '"' << gl << "\"," << projector.id << ',' << run << ',' << k << ',' << ms[&single] << ',' << ms[&two]
               << ',' << ms[&two_equal];
           for (double p : psnr) csv << ',' << (run == 0 ? std::to_string(p) : "");
           csv << '\n';
@@ -192,10 +181,10 @@ int main(int argc, char** argv) {
       auto row = [&](const char* method, const Method& m, const std::vector<double>& times,
                      const std::vector<double>& ratio, const std::vector<double>& psnrs) {
         char k[32];
-        std::snprintf(k, sizeof k, "%.3f", single.view.oblique().depth_scale);
-        table << "| " << projector.id() << " | " << k << " | " << method << " | "
-              << (m.view.method() == render::RenderMethod::two_pass
-                      ? std::to_string(m.view.render_width()) + "×" + std::to_string(m.view.render_height())
+        std::snprintf(k, sizeof k, "%.3f", single.view().oblique().depth_scale);
+        table << "| " << projector.id << " | " << k << " | " << method << " | "
+              << (m.view().method() == render::RenderMethod::two_pass
+                      ? std::to_string(m.view().render_width()) + "×" + std::to_string(m.view().render_height())
                       : std::string("–"))
               << " | " << bench::cell(bench::spread(times), 2) << " | "
               << (ratio.empty() ? std::string("1") : bench::cell(bench::spread(ratio), 2)) << " | "

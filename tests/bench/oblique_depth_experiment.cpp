@@ -22,8 +22,6 @@ const std::array<glm::vec3, kObjectCount> kColours{glm::vec3(0.0f), glm::vec3(1.
                                                    glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 0.0f, 1.0f),
                                                    glm::vec3(1.0f, 1.0f, 0.0f)};
 
-glm::dvec3 vec3_of(const google::protobuf::RepeatedField<double>& v) { return {v.Get(0), v.Get(1), v.Get(2)}; }
-
 struct Frame {
   glm::dvec3 origin;
   glm::dvec3 right;
@@ -33,12 +31,10 @@ struct Frame {
 };
 
 Frame frame_of(const config::Screen& screen) {
-  Frame f{vec3_of(screen.origin()), glm::normalize(vec3_of(screen.right())), glm::normalize(vec3_of(screen.up())), {}};
-  f.normal = glm::normalize(glm::cross(f.right, f.up));
-  return f;
+  return {screen.origin, screen.right, screen.up, glm::normalize(glm::cross(screen.right, screen.up))};
 }
 
-glm::dvec2 screen_centre(const config::Screen& screen) { return {0.5 * screen.width(), 0.5 * screen.height()}; }
+glm::dvec2 screen_centre(const config::Screen& screen) { return {0.5 * screen.width, 0.5 * screen.height}; }
 
 // The world point the eye sees through wall point `offset` (metres from the
 // wall's centre) at `behind` metres behind the wall.
@@ -276,12 +272,12 @@ int classify(const image::FloatImage& image, int x, int y) {
 
 Installation installation() {
   Installation inst;
-  inst.screen.set_id("wall");
-  for (double v : {-1.0, 0.9, 0.0}) inst.screen.add_origin(v);
-  for (double v : {1.0, 0.0, 0.0}) inst.screen.add_right(v);
-  for (double v : {0.0, 1.0, 0.0}) inst.screen.add_up(v);
-  inst.screen.set_width(2.0);
-  inst.screen.set_height(1.2);
+  inst.screen.id = "wall";
+  inst.screen.origin = {-1.0, 0.9, 0.0};
+  inst.screen.right = {1.0, 0.0, 0.0};
+  inst.screen.up = {0.0, 1.0, 0.0};
+  inst.screen.width = 2.0;
+  inst.screen.height = 1.2;
   inst.eye = {0.0, 1.5, 2.0};
   return inst;
 }

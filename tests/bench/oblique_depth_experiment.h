@@ -16,8 +16,8 @@
 #include <glm/mat3x3.hpp>
 #include <glm/vec3.hpp>
 
+#include "config/installation.h"
 #include "geometry/projector_geometry.h"
-#include "optique/config.pb.h"
 #include "render/projector_view.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"

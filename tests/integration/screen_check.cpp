@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "config/load.h"
+#include "config/to_schema.h"
 #include "image/compare.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
@@ -47,11 +48,9 @@ ScreenMatch compare_with_reference(const ScreenCheck& check, std::uint64_t frame
   EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
   if (!loaded) return {};
   double black = 0.0;
-  for (const auto& p : loaded.value().installation.projectors()) {
-    if (p.screen() != check.screen) continue;
-    auto model = optics::ProjectorModel::from_config(p);
-    EXPECT_TRUE(model) << (model ? "" : model.error());
-    if (model) black += model.value().black();
+  const config::Installation& installation = loaded.value().installation;
+  for (const config::Projector& p : installation.projectors) {
+    if (installation.screen_of(p).id == check.screen) black += optics::ProjectorModel(p.response).black();
   }
   image::FloatImage composite = read(image::frame_path(check.out_dir + "/screens/" + check.screen, frame, "exr"));
   const image::FloatImage expected =
@@ -81,11 +80,13 @@ ScreenMatch compare_with_reference(const ScreenCheck& check, std::uint64_t frame
   return match;
 }
 
-std::string write_config_variant(const std::string& config, const std::function<void(config::Installation&)>& change,
+std::string write_config_variant(const std::string& config, const std::function<void(schema::Installation&)>& change,
                                  const std::string& path) {
   auto loaded = config::load_installation(config);
   EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
-  config::Installation installation = loaded ? loaded.value().installation : config::Installation{};
+  // Written out resolved (config/to_schema.h): the copy need not sit beside the
+  // original's calibration files.
+  schema::Installation installation = loaded ? config::to_schema(loaded.value().installation) : schema::Installation{};
   change(installation);
   google::protobuf::util::JsonPrintOptions print;
   print.preserve_proto_field_names = true;

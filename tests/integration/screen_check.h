@@ -35,7 +35,7 @@ struct ScreenCheck {
 
 // Loads `config`, changes it, and writes it to `path` as JSON; returns `path`.
 [[nodiscard]] std::string write_config_variant(const std::string& config,
-                                               const std::function<void(config::Installation&)>& change,
+                                               const std::function<void(schema::Installation&)>& change,
                                                const std::string& path);
 
 }  // namespace optique::testing

@@ -29,7 +29,7 @@ std::vector<std::string> projector_ids(const std::string& config) {
   EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error());
   std::vector<std::string> ids;
   if (loaded.ok()) {
-    for (const auto& p : loaded.value().installation.projectors()) ids.push_back(p.id());
+    for (const auto& p : loaded.value().installation.projectors) ids.push_back(p.id);
   }
   return ids;
 }

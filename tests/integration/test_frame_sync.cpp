@@ -47,14 +47,14 @@ NullNodes start_null_nodes(const ExternalMaster& master, const std::string& conf
   auto loaded = config::load_installation(config);
   EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
   if (!loaded) return nodes;
-  for (const auto& p : loaded.value().installation.projectors()) {
+  for (const auto& p : loaded.value().installation.projectors) {
     std::vector<std::string> arguments{"--renderer", "null"};
     if (extra) {
       const std::vector<std::string> more = extra(nodes.ids.size());
       arguments.insert(arguments.end(), more.begin(), more.end());
     }
-    nodes.ids.push_back(p.id());
-    nodes.processes.push_back(master.node(p.id(), arguments));
+    nodes.ids.push_back(p.id);
+    nodes.processes.push_back(master.node(p.id, arguments));
   }
   return nodes;
 }
@@ -113,11 +113,11 @@ TEST(FrameSync, EightNodesPresentTogetherAt60HzFor10Seconds) {
   const std::string dir = make_temp_dir("optique-eight");
   const std::string config = write_config_variant(
       kConfigs + "/powerwall-2x2.json",
-      [](config::Installation& installation) {
+      [](schema::Installation& installation) {
         auto& projectors = *installation.mutable_projectors();
         const int four = projectors.size();
         for (int i = 0; i < four; ++i) {
-          config::Projector copy = projectors.Get(i);
+          schema::Projector copy = projectors.Get(i);
           copy.set_id(copy.id() + "-stacked");
           *projectors.Add() = copy;
         }
@@ -175,7 +175,7 @@ TEST(FrameSync, AStragglerIsWaitedForThenItsFrameIsDroppedEverywhere) {
   const std::string dir = make_temp_dir("optique-straggler");
   const std::string config = write_config_variant(
       kConfigs + "/powerwall-2x2.json",
-      [](config::Installation& installation) {
+      [](schema::Installation& installation) {
         installation.mutable_master()->set_straggler_policy("drop");
         installation.mutable_master()->set_frame_rate(30.0);
       },
@@ -235,11 +235,11 @@ TEST(FrameSync, NodesShowBlackWhileTheMasterIsGoneAndARestartedMasterTakesThemBa
   std::vector<std::unique_ptr<Process>> nodes;
   auto loaded = config::load_installation(config);
   ASSERT_TRUE(loaded) << loaded.error();
-  for (const auto& p : loaded.value().installation.projectors()) {
+  for (const auto& p : loaded.value().installation.projectors) {
     nodes.push_back(
-        std::make_unique<Process>(std::vector<std::string>{node_binary(), "--master", "127.0.0.1:" + port, "--id",
-                                                           p.id(), "--renderer", "null", "--give-up-after-ms", "20000"},
-                                  dir + "/node-" + p.id() + ".log"));
+        std::make_unique<Process>(std::vector<std::string>{node_binary(), "--master", "127.0.0.1:" + port, "--id", p.id,
+                                                           "--renderer", "null", "--give-up-after-ms", "20000"},
+                                  dir + "/node-" + p.id + ".log"));
   }
   ASSERT_TRUE(first->wait_for_output("starting frames", 20s)) << first->output();
   std::this_thread::sleep_for(1s);
@@ -254,8 +254,8 @@ TEST(FrameSync, NodesShowBlackWhileTheMasterIsGoneAndARestartedMasterTakesThemBa
   ASSERT_EQ(second->wait(60s).value_or(-1), 0) << second->output();
   const ClusterRun run = read_cluster_run(dir + "/second");
   ASSERT_TRUE(run.error.empty()) << run.error;
-  for (const auto& p : loaded.value().installation.projectors()) {
-    EXPECT_EQ(find_node(run.report, p.id())->frames_presented(), 120u) << p.id();
+  for (const auto& p : loaded.value().installation.projectors) {
+    EXPECT_EQ(find_node(run.report, p.id)->frames_presented(), 120u) << p.id;
   }
   EXPECT_EQ(run.report.sync().frames_incoherent(), 0u);
   for (const auto& node : nodes) EXPECT_EQ(node->wait(10s).value_or(-1), 0) << node->output();
@@ -333,7 +333,7 @@ TEST(FrameSync, AHundredConnectionResetsAllResync) {
   ASSERT_TRUE(loaded) << loaded.error();
   std::vector<std::unique_ptr<Process>> nodes;
   std::vector<std::string> ids;
-  for (const auto& p : loaded.value().installation.projectors()) ids.push_back(p.id());
+  for (const auto& p : loaded.value().installation.projectors) ids.push_back(p.id);
   const std::string through_proxy = ids.front();
   for (const auto& id : ids) {
     if (id == through_proxy) {

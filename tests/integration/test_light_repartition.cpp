@@ -15,8 +15,8 @@
 #include <set>
 #include <sstream>
 
+#include "config/light_list.h"
 #include "image/frame_files.h"
-#include "master/light_share.h"
 #include "process.h"
 #include "screen_check.h"
 
@@ -59,7 +59,7 @@ ShareLog parse_share_log(const std::string& log) {
     if (line.find("node '" + kKilled + "' left") != std::string::npos) left = true;
     std::smatch m;
     if (!std::regex_search(line, m, share_line)) continue;
-    auto lights = master::parse_light_list(m[2].str(), 20);
+    auto lights = config::parse_light_list(m[2].str());
     EXPECT_TRUE(lights) << line;
     LoggedShare share{std::stoull(m[4].str()), {}, m[3].matched};
     if (lights) share.lights.insert(lights.value().begin(), lights.value().end());
@@ -104,7 +104,7 @@ TEST(LightRepartition, LightsSwitchedAndANodeKilledAreSharedOutAnewAndTheScreenS
   const std::string dir = make_temp_dir("optique-repartition");
   const std::string config = write_config_variant(
       kConfig,
-      [](config::Installation& installation) {
+      [](schema::Installation& installation) {
         installation.mutable_master()->set_frame_rate(5.0);
         installation.mutable_master()->set_frame_timeout_ms(5000);  // captures on a shared software rasterizer
         auto& switches = *installation.mutable_scene()->mutable_light_switches();
@@ -172,7 +172,7 @@ TEST(LightRepartition, LightsSwitchedAndANodeKilledAreSharedOutAnewAndTheScreenS
   // The two survivors alone, before the kill (the killed node's lights missing) and after:
   const std::string two_config = write_config_variant(
       config,
-      [](config::Installation& installation) {
+      [](schema::Installation& installation) {
         auto& projectors = *installation.mutable_projectors();
         for (int i = 0; i < projectors.size(); ++i) {
           if (projectors.Get(i).id() == kKilled) projectors.DeleteSubrange(i, 1);

@@ -11,8 +11,8 @@
 #include <filesystem>
 #include <fstream>
 
-#include "config/geometry.h"
 #include "config/load.h"
+#include "config/to_schema.h"
 #include "image/compare.h"
 #include "image/edges.h"
 #include "image/frame_files.h"
@@ -42,17 +42,17 @@ struct WallResult {
 
 WallResult measure(const config::Installation& installation, const image::FloatImage& composite,
                    const image::FloatImage& reference) {
-  const auto& screen = installation.screens(0);
-  const double ppm = screen.pixels_per_metre();
+  const config::Screen& screen = installation.screens[0];
+  const double ppm = screen.pixels_per_metre;
   std::vector<geometry::ProjectorGeometry> geometries;
-  for (const auto& p : installation.projectors()) geometries.push_back(config::projector_geometry(p).value());
+  for (const config::Projector& p : installation.projectors) geometries.push_back(p.geometry());
   // Projectors lighting each output pixel's centre.
   const int w = composite.width;
   const int h = composite.height;
   std::vector<int> coverage(static_cast<std::size_t>(w) * h, 0);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const glm::dvec2 s((x + 0.5) / ppm, screen.height() - (y + 0.5) / ppm);
+      const glm::dvec2 s((x + 0.5) / ppm, screen.height - (y + 0.5) / ppm);
       for (const auto& g : geometries) {
         const glm::dvec2 p = g.to_pixel(s);
         if (p.x >= 0 && p.y >= 0 && p.x <= g.width() && p.y <= g.height())
@@ -109,11 +109,12 @@ TEST(ObliqueWall, ComposedScreenMatchesTheReferenceWithoutSeams) {
   // share two cores here.
   auto loaded = config::load_installation(kConfig);
   ASSERT_TRUE(loaded.ok()) << loaded.error();
-  config::Installation installation = loaded.value().installation;
-  installation.mutable_master()->set_frame_timeout_ms(20000);
+  const config::Installation& installation = loaded.value().installation;
+  schema::Installation patient = config::to_schema(installation);
+  patient.mutable_master()->set_frame_timeout_ms(20000);
   const std::string dir = make_temp_dir("optique-wall");
   std::string json;
-  ASSERT_TRUE(google::protobuf::util::MessageToJsonString(installation, &json).ok());
+  ASSERT_TRUE(google::protobuf::util::MessageToJsonString(patient, &json).ok());
   const std::string config_path = dir + "/wall.json";
   std::ofstream(config_path) << json;
 
@@ -155,9 +156,8 @@ TEST(ObliqueWall, ComposedScreenMatchesTheReferenceWithoutSeams) {
   // The same captures composed as if the centre projector hung 3 px off where
   // its calibration says: the checks must see it.
   config::LoadedConfig wrong = loaded.value();
-  auto& centre = *wrong.installation.mutable_projectors(1);
-  ASSERT_EQ(centre.homography_size(), 9);
-  for (int c = 0; c < 3; ++c) centre.set_homography(c, centre.homography(c) + 3.0 * centre.homography(6 + c));
+  glm::dmat3& centre = wrong.installation.projectors[1].homography;  // [column][row]
+  for (int c = 0; c < 3; ++c) centre[c][0] += 3.0 * centre[c][2];
   auto logger = log::make_logger("test", "warn");
   auto composed = tools::compose_frame(wrong, 0, out + "/nodes", dir + "/wrong", *logger);
   ASSERT_TRUE(composed.ok()) << composed.error();

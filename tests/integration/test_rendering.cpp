@@ -11,6 +11,7 @@
 
 #include "cluster_run.h"
 #include "config/load.h"
+#include "config/to_schema.h"
 #include "image/compare.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
@@ -44,10 +45,10 @@ image::FloatImage capture(const std::string& out, const std::string& projector, 
 }
 
 // A shipped config with another scene and a fixed eye, written to a temp file.
-std::string variant(const std::string& shipped, const std::function<void(config::Installation&)>& change) {
+std::string variant(const std::string& shipped, const std::function<void(schema::Installation&)>& change) {
   auto loaded = config::load_installation(kConfigs + "/" + shipped);
   EXPECT_TRUE(loaded.ok());
-  config::Installation installation = loaded.value().installation;
+  schema::Installation installation = config::to_schema(loaded.value().installation);
   change(installation);
   std::string json;
   EXPECT_TRUE(google::protobuf::util::MessageToJsonString(installation, &json).ok());
@@ -112,7 +113,7 @@ TEST(Rendering, TheFourTilesOfThePowerWallEqualTheSingleWall) {
 }
 
 TEST(Rendering, GeometryCrossingACaveCornerLinesUpOnBothWalls) {
-  const std::string config = variant("cave-4wall.json", [](config::Installation& inst) {
+  const std::string config = variant("cave-4wall.json", [](schema::Installation& inst) {
     inst.mutable_scene()->set_builtin("corner-probe");
     inst.mutable_viewer()->clear_path();
     for (double v : {0.1, 1.6, 0.2}) inst.mutable_viewer()->add_eye(v);  // off centre: walls see it differently
@@ -157,14 +158,14 @@ double centroid_x(const image::FloatImage& image) {
 }
 
 TEST(Rendering, LeftAndRightEyesDifferByTheParallaxOfTheDepth) {
-  const std::string config = variant("single-wall.json", [](config::Installation& inst) {
+  const std::string config = variant("single-wall.json", [](schema::Installation& inst) {
     inst.mutable_scene()->set_builtin("stereo-probe");  // a square 1 m behind the wall, at eye height
-    config::Projector left = inst.projectors(0);
+    schema::Projector left = inst.projectors(0);
     left.set_width(2560);  // 640 px/m: pixel edges quantize the measurement less
     left.set_height(1440);
     left.set_id("left-eye");
     left.set_eye("left");
-    config::Projector right = left;
+    schema::Projector right = left;
     right.set_id("right-eye");
     right.set_eye("right");
     inst.clear_projectors();
@@ -189,7 +190,7 @@ TEST(Rendering, LeftAndRightEyesDifferByTheParallaxOfTheDepth) {
 
 TEST(Rendering, AWindowOnAProjectorShowsWhatHeadlessRenders) {
   // A window needs a display: a virtual X server stands in for the projector.
-  const std::string windowed = variant("single-wall.json", [](config::Installation& inst) {
+  const std::string windowed = variant("single-wall.json", [](schema::Installation& inst) {
     inst.mutable_projectors(0)->mutable_output()->set_kind("window");
   });
   const std::string dir = make_temp_dir("optique-gl");
@@ -208,12 +209,12 @@ TEST(Rendering, AWindowOnAProjectorShowsWhatHeadlessRenders) {
 const std::string kAnimatedCubes = kConfigs + "/assets/animated-cubes.gltf";
 
 TEST(Rendering, AnAnimatedGltfRendersTheSameOnStackedNodes) {
-  const std::string config = variant("single-wall.json", [](config::Installation& inst) {
+  const std::string config = variant("single-wall.json", [](schema::Installation& inst) {
     inst.mutable_scene()->clear_builtin();
     inst.mutable_scene()->set_gltf(kAnimatedCubes);
-    config::Projector a = inst.projectors(0);
+    schema::Projector a = inst.projectors(0);
     a.set_id("stack-a");
-    config::Projector b = a;
+    schema::Projector b = a;
     b.set_id("stack-b");
     inst.clear_projectors();
     *inst.add_projectors() = a;
@@ -232,7 +233,7 @@ TEST(Rendering, AnAnimatedGltfRendersTheSameOnStackedNodes) {
 }
 
 std::string with_gltf(const std::string& gltf) {
-  return variant("single-wall.json", [&gltf](config::Installation& inst) {
+  return variant("single-wall.json", [&gltf](schema::Installation& inst) {
     inst.mutable_scene()->clear_builtin();
     inst.mutable_scene()->set_gltf(gltf);
   });

@@ -64,14 +64,14 @@ StackedRun run_cluster(const std::string& lagging_node) {
   std::vector<std::unique_ptr<Process>> nodes;
   auto loaded = config::load_installation(config);
   EXPECT_TRUE(loaded);
-  for (const auto& p : loaded.value().installation.projectors()) {
-    std::vector<std::string> argv{kNode,  "--master",      "127.0.0.1:" + port,         "--id",
-                                  p.id(), "--capture-dir", run.out + "/nodes/" + p.id()};
-    if (p.id() == lagging_node) {
+  for (const auto& p : loaded.value().installation.projectors) {
+    std::vector<std::string> argv{kNode, "--master",      "127.0.0.1:" + port,       "--id",
+                                  p.id,  "--capture-dir", run.out + "/nodes/" + p.id};
+    if (p.id == lagging_node) {
       argv.push_back("--lag-frames");
       argv.push_back("1");
     }
-    nodes.push_back(std::make_unique<Process>(argv, dir + "/node-" + p.id() + ".log"));
+    nodes.push_back(std::make_unique<Process>(argv, dir + "/node-" + p.id + ".log"));
   }
   EXPECT_EQ(master.wait(120s).value_or(-1), 0) << master.output();
   for (auto& node : nodes) EXPECT_EQ(node->wait(30s).value_or(-1), 0) << node->output();

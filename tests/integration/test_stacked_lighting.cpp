@@ -9,14 +9,13 @@
 #include <cmath>
 #include <set>
 
-#include "config/geometry.h"
+#include "config/job.h"
 #include "config/load.h"
 #include "image/texture_decode.h"
 #include "master/stacked_groups.h"
 #include "optics/projector_model.h"
 #include "render/gl_context.h"
-#include "render/projector_view.h"
-#include "render/scene_renderer.h"
+#include "render/projector_pipeline.h"
 #include "scene/load_scene.h"
 
 namespace optique {
@@ -38,40 +37,29 @@ class StackedLighting : public ::testing::Test {
     auto loaded = config::load_installation(kConfig);
     ASSERT_TRUE(loaded) << loaded.error();
     config_ = std::move(loaded).value();
-    auto scene = scene::load_scene(config_.installation.scene(), config_.directory, image::decode_texture);
+    auto scene =
+        scene::load_scene(config_.installation.scene.builtin, config_.installation.scene.gltf, image::decode_texture);
     ASSERT_TRUE(scene) << scene.error();
     scene_ = std::move(scene).value().definition;
     for (const auto& object : scene_.objects) {
       state_.objects[object.id] = {object.pose_at(1.0), object.pose_at(1.0)};
     }
-    const auto& eye = config_.installation.viewer().eye();
-    state_.eye_now = state_.eye_next = glm::dvec3(eye[0], eye[1], eye[2]);
+    state_.eye_now = state_.eye_next = config_.installation.viewer.eye_at(0.0);
   }
 
-  // Draws `projector` with `lights` (all: the full render) through its model.
-  Drawn draw(const config::Projector& projector, const master::LightShare* share) {
-    const config::Screen& screen = config_.installation.screens(0);
-    auto geometry = config::projector_geometry(projector);
-    EXPECT_TRUE(geometry);
-    auto view = render::ProjectorView::make(screen, geometry.value(), render::RenderMethod::single_pass);
-    EXPECT_TRUE(view);
-    auto renderer = render::SceneRenderer::create(scene_, view.value().render_width(), view.value().render_height());
-    EXPECT_TRUE(renderer);
-    render::OutputStage stage = view.value().output_stage({});
-    auto model = optics::ProjectorModel::from_config(projector);
-    EXPECT_TRUE(model);
-    stage.projector = model.value();
-    EXPECT_TRUE(renderer.value()->set_output(stage));
-    render::LightTerms terms;
-    if (share != nullptr) {
-      renderer.value()->set_lights(share->lights);
-      terms = {share->ambient, share->ambient};
-    }
-    const auto& viewer = config_.installation.viewer();
-    auto frustum = view.value().frustum(state_.eye_now, viewer.near(), viewer.far());
-    EXPECT_TRUE(frustum);
-    renderer.value()->draw(state_, 0.0, state_.eye_now, frustum.value(), terms);
-    return {renderer.value()->read_rendered(), renderer.value()->read_linear()};
+  // Projector i's job, as its node gets it.
+  config::ProjectorJob job(std::size_t i) const { return config::job_for(config_.installation, i); }
+
+  // Draws the job's projector with its share of the lights (none: all of them,
+  // the full render), through its pipeline as a node would.
+  Drawn draw(const config::ProjectorJob& job, const master::LightShare* share) {
+    auto pipeline = render::ProjectorPipeline::make(job, scene_);
+    EXPECT_TRUE(pipeline) << (pipeline ? "" : pipeline.error());
+    if (!pipeline) return {};
+    if (share != nullptr) pipeline.value()->set_share(*share);
+    const auto drawn = pipeline.value()->draw(state_);
+    EXPECT_TRUE(drawn) << (drawn ? "" : drawn.error());
+    return {pipeline.value()->renderer().read_rendered(), pipeline.value()->renderer().read_linear()};
   }
 
   std::unique_ptr<render::GlContext> context_;
@@ -84,22 +72,22 @@ TEST_F(StackedLighting, TheOpticalSumIsTheFullRender) {
   const auto& installation = config_.installation;
   const auto shares = master::listed_shares(installation, scene_.lights.size());
   ASSERT_EQ(shares.size(), 3u);
-  config::Projector single = installation.projectors(0);
-  single.clear_response();
-  single.set_black_level(0.0);
-  single.set_brightness(1.0);
+  // One plain projector (sRGB, no black, brightness 1) drawing every light.
+  config::ProjectorJob single = job(0);
+  single.installation.projectors[single.projector].response = {};
+  single.installation.projectors[single.projector].content = {};
   const Drawn full = draw(single, nullptr);
 
   image::FloatImage sum(full.rendered.width, full.rendered.height, 4);
   image::FloatImage emitted_sum(full.rendered.width, full.rendered.height, 4);
   double black = 0.0;
   for (int i = 0; i < 3; ++i) {
-    const Drawn share = draw(installation.projectors(i), &shares.at(static_cast<std::size_t>(i)));
+    const Drawn share = draw(job(static_cast<std::size_t>(i)), &shares.at(static_cast<std::size_t>(i)));
     for (std::size_t k = 0; k < sum.pixels.size(); ++k) {
       sum.pixels[k] += share.rendered.pixels[k];
       emitted_sum.pixels[k] += share.emitted.pixels[k];
     }
-    black += optics::ProjectorModel::from_config(installation.projectors(i)).value().black();
+    black += optics::ProjectorModel(installation.projectors[static_cast<std::size_t>(i)].response).black();
   }
   // Before quantization: the sum of the shares is the full render.
   double worst = 0.0;
@@ -130,13 +118,16 @@ TEST_F(StackedLighting, TheOpticalSumIsTheFullRender) {
 TEST_F(StackedLighting, ThreeProjectorsShowMoreLevelsThanOne) {
   const auto& installation = config_.installation;
   const auto shares = master::listed_shares(installation, scene_.lights.size());
-  config::Projector plain = installation.projectors(0);
-  plain.clear_response();
-  plain.set_black_level(0.0);
+  // One 8-bit sRGB projector without black, as bright as the first.
+  config::ProjectorJob plain = job(0);
+  config::Projector& one_projector = plain.installation.projectors[plain.projector];
+  const double brightness = one_projector.response.brightness;
+  one_projector.response = {};
+  one_projector.response.brightness = brightness;
+  one_projector.content = {};
   const Drawn one = draw(plain, nullptr);
   std::vector<Drawn> three;
-  for (int i = 0; i < 3; ++i)
-    three.push_back(draw(installation.projectors(i), &shares.at(static_cast<std::size_t>(i))));
+  for (std::size_t i = 0; i < 3; ++i) three.push_back(draw(job(i), &shares.at(i)));
 
   // A row of the wall above the statue, across the whole image: green channel.
   const int y = one.emitted.height / 10;

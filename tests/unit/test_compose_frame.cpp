@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "config/geometry.h"
+#include "config/parse.h"
 #include "image/convert.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
@@ -30,17 +30,16 @@ std::string make_temp_dir() {
   return pattern;
 }
 
-void add_homography(config::Projector& p, const glm::dmat3& h) {
+void add_homography(schema::Projector& p, const glm::dmat3& h) {
   for (double v : geometry::homography_rows(h)) p.add_homography(v);
 }
 
 // A 3 m × 1 m wall lit by two keystoned mono projectors (160 × 100 px), and a
 // 2 m × 1 m floor lit by a stereo pair of aligned projectors (100 × 50 px).
 config::LoadedConfig installation() {
-  config::LoadedConfig loaded;
-  config::Installation& inst = loaded.installation;
+  schema::Installation inst;
   auto add_screen = [&](const std::string& id, double width, double height, double ppm) {
-    config::Screen& s = *inst.add_screens();
+    schema::Screen& s = *inst.add_screens();
     s.set_id(id);
     for (double v : {0.0, 0.0, 0.0}) s.add_origin(v);
     for (double v : {1.0, 0.0, 0.0}) s.add_right(v);
@@ -53,7 +52,7 @@ config::LoadedConfig installation() {
   add_screen("floor", 2.0, 1.0, 50.0);
   const auto quads = testing::keystoned_quads();
   for (int i = 0; i < 2; ++i) {
-    config::Projector& p = *inst.add_projectors();
+    schema::Projector& p = *inst.add_projectors();
     p.set_id("wall-" + std::to_string(i));
     p.set_width(160);
     p.set_height(100);
@@ -61,7 +60,7 @@ config::LoadedConfig installation() {
     add_homography(p, testing::homography_onto(quads[static_cast<std::size_t>(i)], 160, 100));
   }
   for (const char* eye : {"left", "right"}) {
-    config::Projector& p = *inst.add_projectors();
+    schema::Projector& p = *inst.add_projectors();
     p.set_id(std::string("floor-") + eye);
     p.set_width(100);
     p.set_height(50);
@@ -70,25 +69,26 @@ config::LoadedConfig installation() {
   }
   for (double v : {1.5, 0.5, 2.0}) inst.mutable_viewer()->add_eye(v);
   inst.mutable_scene()->set_builtin("cubes");
-  config::apply_defaults(inst);
-  const auto problems = config::resolve_geometry(inst, ".");
-  EXPECT_TRUE(problems.empty()) << problems.front().path << ": " << problems.front().message;
+  auto parsed = config::parse_installation(inst, ".", "compose-test");
+  EXPECT_TRUE(parsed.ok()) << parsed.error();
+  config::LoadedConfig loaded;
+  if (parsed.ok()) loaded.installation = std::move(parsed).value();
   return loaded;
 }
 
 // What the nodes would capture: `level` × the projector's blend weight.
 void write_captures(const config::LoadedConfig& loaded, const std::string& captures) {
-  const auto& inst = loaded.installation;
+  const config::Installation& inst = loaded.installation;
   std::vector<geometry::ProjectorGeometry> wall;
-  for (int i = 0; i < 2; ++i) wall.push_back(config::projector_geometry(inst.projectors(i)).value());
-  for (int i = 0; i < inst.projectors_size(); ++i) {
-    const config::Projector& p = inst.projectors(i);
+  for (std::size_t i = 0; i < 2; ++i) wall.push_back(inst.projectors[i].geometry());
+  for (std::size_t i = 0; i < inst.projectors.size(); ++i) {
+    const config::Projector& p = inst.projectors[i];
     image::FloatImage weights;
     if (i < 2) {
-      weights = optics::blend_weights(wall, static_cast<std::size_t>(i), config::usable_area(inst.screens(0)), 0.0);
+      weights = optics::blend_weights(wall, i, inst.screens[0].area(), 0.0);
     } else {
-      weights = image::FloatImage(static_cast<int>(p.width()), static_cast<int>(p.height()), 1);
-      std::fill(weights.pixels.begin(), weights.pixels.end(), p.eye() == "left" ? 0.25f : 0.75f);
+      weights = image::FloatImage(p.width, p.height, 1);
+      std::fill(weights.pixels.begin(), weights.pixels.end(), p.eye == config::Eye::left ? 0.25f : 0.75f);
     }
     image::FloatImage linear(weights.width, weights.height, 4);
     for (int y = 0; y < linear.height; ++y) {
@@ -97,7 +97,7 @@ void write_captures(const config::LoadedConfig& loaded, const std::string& captu
         linear.at(x, y, 3) = 1.0f;
       }
     }
-    ASSERT_TRUE(image::write_frame(captures + "/" + p.id(), kFrame, linear, image::encode_srgb(linear)).ok());
+    ASSERT_TRUE(image::write_frame(captures + "/" + p.id, kFrame, linear, image::encode_srgb(linear)).ok());
   }
 }
 
@@ -199,9 +199,9 @@ TEST(ComposeFrame, UnreadableCaptureIsNamed) {
 }
 
 TEST(CompositeFolder, NamesEyes) {
-  EXPECT_EQ(composite_folder("front", "mono"), "front");
-  EXPECT_EQ(composite_folder("front", "left"), "front.left");
-  EXPECT_EQ(composite_folder("front", "right"), "front.right");
+  EXPECT_EQ(composite_folder("front", config::Eye::mono), "front");
+  EXPECT_EQ(composite_folder("front", config::Eye::left), "front.left");
+  EXPECT_EQ(composite_folder("front", config::Eye::right), "front.right");
 }
 
 }  // namespace

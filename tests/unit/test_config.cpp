@@ -1,4 +1,4 @@
-// Installation files: common/config/load.h and common/config/validate.h.
+// Installation files: common/config/load.h, parse.h, validate.h and to_schema.h.
 
 #include <gtest/gtest.h>
 
@@ -11,8 +11,9 @@
 #include <string>
 #include <vector>
 
-#include "config/geometry.h"
 #include "config/load.h"
+#include "config/parse.h"
+#include "config/to_schema.h"
 #include "config/validate.h"
 #include "geometry/homography.h"
 
@@ -95,20 +96,24 @@ TEST(ShippedConfigs, EveryConfigLoadsAndHasAProjector) {
     auto loaded = load_installation(entry.path().string());
     ASSERT_TRUE(loaded.ok()) << loaded.error();
     const LoadedConfig& c = loaded.value();
-    EXPECT_GE(c.installation.projectors_size(), 1);
-    EXPECT_GE(c.installation.screens_size(), 1);
+    EXPECT_GE(c.installation.projectors.size(), 1u);
+    EXPECT_GE(c.installation.screens.size(), 1u);
     EXPECT_EQ(c.path, entry.path().string());
     EXPECT_EQ(fs::path(c.directory), dir);
     ASSERT_EQ(c.sha256.size(), 64u);
     EXPECT_EQ(c.sha256.find_first_not_of("0123456789abcdef"), std::string::npos) << c.sha256;
     // Defaults were applied.
-    EXPECT_GT(c.installation.master().frame_rate(), 0.0);
+    EXPECT_GT(c.installation.master.frame_rate, 0.0);
     // Every projector's geometry is resolved, and it lights its screen.
-    for (const auto& p : c.installation.projectors()) {
-      EXPECT_TRUE(p.has_region() || p.homography_size() == 9) << p.id();
-      auto geometry = projector_geometry(p);
-      EXPECT_TRUE(geometry.ok()) << p.id() << ": " << (geometry.ok() ? "" : geometry.error());
+    for (const Projector& p : c.installation.projectors) {
+      auto geometry = geometry::ProjectorGeometry::make(p.homography, p.width, p.height);
+      ASSERT_TRUE(geometry.ok()) << p.id << ": " << geometry.error();
+      EXPECT_TRUE(geometry::oblique_projection(geometry.value(), c.installation.screen_of(p).area()).ok()) << p.id;
     }
+    // Written back as a schema, it parses to the same installation.
+    const auto again = parse_installation(to_schema(c.installation), c.directory, "again");
+    ASSERT_TRUE(again.ok()) << again.error();
+    EXPECT_EQ(to_schema(again.value()).SerializeAsString(), to_schema(c.installation).SerializeAsString());
   }
   EXPECT_GE(count, 1u) << "no *.json in " << dir;
 }
@@ -156,9 +161,9 @@ TEST(LoadInstallation, HashIsOfTheFileBytes) {
 TEST(ParseInstallation, ValidBaseParses) {
   auto parsed = parse(kValid);
   ASSERT_TRUE(parsed.ok()) << parsed.error();
-  EXPECT_EQ(parsed.value().name(), "unit test");
-  EXPECT_EQ(parsed.value().projectors_size(), 2);
-  EXPECT_TRUE(validate(parsed.value(), test_dir()).empty());
+  EXPECT_EQ(parsed.value().name, "unit test");
+  EXPECT_EQ(parsed.value().projectors.size(), 2u);
+  EXPECT_TRUE(validate(to_schema(parsed.value()), test_dir()).empty());
 }
 
 // --- one test per kind of problem ------------------------------------------------
@@ -223,11 +228,11 @@ TEST(ParseInstallation, RegionPastTheTop) {
 }
 
 TEST(Validate, ShrunkScreenAfterDefaultsCatchesTheDefaultedRegion) {
-  // apply_defaults gave p-front the whole 4 m x 2 m screen; shrinking the screen
-  // afterwards leaves that region hanging over the top.
+  // The defaults gave p-front the whole 4 m x 2 m screen, and to_schema writes it
+  // out; shrinking the screen afterwards leaves that region hanging over the top.
   auto parsed = parse(kValid);
   ASSERT_TRUE(parsed.ok()) << parsed.error();
-  Installation inst = parsed.value();
+  schema::Installation inst = to_schema(parsed.value());
   inst.mutable_screens(0)->set_height(1.0);
   const auto problems = validate(inst, test_dir());
   ASSERT_EQ(problems.size(), 1u);
@@ -324,7 +329,7 @@ TEST(ParseInstallation, FrameRateNegative) {
 TEST(ParseInstallation, FrameRateAtTheLimitIsFine) {
   auto parsed = parse(with(R"("port": 7400)", R"("port": 7400, "frame_rate": 1000)"));
   ASSERT_TRUE(parsed.ok()) << parsed.error();
-  EXPECT_DOUBLE_EQ(parsed.value().master().frame_rate(), 1000.0);
+  EXPECT_DOUBLE_EQ(parsed.value().master.frame_rate, 1000.0);
 }
 
 TEST(ParseInstallation, UnknownOutputKind) {
@@ -366,7 +371,7 @@ TEST(ParseInstallation, SeveralProblemsReportedAtOnce) {
 TEST(Validate, ReturnsEveryProblemWithItsPath) {
   auto parsed = parse(kValid);
   ASSERT_TRUE(parsed.ok()) << parsed.error();
-  Installation inst = parsed.value();
+  schema::Installation inst = to_schema(parsed.value());
   inst.mutable_projectors(1)->set_height(20000);
   inst.mutable_screens(0)->set_pixels_per_metre(-1.0);
   const auto problems = validate(inst, test_dir());
@@ -382,9 +387,9 @@ TEST(Validate, ReturnsEveryProblemWithItsPath) {
 TEST(ParseInstallation, LivenessTimeoutCheckedAgainstDefaultHeartbeat) {
   auto parsed = parse(with(R"("port": 7400)", R"("port": 7400, "liveness_timeout_ms": 400)"));
   if (parsed.ok()) {
-    const MasterSettings& m = parsed.value().master();
-    EXPECT_GT(m.liveness_timeout_ms(), 2 * m.heartbeat_ms())
-        << "accepted liveness_timeout_ms " << m.liveness_timeout_ms() << " with heartbeat_ms " << m.heartbeat_ms();
+    const MasterSettings& m = parsed.value().master;
+    EXPECT_GT(m.liveness_timeout, 2 * m.heartbeat) << "accepted liveness_timeout_ms " << m.liveness_timeout.count()
+                                                   << " with heartbeat_ms " << m.heartbeat.count();
   } else {
     expect_problem(parsed, "master.liveness_timeout_ms", {"twice heartbeat_ms"});
   }
@@ -397,57 +402,73 @@ TEST(ParseInstallation, LivenessTimeoutCheckedAgainstExplicitHeartbeat) {
 
 // --- defaults -----------------------------------------------------------------------
 
-TEST(ApplyDefaults, FillsFrameRateAndWholeScreenRegion) {
+TEST(Defaults, FillFrameRateAndWholeScreenRegion) {
   auto parsed = parse(kValid);
   ASSERT_TRUE(parsed.ok()) << parsed.error();
   const Installation& inst = parsed.value();
-  EXPECT_DOUBLE_EQ(inst.master().frame_rate(), 60.0);
-  EXPECT_EQ(inst.master().listen(), "0.0.0.0");
-  EXPECT_EQ(inst.master().port(), 7400u);  // given values stay
+  EXPECT_DOUBLE_EQ(inst.master.frame_rate, 60.0);
+  EXPECT_EQ(inst.master.listen, "0.0.0.0");
+  EXPECT_EQ(inst.master.port, 7400u);  // given values stay
 
   // p-front gave no region: the whole of "front" (4 m x 2 m).
-  const Projector& front = inst.projectors(0);
-  ASSERT_TRUE(front.has_region());
-  EXPECT_DOUBLE_EQ(front.region().x(), 0.0);
-  EXPECT_DOUBLE_EQ(front.region().y(), 0.0);
-  EXPECT_DOUBLE_EQ(front.region().width(), 4.0);
-  EXPECT_DOUBLE_EQ(front.region().height(), 2.0);
-  EXPECT_EQ(front.eye(), "mono");
-  EXPECT_EQ(front.output().kind(), "headless");
-  EXPECT_EQ(front.host(), "localhost");
+  const Projector& front = inst.projectors[0];
+  EXPECT_EQ(front.geometry_source, GeometrySource::whole_screen);
+  ASSERT_TRUE(front.region);
+  EXPECT_DOUBLE_EQ(front.region->min.x, 0.0);
+  EXPECT_DOUBLE_EQ(front.region->min.y, 0.0);
+  EXPECT_DOUBLE_EQ(front.region->width(), 4.0);
+  EXPECT_DOUBLE_EQ(front.region->height(), 2.0);
+  EXPECT_EQ(front.eye, Eye::mono);
+  EXPECT_EQ(front.output.kind, OutputKind::headless);
+  EXPECT_EQ(front.host, "localhost");
+  EXPECT_EQ(inst.screen_of(front).id, "front");
 
   // p-floor gave one: kept.
-  const Projector& floor = inst.projectors(1);
-  EXPECT_DOUBLE_EQ(floor.region().x(), 1.0);
-  EXPECT_DOUBLE_EQ(floor.region().y(), 0.5);
-  EXPECT_DOUBLE_EQ(floor.region().width(), 2.0);
-  EXPECT_DOUBLE_EQ(floor.region().height(), 1.0);
+  const Projector& floor = inst.projectors[1];
+  EXPECT_EQ(floor.geometry_source, GeometrySource::region);
+  ASSERT_TRUE(floor.region);
+  EXPECT_DOUBLE_EQ(floor.region->min.x, 1.0);
+  EXPECT_DOUBLE_EQ(floor.region->min.y, 0.5);
+  EXPECT_DOUBLE_EQ(floor.region->width(), 2.0);
+  EXPECT_DOUBLE_EQ(floor.region->height(), 1.0);
+  EXPECT_EQ(inst.screen_of(floor).id, "floor");
 }
 
-TEST(ApplyDefaults, KeepsGivenValuesAndFillsTheRest) {
-  Installation inst;
+TEST(Defaults, KeepGivenValuesAndFillTheRest) {
+  schema::Installation inst;
   auto& screen = *inst.add_screens();
   screen.set_id("s");
+  for (double v : {0.0, 0.0, 0.0}) screen.add_origin(v);
+  for (double v : {1.0, 0.0, 0.0}) screen.add_right(v);
+  for (double v : {0.0, 1.0, 0.0}) screen.add_up(v);
   screen.set_width(3.0);
   screen.set_height(1.5);
   auto& p = *inst.add_projectors();
   p.set_id("p");
   p.set_screen("s");
+  p.set_width(300);
+  p.set_height(150);
   p.set_eye("left");
+  for (double v : {0.0, 1.0, 2.0}) inst.mutable_viewer()->add_eye(v);
+  inst.mutable_scene()->set_builtin("cubes");
   inst.mutable_master()->set_frame_rate(30.0);
   inst.mutable_master()->set_heartbeat_ms(2000);
 
-  apply_defaults(inst);
-  EXPECT_DOUBLE_EQ(inst.master().frame_rate(), 30.0);
-  EXPECT_EQ(inst.master().heartbeat_ms(), 2000u);
-  EXPECT_EQ(inst.master().liveness_timeout_ms(), 6000u);  // 3 heartbeats, above the 3000 floor
-  EXPECT_EQ(inst.master().max_message_bytes(), 16u << 20);
-  EXPECT_NEAR(inst.viewer().eye_separation(), 0.065, 1e-12);
-  EXPECT_DOUBLE_EQ(inst.screens(0).pixels_per_metre(), 200.0);
-  EXPECT_EQ(inst.projectors(0).eye(), "left");
-  ASSERT_TRUE(inst.projectors(0).has_region());
-  EXPECT_DOUBLE_EQ(inst.projectors(0).region().width(), 3.0);
-  EXPECT_DOUBLE_EQ(inst.projectors(0).region().height(), 1.5);
+  auto parsed = parse_installation(inst, test_dir(), "built.json");
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  const Installation& out = parsed.value();
+  EXPECT_DOUBLE_EQ(out.master.frame_rate, 30.0);
+  EXPECT_EQ(out.master.heartbeat.count(), 2000);
+  EXPECT_EQ(out.master.liveness_timeout.count(), 6000);  // 3 heartbeats, above the 3000 floor
+  EXPECT_EQ(out.master.max_message_bytes, 16u << 20);
+  EXPECT_EQ(out.master.straggler_policy, StragglerPolicy::present);
+  EXPECT_NEAR(out.viewer.eye_separation, 0.065, 1e-12);
+  EXPECT_DOUBLE_EQ(out.screens[0].pixels_per_metre, 200.0);
+  EXPECT_EQ(out.projectors[0].eye, Eye::left);
+  EXPECT_EQ(out.projectors[0].content.role, ContentRole::full);
+  ASSERT_TRUE(out.projectors[0].region);
+  EXPECT_DOUBLE_EQ(out.projectors[0].region->width(), 3.0);
+  EXPECT_DOUBLE_EQ(out.projectors[0].region->height(), 1.5);
 }
 
 // ------------------------------------------------------------- projector geometry
@@ -475,12 +496,12 @@ glm::dmat3 rows(const std::vector<double>& nine) {
 TEST(ProjectorGeometry, ACameraViewRelatesAPartnerToTheScreen) {
   auto parsed = parse(two_through_a_camera());
   ASSERT_TRUE(parsed.ok()) << parsed.error();
-  const auto& first = parsed.value().projectors(0);
-  const auto& second = parsed.value().projectors(1);
-  ASSERT_EQ(second.id(), "p-front-2");
-  ASSERT_EQ(second.homography_size(), 9);
-  const glm::dmat3 h1 = rows({first.homography().begin(), first.homography().end()});
-  const glm::dmat3 h2 = rows({second.homography().begin(), second.homography().end()});
+  const Projector& first = parsed.value().projectors[0];
+  const Projector& second = parsed.value().projectors[1];
+  ASSERT_EQ(second.id, "p-front-2");
+  EXPECT_EQ(second.geometry_source, GeometrySource::camera);
+  const glm::dmat3 h1 = first.homography;
+  const glm::dmat3 h2 = second.homography;
   const glm::dmat3 a1c = rows({0.9, 0.05, 40, 0.02, 1.1, 30, 0.0001, 0.0002, 1});
   const glm::dmat3 a2c = rows({1.2, -0.03, -500, 0.01, 1.0, 20, 0.0002, -0.0001, 1});
   // A screen point seen by the camera through either projector is the same
@@ -536,11 +557,11 @@ TEST(ProjectorGeometry, ACalibrationFileIsReadIntoTheHomography) {
   std::ofstream(file) << R"({"homography": [[160, 0, 0], [0, -160, 320], [0, 0, 1]], "rms_px": 0.1})";
   auto parsed = parse(with(R"("screen": "front"})", R"("screen": "front", "calibration": "front.calibration.json"})"));
   ASSERT_TRUE(parsed.ok()) << parsed.error();
-  const auto& p = parsed.value().projectors(0);
-  EXPECT_TRUE(p.calibration().empty());  // the installation now carries the matrix itself
-  ASSERT_EQ(p.homography_size(), 9);
-  EXPECT_DOUBLE_EQ(p.homography(0), 160.0);
-  EXPECT_DOUBLE_EQ(p.homography(5), 320.0);
+  const Projector& p = parsed.value().projectors[0];
+  EXPECT_EQ(p.geometry_source, GeometrySource::calibration);
+  const auto nine = geometry::homography_rows(p.homography);
+  EXPECT_DOUBLE_EQ(nine[0], 160.0);
+  EXPECT_DOUBLE_EQ(nine[5], 320.0);
 
   std::ofstream(file) << R"({"homography": [[160, 0], [0, -160, 320], [0, 0, 1]]})";
   auto broken = parse(with(R"("screen": "front"})", R"("screen": "front", "calibration": "front.calibration.json"})"));

@@ -1,7 +1,6 @@
 // The automatic light split (master/light_share.h) and the coverage estimate it
 // runs on (common/scene/light_coverage.h): every light in exactly one share, the
-// ambient in exactly one, modelled times balanced; the role-"lights" list syntax
-// and each of its error messages.
+// ambient in exactly one, modelled times balanced.
 
 #include <gtest/gtest.h>
 
@@ -194,87 +193,6 @@ TEST(ShareLights, IsDeterministic) {
   EXPECT_EQ(dealt[2].lights, (std::vector<std::uint32_t>{2, 5}));
 }
 
-// --- the role-"lights" list ---
-
-std::vector<std::uint32_t> parsed(std::string_view text, std::size_t light_count) {
-  auto result = parse_light_list(text, light_count);
-  EXPECT_TRUE(result.ok()) << text << ": " << result.error();
-  return result.ok() ? std::move(result).value() : std::vector<std::uint32_t>{};
-}
-
-std::string parse_error(std::string_view text, std::size_t light_count) {
-  const auto result = parse_light_list(text, light_count);
-  EXPECT_FALSE(result.ok()) << text;
-  return result.ok() ? std::string{} : result.error();
-}
-
-TEST(LightList, ParsesIndicesAndRanges) {
-  EXPECT_EQ(parsed("0-6", 20), range(0, 7));
-  EXPECT_EQ(parsed("0, 3, 7-9", 20), (std::vector<std::uint32_t>{0, 3, 7, 8, 9}));
-  EXPECT_EQ(parsed(" 9 ,\t2 - 4 ,0", 20), (std::vector<std::uint32_t>{0, 2, 3, 4, 9}));
-  EXPECT_EQ(parsed("19", 20), (std::vector<std::uint32_t>{19}));
-  EXPECT_EQ(parsed("5-5", 20), (std::vector<std::uint32_t>{5}));
-  EXPECT_EQ(parsed("", 20), std::vector<std::uint32_t>{});
-  EXPECT_EQ(parsed("  ", 0), std::vector<std::uint32_t>{});
-}
-
-TEST(LightList, FormatsRunsAsRanges) {
-  const std::vector<std::uint32_t> lights{0, 1, 2, 3, 4, 5, 6, 9};
-  EXPECT_EQ(format_light_list(lights), "0-6, 9");
-  EXPECT_EQ(format_light_list(std::vector<std::uint32_t>{}), "");
-  EXPECT_EQ(format_light_list(std::vector<std::uint32_t>{3}), "3");
-  EXPECT_EQ(format_light_list(std::vector<std::uint32_t>{3, 4}), "3-4");
-  EXPECT_EQ(format_light_list(std::vector<std::uint32_t>{1, 3, 5, 6, 7, 10, 12, 13}), "1, 3, 5-7, 10, 12-13");
-}
-
-TEST(LightList, RoundTrips) {
-  const std::vector<std::vector<std::uint32_t>> lists{
-      {}, {0}, range(0, 24), {0, 2, 4, 6}, {1, 2, 3, 7, 8, 23}, {5, 6, 7, 8, 9, 10, 11, 19}};
-  for (const auto& lights : lists) {
-    EXPECT_EQ(parsed(format_light_list(lights), 24), lights) << format_light_list(lights);
-  }
-  // And text in canonical form comes back as it was.
-  for (const std::string text : {"0-6, 9", "1, 3, 5-7", "0-23", "4"}) {
-    EXPECT_EQ(format_light_list(parsed(text, 24)), text);
-  }
-}
-
-TEST(LightList, NamesAnEmptyItem) {
-  EXPECT_EQ(parse_error("0,,3", 20), "item 2 of the light list \"0,,3\" is empty: remove the extra comma");
-  EXPECT_EQ(parse_error("0-6, ", 20), "item 2 of the light list \"0-6, \" is empty: remove the extra comma");
-  EXPECT_EQ(parse_error(",1", 20), "item 1 of the light list \",1\" is empty: remove the extra comma");
-}
-
-TEST(LightList, NamesWhatIsNotANumber) {
-  const std::string suffix = "\" in the light list is not a light index or range (write 7 or 7-9)";
-  EXPECT_EQ(parse_error("0, x", 20), "\"x" + suffix);
-  EXPECT_EQ(parse_error("1-2-3", 20), "\"1-2-3" + suffix);
-  EXPECT_EQ(parse_error("-3", 20), "\"-3" + suffix);
-  EXPECT_EQ(parse_error("4-", 20), "\"4-" + suffix);
-  EXPECT_EQ(parse_error("+4", 20), "\"+4" + suffix);
-  EXPECT_EQ(parse_error("1.5", 20), "\"1.5" + suffix);
-  EXPECT_EQ(parse_error("3 4", 20), "\"3 4" + suffix);
-  EXPECT_EQ(parse_error("99999999999999999999999", 20), "\"99999999999999999999999" + suffix);
-}
-
-TEST(LightList, NamesAReversedRange) {
-  EXPECT_EQ(parse_error("0, 6-2", 20), "the range \"6-2\" is reversed: write \"2-6\"");
-}
-
-TEST(LightList, NamesALightTheSceneDoesNotHave) {
-  EXPECT_EQ(parse_error("0-3, 24", 20), "light 24 does not exist: the scene has 20 lights (0-19)");
-  EXPECT_EQ(parse_error("20", 20), "light 20 does not exist: the scene has 20 lights (0-19)");
-  EXPECT_EQ(parse_error("18-24", 20), "lights 18-24 do not all exist: the scene has 20 lights (0-19)");
-  EXPECT_EQ(parse_error("1", 1), "light 1 does not exist: the scene has 1 light (0)");
-  EXPECT_EQ(parse_error("0", 0), "light 0 does not exist: the scene has no lights");
-}
-
-TEST(LightList, NamesALightListedTwice) {
-  EXPECT_EQ(parse_error("3, 1-4", 20), "light 3 is listed twice");
-  EXPECT_EQ(parse_error("0-6, 5-9", 20), "light 5 is listed twice");
-  EXPECT_EQ(parse_error("7, 7", 20), "light 7 is listed twice");
-}
-
 // --- the coverage the costs come from ---
 
 scene::SceneDefinition builtin(std::string_view name) {
@@ -285,7 +203,7 @@ scene::SceneDefinition builtin(std::string_view name) {
 
 scene::SceneState frame_zero(const scene::SceneDefinition& scene) {
   config::Viewer viewer;
-  for (const double x : {0.0, 1.2, 2.0}) viewer.add_eye(x);
+  viewer.path = {{0.0, {0.0, 1.2, 2.0}}};
   return SceneAuthority(scene.objects, viewer, 60.0).state_at_frame(0);
 }
 

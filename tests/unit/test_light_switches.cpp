@@ -1,35 +1,46 @@
-// Lights switched on and off over a show (master/light_switches.h): what
-// check-config refuses, and which lights are off when.
+// Lights switched on and off over a show (master/light_switches.h, checked as the
+// config is read and again against the scene): what check-config refuses, and
+// which lights are off when.
 
 #include "master/light_switches.h"
 
 #include <gtest/gtest.h>
 
-#include <google/protobuf/util/json_util.h>
-
 #include <set>
 #include <string>
+
+#include "config/load.h"
 
 namespace optique::master {
 namespace {
 
-config::Scene scene_with(const std::string& switches) {
-  config::Scene scene;
-  const std::string json = R"({"builtin": "many-lights", "light_switches": [)" + switches + "]}";
-  const auto status = google::protobuf::util::JsonStringToMessage(json, &scene);
-  EXPECT_TRUE(status.ok()) << status.ToString();
-  return scene;
+Result<config::Installation> show_with(const std::string& switches) {
+  const std::string json =
+      R"({"screens": [{"id": "s", "origin": [0, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0], "width": 2, "height": 1}],
+          "projectors": [{"id": "p", "width": 64, "height": 32, "screen": "s"}], "viewer": {"eye": [1, 0.5, 2]},
+          "scene": {"builtin": "many-lights", "light_switches": [)" +
+      switches + "]}}";
+  return config::parse_installation(json, "show.json", ::testing::TempDir());
 }
 
+config::SceneSource scene_with(const std::string& switches) {
+  auto show = show_with(switches);
+  EXPECT_TRUE(show.ok()) << show.error();
+  return show.ok() ? show.value().scene : config::SceneSource{};
+}
+
+// What check-config says of these switches in a scene of 20 lights.
 std::string problems_of(const std::string& switches) {
-  return config::describe_problems(LightSwitches::check(scene_with(switches), 20), "show.json");
+  auto show = show_with(switches);
+  if (!show) return show.error();
+  return config::describe_problems(LightSwitches::check(show.value().scene, 20), "show.json");
 }
 
 TEST(LightSwitches, LightsGoDarkAndComeBackAtTheirTimes) {
   const std::string show = R"({"time": 1.0, "off": "10-19"}, {"time": 2.0, "on": "10-14", "off": "0"},
                               {"time": 2.0, "on": "15-19"})";
   ASSERT_EQ(problems_of(show), "");
-  const LightSwitches switches = LightSwitches::from_config(scene_with(show), 20);
+  const LightSwitches switches = LightSwitches::from_config(scene_with(show));
   EXPECT_TRUE(switches.off_at(0.0).empty());
   EXPECT_TRUE(switches.off_at(0.999).empty());
   EXPECT_EQ(switches.off_at(1.0), (std::set<std::uint32_t>{10, 11, 12, 13, 14, 15, 16, 17, 18, 19}));
@@ -41,7 +52,7 @@ TEST(LightSwitches, LightsGoDarkAndComeBackAtTheirTimes) {
 
 TEST(LightSwitches, ASwitchLandsOnTheFrameOfItsTime) {
   // Frame 120 at 60 Hz is at 120 · 16 666 666 ns = 1.99999992 s: that is 2 s.
-  const LightSwitches switches = LightSwitches::from_config(scene_with(R"({"time": 2.0, "off": "3"})"), 20);
+  const LightSwitches switches = LightSwitches::from_config(scene_with(R"({"time": 2.0, "off": "3"})"));
   EXPECT_EQ(switches.off_at(120 * 16'666'666 * 1e-9), std::set<std::uint32_t>{3});
   EXPECT_TRUE(switches.off_at(119 * 16'666'666 * 1e-9).empty());
 }
@@ -54,8 +65,8 @@ TEST(LightSwitches, EachMistakeHasItsOwnMessage) {
             "above it at 2 s");
   EXPECT_EQ(problems_of(R"({"time": 1})"),
             "show.json: scene.light_switches[0]: switches nothing: give the lights that go \"off\" or come \"on\"");
-  EXPECT_NE(problems_of(R"({"time": 1, "off": "18-22"})").find("show.json: scene.light_switches[0].off: "),
-            std::string::npos);
+  EXPECT_EQ(problems_of(R"({"time": 1, "off": "18-22"})"),
+            "show.json: scene.light_switches[0].off: lights 20-22 do not exist: the scene has 20 lights (0-19)");
   EXPECT_NE(problems_of(R"({"time": 1, "on": "x"})").find("show.json: scene.light_switches[0].on: "),
             std::string::npos);
   EXPECT_EQ(problems_of(R"({"time": 1, "off": "3-5"}, {"time": 2, "off": "5, 6"})"),

@@ -8,15 +8,16 @@
 namespace optique::optics {
 namespace {
 
-ProjectorModel model_of(const config::Projector& projector) {
-  auto model = ProjectorModel::from_config(projector);
-  EXPECT_TRUE(model) << (model ? "" : model.error());
-  return model ? model.value() : ProjectorModel{};
+// As the config gives it: checked by config::parse_response, then modelled.
+ProjectorModel model_of(const schema::Projector& projector) {
+  auto response = config::parse_response(projector);
+  EXPECT_TRUE(response) << (response ? "" : response.error());
+  return response ? ProjectorModel(response.value()) : ProjectorModel{};
 }
 
-std::string error_of(const config::Projector& projector) {
-  auto model = ProjectorModel::from_config(projector);
-  return model ? std::string("(accepted)") : model.error();
+std::string error_of(const schema::Projector& projector) {
+  auto response = config::parse_response(projector);
+  return response ? std::string("(accepted)") : response.error();
 }
 
 TEST(ProjectorModel, DefaultIsEightBitSrgbWithoutBlack) {
@@ -30,7 +31,7 @@ TEST(ProjectorModel, DefaultIsEightBitSrgbWithoutBlack) {
 
 TEST(ProjectorModel, EmittedLightIsBlackPlusWhatWasRendered) {
   for (const double gamma : {1.0, 1.8, 2.2, 2.6}) {
-    config::Projector p;
+    schema::Projector p;
     p.mutable_response()->set_gamma(gamma);
     p.mutable_response()->set_bits(16);
     p.set_black_level(0.02);
@@ -46,7 +47,7 @@ TEST(ProjectorModel, EmittedLightIsBlackPlusWhatWasRendered) {
 }
 
 TEST(ProjectorModel, MeasuredTableIsInvertedWhereItIsFlatAndSteep) {
-  config::Projector p;
+  schema::Projector p;
   for (const double v : {0.0, 0.0, 0.05, 0.2, 0.2, 0.6, 1.0}) p.mutable_response()->add_table(v);
   p.mutable_response()->set_bits(16);
   const ProjectorModel model = model_of(p);
@@ -63,7 +64,7 @@ TEST(ProjectorModel, MeasuredTableIsInvertedWhereItIsFlatAndSteep) {
 
 TEST(ProjectorModel, QuantizationHasTwoToTheBitsLevels) {
   for (const int bits : {1, 4, 8, 10}) {
-    config::Projector p;
+    schema::Projector p;
     p.mutable_response()->set_gamma(2.2);
     p.mutable_response()->set_bits(static_cast<unsigned>(bits));
     const ProjectorModel model = model_of(p);
@@ -81,45 +82,45 @@ TEST(ProjectorModel, QuantizationHasTwoToTheBitsLevels) {
 }
 
 TEST(ProjectorModel, BadSettingsNameTheField) {
-  config::Projector p;
+  schema::Projector p;
   p.mutable_response()->set_gamma(-1.0);
   EXPECT_NE(error_of(p).find("response.gamma"), std::string::npos) << error_of(p);
   p.mutable_response()->set_gamma(std::nan(""));
   EXPECT_NE(error_of(p).find("response.gamma"), std::string::npos);
 
-  config::Projector both;
+  schema::Projector both;
   both.mutable_response()->set_gamma(2.2);
   both.mutable_response()->add_table(0.0);
   both.mutable_response()->add_table(1.0);
   EXPECT_NE(error_of(both).find("either gamma or table"), std::string::npos) << error_of(both);
 
-  config::Projector short_table;
+  schema::Projector short_table;
   short_table.mutable_response()->add_table(0.0);
   EXPECT_NE(error_of(short_table).find("at least 2"), std::string::npos) << error_of(short_table);
 
-  config::Projector dips;
+  schema::Projector dips;
   for (const double v : {0.0, 0.5, 0.4, 1.0}) dips.mutable_response()->add_table(v);
   EXPECT_NE(error_of(dips).find("response.table[2]"), std::string::npos) << error_of(dips);
 
-  config::Projector unnormalized;
+  schema::Projector unnormalized;
   for (const double v : {0.01, 0.5, 0.9}) unnormalized.mutable_response()->add_table(v);
   EXPECT_NE(error_of(unnormalized).find("from 0"), std::string::npos) << error_of(unnormalized);
 
-  config::Projector infinite;
+  schema::Projector infinite;
   for (const double v : {0.0, static_cast<double>(INFINITY), 1.0}) infinite.mutable_response()->add_table(v);
   EXPECT_NE(error_of(infinite).find("response.table[1]"), std::string::npos) << error_of(infinite);
 
-  config::Projector bits;
+  schema::Projector bits;
   bits.mutable_response()->set_bits(17);
   EXPECT_NE(error_of(bits).find("response.bits"), std::string::npos) << error_of(bits);
 
-  config::Projector black;
+  schema::Projector black;
   black.set_black_level(1.0);
   EXPECT_NE(error_of(black).find("black_level"), std::string::npos) << error_of(black);
   black.set_black_level(-0.1);
   EXPECT_NE(error_of(black).find("black_level"), std::string::npos);
 
-  config::Projector brightness;
+  schema::Projector brightness;
   brightness.set_brightness(-2.0);
   EXPECT_NE(error_of(brightness).find("brightness"), std::string::npos) << error_of(brightness);
 }

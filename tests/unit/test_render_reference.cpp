@@ -29,7 +29,8 @@ struct Rendered {
 Rendered render(int supersample) {
   auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
   EXPECT_TRUE(config.ok()) << config.error();
-  auto scene = scene::load_scene(config.value().installation.scene(), config.value().directory, image::decode_texture);
+  auto scene = scene::load_scene(config.value().installation.scene.builtin, config.value().installation.scene.gltf,
+                                 image::decode_texture);
   EXPECT_TRUE(scene.ok()) << scene.error();
   std::string dir = (fs::temp_directory_path() / "optique-reference-XXXXXX").string();
   EXPECT_NE(mkdtemp(dir.data()), nullptr);
@@ -81,7 +82,8 @@ TEST(RenderReference, SupersampledHasTheScreensPixelsAndAveragesThem) {
 TEST(RenderReference, RefusesAZeroFactor) {
   auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
   ASSERT_TRUE(config.ok()) << config.error();
-  auto scene = scene::load_scene(config.value().installation.scene(), config.value().directory, image::decode_texture);
+  auto scene = scene::load_scene(config.value().installation.scene.builtin, config.value().installation.scene.gltf,
+                                 image::decode_texture);
   ASSERT_TRUE(scene.ok()) << scene.error();
   spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
   auto written = render_reference(config.value(), scene.value(), 0, "/nonexistent", log, ReferenceOptions{0});

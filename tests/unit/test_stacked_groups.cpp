@@ -124,7 +124,7 @@ TEST(LightPlan, AutomaticGroupsShareAmongTheNodesThatAreUp) {
   EXPECT_EQ(light_problems(stacked(autolights, autolights, autolights)), "");
   auto scene = scene::builtin_scene("many-lights");
   ASSERT_TRUE(scene);
-  const SceneAuthority authority(scene.value().objects, installation.viewer(), 60.0);
+  const SceneAuthority authority(scene.value().objects, installation.viewer, 60.0);
   const scene::SceneState state = authority.state_at_frame(0);
   LightPlan plan(installation, scene.value());
   EXPECT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));
@@ -155,7 +155,7 @@ TEST(LightPlan, LightsThatAreOffGoToNobodyAndComeBackWhenOn) {
   const config::Installation installation = parsed(stacked(autolights, autolights, autolights));
   auto scene = scene::builtin_scene("many-lights");
   ASSERT_TRUE(scene);
-  const SceneAuthority authority(scene.value().objects, installation.viewer(), 60.0);
+  const SceneAuthority authority(scene.value().objects, installation.viewer, 60.0);
   scene::SceneState state = authority.state_at_frame(0);
   LightPlan plan(installation, scene.value());
   ASSERT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));

@@ -6,10 +6,6 @@
 #include <cassert>
 #include <cmath>
 
-#include <glm/vec3.hpp>
-
-#include "optique/config.pb.h"
-
 namespace optique::scene {
 
 // Where `seconds` falls on a looped path of `count` points whose times
@@ -38,9 +34,14 @@ template <class TimeOf>
   return {last, last, 0.0};
 }
 
-// The eye at simulation time `seconds`: the fixed eye, or the scripted path
-// interpolated linearly between its points and looped over its duration.
-// `viewer` must be validated (config::validate).
-[[nodiscard]] glm::dvec3 eye_at(const config::Viewer& viewer, double seconds);
+// The value of a looped path of points (each with a `time`) at `seconds`:
+// `value_of` of the points around it, linearly between them.
+template <class Points, class ValueOf>
+[[nodiscard]] auto path_value(const Points& path, double seconds, const ValueOf& value_of) {
+  const PathSpot spot = path_spot(
+      static_cast<int>(path.size()), [&](int i) { return path[static_cast<std::size_t>(i)].time; }, seconds);
+  return value_of(path[static_cast<std::size_t>(spot.from)]) * (1.0 - spot.fraction) +
+         value_of(path[static_cast<std::size_t>(spot.to)]) * spot.fraction;
+}
 
 }  // namespace optique::scene

@@ -1,0 +1,76 @@
+#include "config/installation.h"
+
+#include <algorithm>
+#include <cassert>
+
+#include "scene/scripted_path.h"
+
+namespace optique::config {
+
+std::string_view to_string(Eye eye) {
+  switch (eye) {
+    case Eye::left:
+      return "left";
+    case Eye::right:
+      return "right";
+    case Eye::mono:
+      break;
+  }
+  return "mono";
+}
+
+std::string_view to_string(RenderMethod method) {
+  return method == RenderMethod::two_pass ? "two-pass" : "single-pass";
+}
+
+std::string_view to_string(ContentRole role) {
+  switch (role) {
+    case ContentRole::lights:
+      return "lights";
+    case ContentRole::focus:
+      return "focus";
+    case ContentRole::defocus:
+      return "defocus";
+    case ContentRole::full:
+      break;
+  }
+  return "full";
+}
+
+std::string_view to_string(StragglerPolicy policy) { return policy == StragglerPolicy::drop ? "drop" : "present"; }
+
+std::string_view to_string(OutputKind kind) { return kind == OutputKind::window ? "window" : "headless"; }
+
+geometry::WorldRect Screen::world(const geometry::ScreenRect& part) const {
+  geometry::WorldRect rect;
+  rect.right = right;
+  rect.up = up;
+  rect.lower_left = point(part.min);
+  rect.width = part.width();
+  rect.height = part.height();
+  return rect;
+}
+
+geometry::ProjectorGeometry Projector::geometry() const {
+  auto made = geometry::ProjectorGeometry::make(homography, width, height);
+  assert(made);  // checked when the installation was parsed
+  return std::move(made).value();
+}
+
+glm::dvec3 Viewer::eye_at(double seconds) const {
+  assert(!path.empty());
+  return scene::path_value(path, seconds, [](const PathPoint& p) { return p.position; });
+}
+
+glm::dvec2 Gaze::at(double seconds) const {
+  assert(!path.empty());
+  return scene::path_value(path, seconds, [](const GazePoint& p) { return p.point; });
+}
+
+std::optional<std::size_t> Installation::find_projector(std::string_view id) const {
+  const auto found = std::find_if(projectors.begin(), projectors.end(), [&](const Projector& p) { return p.id == id; });
+  if (found == projectors.end()) return std::nullopt;
+  return static_cast<std::size_t>(found - projectors.begin());
+}
+
+}  // namespace optique::config

@@ -1,0 +1,25 @@
+#pragma once
+// A projector's job: the part of an installation that one node needs to draw its
+// projector. The master cuts it out (job_for) and sends it in its welcome; the
+// node parses it back (parse_job); tests and benches cut it out the same way.
+
+#include <cstddef>
+
+#include "config/installation.h"
+
+namespace optique::config {
+
+struct ProjectorJob {
+  // Its screen (the only one), the projectors it blends with (itself among them:
+  // the same screen, eye and share of the light), the viewer, the scene, and the
+  // depth of field's range and inset (the focal depth comes with each frame).
+  Installation installation;
+  std::size_t projector = 0;  // which of installation.projectors this job draws
+
+  [[nodiscard]] const Projector& self() const { return installation.projectors[projector]; }
+  [[nodiscard]] const Screen& screen() const { return installation.screens.front(); }
+};
+
+[[nodiscard]] ProjectorJob job_for(const Installation& installation, std::size_t projector);
+
+}  // namespace optique::config

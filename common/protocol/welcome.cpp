@@ -1,0 +1,106 @@
+#include "protocol/welcome.h"
+
+#include "config/to_schema.h"
+
+namespace optique::protocol {
+namespace {
+
+// The job part of a welcome as one installation, for config::parse_job: its
+// screen, its blend group as the projectors, the viewer, scene and depth of field.
+schema::Installation job_of(const wire::Welcome& welcome) {
+  schema::Installation job;
+  *job.add_screens() = welcome.screen();
+  for (const schema::Projector& member : welcome.blend_group()) *job.add_projectors() = member;
+  *job.mutable_viewer() = welcome.viewer();
+  *job.mutable_scene() = welcome.scene();
+  if (welcome.has_depth_of_field()) *job.mutable_depth_of_field() = welcome.depth_of_field();
+  return job;
+}
+
+// Longer than any sane setting, short enough that doubling it cannot overflow.
+constexpr clock::Nanos kLongestPeriod = 10 * clock::kNanosPerSecond;
+constexpr std::uint32_t kLongestMs = 24 * 3600 * 1000;
+
+}  // namespace
+
+wire::Welcome encode_welcome(const config::Installation& installation, std::size_t projector,
+                             const std::string& scene_sha256, std::uint32_t light_count, clock::Nanos frame_period,
+                             const LightShare* share) {
+  const config::ProjectorJob job = config::job_for(installation, projector);
+  const config::Installation& part = job.installation;
+  wire::Welcome welcome;
+  *welcome.mutable_projector() = config::to_schema(job.self(), part.screens);
+  *welcome.mutable_screen() = config::to_schema(job.screen());
+  for (const config::Projector& member : part.projectors)
+    *welcome.add_blend_group() = config::to_schema(member, part.screens);
+  *welcome.mutable_viewer() = config::to_schema(part.viewer);
+  *welcome.mutable_scene() = config::to_schema(part.scene);
+  if (part.depth_of_field) *welcome.mutable_depth_of_field() = config::to_schema(*part.depth_of_field, part.screens);
+  welcome.set_scene_sha256(scene_sha256);
+  welcome.set_light_count(light_count);
+  if (share != nullptr) *welcome.mutable_lights() = to_wire(*share);
+  welcome.set_frame_period_ns(frame_period);
+  welcome.set_heartbeat_ms(static_cast<std::uint32_t>(installation.master.heartbeat.count()));
+  welcome.set_liveness_timeout_ms(static_cast<std::uint32_t>(installation.master.liveness_timeout.count()));
+  return welcome;
+}
+
+Result<NodeJob> decode_welcome(const wire::Welcome& welcome, std::string_view projector_id) {
+  NodeJob node;
+  if (welcome.frame_period_ns() <= 0 || welcome.frame_period_ns() > kLongestPeriod) {
+    return Error{"welcome: frame_period_ns " + std::to_string(welcome.frame_period_ns()) + " is not in (0, 10 s]"};
+  }
+  if (welcome.heartbeat_ms() == 0 || welcome.heartbeat_ms() > kLongestMs || welcome.liveness_timeout_ms() == 0 ||
+      welcome.liveness_timeout_ms() > kLongestMs) {
+    return Error{"welcome: heartbeat_ms " + std::to_string(welcome.heartbeat_ms()) + " and liveness_timeout_ms " +
+                 std::to_string(welcome.liveness_timeout_ms()) + " must be in [1, 86400000]"};
+  }
+  if (welcome.projector().id() != projector_id) {
+    return Error{"welcome: it is for projector '" + welcome.projector().id() + "', this node drives '" +
+                 std::string(projector_id) + "'"};
+  }
+  schema::Installation job = job_of(welcome);
+  // A master that sends no blend group: this projector alone.
+  if (job.projectors().empty()) *job.add_projectors() = welcome.projector();
+  auto parsed = config::parse_job(job, projector_id, "welcome");
+  if (!parsed) return Error{parsed.error()};
+  node.job = std::move(parsed).value();
+  node.scene_sha256 = welcome.scene_sha256();
+  node.light_count = welcome.light_count();
+  node.frame_period = welcome.frame_period_ns();
+  node.heartbeat = std::chrono::milliseconds(welcome.heartbeat_ms());
+  node.liveness_timeout = std::chrono::milliseconds(welcome.liveness_timeout_ms());
+  if (node.job.self().content.role == config::ContentRole::lights) {
+    auto share = decode_light_share(welcome.lights(), node.light_count);
+    if (!share) return Error{"welcome: lights: " + share.error()};
+    node.lights = std::move(share).value();
+  }
+  return node;
+}
+
+wire::LightShare to_wire(const LightShare& share) {
+  wire::LightShare out;
+  out.mutable_lights()->Add(share.lights.begin(), share.lights.end());
+  out.set_ambient(share.ambient);
+  return out;
+}
+
+Result<LightShare> decode_light_share(const wire::LightShare& share, std::uint32_t light_count) {
+  LightShare out;
+  out.ambient = share.ambient();
+  for (int i = 0; i < share.lights_size(); ++i) {
+    const std::uint32_t light = share.lights(i);
+    if (light >= light_count) {
+      return Error{"light " + std::to_string(light) + " does not exist (the scene has " + std::to_string(light_count) +
+                   ")"};
+    }
+    if (i > 0 && light <= share.lights(i - 1)) {
+      return Error{"lights must ascend, each once (" + std::to_string(light) + " after " +
+                   std::to_string(share.lights(i - 1)) + ")"};
+    }
+    out.lights.push_back(light);
+  }
+  return out;
+}
+
+}  // namespace optique::protocol

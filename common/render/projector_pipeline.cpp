@@ -1,0 +1,93 @@
+#include "render/projector_pipeline.h"
+
+#include <vector>
+
+#include "optics/blend.h"
+#include "optics/defocus.h"
+
+namespace optique::render {
+namespace {
+
+// This projector's share of the light where it overlaps the others of its blend
+// group, zero where it is masked outside the screen's area.
+image::FloatImage blend_weights(const config::ProjectorJob& job) {
+  std::vector<geometry::ProjectorGeometry> group;
+  std::vector<double> ramps;
+  for (const config::Projector& member : job.installation.projectors) {
+    group.push_back(member.geometry());
+    ramps.push_back(member.blend_ramp);
+  }
+  const optics::BlendField field(group, job.screen().area(), ramps);
+  return optics::blend_weights(field, group[job.projector], job.projector);
+}
+
+}  // namespace
+
+ProjectorPipeline::ProjectorPipeline(ProjectorView view, std::unique_ptr<SceneRenderer> renderer,
+                                     const config::ProjectorJob& job, optics::ProjectorModel model)
+    : view_(std::move(view)),
+      renderer_(std::move(renderer)),
+      model_(std::move(model)),
+      eye_(job.self().eye),
+      viewer_(job.installation.viewer),
+      focus_role_(focus_role(job.self().content.role)),
+      depth_of_field_(job.installation.depth_of_field) {}
+
+Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config::ProjectorJob& job,
+                                                                   const scene::SceneDefinition& scene,
+                                                                   const PipelineOptions& options) {
+  const config::Projector& self = job.self();
+  auto view = ProjectorView::make(job.screen(), self.geometry(), self.rendering, options.two_pass_pixels_per_metre);
+  if (!view) return Error{"projector '" + self.id + "': " + view.error()};
+  auto renderer =
+      SceneRenderer::create(scene, view.value().render_width(), view.value().render_height(), options.depth);
+  if (!renderer) return Error{renderer.error()};
+  const FocusRole role = focus_role(self.content.role);
+  OutputStage stage = view.value().output_stage(options.blend ? blend_weights(job) : image::FloatImage{}, role);
+  stage.focus.inset = job.installation.depth_of_field && job.installation.depth_of_field->inset_radius > 0.0;
+  stage.projector = optics::ProjectorModel(self.response);
+  if (auto output = renderer.value()->set_output(stage); !output) return Error{output.error()};
+  std::unique_ptr<ProjectorPipeline> pipeline(
+      new ProjectorPipeline(std::move(view).value(), std::move(renderer).value(), job, stage.projector));
+  if (self.content.role == config::ContentRole::lights) pipeline->set_share({});
+  return pipeline;
+}
+
+void ProjectorPipeline::set_share(const protocol::LightShare& share) {
+  renderer_->set_lights(share.lights);
+  terms_ = {share.ambient, share.ambient};
+}
+
+void ProjectorPipeline::set_focus(const protocol::Focus& focus) {
+  if (focus_role_ == FocusRole::none || !depth_of_field_) return;
+  FocusFrame frame;
+  frame.coc = optics::coc_from_window_depth(focus.depth, {depth_of_field_->near, depth_of_field_->far}, viewer_.near,
+                                            viewer_.far);
+  frame.gaze = focus.gaze;
+  frame.inset_radius = depth_of_field_->inset_radius;
+  renderer_->set_focus(frame);
+}
+
+glm::dvec3 ProjectorPipeline::eye(const glm::dvec3& centre) const {
+  return geometry::eye_position(centre, viewer_.head_right, viewer_.eye_separation, eye_);
+}
+
+Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double fraction) {
+  const glm::dvec3 at = eye(state.eye_now);
+  auto frustum = view_.frustum(at, viewer_.near, viewer_.far);
+  if (!frustum) {
+    renderer_->draw_black();
+    return Error{frustum.error()};
+  }
+  renderer_->draw(state, fraction, at, frustum.value(), terms_);
+  return {};
+}
+
+void ProjectorPipeline::warm_up() {
+  const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
+  if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
+    renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
+  }
+}
+
+}  // namespace optique::render

@@ -1,0 +1,78 @@
+#pragma once
+// What a projector's job needs to draw, built in one place: its view of the
+// screen (single pass through R, or two passes), a scene renderer of the right
+// size, and the output stage — blend weights shared with its blend group, its
+// response, bit depth, black level and brightness, its share of the depth of
+// field. The node's GL renderer builds one per welcome; tests and benches build
+// theirs from config::job_for, the same way.
+
+#include <memory>
+#include <optional>
+
+#include <glm/vec3.hpp>
+
+#include "config/job.h"
+#include "protocol/focus.h"
+#include "protocol/light_share.h"
+#include "render/projector_view.h"
+#include "render/scene_renderer.h"
+#include "scene/definition.h"
+#include "scene/state.h"
+#include "util/result.h"
+
+namespace optique::render {
+
+struct PipelineOptions {
+  DepthFormat depth = DepthFormat::float32;
+  // Two-pass projectors render R at this density; 0: the projector's densest.
+  double two_pass_pixels_per_metre = 0.0;
+  // No blend weights (1 everywhere inside the screen's area): for experiments
+  // that look at one projector alone.
+  bool blend = true;
+};
+
+class ProjectorPipeline {
+ public:
+  // Needs a current GL context. Fails with the reason (the projector lights none
+  // of its screen, a shader or framebuffer the driver refuses).
+  [[nodiscard]] static Result<std::unique_ptr<ProjectorPipeline>> make(const config::ProjectorJob& job,
+                                                                       const scene::SceneDefinition& scene,
+                                                                       const PipelineOptions& options = {});
+
+  // Draws these of the scene's lights from now on, and the ambient and emissive
+  // terms if the share carries them. By default: all of it.
+  void set_share(const protocol::LightShare& share);
+  // The frame's focal depth and gaze (focus/defocus projectors; ignored by others).
+  void set_focus(const protocol::Focus& focus);
+
+  // Where this projector's eye is when the viewer's eyes are centred at `centre`.
+  [[nodiscard]] glm::dvec3 eye(const glm::dvec3& centre) const;
+  // Draws the scene in `state` (objects `fraction` of the way to their next
+  // pose) from this projector's eye. When the eye is not in front of the screen,
+  // nothing of the scene can be seen through it: the projector shows black and
+  // the reason comes back.
+  [[nodiscard]] Result<void> draw(const scene::SceneState& state, double fraction = 0.0);
+  // One draw of an empty scene from a metre in front of the screen: drivers
+  // compile shaders lazily, and the first frame should not pay for it.
+  void warm_up();
+
+  [[nodiscard]] SceneRenderer& renderer() { return *renderer_; }
+  [[nodiscard]] const SceneRenderer& renderer() const { return *renderer_; }
+  [[nodiscard]] const ProjectorView& view() const { return view_; }
+  [[nodiscard]] const optics::ProjectorModel& projector_model() const { return model_; }
+
+ private:
+  ProjectorPipeline(ProjectorView view, std::unique_ptr<SceneRenderer> renderer, const config::ProjectorJob& job,
+                    optics::ProjectorModel model);
+
+  ProjectorView view_;
+  std::unique_ptr<SceneRenderer> renderer_;
+  optics::ProjectorModel model_;
+  config::Eye eye_;
+  config::Viewer viewer_;
+  FocusRole focus_role_;
+  std::optional<config::DepthOfField> depth_of_field_;
+  LightTerms terms_;
+};
+
+}  // namespace optique::render
