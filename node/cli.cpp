@@ -22,7 +22,8 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
   std::int64_t clock_offset_ns = 0;
   double clock_drift_ppm = 0.0;
   app.add_option("-m,--master", master, "the master's HOST:PORT")->required();
-  app.add_option("-i,--id", options.id, "the projector this node drives (its id in the installation)")->required();
+  app.add_option("-i,--id", options.protocol.id, "the projector this node drives (its id in the installation)")
+      ->required();
   app.add_option("--give-up-after-ms", give_up_ms, "exit when the master is unreachable this long")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{86'400'000}));
   std::string renderer_kind = "gl";
@@ -42,16 +43,17 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
   app.add_option("--log-level", log_level, "trace, debug, info, warn or error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   // Test hooks, hidden from --help.
-  app.add_option("--protocol-version", options.protocol_version, "speak this protocol version")->group("");
+  app.add_option("--protocol-version", options.protocol.protocol_version, "speak this protocol version")->group("");
   app.add_option("--clock-offset-ns", clock_offset_ns, "skew this node's clock")->group("");
   app.add_option("--clock-drift-ppm", clock_drift_ppm, "make this node's clock drift")->group("");
   std::int64_t present_spin_us = options.present_spin.count();
   app.add_option("--present-spin-us", present_spin_us, "spin this long before each present deadline")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{5000}))
       ->group("");
-  app.add_option("--corrupt-state-at-frame", options.corrupt_state_at_frame, "nudge the scene state at this frame")
+  app.add_option("--corrupt-state-at-frame", options.protocol.corrupt_state_at_frame,
+                 "nudge the scene state at this frame")
       ->group("");
-  app.add_option("--lag-frames", options.lag_frames, "show the content of this many frames ago")
+  app.add_option("--lag-frames", options.protocol.lag_frames, "show the content of this many frames ago")
       ->check(CLI::Range(0u, 100u))
       ->group("");
 
@@ -66,22 +68,23 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
     std::cerr << "optique-node: --master must be HOST:PORT (got '" << master << "')\n";
     return kExitRefused;
   }
+  options.protocol.master = master;
   options.master_host = master.substr(0, colon);
   options.master_port = master.substr(colon + 1);
   if (options.master_host.front() == '[' && options.master_host.back() == ']') {
     options.master_host = options.master_host.substr(1, options.master_host.size() - 2);  // [::1]:7400
   }
-  options.give_up_after = std::chrono::milliseconds(give_up_ms);
+  options.protocol.give_up_after = std::chrono::milliseconds(give_up_ms);
   options.present_spin = std::chrono::microseconds(present_spin_us);
-  options.hold_last_frame = on_master_lost == "hold";
-  options.clock = clock::LocalClock(clock_offset_ns, clock_drift_ppm);
+  options.protocol.hold_last_frame = on_master_lost == "hold";
+  options.protocol.clock = clock::LocalClock(clock_offset_ns, clock_drift_ppm);
   if (!secret_file.empty()) {
     auto secret = net::load_secret_file(secret_file);
     if (!secret) {
       std::cerr << "optique-node: --secret-file: " << secret.error() << "\n";
       return kExitRefused;
     }
-    options.secret = std::move(secret).value();
+    options.protocol.secret = std::move(secret).value();
   }
 
   if (renderer_kind == "gl" && !make_gl) {
@@ -94,9 +97,9 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
   // The kernel may wake a sleeper up to its timer slack late (50 µs by default);
   // presents are timed to tens of microseconds.
   prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
-  auto logger = log::make_logger("node " + options.id, log_level);
+  auto logger = log::make_logger("node " + options.protocol.id, log_level);
   boost::asio::io_context io;
-  if (capture_dir.empty()) capture_dir = "captures/" + options.id;
+  if (capture_dir.empty()) capture_dir = "captures/" + options.protocol.id;
   std::unique_ptr<Renderer> renderer;
   if (renderer_kind == "null") {
     renderer = std::make_unique<NullRenderer>();

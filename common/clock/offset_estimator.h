@@ -42,7 +42,7 @@ struct ClockEstimate {
 class OffsetEstimator {
  public:
   struct Settings {
-    std::size_t window = 256;                     // samples kept (pings come about 10 a second)
+    std::size_t window = 256;                     // samples kept (pings come 40 a second: 6.4 s)
     Nanos bucket = 200 * kNanosPerMilli;          // one point per bucket: its lowest round trip
     Nanos min_drift_span = 500 * kNanosPerMilli;  // fit a drift only over at least this much time
     double max_drift_ppm = 1000.0;                // quartz is within ±100 ppm; beyond this the fit is noise

@@ -1,0 +1,466 @@
+#include "node/protocol.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+namespace optique::node {
+
+using std::chrono::milliseconds;
+
+NodeProtocol::NodeProtocol(NodeSettings settings) : settings_(std::move(settings)) {}
+
+void NodeProtocol::log(Actions& out, spdlog::level::level_enum level, std::string text) const {
+  out.push_back(Log{level, std::move(text)});
+}
+
+void NodeProtocol::stop(int exit_code, const std::string& reason, Actions& out) {
+  if (phase_ == Phase::stopped) return;
+  const bool connected = connection_open_;
+  phase_ = Phase::stopped;
+  log(out, exit_code == kExitOk ? spdlog::level::info : spdlog::level::err, reason);
+  out.push_back(CancelPings{});
+  if (connected) {
+    // The master logs why a node leaves: a node that cannot render says so there too.
+    if (exit_code != kExitOk) {
+      wire::Envelope goodbye;
+      goodbye.mutable_goodbye()->set_reason(reason);
+      out.push_back(Send{std::move(goodbye)});
+    }
+    out.push_back(Close{reason, true});
+  }
+  out.push_back(Stop{exit_code});
+}
+
+// ---------------------------------------------------------------- connection
+
+Actions NodeProtocol::connected(clock::Nanos) {
+  Actions out;
+  if (phase_ == Phase::stopped) return out;
+  phase_ = Phase::awaiting_challenge;
+  connection_open_ = true;
+  out.push_back(SetDeadline{kHandshakeTimeout, "no welcome from the master within 5 s"});
+  return out;
+}
+
+Actions NodeProtocol::connect_failed(const std::string& reason, clock::Nanos now) {
+  Actions out;
+  if (phase_ == Phase::stopped) return out;
+  ++attempts_;
+  if (!unreachable_since_) unreachable_since_ = now;
+  const auto waited = milliseconds((now - *unreachable_since_) / clock::kNanosPerMilli);
+  if (waited >= settings_.give_up_after) {
+    stop(kExitNoMaster,
+         "gave up: the master at " + settings_.master + " was not reachable for " + std::to_string(waited.count()) +
+             " ms (" + reason + ")",
+         out);
+    return out;
+  }
+  // One line at the first failure and then about every few seconds, not one per try.
+  if (attempts_ == 1 || attempts_ % 5 == 0) {
+    log(out, spdlog::level::info,
+        fmt::format("master at {} not reachable ({}); retrying every {} ms, giving up after {} ms", settings_.master,
+                    reason, backoff_.count(), settings_.give_up_after.count()));
+  }
+  out.push_back(Reconnect{backoff_});
+  backoff_ = std::min(backoff_ * 2, kMaxBackoff);
+  return out;
+}
+
+Actions NodeProtocol::closed(const std::string& reason, clock::Nanos now) {
+  Actions out;
+  connection_open_ = false;
+  out.push_back(CancelPings{});
+  if (phase_ == Phase::stopped) return out;
+  const bool was_joined = phase_ == Phase::joined;
+  phase_ = Phase::disconnected;
+  pending_.reset();
+  held_.clear();
+  if (was_joined) {
+    log(out, spdlog::level::warn,
+        "lost the master: " + reason + "; " + (settings_.hold_last_frame ? "holding the last frame" : "showing black") +
+            " while reconnecting");
+    if (!settings_.hold_last_frame) out.push_back(ShowBlack{});
+  } else {
+    log(out, spdlog::level::info, "connection to the master closed during the handshake: " + reason);
+  }
+  Actions retry = connect_failed(reason, now);
+  out.insert(out.end(), std::make_move_iterator(retry.begin()), std::make_move_iterator(retry.end()));
+  return out;
+}
+
+Actions NodeProtocol::interrupted(const std::string& signal_name) {
+  Actions out;
+  if (connection_open_ && phase_ != Phase::stopped) {
+    wire::Envelope goodbye;
+    goodbye.mutable_goodbye()->set_reason("node " + signal_name);
+    out.push_back(Send{std::move(goodbye)});
+  }
+  stop(kExitOk, "stopping on " + signal_name, out);
+  return out;
+}
+
+// ---------------------------------------------------------------- messages
+
+Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
+  Actions out;
+  if (phase_ == Phase::stopped || !connection_open_) return out;
+  switch (message.body_case()) {
+    case wire::Envelope::kChallenge:
+      on_challenge(message, out);
+      return out;
+    case wire::Envelope::kRefuse:
+      if (message.refuse().retriable()) {
+        log(out, spdlog::level::warn, "the master refused this node for now: " + message.refuse().reason());
+        out.push_back(Close{"refused (will retry)"});
+      } else {
+        stop(kExitRefused, "the master refused this node: " + message.refuse().reason(), out);
+      }
+      return out;
+    case wire::Envelope::kGoodbye:
+      stop(kExitOk, "the master said goodbye (" + message.goodbye().reason() + ")", out);
+      return out;
+    default:
+      break;
+  }
+  if (message.protocol_version() != net::kProtocolVersion) {
+    stop(kExitRefused,
+         "the master speaks protocol v" + std::to_string(message.protocol_version()) + ", this node v" +
+             std::to_string(net::kProtocolVersion),
+         out);
+    return out;
+  }
+  if (phase_ == Phase::awaiting_welcome && message.body_case() == wire::Envelope::kWelcome) {
+    on_welcome(message.welcome(), out);
+    return out;
+  }
+  if ((phase_ == Phase::awaiting_state || phase_ == Phase::joined) && message.body_case() == wire::Envelope::kResync) {
+    if (pending_) {
+      held_.push_back(message);  // after the frame waiting to be shown
+    } else {
+      on_resync(message.resync(), now, out);
+    }
+    return out;
+  }
+  if (phase_ != Phase::joined) {
+    out.push_back(Close{std::string("unexpected ") + net::body_name(message) + " before the welcome"});
+    return out;
+  }
+  switch (message.body_case()) {
+    case wire::Envelope::kFrameBegin:
+      // A frame is waiting for its deadline: the next one must not be drawn over
+      // it before it is shown.
+      if (pending_) {
+        held_.push_back(message);
+      } else {
+        on_frame_begin(message.frame_begin(), out);
+      }
+      break;
+    case wire::Envelope::kSwap:
+      if (pending_) {
+        held_.push_back(message);
+      } else {
+        on_swap(message.swap(), now, out);
+      }
+      break;
+    case wire::Envelope::kPong:
+      on_pong(message.pong(), now, out);
+      break;
+    case wire::Envelope::kHeartbeat:
+      break;
+    default:
+      out.push_back(Close{std::string("unexpected ") + net::body_name(message) + " from the master"});
+      break;
+  }
+  return out;
+}
+
+void NodeProtocol::on_challenge(const wire::Envelope& message, Actions& out) {
+  if (phase_ != Phase::awaiting_challenge) {
+    out.push_back(Close{"a second challenge from the master"});
+    return;
+  }
+  const wire::Challenge& challenge = message.challenge();
+  if (challenge.secret_required() && !settings_.secret) {
+    stop(kExitRefused,
+         "the master requires the installation's shared secret: start this node with --secret-file FILE (the file "
+         "the config's master.secret_file names)",
+         out);
+    return;
+  }
+  wire::Envelope hello;
+  hello.set_protocol_version(settings_.protocol_version);
+  hello.mutable_hello()->set_node_id(settings_.id);
+  hello.mutable_hello()->add_capabilities("render");
+  if (settings_.secret) {
+    const std::string& nonce = challenge.nonce();
+    const auto mac =
+        net::hello_mac(*settings_.secret, std::span(reinterpret_cast<const std::uint8_t*>(nonce.data()), nonce.size()),
+                       settings_.id, settings_.protocol_version);
+    hello.mutable_hello()->set_nonce_mac(mac.data(), mac.size());
+  }
+  out.push_back(Send{std::move(hello)});
+  phase_ = Phase::awaiting_welcome;
+}
+
+void NodeProtocol::on_welcome(const wire::Welcome& welcome, Actions& out) {
+  auto job = protocol::decode_welcome(welcome, settings_.id);
+  if (!job) {
+    stop(kExitRefused, "the master's welcome cannot be used: " + job.error(), out);
+    return;
+  }
+  job_ = std::move(job).value();
+  phase_ = Phase::configuring;
+  out.push_back(Configure{*job_});
+}
+
+Actions NodeProtocol::configured(const Result<void>& result, const std::string& renderer_description) {
+  Actions out;
+  if (phase_ != Phase::configuring) return out;  // the connection went meanwhile
+  if (!result) {
+    stop(kExitRefused, "cannot drive projector '" + settings_.id + "': " + result.error(), out);
+    return out;
+  }
+  frame_period_ = job_->frame_period;
+  heartbeat_ = std::max(job_->heartbeat, milliseconds(10));
+  liveness_timeout_ = job_->liveness_timeout;
+  wire::Envelope envelope;
+  envelope.mutable_configured()->set_renderer(renderer_description);
+  out.push_back(Send{std::move(envelope)});
+  phase_ = Phase::awaiting_state;
+  out.push_back(SetDeadline{kHandshakeTimeout, "no state from the master within 5 s of being configured"});
+  const config::Projector& p = job_->job.self();
+  log(out, spdlog::level::info,
+      fmt::format("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}", p.id, p.width, p.height,
+                  job_->job.screen().id, config::to_string(p.eye), static_cast<double>(frame_period_) / 1e6,
+                  renderer_description));
+  return out;
+}
+
+void NodeProtocol::on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out) {
+  auto state = scene::from_snapshot(resync.snapshot());
+  if (!state) {
+    out.push_back(Close{"bad snapshot from the master: " + state.error()});
+    return;
+  }
+  if (scene::state_hash(state.value()) != resync.state_hash()) {
+    out.push_back(Close{"the master's snapshot does not match its hash"});
+    return;
+  }
+  state_ = std::move(state).value();
+  past_frames_.clear();
+  next_frame_ = resync.next_frame_id();
+  if (phase_ == Phase::joined) {
+    // A repair between frames: the frame already rendered still swaps.
+    log(out, spdlog::level::info, "state resynchronized at frame " + std::to_string(next_frame_));
+    return;
+  }
+  rendered_any_ = false;
+  phase_ = Phase::joined;
+  estimator_ = clock::OffsetEstimator{};  // samples from an earlier connection may be from another master
+  unreachable_since_.reset();
+  attempts_ = 0;
+  backoff_ = kFirstBackoff;
+  out.push_back(CancelDeadline{});
+  out.push_back(
+      SetLiveness{liveness_timeout_, "master silent for " + std::to_string(liveness_timeout_.count()) + " ms"});
+  log(out, spdlog::level::info, "joined at frame " + std::to_string(next_frame_));
+  // A quick burst of pings to get a clock offset before the first swap.
+  pings_in_burst_ = kPingBurst;
+  send_ping(now, out);
+}
+
+void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, Actions& out) {
+  if (begin.frame_id() != next_frame_) {
+    log(out, spdlog::level::warn,
+        "frame ids jumped from " + std::to_string(next_frame_) + " to " + std::to_string(begin.frame_id()));
+  }
+  next_frame_ = begin.frame_id() + 1;
+  if (auto applied = scene::apply_delta(state_, begin.delta()); !applied) {
+    out.push_back(Close{"cannot apply frame " + std::to_string(begin.frame_id()) + ": " + applied.error()});
+    return;
+  }
+  if (settings_.corrupt_state_at_frame != 0 && begin.frame_id() == settings_.corrupt_state_at_frame) {
+    state_.eye_now.x += 1e-3;
+  }
+  last_hash_ = scene::state_hash(state_);
+  if (last_hash_ != begin.state_hash()) {
+    log(out, spdlog::level::warn,
+        fmt::format("state hash {:016x} differs from the master's {:016x} at frame {}", last_hash_, begin.state_hash(),
+                    begin.frame_id()));
+  }
+  // A node that lags shows an older frame's content (the light share applies at
+  // once: it is how this node's light is split, not content).
+  const wire::FrameBegin* shown = &begin;
+  const scene::SceneState* shown_state = &state_;
+  if (settings_.lag_frames > 0) {
+    past_frames_.push_back({begin, state_});
+    while (past_frames_.size() > settings_.lag_frames + 1) past_frames_.pop_front();
+    shown = &past_frames_.front().begin;
+    shown_state = &past_frames_.front().state;
+  }
+  FrameInput input;
+  input.frame_id = begin.frame_id();
+  input.simulation_time = shown->simulation_time_ns();
+  input.present_time = shown->present_time_ns();
+  input.frame_period = frame_period_;
+  input.state = shown_state;
+  input.capture = begin.capture();
+  if (shown->has_focus()) {
+    auto focus = protocol::decode_focus(shown->focus());
+    if (!focus) {
+      out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": " + focus.error()});
+      return;
+    }
+    input.focus = focus.value();
+  }
+  share_.reset();
+  if (begin.has_lights()) {
+    auto share = protocol::decode_light_share(begin.lights(), job_ ? job_->light_count : 0);
+    if (!share) {
+      out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": lights: " + share.error()});
+      return;
+    }
+    share_ = std::move(share).value();
+    input.lights = &*share_;
+  }
+  last_content_frame_ = shown->frame_id();
+  rendering_ = input;
+  out.push_back(Render{input});
+}
+
+Actions NodeProtocol::rendered(std::uint64_t frame_id, clock::Nanos render_time) {
+  Actions out;
+  if (!rendering_ || rendering_->frame_id != frame_id) return out;
+  rendering_.reset();
+  last_rendered_ = frame_id;
+  rendered_any_ = true;
+  if (phase_ != Phase::joined || !connection_open_) return out;
+  wire::Envelope envelope;
+  auto& ready = *envelope.mutable_frame_ready();
+  ready.set_frame_id(frame_id);
+  ready.set_render_ns(render_time);
+  ready.set_state_hash(last_hash_);
+  out.push_back(Send{std::move(envelope)});
+  return out;
+}
+
+void NodeProtocol::on_swap(const wire::FrameSwap& swap, clock::Nanos now, Actions& out) {
+  if (!rendered_any_ || swap.frame_id() != last_rendered_) {
+    log(out, spdlog::level::warn,
+        "swap for frame " + std::to_string(swap.frame_id()) + " but the last rendered frame is " +
+            std::to_string(last_rendered_) + "; not presenting");
+    return;
+  }
+  const std::optional<clock::ClockEstimate> estimate = estimator_.at(settings_.clock.to_local(now));
+  const clock::Nanos to_master = estimate ? estimate->offset : 0;
+  clock::Nanos deadline = settings_.clock.to_monotonic(swap.present_deadline_ns() - to_master);
+  // Never wait on a deadline from a broken or hostile master for longer than a
+  // few frames.
+  const clock::Nanos longest = std::max<clock::Nanos>(4 * frame_period_, 100 * clock::kNanosPerMilli);
+  if (deadline > now + longest) {
+    log(out, spdlog::level::warn,
+        fmt::format("swap for frame {} asks to present {:.1f} ms from now; presenting in {:.1f} ms", swap.frame_id(),
+                    static_cast<double>(deadline - now) / 1e6, static_cast<double>(longest) / 1e6));
+    deadline = now + longest;
+  }
+  pending_ = Pending{swap.frame_id(), deadline, swap.present_deadline_ns(), false};
+  // Checked here and again when the deadline comes: a stop can stretch the wait too.
+  if (stale(now, out)) {
+    pending_.reset();
+    return;
+  }
+  out.push_back(PresentAt{swap.frame_id(), deadline});
+}
+
+bool NodeProtocol::stale(clock::Nanos now, Actions& out) const {
+  if (now <= pending_->deadline + frame_period_) return false;
+  log(out, spdlog::level::warn,
+      fmt::format("frame {}'s present deadline passed {:.1f} ms ago: not showing a stale frame", pending_->frame_id,
+                  static_cast<double>(now - pending_->deadline) / 1e6));
+  return true;
+}
+
+Actions NodeProtocol::present_due(clock::Nanos now) {
+  Actions out;
+  if (!pending_ || pending_->due) return out;
+  if (stale(now, out)) {
+    pending_.reset();
+  } else {
+    pending_->due = true;
+    out.push_back(Present{});
+    return out;
+  }
+  release_held(now, out);  // not shown: what waited behind it goes on
+  return out;
+}
+
+// What came while a frame waited for its deadline, in order, until one of them
+// waits again.
+void NodeProtocol::release_held(clock::Nanos now, Actions& out) {
+  while (!held_.empty() && !pending_) {
+    wire::Envelope next = std::move(held_.front());
+    held_.pop_front();
+    Actions more = message(next, now);
+    out.insert(out.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
+  }
+}
+
+Actions NodeProtocol::presented(clock::Nanos now) {
+  Actions out;
+  if (!pending_ || !pending_->due) return out;
+  const Pending shown = *pending_;
+  pending_.reset();
+  const clock::Nanos local = settings_.clock.to_local(now);
+  // The offset drifts while the node waits for the deadline: convert at this instant.
+  const std::optional<clock::ClockEstimate> estimate = estimator_.at(local);
+  const clock::Nanos offset = estimate ? estimate->offset : 0;
+  const clock::Nanos presented_at = local + offset;
+  if (connection_open_ && phase_ == Phase::joined) {
+    wire::Envelope envelope;
+    auto& report = *envelope.mutable_presented();
+    report.set_frame_id(shown.frame_id);
+    report.set_presented_ns(presented_at);
+    report.set_content_frame_id(last_content_frame_);
+    report.set_clock_offset_ns(offset);
+    if (estimate) {
+      report.set_clock_rtt_ns(estimate->round_trip);
+      report.set_clock_drift_ppm(estimate->drift_ppm);
+      report.set_clock_error_bound_ns(estimate->error_bound);
+    }
+    if (settings_.clock.skewed()) {
+      report.set_clock_truth_known(true);
+      report.set_clock_true_error_ns(offset - (now - local));
+    }
+    out.push_back(Send{std::move(envelope)});
+    log(out, spdlog::level::debug,
+        fmt::format("presented frame {} at master time {} ns ({:+.1f} µs from the deadline)", shown.frame_id,
+                    presented_at, static_cast<double>(presented_at - shown.master_deadline) / 1e3));
+  }
+  release_held(now, out);
+  return out;
+}
+
+// ---------------------------------------------------------------- clock
+
+void NodeProtocol::send_ping(clock::Nanos now, Actions& out) {
+  if (phase_ != Phase::joined || !connection_open_) return;
+  wire::Envelope envelope;
+  envelope.mutable_ping()->set_t1(settings_.clock.to_local(now));
+  out.push_back(Send{std::move(envelope)});
+  if (pings_in_burst_ > 0) --pings_in_burst_;
+  out.push_back(PingIn{pings_in_burst_ > 0 ? kBurstInterval : std::min(heartbeat_, kPingInterval)});
+}
+
+Actions NodeProtocol::ping_due(clock::Nanos now) {
+  Actions out;
+  send_ping(now, out);
+  return out;
+}
+
+void NodeProtocol::on_pong(const wire::Pong& pong, clock::Nanos now, Actions& out) {
+  const clock::PingSample sample{pong.t1(), pong.t2(), pong.t3(), settings_.clock.to_local(now)};
+  if (!estimator_.add(sample)) log(out, spdlog::level::debug, "dropped an impossible clock sample");
+}
+
+}  // namespace optique::node

@@ -1,0 +1,200 @@
+#pragma once
+// The node's side of the protocol, without sockets, timers or GL: it takes events
+// (connected, a message, closed, the ping timer, a present deadline reached,
+// rendered, configured, a signal) with the time they happened, and answers with
+// actions for its shell (node/node.h) to carry out, in order, before the next
+// event: send, close, arm a deadline, render, present at, reconnect, stop, log.
+// So every rule — the handshake, joining and rejoining, applying the state,
+// which frames are shown and when, the clock estimate, giving up — is tested in
+// microseconds (tests/unit/test_node_protocol.cpp).
+
+#include <spdlog/common.h>
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "clock/clock.h"
+#include "clock/offset_estimator.h"
+#include "net/auth.h"
+#include "net/envelope.h"
+#include "node/renderer.h"
+#include "optique/wire.pb.h"
+#include "protocol/welcome.h"
+#include "scene/state.h"
+
+namespace optique::node {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitRefused = 2;   // refused by the master, or bad command line
+inline constexpr int kExitNoMaster = 3;  // gave up reaching the master
+
+struct NodeSettings {
+  std::string master;  // HOST:PORT, for messages
+  std::string id;
+  std::chrono::milliseconds give_up_after{10000};          // master unreachable this long: stop
+  std::uint32_t protocol_version = net::kProtocolVersion;  // test hook: speak another version
+  std::optional<net::Secret> secret;                       // proves to the master this node belongs
+  clock::LocalClock clock;                                 // test hook: a skewed clock
+  // Test hook: show the content of this many frames ago, as a node out of step
+  // with its stacked partners would (reported in Presented.content_frame_id).
+  std::uint32_t lag_frames = 0;
+  // Test hook: nudge the scene state at this frame, as a bit flip or a bug would,
+  // to see the master notice and repair it (0: never).
+  std::uint64_t corrupt_state_at_frame = 0;
+  // When the master is lost: show black (a frozen wall looks like a fault in the
+  // show), or keep the last frame.
+  bool hold_last_frame = false;
+};
+
+// --- actions
+
+struct Send {
+  wire::Envelope message;
+};
+struct Close {
+  std::string reason;
+  bool after_sending = false;  // let what is queued (a goodbye) go first
+};
+// A one-shot deadline on the connection: it closes with `reason` unless cancelled.
+struct SetDeadline {
+  std::chrono::milliseconds after{0};
+  std::string reason;
+};
+struct CancelDeadline {};
+// The connection closes with `reason` when nothing arrives for `timeout`.
+struct SetLiveness {
+  std::chrono::milliseconds timeout{0};
+  std::string reason;
+};
+// Set the renderer up for the job; answer with configured().
+struct Configure {
+  protocol::NodeJob job;
+};
+// Draw the frame; answer with rendered(). The frame's state lives in the core
+// until the next event.
+struct Render {
+  FrameInput frame;
+};
+// Wait, without holding up other events, until the monotonic time `deadline`;
+// then answer with present_due().
+struct PresentAt {
+  std::uint64_t frame_id = 0;
+  clock::Nanos deadline = 0;
+};
+// Show the rendered frame now; answer with presented().
+struct Present {};
+struct ShowBlack {};
+struct PingIn {
+  std::chrono::milliseconds after{0};
+};
+struct CancelPings {};
+struct Reconnect {
+  std::chrono::milliseconds after{0};
+};
+struct Stop {
+  int exit_code = kExitOk;
+};
+struct Log {
+  spdlog::level::level_enum level = spdlog::level::info;
+  std::string text;
+};
+
+using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, Configure, Render, PresentAt,
+                            Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log>;
+using Actions = std::vector<Action>;
+
+class NodeProtocol {
+ public:
+  // How long the handshake and the state may take to arrive.
+  static constexpr std::chrono::milliseconds kHandshakeTimeout{5000};
+  static constexpr std::chrono::milliseconds kFirstBackoff{100};
+  static constexpr std::chrono::milliseconds kMaxBackoff{2000};
+  static constexpr int kPingBurst = 8;  // pings 5 ms apart on joining: an offset before the first swap
+  static constexpr std::chrono::milliseconds kBurstInterval{5};
+  // Forty a second: several samples in each 200 ms bucket of the drift fit, so
+  // that its quietest is really quiet (the skewed-clock test's worst error fell
+  // from 42 to 14 µs going from ten a second to forty).
+  static constexpr std::chrono::milliseconds kPingInterval{25};
+
+  explicit NodeProtocol(NodeSettings settings);
+
+  // Times are this machine's monotonic clock (clock::monotonic_now()).
+  [[nodiscard]] Actions connected(clock::Nanos now);
+  [[nodiscard]] Actions connect_failed(const std::string& reason, clock::Nanos now);
+  [[nodiscard]] Actions message(const wire::Envelope& message, clock::Nanos now);
+  [[nodiscard]] Actions closed(const std::string& reason, clock::Nanos now);
+  [[nodiscard]] Actions configured(const Result<void>& result, const std::string& renderer_description);
+  [[nodiscard]] Actions rendered(std::uint64_t frame_id, clock::Nanos render_time);
+  [[nodiscard]] Actions ping_due(clock::Nanos now);
+  [[nodiscard]] Actions present_due(clock::Nanos now);
+  [[nodiscard]] Actions presented(clock::Nanos now);
+  // SIGINT or SIGTERM: say goodbye and stop.
+  [[nodiscard]] Actions interrupted(const std::string& signal_name);
+
+  [[nodiscard]] bool stopped() const { return phase_ == Phase::stopped; }
+  [[nodiscard]] bool joined() const { return phase_ == Phase::joined; }
+  [[nodiscard]] const scene::SceneState& state() const { return state_; }
+  [[nodiscard]] const clock::OffsetEstimator& estimator() const { return estimator_; }
+
+ private:
+  enum class Phase { disconnected, awaiting_challenge, awaiting_welcome, configuring, awaiting_state, joined, stopped };
+
+  void on_challenge(const wire::Envelope& message, Actions& out);
+  void on_welcome(const wire::Welcome& welcome, Actions& out);
+  void on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out);
+  void on_frame_begin(const wire::FrameBegin& begin, Actions& out);
+  void on_swap(const wire::FrameSwap& swap, clock::Nanos now, Actions& out);
+  void on_pong(const wire::Pong& pong, clock::Nanos now, Actions& out);
+  void send_ping(clock::Nanos now, Actions& out);
+  // Held up past the next frame's time (the process was stopped, the machine
+  // stalled): showing it would put an old frame beside its partners' new one.
+  [[nodiscard]] bool stale(clock::Nanos now, Actions& out) const;
+  void release_held(clock::Nanos now, Actions& out);
+  void stop(int exit_code, const std::string& reason, Actions& out);
+  void log(Actions& out, spdlog::level::level_enum level, std::string text) const;
+
+  NodeSettings settings_;
+  Phase phase_ = Phase::disconnected;
+  bool connection_open_ = false;
+  std::optional<protocol::NodeJob> job_;
+  scene::SceneState state_;
+  // The lag hook's memory: the last lag_frames + 1 frames as they came.
+  struct PastFrame {
+    wire::FrameBegin begin;
+    scene::SceneState state;
+  };
+  std::deque<PastFrame> past_frames_;
+  std::optional<protocol::LightShare> share_;  // a new share that the frame being rendered starts
+  std::optional<FrameInput> rendering_;        // between Render and rendered()
+  std::uint64_t last_content_frame_ = 0;
+  std::uint64_t next_frame_ = 0;
+  std::uint64_t last_rendered_ = 0;
+  bool rendered_any_ = false;
+  std::uint64_t last_hash_ = 0;
+  clock::OffsetEstimator estimator_;
+  clock::Nanos frame_period_ = 0;
+  std::chrono::milliseconds heartbeat_{250};
+  std::chrono::milliseconds liveness_timeout_{3000};
+  int pings_in_burst_ = 0;
+  // A frame waiting for its present deadline, and the messages that came
+  // meanwhile and must not touch the frame before it is shown.
+  struct Pending {
+    std::uint64_t frame_id = 0;
+    clock::Nanos deadline = 0;         // monotonic, clamped
+    clock::Nanos master_deadline = 0;  // as the master gave it
+    bool due = false;                  // present_due() came; presented() is next
+  };
+  std::optional<Pending> pending_;
+  std::deque<wire::Envelope> held_;
+
+  std::chrono::milliseconds backoff_{kFirstBackoff};
+  std::optional<clock::Nanos> unreachable_since_;
+  int attempts_ = 0;
+};
+
+}  // namespace optique::node

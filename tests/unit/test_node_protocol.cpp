@@ -1,0 +1,407 @@
+// The node's side of the protocol without sockets (node/protocol.h): each rule the
+// process tests once checked by starting processes, as events in and actions out.
+
+#include "node/protocol.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+#include "config/load.h"
+#include "net/auth.h"
+#include "protocol/welcome.h"
+#include "scene/state.h"
+
+namespace optique::node {
+namespace {
+
+constexpr clock::Nanos kMs = clock::kNanosPerMilli;
+constexpr clock::Nanos kPeriod = 16'666'666;
+
+template <class T>
+std::vector<const T*> all_of(const Actions& actions) {
+  std::vector<const T*> found;
+  for (const Action& a : actions) {
+    if (const T* t = std::get_if<T>(&a)) found.push_back(t);
+  }
+  return found;
+}
+
+template <class T>
+const T* first(const Actions& actions) {
+  const auto found = all_of<T>(actions);
+  return found.empty() ? nullptr : found.front();
+}
+
+// The messages the actions send, of one kind.
+std::vector<wire::Envelope> sent(const Actions& actions, wire::Envelope::BodyCase kind) {
+  std::vector<wire::Envelope> out;
+  for (const Send* s : all_of<Send>(actions)) {
+    if (s->message.body_case() == kind) out.push_back(s->message);
+  }
+  return out;
+}
+
+bool logged(const Actions& actions, const std::string& fragment) {
+  for (const Log* l : all_of<Log>(actions)) {
+    if (l->text.find(fragment) != std::string::npos) return true;
+  }
+  return false;
+}
+
+wire::Envelope envelope() {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  return e;
+}
+
+config::Installation wall() {
+  auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-2x2.json");
+  EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
+  return loaded ? loaded.value().installation : config::Installation{};
+}
+
+// A node and its master's side of the conversation, by hand.
+class NodeTest : public ::testing::Test {
+ protected:
+  NodeSettings settings() {
+    NodeSettings s;
+    s.master = "127.0.0.1:7400";
+    s.id = "bottom-left";
+    return s;
+  }
+
+  // Through the handshake to joined at frame `next`, with the scene state `state`.
+  void join(NodeProtocol& node, std::uint64_t next = 0) {
+    Actions a = node.connected(now_);
+    ASSERT_NE(first<SetDeadline>(a), nullptr);
+    wire::Envelope challenge = envelope();
+    challenge.mutable_challenge()->set_nonce(std::string(32, 'n'));
+    a = node.message(challenge, now_);
+    ASSERT_EQ(sent(a, wire::Envelope::kHello).size(), 1u);
+    wire::Envelope welcome = envelope();
+    *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, "", 4, kPeriod, nullptr);
+    a = node.message(welcome, now_);
+    ASSERT_NE(first<Configure>(a), nullptr);
+    a = node.configured({}, "test renderer");
+    ASSERT_EQ(sent(a, wire::Envelope::kConfigured).size(), 1u);
+    wire::Envelope resync = envelope();
+    *resync.mutable_resync()->mutable_snapshot() = scene::to_snapshot(state_);
+    resync.mutable_resync()->set_next_frame_id(next);
+    resync.mutable_resync()->set_state_hash(scene::state_hash(state_));
+    a = node.message(resync, now_);
+    ASSERT_TRUE(node.joined());
+    ASSERT_NE(first<SetLiveness>(a), nullptr);
+    ASSERT_EQ(sent(a, wire::Envelope::kPing).size(), 1u);
+  }
+
+  // The master answers a ping `one_way` later, holding it `hold`; the pong comes back `one_way` after that.
+  void pong(NodeProtocol& node, clock::Nanos one_way, clock::Nanos hold, clock::Nanos master_ahead) {
+    Actions a = node.ping_due(now_);
+    const auto pings = sent(a, wire::Envelope::kPing);
+    ASSERT_EQ(pings.size(), 1u);
+    wire::Envelope reply = envelope();
+    auto& p = *reply.mutable_pong();
+    p.set_t1(pings.front().ping().t1());
+    p.set_t2(now_ + one_way + master_ahead);
+    p.set_t3(now_ + one_way + hold + master_ahead);
+    now_ += 2 * one_way + hold;
+    (void)node.message(reply, now_);
+  }
+
+  Actions begin(NodeProtocol& node, std::uint64_t frame) {
+    wire::Envelope e = envelope();
+    auto& b = *e.mutable_frame_begin();
+    b.set_frame_id(frame);
+    b.set_simulation_time_ns(static_cast<clock::Nanos>(frame) * kPeriod);
+    b.set_state_hash(scene::state_hash(state_));
+    return node.message(e, now_);
+  }
+
+  Actions swap(NodeProtocol& node, std::uint64_t frame, clock::Nanos master_deadline) {
+    wire::Envelope e = envelope();
+    e.mutable_swap()->set_frame_id(frame);
+    e.mutable_swap()->set_present_deadline_ns(master_deadline);
+    return node.message(e, now_);
+  }
+
+  config::Installation wall_ = wall();
+  scene::SceneState state_;
+  clock::Nanos now_ = 1'000'000 * kMs;
+};
+
+TEST_F(NodeTest, HandshakeAnswersTheChallengeWithItsMacAndJoinsOnTheState) {
+  NodeSettings s = settings();
+  s.secret = net::Secret{std::vector<std::uint8_t>(32, 7)};
+  NodeProtocol node(s);
+  (void)node.connected(now_);
+  wire::Envelope challenge = envelope();
+  const std::string nonce(32, 'x');
+  challenge.mutable_challenge()->set_nonce(nonce);
+  challenge.mutable_challenge()->set_secret_required(true);
+  const auto hello = sent(node.message(challenge, now_), wire::Envelope::kHello);
+  ASSERT_EQ(hello.size(), 1u);
+  EXPECT_EQ(hello.front().hello().node_id(), "bottom-left");
+  const std::string& mac = hello.front().hello().nonce_mac();
+  EXPECT_TRUE(net::verify_hello_mac(*s.secret, std::span(reinterpret_cast<const std::uint8_t*>(nonce.data()), 32),
+                                    "bottom-left", net::kProtocolVersion,
+                                    std::span(reinterpret_cast<const std::uint8_t*>(mac.data()), mac.size())));
+  // A second challenge is a broken master.
+  EXPECT_NE(first<Close>(node.message(challenge, now_)), nullptr);
+}
+
+TEST_F(NodeTest, ASecretTheNodeLacksStopsIt) {
+  NodeProtocol node(settings());
+  (void)node.connected(now_);
+  wire::Envelope challenge = envelope();
+  challenge.mutable_challenge()->set_secret_required(true);
+  const Actions a = node.message(challenge, now_);
+  ASSERT_NE(first<Stop>(a), nullptr);
+  EXPECT_EQ(first<Stop>(a)->exit_code, kExitRefused);
+  EXPECT_TRUE(logged(a, "--secret-file"));
+}
+
+TEST_F(NodeTest, ABadWelcomeStopsTheNodeNamingTheField) {
+  NodeProtocol node(settings());
+  (void)node.connected(now_);
+  wire::Envelope challenge = envelope();
+  challenge.mutable_challenge();
+  ASSERT_EQ(sent(node.message(challenge, now_), wire::Envelope::kHello).size(), 1u);
+  wire::Envelope welcome = envelope();
+  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, "", 4, kPeriod, nullptr);
+  welcome.mutable_welcome()->mutable_screen()->set_width(-2.0);
+  const Actions a = node.message(welcome, now_);
+  ASSERT_NE(first<Stop>(a), nullptr);
+  EXPECT_EQ(first<Stop>(a)->exit_code, kExitRefused);
+  EXPECT_TRUE(logged(a, "screens[0].width: must be > 0")) << "the message names the field";
+  EXPECT_EQ(first<Configure>(a), nullptr);
+}
+
+TEST_F(NodeTest, RefusalsGoodbyesAndOtherVersions) {
+  {
+    NodeProtocol node(settings());
+    (void)node.connected(now_);
+    wire::Envelope refuse = envelope();
+    refuse.mutable_refuse()->set_reason("projector 'bottom-left' is already driven");
+    refuse.mutable_refuse()->set_retriable(true);
+    Actions a = node.message(refuse, now_);
+    ASSERT_NE(first<Close>(a), nullptr);
+    EXPECT_EQ(first<Stop>(a), nullptr);
+    refuse.mutable_refuse()->set_retriable(false);
+    (void)node.connected(now_);
+    a = node.message(refuse, now_);
+    ASSERT_NE(first<Stop>(a), nullptr);
+    EXPECT_EQ(first<Stop>(a)->exit_code, kExitRefused);
+  }
+  {
+    NodeProtocol node(settings());
+    join(node);
+    wire::Envelope goodbye = envelope();
+    goodbye.mutable_goodbye()->set_reason("ran 300 frames");
+    const Actions a = node.message(goodbye, now_);
+    ASSERT_NE(first<Stop>(a), nullptr);
+    EXPECT_EQ(first<Stop>(a)->exit_code, kExitOk);
+    EXPECT_TRUE(node.stopped());
+    EXPECT_TRUE(node.message(goodbye, now_).empty()) << "a stopped node does nothing";
+  }
+  {
+    NodeProtocol node(settings());
+    join(node);
+    wire::Envelope other = envelope();
+    other.set_protocol_version(net::kProtocolVersion + 1);
+    other.mutable_heartbeat();
+    const Actions a = node.message(other, now_);
+    ASSERT_NE(first<Stop>(a), nullptr);
+    EXPECT_EQ(first<Stop>(a)->exit_code, kExitRefused);
+  }
+}
+
+TEST_F(NodeTest, AFrameIsRenderedReportedAndShownAtItsDeadline) {
+  NodeProtocol node(settings());
+  join(node, 5);
+  // The master's clock is 3 s ahead; loopback takes 20 µs each way.
+  for (int i = 0; i < 8; ++i) pong(node, 20'000, 5'000, 3'000 * kMs);
+  Actions a = begin(node, 5);
+  const Render* render = first<Render>(a);
+  ASSERT_NE(render, nullptr);
+  EXPECT_EQ(render->frame.frame_id, 5u);
+  EXPECT_EQ(render->frame.state, &node.state());
+  a = node.rendered(5, 3 * kMs);
+  const auto ready = sent(a, wire::Envelope::kFrameReady);
+  ASSERT_EQ(ready.size(), 1u);
+  EXPECT_EQ(ready.front().frame_ready().state_hash(), scene::state_hash(state_));
+  EXPECT_EQ(ready.front().frame_ready().render_ns(), 3 * kMs);
+
+  // Present 2 ms from now on the master's clock: 2 ms from now on the node's.
+  const clock::Nanos master_deadline = now_ + 3'000 * kMs + 2 * kMs;
+  a = swap(node, 5, master_deadline);
+  const PresentAt* at = first<PresentAt>(a);
+  ASSERT_NE(at, nullptr);
+  EXPECT_NEAR(static_cast<double>(at->deadline - now_), 2e6, 1e3) << "the offset estimate converts the deadline";
+  now_ = at->deadline;
+  a = node.present_due(now_);
+  ASSERT_NE(first<Present>(a), nullptr);
+  a = node.presented(now_ + 10'000);
+  const auto reports = sent(a, wire::Envelope::kPresented);
+  ASSERT_EQ(reports.size(), 1u);
+  EXPECT_EQ(reports.front().presented().frame_id(), 5u);
+  EXPECT_NEAR(static_cast<double>(reports.front().presented().presented_ns() - master_deadline), 10e3, 1e3);
+  EXPECT_TRUE(node.presented(now_).empty()) << "shown once";
+}
+
+TEST_F(NodeTest, AFrameThatComesWhileOneWaitsForItsDeadlineWaitsForIt) {
+  NodeProtocol node(settings());
+  join(node);
+  (void)begin(node, 0);
+  (void)node.rendered(0, kMs);
+  Actions a = swap(node, 0, now_ + 2 * kMs);
+  ASSERT_NE(first<PresentAt>(a), nullptr);
+  // Frame 1 arrives early (a master behind schedule): not drawn over frame 0.
+  a = begin(node, 1);
+  EXPECT_EQ(first<Render>(a), nullptr);
+  // A pong meanwhile is taken at once: the clock estimate does not wait.
+  pong(node, 20'000, 5'000, 0);
+  EXPECT_GE(node.estimator().size(), 1u);
+  now_ += 2 * kMs;
+  a = node.present_due(now_);
+  ASSERT_NE(first<Present>(a), nullptr);
+  a = node.presented(now_);
+  ASSERT_EQ(sent(a, wire::Envelope::kPresented).size(), 1u);
+  const Render* render = first<Render>(a);
+  ASSERT_NE(render, nullptr) << "frame 1 is drawn once frame 0 is shown";
+  EXPECT_EQ(render->frame.frame_id, 1u);
+}
+
+TEST_F(NodeTest, AStaleFrameIsNotShown) {
+  NodeProtocol node(settings());
+  join(node);
+  (void)begin(node, 0);
+  (void)node.rendered(0, kMs);
+  // The deadline passed more than a frame ago already (the process was stopped).
+  Actions a = swap(node, 0, now_ - 2 * kPeriod);
+  EXPECT_EQ(first<PresentAt>(a), nullptr);
+  EXPECT_TRUE(logged(a, "not showing a stale frame"));
+  // Or the wait itself was stretched past the next frame's time.
+  (void)begin(node, 1);
+  (void)node.rendered(1, kMs);
+  a = swap(node, 1, now_ + 2 * kMs);
+  ASSERT_NE(first<PresentAt>(a), nullptr);
+  now_ += 2 * kMs + kPeriod + kMs;
+  a = node.present_due(now_);
+  EXPECT_EQ(first<Present>(a), nullptr);
+  EXPECT_TRUE(logged(a, "not showing a stale frame"));
+}
+
+TEST_F(NodeTest, ASwapForAFrameNotRenderedIsNotShown) {
+  NodeProtocol node(settings());
+  join(node);
+  (void)begin(node, 0);
+  (void)node.rendered(0, kMs);
+  const Actions a = swap(node, 7, now_ + 2 * kMs);
+  EXPECT_EQ(first<PresentAt>(a), nullptr);
+  EXPECT_TRUE(logged(a, "swap for frame 7 but the last rendered frame is 0"));
+}
+
+TEST_F(NodeTest, ADeadlineFarAwayIsCutToFourFrames) {
+  NodeProtocol node(settings());
+  join(node);
+  (void)begin(node, 0);
+  (void)node.rendered(0, kMs);
+  const Actions a = swap(node, 0, now_ + 60'000 * kMs);
+  const PresentAt* at = first<PresentAt>(a);
+  ASSERT_NE(at, nullptr);
+  EXPECT_EQ(at->deadline - now_, 100 * kMs);  // four frames at 60 Hz are less than the 100 ms floor
+  EXPECT_TRUE(logged(a, "presenting in 100.0 ms"));
+}
+
+TEST_F(NodeTest, BadFrameInputClosesTheConnection) {
+  NodeProtocol node(settings());
+  join(node);
+  wire::Envelope e = envelope();
+  auto& b = *e.mutable_frame_begin();
+  b.set_frame_id(0);
+  b.mutable_lights()->add_lights(4);  // the welcome said the scene has 4 lights: 0-3
+  Actions a = node.message(e, now_);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_NE(first<Close>(a)->reason.find("light 4 does not exist"), std::string::npos) << first<Close>(a)->reason;
+  EXPECT_EQ(first<Render>(a), nullptr);
+
+  NodeProtocol other(settings());
+  join(other);
+  wire::Envelope nan = envelope();
+  nan.mutable_frame_begin()->mutable_focus()->set_depth(std::numeric_limits<double>::quiet_NaN());
+  a = other.message(nan, now_);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_NE(first<Close>(a)->reason.find("focus depth"), std::string::npos);
+}
+
+TEST_F(NodeTest, LosingTheMasterShowsBlackAndReconnectsWithBackoffThenGivesUp) {
+  NodeProtocol node(settings());
+  join(node);
+  Actions a = node.closed("master silent for 3000 ms", now_);
+  EXPECT_NE(first<ShowBlack>(a), nullptr);
+  ASSERT_NE(first<Reconnect>(a), nullptr);
+  EXPECT_EQ(first<Reconnect>(a)->after, std::chrono::milliseconds(100));
+  std::vector<long> waits;
+  for (int i = 0; i < 8; ++i) {
+    now_ += 500 * kMs;
+    a = node.connect_failed("connection refused", now_);
+    if (const Reconnect* r = first<Reconnect>(a)) waits.push_back(r->after.count());
+  }
+  EXPECT_EQ(waits, (std::vector<long>{200, 400, 800, 1600, 2000, 2000, 2000, 2000}));
+  now_ += 7 * 1000 * kMs;  // 10.5 s unreachable in all
+  a = node.connect_failed("connection refused", now_);
+  ASSERT_NE(first<Stop>(a), nullptr);
+  EXPECT_EQ(first<Stop>(a)->exit_code, kExitNoMaster);
+  EXPECT_TRUE(logged(a, "gave up: the master at 127.0.0.1:7400 was not reachable"));
+
+  NodeSettings hold = settings();
+  hold.hold_last_frame = true;
+  NodeProtocol holding(hold);
+  join(holding);
+  a = holding.closed("reset", now_);
+  EXPECT_EQ(first<ShowBlack>(a), nullptr);
+  EXPECT_TRUE(logged(a, "holding the last frame"));
+}
+
+TEST_F(NodeTest, ALaggingNodeShowsAnOlderFramesContent) {
+  NodeSettings s = settings();
+  s.lag_frames = 2;
+  NodeProtocol node(s);
+  join(node);
+  for (std::uint64_t frame = 0; frame < 4; ++frame) {
+    const Actions a = begin(node, frame);
+    const Render* render = first<Render>(a);
+    ASSERT_NE(render, nullptr);
+    EXPECT_EQ(render->frame.simulation_time, static_cast<clock::Nanos>(frame >= 2 ? frame - 2 : 0) * kPeriod);
+    (void)node.rendered(frame, kMs);
+  }
+}
+
+TEST_F(NodeTest, InterruptedSaysGoodbye) {
+  NodeProtocol node(settings());
+  join(node);
+  const Actions a = node.interrupted("Terminated");
+  const auto goodbye = sent(a, wire::Envelope::kGoodbye);
+  ASSERT_EQ(goodbye.size(), 1u);
+  EXPECT_EQ(goodbye.front().goodbye().reason(), "node Terminated");
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_TRUE(first<Close>(a)->after_sending);
+  ASSERT_NE(first<Stop>(a), nullptr);
+  EXPECT_EQ(first<Stop>(a)->exit_code, kExitOk);
+}
+
+TEST_F(NodeTest, PingsComeInABurstOnJoiningThenFortyASecond) {
+  NodeProtocol node(settings());
+  join(node);
+  std::vector<long> intervals;
+  for (int i = 0; i < 10; ++i) {
+    const Actions a = node.ping_due(now_);
+    ASSERT_NE(first<PingIn>(a), nullptr);
+    intervals.push_back(first<PingIn>(a)->after.count());
+  }
+  EXPECT_EQ(intervals, (std::vector<long>{5, 5, 5, 5, 5, 5, 25, 25, 25, 25}));
+}
+
+}  // namespace
+}  // namespace optique::node
