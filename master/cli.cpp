@@ -49,7 +49,7 @@ int run_cli(int argc, char** argv) {
   bool no_status = false;
   app.add_option("-c,--config", config_path, "installation file (configs/*.json)");
   app.add_flag("--local", options.local, "start one optique-node per projector on this machine (127.0.0.1)");
-  app.add_option("-n,--frames", options.frames, "run this many frames, then shut down (default: until Ctrl-C)");
+  app.add_option("-n,--frames", options.run.frames, "run this many frames, then shut down (default: until Ctrl-C)");
   app.add_option("-o,--out", out_dir, "write run.json, frames.csv and logs here");
   app.add_option("--port", port, "listen on this port (0: ephemeral); overrides the config")
       ->check(CLI::Range(0, 65535));
@@ -63,7 +63,7 @@ int run_cli(int argc, char** argv) {
   app.add_option("--node-log-level", options.node_log_level, "log level for local nodes")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_flag("--no-status", no_status, "no live status line, even on a terminal");
-  app.add_option("--capture-every", options.capture_every,
+  app.add_option("--capture-every", options.run.capture_every,
                  "nodes write every K-th frame (frame 0, K, 2K, ...); with --local into OUT/nodes/<projector-id>/");
 
   std::vector<CLI::App*> tools;
@@ -108,7 +108,7 @@ int run_cli(int argc, char** argv) {
     std::cerr << config::describe_problems({{"master.secret_file", secret.error()}}, config_path) << "\n";
     return kExitUsage;
   }
-  options.secret = std::move(secret).value();
+  options.run.secret = std::move(secret).value();
   options.secret_path = secret_path(options.config);
   config::MasterSettings& settings = options.config.installation.master;
   if (options.local) {
@@ -129,13 +129,13 @@ int run_cli(int argc, char** argv) {
     }
     log_file = (std::filesystem::path(out_dir) / "master.log").string();
   }
-  if (options.local && options.capture_every != 0 && out_dir.empty()) {
+  if (options.local && options.run.capture_every != 0 && out_dir.empty()) {
     std::cerr << "optique-master: --capture-every with --local needs --out DIR (captures go to DIR/nodes/)\n";
     return kExitUsage;
   }
   options.out_dir = out_dir;
   // A --local run that captured frames also shows what the screens received.
-  const bool local_captures = options.local && options.capture_every != 0;
+  const bool local_captures = options.local && options.run.capture_every != 0;
   options.status_line = !no_status && isatty(STDERR_FILENO) == 1;
   auto logger = log::make_logger("master", log_level, log_file);
   // On a terminal, each log line first clears the status line (stderr only, not the log file).

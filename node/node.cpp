@@ -6,19 +6,14 @@
 #include <cstring>
 #include <thread>
 
+#include "util/overloaded.h"
+
 namespace optique::node {
 
 namespace {
 // A master host that drops connection attempts silently would keep a connect
 // pending for minutes of kernel retries: bound it.
 constexpr std::chrono::milliseconds kConnectTimeout{3000};
-
-template <class... Ts>
-struct Overloaded : Ts... {
-  using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
 
 }  // namespace
 
@@ -91,7 +86,7 @@ void Node::carry_out(Actions actions) {
 }
 
 void Node::carry_out(Action& action) {
-  std::visit(Overloaded{
+  std::visit(util::Overloaded{
                  [&](Send& a) {
                    if (connection_ && connection_->is_open()) connection_->send(a.message);
                  },

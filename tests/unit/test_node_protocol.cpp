@@ -7,6 +7,7 @@
 
 #include <algorithm>
 
+#include "actions.h"
 #include "config/load.h"
 #include "net/auth.h"
 #include "protocol/welcome.h"
@@ -18,20 +19,8 @@ namespace {
 constexpr clock::Nanos kMs = clock::kNanosPerMilli;
 constexpr clock::Nanos kPeriod = 16'666'666;
 
-template <class T>
-std::vector<const T*> all_of(const Actions& actions) {
-  std::vector<const T*> found;
-  for (const Action& a : actions) {
-    if (const T* t = std::get_if<T>(&a)) found.push_back(t);
-  }
-  return found;
-}
-
-template <class T>
-const T* first(const Actions& actions) {
-  const auto found = all_of<T>(actions);
-  return found.empty() ? nullptr : found.front();
-}
+using testing::all_of;
+using testing::first;
 
 // The messages the actions send, of one kind.
 std::vector<wire::Envelope> sent(const Actions& actions, wire::Envelope::BodyCase kind) {
@@ -42,12 +31,7 @@ std::vector<wire::Envelope> sent(const Actions& actions, wire::Envelope::BodyCas
   return out;
 }
 
-bool logged(const Actions& actions, const std::string& fragment) {
-  for (const Log* l : all_of<Log>(actions)) {
-    if (l->text.find(fragment) != std::string::npos) return true;
-  }
-  return false;
-}
+bool logged(const Actions& actions, const std::string& fragment) { return testing::logged<Log>(actions, fragment); }
 
 wire::Envelope envelope() {
   wire::Envelope e;

@@ -1,0 +1,214 @@
+#pragma once
+// The master's side of the protocol, without sockets, timers or processes: it
+// takes events (a connection accepted, a message, a connection closed, a timer
+// due, a local node's exit, an interrupt) with the time they happened, and
+// answers with actions for its shell (master/master.h) to carry out, in order:
+// send, close, set a connection's deadline, arm a timer, stop accepting, signal
+// the local nodes, finish, log. Every rule — admission and authentication, the
+// frame loop and its barrier, stragglers, rejoining and resyncing, the lights'
+// shares, shutting down — lives here and is tested in microseconds
+// (tests/unit/test_master_protocol.cpp).
+
+#include <spdlog/common.h>
+
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "clock/clock.h"
+#include "config/installation.h"
+#include "master/barrier.h"
+#include "master/exit_codes.h"
+#include "master/focus_schedule.h"
+#include "master/run_recorder.h"
+#include "master/scene_authority.h"
+#include "master/stacked_groups.h"
+#include "net/auth.h"
+#include "optique/report.pb.h"
+#include "optique/wire.pb.h"
+#include "scene/load_scene.h"
+
+namespace optique::master {
+
+// The largest frame a peer may send before its hello is accepted.
+inline constexpr std::uint32_t kMaxHelloBytes = 4096;
+// How long a node may take to set itself up (GL context, scene) after the welcome.
+inline constexpr std::chrono::seconds kConfigureTimeout{30};
+
+using PeerId = std::uint64_t;
+
+// The master's timers; arming one replaces its pending time.
+enum class Timer { startup, next_frame, barrier, last_presents, goodbye, heartbeat };
+
+// --- actions
+
+struct Send {
+  PeerId peer = 0;
+  wire::Envelope message;
+};
+struct Close {
+  PeerId peer = 0;
+  std::string reason;
+  bool after_sending = false;  // let what is queued (a refusal, a goodbye) go first
+};
+// A one-shot deadline on a connection: it closes with `reason` unless cancelled.
+struct SetDeadline {
+  PeerId peer = 0;
+  std::chrono::milliseconds after{0};
+  std::string reason;
+};
+struct CancelDeadline {
+  PeerId peer = 0;
+};
+struct SetLiveness {
+  PeerId peer = 0;
+  std::chrono::milliseconds timeout{0};
+  std::string reason;
+};
+struct SetMaxPayload {
+  PeerId peer = 0;
+  std::uint32_t bytes = 0;
+};
+struct Arm {
+  Timer timer = Timer::startup;
+  clock::Nanos at = 0;  // monotonic
+};
+struct Disarm {
+  Timer timer = Timer::startup;
+};
+struct StopAccepting {};
+struct SignalLocalNodes {
+  int signal = 0;
+};
+// The run is over: write the outputs (report()) and end with this status.
+struct Finish {
+  int exit_code = kExitOk;
+};
+struct Log {
+  spdlog::level::level_enum level = spdlog::level::info;
+  std::string text;
+};
+
+using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Arm, Disarm,
+                            StopAccepting, SignalLocalNodes, Finish, Log>;
+using Actions = std::vector<Action>;
+
+struct RunSettings {
+  std::uint64_t frames = 0;         // 0: until interrupted
+  std::uint64_t capture_every = 0;  // ask nodes to capture every K-th frame (0: never)
+  // Nodes must prove they hold it; without one only loopback peers are accepted.
+  std::optional<net::Secret> secret;
+};
+
+class MasterProtocol {
+ public:
+  // Keeps references to all four; they must outlive it.
+  MasterProtocol(const config::Installation& installation, const scene::LoadedScene& scene, RunSettings settings,
+                 RunRecorder& recorder);
+
+  // Times are the master's monotonic clock (clock::monotonic_now()), the
+  // protocol's clock.
+  [[nodiscard]] Actions start(clock::Nanos now);
+  // A connection came from `peer_text` (loopback: from this machine); `nonce` is
+  // fresh randomness for its challenge (net::random_nonce()).
+  [[nodiscard]] Actions accepted(PeerId peer, const std::string& peer_text, bool loopback,
+                                 const std::vector<std::uint8_t>& nonce, clock::Nanos now);
+  [[nodiscard]] Actions message(PeerId peer, const wire::Envelope& message, clock::Nanos now);
+  [[nodiscard]] Actions closed(PeerId peer, const std::string& reason, clock::Nanos now);
+  [[nodiscard]] Actions timer(Timer timer, clock::Nanos now);
+  // A local node process ended (`how`: "exited with status 2"; clean: status 0).
+  [[nodiscard]] Actions local_node_exited(const std::string& id, const std::string& how, bool clean,
+                                          const std::string& log_hint, clock::Nanos now);
+  // How many local node processes are still running (after spawning, reaping).
+  [[nodiscard]] Actions local_nodes_running(std::size_t count, clock::Nanos now);
+  // SIGINT or SIGTERM: the first finishes the frame and shuts down in order, a
+  // second stops at once.
+  [[nodiscard]] Actions interrupted(const std::string& signal_name, clock::Nanos now);
+
+  // For the status line and the outputs.
+  [[nodiscard]] std::uint64_t next_frame() const { return next_frame_; }
+  [[nodiscard]] std::size_t nodes_up() const;
+  [[nodiscard]] std::size_t projectors() const { return slots_.size(); }
+  [[nodiscard]] bool done() const { return state_ == RunState::done; }
+  [[nodiscard]] bool running() const { return state_ == RunState::running; }
+  // The run's summary (after Finish: every frame finalized).
+  [[nodiscard]] report::RunReport report() const;
+
+ private:
+  enum class Phase { handshake, configuring, joined, in_barrier, out_of_barrier };
+  enum class RunState { starting, running, draining, closing, done };
+
+  struct Session {
+    std::string peer_text;
+    std::optional<std::size_t> slot;
+    Phase phase = Phase::handshake;
+    std::vector<std::uint8_t> nonce;  // of its challenge
+    bool refused = false;             // said so in the log already
+  };
+  struct Slot {
+    std::optional<PeerId> peer;
+    std::optional<LightShare> sent_share;  // the share of the lights its node was last told
+  };
+
+  void on_hello(PeerId peer, Session& session, const wire::Envelope& message, clock::Nanos now, Actions& out);
+  void on_configured(PeerId peer, Session& session, const wire::Configured& configured, clock::Nanos now, Actions& out);
+  void on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now, Actions& out);
+  void on_presented(Session& session, const wire::Presented& presented);
+  void refuse(PeerId peer, Session& session, const std::string& node_id, const std::string& reason, bool retriable,
+              Actions& out);
+  void send_resync(PeerId peer, Actions& out) const;
+
+  void start_frames(clock::Nanos now, Actions& out);
+  void begin_frame(clock::Nanos now, Actions& out);
+  void on_barrier_timeout(clock::Nanos now, Actions& out);
+  void swap(clock::Nanos now, Actions& out);
+  void drain(const std::string& reason, clock::Nanos now, Actions& out);
+  void wait_for_last_presents(bool frames_ran, clock::Nanos now, Actions& out);
+  void say_goodbye(clock::Nanos now, Actions& out);
+  void fail(const std::string& reason, clock::Nanos now, Actions& out);
+  void finish_if_all_gone(Actions& out);
+  void finish(Actions& out);
+
+  // Shares automatic groups' lights among the nodes that are up (a node came or
+  // went: `force`); the changes go out with the next FrameBegin.
+  void rebalance_lights(bool force);
+  void log_light_switches(std::uint64_t frame, const wire::StateDelta& delta, Actions& out) const;
+  [[nodiscard]] bool up(const Slot& slot) const;  // through the handshake and configured
+  [[nodiscard]] std::string slot_id(std::size_t slot) const;
+  [[nodiscard]] Session* session_of(std::size_t slot);
+
+  const config::Installation& installation_;
+  const config::MasterSettings& config_;
+  const scene::LoadedScene& scene_;
+  RunSettings settings_;
+  RunRecorder& recorder_;
+
+  std::map<PeerId, Session> sessions_;
+  std::vector<Slot> slots_;
+  SceneAuthority authority_;
+  LightPlan light_plan_;
+  std::optional<FocusSchedule> focus_;
+  scene::SceneState current_state_;
+  std::uint64_t current_hash_ = 0;
+  Barrier barrier_;
+  std::vector<std::size_t> ready_for_swap_;
+
+  std::uint64_t next_frame_ = 0;
+  clock::Nanos frame_period_ = 0;
+  clock::Nanos schedule_origin_ = 0;
+  std::uint64_t schedule_origin_frame_ = 0;
+
+  RunState state_ = RunState::starting;
+  bool terminating_ = false;  // goodbye's grace is over: SIGTERM sent, SIGKILL next
+  std::string stopped_because_;
+  std::uint64_t refused_connections_ = 0;
+  std::size_t local_running_ = 0;
+  int interrupts_ = 0;
+  int exit_code_ = kExitOk;
+};
+
+}  // namespace optique::master

@@ -1,0 +1,426 @@
+// The master's side of the protocol without sockets (master/protocol.h): the
+// refusals, the barrier and its stragglers, rejoining, repairs and shutting down,
+// as events in and actions out.
+
+#include "master/protocol.h"
+
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <map>
+#include <set>
+
+#include "actions.h"
+#include "config/load.h"
+#include "master/run_config.h"
+#include "net/envelope.h"
+#include "protocol/welcome.h"
+
+namespace optique::master {
+namespace {
+
+constexpr clock::Nanos kMs = clock::kNanosPerMilli;
+
+using testing::all_of;
+using testing::first;
+
+// What `peer` is sent of one kind.
+std::vector<wire::Envelope> sent_to(const Actions& actions, PeerId peer, wire::Envelope::BodyCase kind) {
+  std::vector<wire::Envelope> out;
+  for (const Send* s : all_of<Send>(actions)) {
+    if (s->peer == peer && s->message.body_case() == kind) out.push_back(s->message);
+  }
+  return out;
+}
+
+bool logged(const Actions& actions, const std::string& fragment) { return testing::logged<Log>(actions, fragment); }
+
+const clock::Nanos* armed(const Actions& actions, Timer timer) {
+  for (const Arm* a : all_of<Arm>(actions)) {
+    if (a->timer == timer) return &a->at;
+  }
+  return nullptr;
+}
+
+wire::Envelope envelope() {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  return e;
+}
+
+// A master over a shipped config (changed by `change`), with nodes joined by hand.
+class MasterTest : public ::testing::Test {
+ protected:
+  void load(const std::string& name, const std::function<void(config::Installation&)>& change = {},
+            RunSettings settings = {}) {
+    auto loaded = load_run_config(std::string(OPTIQUE_SOURCE_DIR) + "/configs/" + name, {});
+    ASSERT_TRUE(loaded) << loaded.error();
+    run_ = std::move(loaded).value();
+    if (change) change(run_.config.installation);
+    std::vector<std::string> ids;
+    for (const auto& p : run_.config.installation.projectors) ids.push_back(p.id);
+    recorder_.emplace(ids, nullptr);
+    master_.emplace(run_.config.installation, run_.scene, std::move(settings), *recorder_);
+    (void)master_->start(now_);
+  }
+
+  // Connected and through the hello; returns what the hello brought.
+  Actions hello(PeerId peer, const std::string& id) {
+    (void)master_->accepted(peer, "127.0.0.1:" + std::to_string(40000 + peer), true, nonce_, now_);
+    wire::Envelope e = envelope();
+    e.mutable_hello()->set_node_id(id);
+    return master_->message(peer, e, now_);
+  }
+
+  Actions configured(PeerId peer) {
+    wire::Envelope e = envelope();
+    e.mutable_configured()->set_renderer("test");
+    return master_->message(peer, e, now_);
+  }
+
+  // Every projector of the config joined, peers 1, 2, …; returns the last join's actions.
+  Actions join_all() {
+    Actions last;
+    const auto& projectors = run_.config.installation.projectors;
+    for (std::size_t i = 0; i < projectors.size(); ++i) (void)hello(i + 1, projectors[i].id);
+    for (std::size_t i = 0; i < projectors.size(); ++i) last = configured(i + 1);
+    return last;
+  }
+
+  Actions ready(PeerId peer, std::uint64_t frame, std::uint64_t hash) {
+    wire::Envelope e = envelope();
+    e.mutable_frame_ready()->set_frame_id(frame);
+    e.mutable_frame_ready()->set_state_hash(hash);
+    return master_->message(peer, e, now_);
+  }
+
+  // The hash of the frame begun in `actions` for `peer`.
+  static std::uint64_t hash_of(const Actions& actions, PeerId peer) {
+    const auto begins = sent_to(actions, peer, wire::Envelope::kFrameBegin);
+    EXPECT_EQ(begins.size(), 1u);
+    return begins.empty() ? 0 : begins.front().frame_begin().state_hash();
+  }
+
+  RunConfig run_;
+  std::optional<RunRecorder> recorder_;
+  std::optional<MasterProtocol> master_;
+  clock::Nanos now_ = 5'000'000 * kMs;
+  std::vector<std::uint8_t> nonce_ = std::vector<std::uint8_t>(32, 3);
+};
+
+TEST_F(MasterTest, AConnectionGetsAChallengeAndADeadline) {
+  load("powerwall-2x2.json");
+  const Actions a = master_->accepted(1, "127.0.0.1:5000", true, nonce_, now_);
+  const auto challenge = sent_to(a, 1, wire::Envelope::kChallenge);
+  ASSERT_EQ(challenge.size(), 1u);
+  EXPECT_EQ(challenge.front().challenge().nonce(), std::string(32, '\3'));
+  EXPECT_FALSE(challenge.front().challenge().secret_required());
+  ASSERT_NE(first<SetMaxPayload>(a), nullptr);
+  EXPECT_EQ(first<SetMaxPayload>(a)->bytes, kMaxHelloBytes);
+  ASSERT_NE(first<SetDeadline>(a), nullptr);
+  EXPECT_EQ(first<SetDeadline>(a)->after, std::chrono::milliseconds(2000));
+}
+
+TEST_F(MasterTest, WithoutASecretOnlyThisMachineIsLetIn) {
+  load("powerwall-2x2.json");
+  const Actions a = master_->accepted(1, "10.0.0.7:5000", false, nonce_, now_);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_TRUE(sent_to(a, 1, wire::Envelope::kChallenge).empty());
+  EXPECT_TRUE(logged(a, "refused connection from 10.0.0.7:5000: no shared secret"));
+  EXPECT_TRUE(master_->closed(1, "closed", now_).empty()) << "refused once, logged once";
+  EXPECT_EQ(master_->report().connections_refused(), 1u);
+}
+
+TEST_F(MasterTest, TooManyWaitingToAuthenticateAreRefused) {
+  load("powerwall-2x2.json", [](config::Installation& i) { i.master.max_pending_connections = 2; });
+  (void)master_->accepted(1, "127.0.0.1:1", true, nonce_, now_);
+  (void)master_->accepted(2, "127.0.0.1:2", true, nonce_, now_);
+  const Actions a = master_->accepted(3, "127.0.0.1:3", true, nonce_, now_);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_TRUE(logged(a, "2 connections are already waiting to authenticate"));
+}
+
+TEST_F(MasterTest, EachWrongHelloIsRefusedWithItsReason) {
+  load("powerwall-2x2.json");
+  const auto refusal = [&](const Actions& a, PeerId peer) {
+    const auto r = sent_to(a, peer, wire::Envelope::kRefuse);
+    EXPECT_EQ(r.size(), 1u);
+    EXPECT_NE(first<Close>(a), nullptr);
+    return r.empty() ? wire::Refuse{} : r.front().refuse();
+  };
+  (void)master_->accepted(1, "127.0.0.1:1", true, nonce_, now_);
+  wire::Envelope ping = envelope();
+  ping.mutable_ping();
+  EXPECT_EQ(refusal(master_->message(1, ping, now_), 1).reason(), "expected hello, got ping");
+
+  (void)master_->accepted(2, "127.0.0.1:2", true, nonce_, now_);
+  wire::Envelope old = envelope();
+  old.set_protocol_version(net::kProtocolVersion - 1);
+  old.mutable_hello()->set_node_id("bottom-left");
+  EXPECT_NE(refusal(master_->message(2, old, now_), 2).reason().find("protocol version mismatch"), std::string::npos);
+
+  const wire::Refuse unknown = refusal(hello(3, "ceiling"), 3);
+  EXPECT_EQ(unknown.reason(),
+            "unknown projector id 'ceiling' (this installation has: bottom-left, bottom-right, top-left, top-right)");
+  EXPECT_FALSE(unknown.retriable());
+
+  (void)hello(4, "top-left");
+  const wire::Refuse taken = refusal(hello(5, "top-left"), 5);
+  EXPECT_NE(taken.reason().find("'top-left' is already driven by the node at 127.0.0.1:40004"), std::string::npos);
+  EXPECT_TRUE(taken.retriable()) << "it may come back once the other is gone";
+}
+
+TEST_F(MasterTest, TheSharedSecretIsChecked) {
+  RunSettings settings;
+  settings.secret = net::Secret{std::vector<std::uint8_t>(32, 9)};
+  load("powerwall-2x2.json", {}, settings);
+  const Actions challenge = master_->accepted(1, "10.0.0.7:5000", false, nonce_, now_);
+  ASSERT_EQ(sent_to(challenge, 1, wire::Envelope::kChallenge).size(), 1u) << "from anywhere, with the secret";
+  EXPECT_TRUE(sent_to(challenge, 1, wire::Envelope::kChallenge).front().challenge().secret_required());
+
+  wire::Envelope no_mac = envelope();
+  no_mac.mutable_hello()->set_node_id("top-left");
+  EXPECT_TRUE(logged(master_->message(1, no_mac, now_), "start the node with --secret-file"));
+
+  (void)master_->accepted(2, "10.0.0.8:5000", false, nonce_, now_);
+  wire::Envelope wrong = no_mac;
+  const auto bad =
+      net::hello_mac(net::Secret{std::vector<std::uint8_t>(32, 8)}, nonce_, "top-left", net::kProtocolVersion);
+  wrong.mutable_hello()->set_nonce_mac(bad.data(), bad.size());
+  EXPECT_TRUE(logged(master_->message(2, wrong, now_), "authentication failed"));
+
+  (void)master_->accepted(3, "10.0.0.9:5000", false, nonce_, now_);
+  wire::Envelope right = no_mac;
+  const auto good = net::hello_mac(*settings.secret, nonce_, "top-left", net::kProtocolVersion);
+  right.mutable_hello()->set_nonce_mac(good.data(), good.size());
+  EXPECT_EQ(sent_to(master_->message(3, right, now_), 3, wire::Envelope::kWelcome).size(), 1u);
+}
+
+TEST_F(MasterTest, AGoodHelloGetsItsJobAndTheStateOnceConfigured) {
+  load("powerwall-2x2.json");
+  Actions a = hello(1, "top-right");
+  const auto welcome = sent_to(a, 1, wire::Envelope::kWelcome);
+  ASSERT_EQ(welcome.size(), 1u);
+  auto job = protocol::decode_welcome(welcome.front().welcome(), "top-right");
+  ASSERT_TRUE(job.ok()) << job.error();
+  EXPECT_EQ(job.value().frame_period, 16'666'666);
+  ASSERT_NE(first<SetDeadline>(a), nullptr);
+  EXPECT_EQ(first<SetDeadline>(a)->after, std::chrono::seconds(30));
+  EXPECT_EQ(first<SetMaxPayload>(a)->bytes, 16u << 20);
+  a = configured(1);
+  EXPECT_NE(first<CancelDeadline>(a), nullptr);
+  ASSERT_NE(first<SetLiveness>(a), nullptr);
+  EXPECT_EQ(first<SetLiveness>(a)->timeout, std::chrono::milliseconds(3000));
+  const auto resync = sent_to(a, 1, wire::Envelope::kResync);
+  ASSERT_EQ(resync.size(), 1u);
+  EXPECT_EQ(resync.front().resync().next_frame_id(), 0u);
+  EXPECT_EQ(master_->nodes_up(), 1u);
+  EXPECT_FALSE(master_->running()) << "it waits for the other three";
+}
+
+TEST_F(MasterTest, FramesStartWhenAllAreUpAndSwapWhenAllAreReady) {
+  load("powerwall-2x2.json");
+  Actions a = join_all();
+  ASSERT_TRUE(master_->running());
+  const std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 4; ++p) ASSERT_EQ(sent_to(a, p, wire::Envelope::kFrameBegin).size(), 1u);
+  ASSERT_NE(armed(a, Timer::barrier), nullptr);
+  EXPECT_EQ(*armed(a, Timer::barrier), now_ + 500 * kMs);
+  for (PeerId p = 1; p <= 3; ++p) EXPECT_TRUE(sent_to(ready(p, 0, hash), p, wire::Envelope::kSwap).empty());
+  now_ += 3 * kMs;
+  a = ready(4, 0, hash);
+  for (PeerId p = 1; p <= 4; ++p) {
+    const auto swap = sent_to(a, p, wire::Envelope::kSwap);
+    ASSERT_EQ(swap.size(), 1u);
+    EXPECT_EQ(swap.front().swap().present_deadline_ns(), now_ + 2 * kMs);  // the present lead
+  }
+  ASSERT_NE(armed(a, Timer::next_frame), nullptr);
+  EXPECT_EQ(*armed(a, Timer::next_frame), now_ - 3 * kMs + 16'666'666) << "on schedule from the first frame";
+}
+
+TEST_F(MasterTest, AStragglerIsLeftOutAndComesBack) {
+  load("powerwall-2x2.json");
+  Actions a = join_all();
+  std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 3; ++p) (void)ready(p, 0, hash);
+  now_ += 500 * kMs;
+  a = master_->timer(Timer::barrier, now_);
+  EXPECT_TRUE(logged(a, "node 'top-right' was not ready for frame 0 within 500 ms"));
+  for (PeerId p = 1; p <= 3; ++p) EXPECT_EQ(sent_to(a, p, wire::Envelope::kSwap).size(), 1u);
+  EXPECT_TRUE(sent_to(a, 4, wire::Envelope::kSwap).empty()) << "never a late frame";
+  // Frame 1 does not wait for it: three readies swap it.
+  a = master_->timer(Timer::next_frame, now_);
+  hash = hash_of(a, 1);
+  EXPECT_EQ(sent_to(a, 4, wire::Envelope::kFrameBegin).size(), 1u) << "it is still sent the frames";
+  for (PeerId p = 1; p <= 2; ++p) (void)ready(p, 1, hash);
+  a = ready(3, 1, hash);
+  EXPECT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u);
+  // It answers again: back in the barrier from the next frame.
+  a = ready(4, 1, hash);
+  EXPECT_TRUE(logged(a, "node 'top-right' answers again (frame 1)"));
+  a = master_->timer(Timer::next_frame, now_);
+  hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 3; ++p) EXPECT_TRUE(sent_to(ready(p, 2, hash), p, wire::Envelope::kSwap).empty());
+  EXPECT_EQ(sent_to(ready(4, 2, hash), 4, wire::Envelope::kSwap).size(), 1u);
+  EXPECT_EQ(recorder_->report().nodes(3).barrier_misses(), 1u);
+}
+
+TEST_F(MasterTest, TheDropPolicyShowsALateFrameNowhere) {
+  load("powerwall-2x2.json",
+       [](config::Installation& i) { i.master.straggler_policy = config::StragglerPolicy::drop; });
+  Actions a = join_all();
+  const std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 3; ++p) (void)ready(p, 0, hash);
+  a = master_->timer(Timer::barrier, now_ + 500 * kMs);
+  EXPECT_TRUE(all_of<Send>(a).empty()) << "no swap to anyone";
+  EXPECT_TRUE(logged(a, "the frame is dropped everywhere"));
+}
+
+TEST_F(MasterTest, AWrongStateHashGetsAFreshSnapshot) {
+  load("powerwall-2x2.json");
+  Actions a = join_all();
+  const std::uint64_t hash = hash_of(a, 2);
+  a = ready(2, 0, hash ^ 1);
+  const auto resync = sent_to(a, 2, wire::Envelope::kResync);
+  ASSERT_EQ(resync.size(), 1u);
+  EXPECT_EQ(resync.front().resync().next_frame_id(), 1u);
+  EXPECT_EQ(resync.front().resync().state_hash(), hash);
+  EXPECT_TRUE(sent_to(ready(1, 0, hash), 1, wire::Envelope::kResync).empty()) << "only the node that differs";
+}
+
+TEST_F(MasterTest, ANodeThatLeavesIsNotWaitedForAndMayRejoin) {
+  load("powerwall-2x2.json");
+  Actions a = join_all();
+  const std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 3; ++p) (void)ready(p, 0, hash);
+  a = master_->closed(4, "connection reset", now_);
+  EXPECT_TRUE(logged(a, "node 'top-right' left: connection reset (3/4 up)"));
+  EXPECT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "the barrier completes without it";
+  for (const Send* s : all_of<Send>(a)) EXPECT_NE(s->peer, 4u) << "nothing for a closed peer";
+  (void)master_->timer(Timer::next_frame, now_);
+  // A new connection for the same projector takes it back, at the frame to come.
+  a = hello(9, "top-right");
+  EXPECT_EQ(sent_to(a, 9, wire::Envelope::kWelcome).size(), 1u);
+  a = configured(9);
+  const auto resync = sent_to(a, 9, wire::Envelope::kResync);
+  ASSERT_EQ(resync.size(), 1u);
+  EXPECT_EQ(resync.front().resync().next_frame_id(), 2u);
+  EXPECT_EQ(master_->nodes_up(), 4u);
+}
+
+TEST_F(MasterTest, PingsAreAnsweredWithTheirTimes) {
+  load("powerwall-2x2.json");
+  (void)join_all();
+  wire::Envelope ping = envelope();
+  ping.mutable_ping()->set_t1(123);
+  const auto pong = sent_to(master_->message(2, ping, now_), 2, wire::Envelope::kPong);
+  ASSERT_EQ(pong.size(), 1u);
+  EXPECT_EQ(pong.front().pong().t1(), 123);
+  EXPECT_EQ(pong.front().pong().t2(), now_);
+}
+
+TEST_F(MasterTest, AfterItsFramesItSaysGoodbyeAndFinishes) {
+  RunSettings settings;
+  settings.frames = 1;
+  load("powerwall-2x2.json", {}, settings);
+  Actions a = join_all();
+  const std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 4; ++p) a = ready(p, 0, hash);
+  a = master_->timer(Timer::next_frame, now_ + 17 * kMs);
+  EXPECT_TRUE(logged(a, "stopping: ran 1 frames"));
+  ASSERT_NE(armed(a, Timer::last_presents), nullptr);
+  a = master_->timer(Timer::last_presents, now_ + 300 * kMs);
+  EXPECT_NE(first<StopAccepting>(a), nullptr);
+  for (PeerId p = 1; p <= 4; ++p) EXPECT_EQ(sent_to(a, p, wire::Envelope::kGoodbye).size(), 1u);
+  for (PeerId p = 1; p <= 3; ++p) EXPECT_EQ(first<Finish>(master_->closed(p, "goodbye", now_)), nullptr);
+  a = master_->closed(4, "goodbye", now_);
+  ASSERT_NE(first<Finish>(a), nullptr);
+  EXPECT_EQ(first<Finish>(a)->exit_code, kExitOk);
+  EXPECT_EQ(master_->report().frames(), 1u);
+  EXPECT_EQ(master_->report().stopped_because(), "ran 1 frames");
+}
+
+TEST_F(MasterTest, NoNodeBeforeTheStartupTimeoutFails) {
+  load("powerwall-2x2.json");
+  const Actions a = master_->timer(Timer::startup, now_ + 10'000 * kMs);
+  EXPECT_TRUE(logged(a, "no node connected within 10000 ms"));
+  ASSERT_NE(first<Finish>(a), nullptr);
+  EXPECT_EQ(first<Finish>(a)->exit_code, kExitFailed);
+}
+
+TEST_F(MasterTest, SomeNodesAfterTheStartupTimeoutStartWithoutTheRest) {
+  load("powerwall-2x2.json");
+  (void)hello(1, "bottom-left");
+  (void)configured(1);
+  const Actions a = master_->timer(Timer::startup, now_ + 10'000 * kMs);
+  EXPECT_TRUE(logged(a, "starting without bottom-right, top-left, top-right"));
+  EXPECT_TRUE(master_->running());
+  EXPECT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u);
+}
+
+TEST_F(MasterTest, InterruptedOnceDrainsTwiceStopsAtOnce) {
+  load("powerwall-2x2.json");
+  (void)join_all();
+  Actions a = master_->interrupted("Interrupt", now_);
+  EXPECT_TRUE(logged(a, "stopping: interrupted (Interrupt)"));
+  EXPECT_EQ(first<Finish>(a), nullptr);
+  a = master_->interrupted("Interrupt", now_);
+  ASSERT_NE(first<SignalLocalNodes>(a), nullptr);
+  EXPECT_EQ(first<SignalLocalNodes>(a)->signal, SIGKILL);
+  ASSERT_NE(first<Finish>(a), nullptr);
+}
+
+TEST_F(MasterTest, ALocalNodeThatDiesBeforeTheStartFailsTheRun) {
+  load("powerwall-2x2.json");
+  (void)master_->local_nodes_running(4, now_);
+  const Actions a = master_->local_node_exited("top-left", "(pid 7) exited with status 2", false, "", now_);
+  EXPECT_TRUE(logged(a, "node 'top-left' stopped before the cluster started"));
+  EXPECT_NE(first<StopAccepting>(a), nullptr);
+  EXPECT_EQ(first<Finish>(a), nullptr) << "three local nodes still run";
+  EXPECT_EQ(first<Finish>(master_->local_nodes_running(3, now_)), nullptr);
+  // They do not go: terminated after the grace, killed after more.
+  Actions grace = master_->timer(Timer::goodbye, now_ + 3000 * kMs);
+  ASSERT_NE(first<SignalLocalNodes>(grace), nullptr);
+  EXPECT_EQ(first<SignalLocalNodes>(grace)->signal, SIGTERM);
+  grace = master_->timer(Timer::goodbye, now_ + 5000 * kMs);
+  EXPECT_EQ(first<SignalLocalNodes>(grace)->signal, SIGKILL);
+  ASSERT_NE(first<Finish>(grace), nullptr);
+  EXPECT_EQ(first<Finish>(grace)->exit_code, kExitFailed);
+}
+
+TEST_F(MasterTest, AnAutomaticGroupsSharesFollowTheNodesThatAreUp) {
+  load("stacked-lighting-3-auto.json");
+  std::map<PeerId, std::vector<std::uint32_t>> shares;  // what each node was last told
+  std::set<PeerId> told;
+  const auto take = [&](const Actions& actions, PeerId peer) {
+    const auto begin = sent_to(actions, peer, wire::Envelope::kFrameBegin);
+    ASSERT_EQ(begin.size(), 1u);
+    if (begin.front().frame_begin().has_lights()) {
+      told.insert(peer);
+      const auto& lights = begin.front().frame_begin().lights().lights();
+      shares[peer].assign(lights.begin(), lights.end());
+    }
+  };
+  const auto every_light_once = [&](std::initializer_list<PeerId> peers) {
+    std::set<std::uint32_t> all;
+    std::size_t count = 0;
+    for (PeerId p : peers) {
+      all.insert(shares[p].begin(), shares[p].end());
+      count += shares[p].size();
+    }
+    return all.size() == 20 && count == 20;
+  };
+  Actions a = join_all();
+  for (PeerId p = 1; p <= 3; ++p) take(a, p);
+  EXPECT_EQ(told.size(), 3u) << "the first frame says each node's share (the largest may get none)";
+  EXPECT_TRUE(every_light_once({1, 2, 3}));
+  const std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 3; ++p) (void)ready(p, 0, hash);
+  (void)master_->closed(3, "killed", now_);
+  a = master_->timer(Timer::next_frame, now_);
+  for (PeerId p = 1; p <= 2; ++p) take(a, p);
+  EXPECT_TRUE(every_light_once({1, 2})) << "its lights are shared out among the two left";
+}
+
+}  // namespace
+}  // namespace optique::master
