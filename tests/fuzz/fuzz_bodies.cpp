@@ -5,22 +5,10 @@
 #include <cmath>
 #include <vector>
 
-#if __has_include(<google/protobuf/stubs/logging.h>)
-#include <google/protobuf/stubs/logging.h>
-#define OPTIQUE_FUZZ_HAS_LOG_SILENCER 1
-#endif
-
 #include "net/envelope.h"
 #include "net/framing.h"
 #include "scene/state.h"
 #include "util/finite.h"
-
-// A failed invariant returns its own text and line from the checking function, so
-// a crash report (or a replay failure) says which one without a debugger.
-#define OPTIQUE_FUZZ_REQUIRE(cond)                                                                             \
-  do {                                                                                                         \
-    if (!(cond)) return std::string("invariant " #cond " (fuzz_bodies.cpp:") + std::to_string(__LINE__) + ")"; \
-  } while (false)
 
 namespace optique::fuzz {
 namespace {
@@ -259,14 +247,6 @@ std::string deltas(std::span<const std::uint8_t> input, Outcome& out) {
   }
   return {};
 }
-
-// Protobuf logs an error for every string field that is not UTF-8: expected for
-// fuzz input, and enough of them to bury a real report.
-struct QuietProtobuf {
-#ifdef OPTIQUE_FUZZ_HAS_LOG_SILENCER
-  google::protobuf::LogSilencer silencer;
-#endif
-};
 
 }  // namespace
 

@@ -9,7 +9,29 @@
 #include <string>
 #include <string_view>
 
+#if __has_include(<google/protobuf/stubs/logging.h>)
+#include <google/protobuf/stubs/logging.h>
+#define OPTIQUE_FUZZ_HAS_LOG_SILENCER 1
+#endif
+
+// A failed invariant returns its own text and place from the checking function,
+// so a crash report (or a replay failure) says which one without a debugger.
+#define OPTIQUE_FUZZ_REQUIRE(cond)                                                                        \
+  do {                                                                                                    \
+    if (!(cond)) {                                                                                        \
+      return std::string("invariant " #cond " (") + __FILE_NAME__ + ":" + std::to_string(__LINE__) + ")"; \
+    }                                                                                                     \
+  } while (false)
+
 namespace optique::fuzz {
+
+// Protobuf logs an error for every string field that is not UTF-8: expected for
+// fuzz input, and enough of them to bury a real report.
+struct QuietProtobuf {
+#ifdef OPTIQUE_FUZZ_HAS_LOG_SILENCER
+  google::protobuf::LogSilencer silencer;
+#endif
+};
 
 // Largest payload the frame target accepts: small enough that an oversized
 // header is cheap to reach, large enough for any real Envelope.
@@ -33,6 +55,10 @@ struct Outcome {
   int deltas_applied = 0;  // deltas that apply_delta accepted
   int deltas_refused = 0;  // parsed deltas that apply_delta refused
   bool snapshot_accepted = false;
+  int frames_presented = 0;  // run_protocol: by all nodes; run_node: by the node
+  int renders = 0;           // run_node: frames the node drew
+  int closes = 0;            // run_node: messages that made it close or stop
+  bool finished = false;     // run_protocol: the master's run ended
 };
 
 // Input: byte 0 picks how the rest is cut into fragments (0: all at once, 1: byte
@@ -46,5 +72,24 @@ struct Outcome {
 // default state, so such inputs still reach the deltas); the deltas apply one after
 // the other.
 [[nodiscard]] Outcome run_deltas(std::span<const std::uint8_t> input);
+
+// Input: byte 0 sets how many frames the master runs (5 … 44), byte 1 at which
+// frame the first node's state is corrupted (0: never); each further byte is one
+// step of a simulated cluster (tests/support/sim_cluster.h: which message
+// arrives, which timer fires, which link breaks, an interrupt). Then the network
+// turns prompt until the run ends. Invariants: the cluster's (no action for a
+// peer the master knows is gone, no frame shown twice or out of order, none
+// skipped after a join, a repaired state right the next frame, no swap without
+// a ready), and the run ends.
+[[nodiscard]] Outcome run_protocol(std::span<const std::uint8_t> input);
+
+// Input: chunks separated by kChunkSeparator. The first is a serialized
+// wire::Welcome (if it does not parse, a good one for the 2×2 wall) that a node
+// in the handshake receives; if it takes the job, a snapshot joins it, and every
+// further chunk arrives as a serialized wire::Envelope. Invariants: a job that
+// is taken is sane (finite geometry, sizes > 0); every frame drawn has a state,
+// lights the scene has (ascending), a finite focus; garbage closes the
+// connection, it never crashes the node.
+[[nodiscard]] Outcome run_node(std::span<const std::uint8_t> input);
 
 }  // namespace optique::fuzz

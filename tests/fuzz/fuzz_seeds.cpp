@@ -1,13 +1,17 @@
 #include "fuzz_seeds.h"
 
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 #include <string_view>
 
 #include "fuzz_bodies.h"
+#include "master/run_config.h"
 #include "net/envelope.h"
 #include "net/framing.h"
+#include "protocol/welcome.h"
+#include "scene/state.h"
 
 namespace optique::fuzz {
 namespace {
@@ -413,6 +417,136 @@ std::vector<Seed> delta_seeds() {
     seeds.push_back(delta_seed("snapshot_nan_eye", {remove({1})}, nan));
   }
   seeds.push_back(delta_seed("empty_snapshot", {change(object(4, 1.0, 2.0, 3.0)), remove({4})}, wire::Snapshot{}));
+  return seeds;
+}
+
+// --- the protocol cores ---
+
+namespace {
+
+// A prompt network, byte by byte: deliver what is there (7), now and then a timer (5).
+Bytes prompt_steps(std::size_t rounds) {
+  Bytes steps;
+  for (std::size_t i = 0; i < rounds; ++i) {
+    for (int k = 0; k < 6; ++k) steps.push_back(7);
+    steps.push_back(5);
+  }
+  return steps;
+}
+
+Bytes with_header(std::uint8_t frames, std::uint8_t corrupt, const Bytes& steps) {
+  Bytes out{frames, corrupt};
+  out.insert(out.end(), steps.begin(), steps.end());
+  return out;
+}
+
+// The step that does `kind` (see SimCluster::step) to node `node` of four.
+std::uint8_t step_for(int kind, int node) { return static_cast<std::uint8_t>(kind + 8 * node); }
+
+void join_chunks(Bytes& out, const Bytes& chunk) {
+  if (!out.empty()) out.insert(out.end(), kChunkSeparator.begin(), kChunkSeparator.end());
+  out.insert(out.end(), chunk.begin(), chunk.end());
+}
+
+wire::Welcome wall_welcome() {
+  auto run = master::load_run_config(std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-2x2.json", {});
+  if (!run) throw std::runtime_error(run.error());
+  return protocol::encode_welcome(run.value().config.installation, 0, "", 4, 16'666'666, nullptr);
+}
+
+Bytes frame_and_swap(std::uint64_t frame, const std::function<void(wire::FrameBegin&)>& change = {}) {
+  wire::Envelope begin = envelope(frame * 2 + 1);
+  begin.mutable_frame_begin()->set_frame_id(frame);
+  begin.mutable_frame_begin()->set_state_hash(scene::state_hash(scene::SceneState{}));
+  if (change) change(*begin.mutable_frame_begin());
+  wire::Envelope swap = envelope(frame * 2 + 2);
+  swap.mutable_swap()->set_frame_id(frame);
+  Bytes out = serialize(begin);
+  join_chunks(out, serialize(swap));
+  return out;
+}
+
+Bytes node_seed(const wire::Welcome& welcome, const std::vector<Bytes>& messages) {
+  Bytes out = serialize(welcome);
+  for (const Bytes& m : messages) {
+    out.insert(out.end(), kChunkSeparator.begin(), kChunkSeparator.end());
+    out.insert(out.end(), m.begin(), m.end());
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<Seed> protocol_seeds() {
+  std::vector<Seed> seeds;
+  seeds.push_back({"prompt_ten_frames", with_header(5, 0, prompt_steps(200))});
+  seeds.push_back({"corrupt_at_frame_three", with_header(10, 3, prompt_steps(300))});
+  {
+    Bytes steps = prompt_steps(150);
+    steps.push_back(static_cast<std::uint8_t>(246));  // reset node 2's link
+    const Bytes more = prompt_steps(300);
+    steps.insert(steps.end(), more.begin(), more.end());
+    seeds.push_back({"link_reset_midway", with_header(25, 0, steps)});
+  }
+  {
+    Bytes steps = prompt_steps(100);
+    steps.push_back(255);  // interrupt the master
+    const Bytes more = prompt_steps(100);
+    steps.insert(steps.end(), more.begin(), more.end());
+    seeds.push_back({"interrupted", with_header(39, 0, steps)});
+  }
+  {
+    // Everyone but node 3 hears from the master; timers run the barrier out.
+    Bytes steps = prompt_steps(60);
+    for (int round = 0; round < 200; ++round) {
+      for (int node = 0; node < 3; ++node) {
+        steps.push_back(step_for(0, node));
+        steps.push_back(step_for(3, node));
+      }
+      steps.push_back(step_for(5, 0));
+    }
+    seeds.push_back({"one_node_starved", with_header(20, 0, steps)});
+  }
+  seeds.push_back({"noise", noise(600, 7)});
+  return seeds;
+}
+
+std::vector<Seed> node_seeds() {
+  std::vector<Seed> seeds;
+  const wire::Welcome welcome = wall_welcome();
+  seeds.push_back(
+      {"welcome_and_three_frames", node_seed(welcome, {frame_and_swap(0), frame_and_swap(1), frame_and_swap(2)})});
+  {
+    wire::Welcome bad = welcome;
+    bad.mutable_projector()->set_width(0);
+    for (auto& member : *bad.mutable_blend_group()) member.set_width(0);
+    seeds.push_back({"welcome_zero_width", node_seed(bad, {frame_and_swap(0)})});
+  }
+  {
+    wire::Welcome bad = welcome;
+    for (auto& member : *bad.mutable_blend_group()) {
+      member.clear_region();
+      for (int k = 0; k < 9; ++k) member.add_homography(k == 0 ? kNaN : 1.0);
+    }
+    seeds.push_back({"welcome_nan_homography", node_seed(bad, {frame_and_swap(0)})});
+  }
+  {
+    wire::Welcome bad = welcome;
+    bad.set_frame_period_ns(0);
+    seeds.push_back({"welcome_no_frame_period", node_seed(bad, {})});
+  }
+  seeds.push_back(
+      {"frame_light_out_of_range",
+       node_seed(welcome, {frame_and_swap(0, [](wire::FrameBegin& b) { b.mutable_lights()->add_lights(9); })})});
+  seeds.push_back(
+      {"frame_nan_focus",
+       node_seed(welcome, {frame_and_swap(0, [](wire::FrameBegin& b) { b.mutable_focus()->set_depth(kNaN); })})});
+  seeds.push_back({"frame_good_focus_and_lights", node_seed(welcome, {frame_and_swap(0, [](wire::FrameBegin& b) {
+                                                              b.mutable_focus()->set_depth(2.0);
+                                                              b.mutable_lights()->add_lights(1);
+                                                              b.mutable_lights()->add_lights(3);
+                                                            })})});
+  seeds.push_back({"not_a_welcome", node_seed(wire::Welcome{}, {noise(40, 3), frame_and_swap(0)})});
   return seeds;
 }
 

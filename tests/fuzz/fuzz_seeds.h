@@ -20,4 +20,10 @@ struct Seed {
 // Inputs for run_deltas: a Snapshot and deltas, joined by kChunkSeparator.
 [[nodiscard]] std::vector<Seed> delta_seeds();
 
+// Inputs for run_protocol: frames, corruption, then one step per byte.
+[[nodiscard]] std::vector<Seed> protocol_seeds();
+
+// Inputs for run_node: a Welcome, then Envelopes, joined by kChunkSeparator.
+[[nodiscard]] std::vector<Seed> node_seeds();
+
 }  // namespace optique::fuzz

@@ -1,0 +1,90 @@
+// A whole cluster of protocol cores on simulated links (tests/support/sim_cluster.h):
+// the runs the process tests make, in milliseconds and without timing noise.
+
+#include "sim_cluster.h"
+
+#include <gtest/gtest.h>
+
+#include <numeric>
+
+namespace optique::testing {
+namespace {
+
+constexpr clock::Nanos kSecond = clock::kNanosPerSecond;
+
+master::RunConfig load(const std::string& name) {
+  auto loaded = master::load_run_config(std::string(OPTIQUE_SOURCE_DIR) + "/configs/" + name, {});
+  EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
+  return loaded ? std::move(loaded).value() : master::RunConfig{};
+}
+
+std::vector<std::uint64_t> frames(std::uint64_t first, std::uint64_t end) {
+  std::vector<std::uint64_t> v(end - first);
+  std::iota(v.begin(), v.end(), first);
+  return v;
+}
+
+master::RunSettings for_frames(std::uint64_t count) {
+  master::RunSettings settings;
+  settings.frames = count;
+  return settings;
+}
+
+TEST(SimCluster, EveryNodeShowsEveryFrameAndTheRunEndsCleanly) {
+  const master::RunConfig run = load("powerwall-2x2.json");
+  SimCluster cluster(run, for_frames(30));
+  cluster.start();
+  cluster.run_promptly(cluster.now() + 10 * kSecond);
+  EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
+  ASSERT_TRUE(cluster.master_finished());
+  EXPECT_EQ(cluster.exit_code(), master::kExitOk);
+  for (std::size_t i = 0; i < cluster.nodes(); ++i) EXPECT_EQ(cluster.presented(i), frames(0, 30)) << i;
+  const report::RunReport report = cluster.master().report();
+  EXPECT_EQ(report.frames(), 30u);
+  EXPECT_EQ(report.sync().frames_with_missing_node(), 0u);
+  EXPECT_EQ(report.sync().present_skew_us().max(), 0.0) << "one clock: every node presents at the deadline";
+}
+
+TEST(SimCluster, AWrongStateIsRepairedTheNextFrame) {
+  const master::RunConfig run = load("powerwall-2x2.json");
+  SimCluster cluster(run, for_frames(20), 5);
+  cluster.start();
+  cluster.run_promptly(cluster.now() + 10 * kSecond);
+  EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
+  const report::RunReport report = cluster.master().report();
+  EXPECT_EQ(report.nodes(0).hash_mismatches(), 1u) << "reported once, repaired at once";
+  EXPECT_EQ(cluster.presented(0), frames(0, 20));
+}
+
+TEST(SimCluster, ANodeWhoseLinkBreaksRejoinsAndShowsEveryFrameFromThereOn) {
+  const master::RunConfig run = load("powerwall-2x2.json");
+  SimCluster cluster(run, for_frames(60));
+  cluster.start();
+  cluster.run_promptly(cluster.now() + kSecond / 4);  // about 15 frames
+  const std::uint64_t before = cluster.presented(2).back();
+  cluster.reset_link(2);
+  cluster.run_promptly(cluster.now() + 10 * kSecond);
+  EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
+  ASSERT_TRUE(cluster.master_finished());
+  const auto& shown = cluster.presented(2);
+  const auto back = std::find_if(shown.begin(), shown.end(), [&](std::uint64_t f) { return f > before; });
+  ASSERT_NE(back, shown.end());
+  EXPECT_EQ(std::vector<std::uint64_t>(back, shown.end()), frames(*back, 60)) << "no frame skipped after the rejoin";
+  EXPECT_EQ(cluster.master().report().nodes(2).joins(), 2u);
+  EXPECT_EQ(cluster.presented(0), frames(0, 60)) << "the others never stopped";
+}
+
+TEST(SimCluster, AnAutomaticGroupKeepsGoingWhenANodeIsLost) {
+  const master::RunConfig run = load("stacked-lighting-3-auto.json");
+  SimCluster cluster(run, for_frames(40));
+  cluster.start();
+  cluster.run_promptly(cluster.now() + kSecond / 6);
+  cluster.reset_link(1);
+  cluster.run_promptly(cluster.now() + 10 * kSecond);
+  EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
+  EXPECT_EQ(cluster.presented(0), frames(0, 40));
+  EXPECT_EQ(cluster.presented(2), frames(0, 40));
+}
+
+}  // namespace
+}  // namespace optique::testing
