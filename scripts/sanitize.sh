@@ -5,17 +5,17 @@
 #   scripts/sanitize.sh thread    [ctest args...]   TSan         -> build-tsan
 #
 # Environment:
-#   SANITIZE_LABELS   test labels, a regex (default 'unit|integration'; the gpu tests
-#                     need llvmpipe, see tests/sanitizers/README.md). Unit tests run
-#                     one process per test executable (all its cases at once: a
-#                     sanitized process takes ~1 s to start with the ~270 shared
-#                     libraries OpenImageIO and GL bring, ~600 s for ctest's one
-#                     process per case); the other labels run through ctest.
+#   SANITIZE_LABELS   test labels (the test folders), a regex (default 'unit|process';
+#                     under TSan 'unit'). The gpu tests need llvmpipe, see
+#                     tests/sanitizers/README.md; the timing tests measure time, which
+#                     a sanitizer's slowdown fails, not a bug. Unit tests run one
+#                     process per test executable (all its cases at once: cheaper
+#                     than ctest's one process per case); the other labels run
+#                     through ctest.
 #   SANITIZE_ALL=1    build every target, not only the tests of those labels and the
 #                     binaries they start (slower; the benches never run here)
 #   SANITIZE_JOBS     build and ctest parallelism (default: nproc)
-#   SANITIZE_EXCLUDE  ctest -E regex of tests not to run (default: the tests that
-#                     measure timing, which a sanitizer's slowdown fails; '' for none)
+#   SANITIZE_EXCLUDE  ctest -E regex of tests not to run (default: none)
 #   SANITIZE_PRELOAD_MESA=0  do not keep Mesa's driver loaded (see below); expect
 #                     LSan reports from every process that drew with llvmpipe
 #
@@ -51,18 +51,12 @@ else
   # Boost.Asio's handler queue uses; -Werror would stop the build on it.
   sanitize_flags="-fsanitize=thread -Wno-tsan"
 fi
-labels="${SANITIZE_LABELS:-unit|integration}"
-# Tests that measure time rather than correctness fail under a sanitizer's
-# slowdown, not for a bug: microsecond thresholds on present skew across 8 nodes,
-# and (TSan: 5-15x slower, nodes that draw with llvmpipe on 2 cores) every run of
-# several nodes that must each answer within the master's 500 ms frame timeout.
-timing_tests='FrameSync\.EightNodesPresentTogether'
-if [ "$mode" = thread ]; then
-  timing_tests+='|FrameSync\.SkewedAndDrifting|ShippedConfig\.RunsSixtyFrames'
-  timing_tests+='|Cluster\.(KilledNodeLeaves|HungNodeIsTakenOut|AStoppedNodeAlone|InterruptStops)'
-  timing_tests+='|FrameSync\.AKilledNodeRestarted'
-fi
-exclude="${SANITIZE_EXCLUDE-$timing_tests}"
+# Under TSan (5-15x slower) nodes that draw with llvmpipe on 2 cores cannot answer
+# within the master's 500 ms frame timeout: only the unit tests by default.
+default_labels='unit|process'
+if [ "$mode" = thread ]; then default_labels='unit'; fi
+labels="${SANITIZE_LABELS:-$default_labels}"
+exclude="${SANITIZE_EXCLUDE:-}"
 jobs="${SANITIZE_JOBS:-$(nproc)}"
 log_dir="$root/$build_dir/sanitizer-logs"
 
@@ -85,10 +79,16 @@ CC=gcc CXX=g++ cmake -S . -B "$build_dir" "${generator[@]}" \
 t1=$(stamp)
 
 # The test executables whose label matches regex $1, read from the optique_test()
-# calls in tests/*/CMakeLists.txt.
+# calls in tests/*/CMakeLists.txt: a test's label is its folder's name, or the
+# LABEL it names.
 tests_labelled() {
-  grep -hoE 'optique_test\([A-Za-z0-9_]+ [a-z]+' tests/*/CMakeLists.txt |
-    awk -v re="^($1)\$" '{ sub(/optique_test\(/, ""); if ($2 ~ re) print $1 }' | sort -u
+  local file folder
+  for file in tests/*/CMakeLists.txt; do
+    folder=$(basename "$(dirname "$file")")
+    grep -oE 'optique_test\([A-Za-z0-9_]+( LABEL [a-z]+)?' "$file" |
+      awk -v folder="$folder" -v re="^($1)\$" \
+        '{ sub(/optique_test\(/, ""); label = ($2 == "LABEL") ? $3 : folder; if (label ~ re) print $1 }'
+  done | sort -u
 }
 
 # The tests' add_dependencies pull in optique-master and optique-node where they run them.

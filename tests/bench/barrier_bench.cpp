@@ -12,11 +12,11 @@
 #include <iostream>
 #include <sstream>
 
-#include "../integration/cluster_run.h"
-#include "../integration/process.h"
+#include "cluster_run.h"
 #include "image/image_io.h"
 #include "metrics/distribution.h"
 #include "plot.h"
+#include "process.h"
 #include "ready_go_baseline.h"
 #include "spread.h"
 

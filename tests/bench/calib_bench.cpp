@@ -16,10 +16,10 @@
 #include <sstream>
 #include <thread>
 
-#include "../unit/pinhole_projector.h"
 #include "calib/fit.h"
 #include "clock/clock.h"
 #include "image/image_io.h"
+#include "pinhole_projector.h"
 #include "plot.h"
 #include "spread.h"
 

@@ -2,6 +2,7 @@
 // A master process on 127.0.0.1 with an ephemeral port the test reads back, and
 // nodes pointed at it: the cluster as a user runs it, for integration tests.
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -27,5 +28,14 @@ struct ExternalMaster {
   // A node for projector `id`, its log in DIR/node-ID.log.
   [[nodiscard]] std::unique_ptr<Process> node(const std::string& id, const std::vector<std::string>& extra = {}) const;
 };
+
+// One null-render node per projector of `config`, in config order; `extra(i)`
+// adds arguments for the i-th.
+struct NullNodes {
+  std::vector<std::string> ids;
+  std::vector<std::unique_ptr<Process>> processes;
+};
+[[nodiscard]] NullNodes start_null_nodes(const ExternalMaster& master, const std::string& config,
+                                         const std::function<std::vector<std::string>(std::size_t)>& extra = {});
 
 }  // namespace optique::testing

@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "../unit/pinhole_projector.h"
 #include "config/calibration_file.h"
+#include "pinhole_projector.h"
 #include "process.h"
 
 namespace optique::testing {

@@ -1,10 +1,13 @@
 #include "external_master.h"
 
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
 
 #include <chrono>
+
+#include "config/load.h"
 
 namespace optique::testing {
 
@@ -41,6 +44,24 @@ std::unique_ptr<Process> ExternalMaster::node(const std::string& id, const std::
   std::vector<std::string> argv{node_binary(), "--master", "127.0.0.1:" + port, "--id", id};
   argv.insert(argv.end(), extra.begin(), extra.end());
   return std::make_unique<Process>(argv, dir + "/node-" + id + ".log");
+}
+
+NullNodes start_null_nodes(const ExternalMaster& master, const std::string& config,
+                           const std::function<std::vector<std::string>(std::size_t)>& extra) {
+  NullNodes nodes;
+  auto loaded = config::load_installation(config);
+  EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
+  if (!loaded) return nodes;
+  for (const auto& p : loaded.value().installation.projectors) {
+    std::vector<std::string> arguments{"--renderer", "null"};
+    if (extra) {
+      const std::vector<std::string> more = extra(nodes.ids.size());
+      arguments.insert(arguments.end(), more.begin(), more.end());
+    }
+    nodes.ids.push_back(p.id);
+    nodes.processes.push_back(master.node(p.id, arguments));
+  }
+  return nodes;
 }
 
 }  // namespace optique::testing
