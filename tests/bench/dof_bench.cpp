@@ -32,6 +32,8 @@
 #include "image/image_io.h"
 #include "plot.h"
 #include "render/gl_context.h"
+#include "render/gl_objects.h"
+#include "shaders.h"
 #include "spread.h"
 
 namespace {
@@ -44,78 +46,6 @@ constexpr int kMaxReach = 62;
 // A pixel sees an object when its exact depth is this close to the object's
 // centre: the slabs are 3 cm deep and at least 1 m apart.
 constexpr double kSameObject = 0.25;  // the gather's largest disc radius (c_max ≤ 62.5 px)
-
-constexpr const char* kGatherVertex = R"(#version 450 core
-void main() {
-  vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
-  gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-)";
-
-// Scatter as gather: a pixel collects, from every pixel q within the largest
-// circle, the share of q's light that q's own disc (radius c_r(q) · c_max) puts
-// on it, with the discs of optics/defocus.h (D_R: dx² + dy² ≤ R(R + 1), a radius
-// between R + ½ and R + 3/2 split between D_R and D_{R+1}). Unnormalized, that is
-// the ideal image itself; normalized by the shares received (the usual real-time
-// form, which never leaves holes), it differs where the circle changes abruptly
-// and at the image's edge. c_r comes from the depth buffer as in the output pass.
-constexpr const char* kGatherFragment = R"(#version 450 core
-layout(binding = 0) uniform sampler2D rendered;
-layout(binding = 1) uniform sampler2D depth;
-uniform vec4 coc;  // k, b', lowest and highest window depth (optics/defocus.h)
-uniform float c_max;
-uniform int reach;
-uniform bool normalized;
-uniform float inv_count[64];  // 1 / |D_R|
-layout(location = 0) out vec4 colour;
-
-float radius_at(ivec2 q) {
-  float d = texelFetch(depth, q, 0).r;
-  return min(1.0, coc.x * abs(clamp(d, coc.z, coc.w) - coc.y)) * c_max;
-}
-
-void main() {
-  ivec2 p = ivec2(gl_FragCoord.xy);
-  ivec2 size = textureSize(rendered, 0);
-  vec3 sum = vec3(0.0);
-  float received = 0.0;
-  for (int dy = -reach; dy <= reach; ++dy) {
-    for (int dx = -reach; dx <= reach; ++dx) {
-      ivec2 q = p + ivec2(dx, dy);
-      if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, size))) continue;
-      float r = radius_at(q);
-      int d2 = dx * dx + dy * dy;
-      float w = 0.0;
-      if (r <= 0.5) {
-        w = d2 == 0 ? 1.0 : 0.0;
-      } else {
-        float s = r - 0.5;
-        int inner = int(floor(s));
-        float t = s - float(inner);
-        if (d2 <= inner * (inner + 1)) w += (1.0 - t) * inv_count[inner];
-        if (t > 0.0 && d2 <= (inner + 1) * (inner + 2)) w += t * inv_count[inner + 1];
-      }
-      sum += w * texelFetch(rendered, q, 0).rgb;
-      received += w;
-    }
-  }
-  colour = vec4(normalized ? sum / received : sum, 1.0);
-}
-)";
-
-GLuint compile(GLenum type, const char* source) {
-  const GLuint shader = glCreateShader(type);
-  glShaderSource(shader, 1, &source, nullptr);
-  glCompileShader(shader);
-  GLint ok = GL_FALSE;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (ok != GL_TRUE) {
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    throw std::runtime_error(std::string("gather shader: ") + log);
-  }
-  return shader;
-}
 
 // The texture a SceneRenderer left bound on `unit` after drawing. Its output pass
 // binds the rendered colour on unit 0 and the depth on unit 3; reading them in
@@ -160,58 +90,42 @@ class Gather {
       }
       inv_count[static_cast<std::size_t>(r)] = 1.0f / static_cast<float>(count);
     }
-    program_ = glCreateProgram();
-    const GLuint vertex = compile(GL_VERTEX_SHADER, kGatherVertex);
-    const GLuint fragment = compile(GL_FRAGMENT_SHADER, kGatherFragment);
-    glAttachShader(program_, vertex);
-    glAttachShader(program_, fragment);
-    glLinkProgram(program_);
-    glDeleteShader(vertex);
-    glDeleteShader(fragment);
-    GLint ok = GL_FALSE;
-    glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-    if (ok != GL_TRUE) throw std::runtime_error("gather program does not link");
-    glProgramUniform1f(program_, glGetUniformLocation(program_, "c_max"), static_cast<float>(c_max));
-    glProgramUniform1i(program_, glGetUniformLocation(program_, "reach"), reach_);
-    glProgramUniform1fv(program_, glGetUniformLocation(program_, "inv_count"), 64, inv_count.data());
-    glCreateTextures(GL_TEXTURE_2D, 1, &target_);
-    glTextureStorage2D(target_, 1, GL_RGBA32F, width, height);
-    glCreateFramebuffers(1, &framebuffer_);
-    glNamedFramebufferTexture(framebuffer_, GL_COLOR_ATTACHMENT0, target_, 0);
-    if (glCheckNamedFramebufferStatus(framebuffer_, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    auto program = render::glo::link_program(shaders::fullscreen_vert, shaders::gather_frag);
+    if (!program) throw std::runtime_error("gather: " + program.error());
+    program_ = std::move(program).value();
+    glProgramUniform1f(program_.get(), glGetUniformLocation(program_.get(), "c_max"), static_cast<float>(c_max));
+    glProgramUniform1i(program_.get(), glGetUniformLocation(program_.get(), "reach"), reach_);
+    glProgramUniform1fv(program_.get(), glGetUniformLocation(program_.get(), "inv_count"), 64, inv_count.data());
+    target_ = render::glo::make_texture();
+    glTextureStorage2D(target_.get(), 1, GL_RGBA32F, width, height);
+    framebuffer_ = render::glo::make_framebuffer();
+    glNamedFramebufferTexture(framebuffer_.get(), GL_COLOR_ATTACHMENT0, target_.get(), 0);
+    if (glCheckNamedFramebufferStatus(framebuffer_.get(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
       throw std::runtime_error("gather framebuffer incomplete");
     }
-    glCreateVertexArrays(1, &vertex_array_);
+    vertex_array_ = render::glo::make_vertex_array();
   }
-  ~Gather() {
-    glDeleteProgram(program_);
-    glDeleteTextures(1, &target_);
-    glDeleteFramebuffers(1, &framebuffer_);
-    glDeleteVertexArrays(1, &vertex_array_);
-  }
-  Gather(const Gather&) = delete;
-  Gather& operator=(const Gather&) = delete;
 
   // Runs on what the renderer drew last and waits for the GPU.
   void run(GLuint rendered, GLuint depth, const optics::CocFromWindowDepth& mapping, bool normalized) {
-    glProgramUniform4f(program_, glGetUniformLocation(program_, "coc"), static_cast<float>(mapping.k),
+    glProgramUniform4f(program_.get(), glGetUniformLocation(program_.get(), "coc"), static_cast<float>(mapping.k),
                        static_cast<float>(mapping.focal), static_cast<float>(mapping.lo),
                        static_cast<float>(mapping.hi));
-    glProgramUniform1i(program_, glGetUniformLocation(program_, "normalized"), normalized ? 1 : 0);
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_);
+    glProgramUniform1i(program_.get(), glGetUniformLocation(program_.get(), "normalized"), normalized ? 1 : 0);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer_.get());
     glViewport(0, 0, width_, height_);
     glDisable(GL_DEPTH_TEST);
-    glUseProgram(program_);
+    glUseProgram(program_.get());
     glBindTextureUnit(0, rendered);
     glBindTextureUnit(1, depth);
-    glBindVertexArray(vertex_array_);
+    glBindVertexArray(vertex_array_.get());
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glFinish();
   }
 
   [[nodiscard]] image::FloatImage read() const {
     image::FloatImage image(width_, height_, 4);
-    glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer_.get());
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, width_, height_, GL_RGBA, GL_FLOAT, image.pixels.data());
@@ -225,10 +139,10 @@ class Gather {
   int width_;
   int height_;
   int reach_ = 0;
-  GLuint program_ = 0;
-  GLuint target_ = 0;
-  GLuint framebuffer_ = 0;
-  GLuint vertex_array_ = 0;
+  render::glo::Program program_;
+  render::glo::Texture target_;
+  render::glo::Framebuffer framebuffer_;
+  render::glo::VertexArray vertex_array_;
 };
 
 std::string fixed(double v, int decimals) {

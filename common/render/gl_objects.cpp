@@ -1,0 +1,75 @@
+#include "render/gl_objects.h"
+
+#include <string>
+
+namespace optique::render::glo {
+
+namespace detail {
+void delete_texture(GLuint name) { glDeleteTextures(1, &name); }
+void delete_buffer(GLuint name) { glDeleteBuffers(1, &name); }
+void delete_framebuffer(GLuint name) { glDeleteFramebuffers(1, &name); }
+void delete_vertex_array(GLuint name) { glDeleteVertexArrays(1, &name); }
+void delete_shader(GLuint name) { glDeleteShader(name); }
+void delete_program(GLuint name) { glDeleteProgram(name); }
+}  // namespace detail
+
+Texture make_texture(GLenum target) {
+  GLuint name = 0;
+  glCreateTextures(target, 1, &name);
+  return Texture(name);
+}
+
+Buffer make_buffer() {
+  GLuint name = 0;
+  glCreateBuffers(1, &name);
+  return Buffer(name);
+}
+
+Framebuffer make_framebuffer() {
+  GLuint name = 0;
+  glCreateFramebuffers(1, &name);
+  return Framebuffer(name);
+}
+
+VertexArray make_vertex_array() {
+  GLuint name = 0;
+  glCreateVertexArrays(1, &name);
+  return VertexArray(name);
+}
+
+namespace {
+
+Result<Shader> compile(GLenum type, std::string_view source) {
+  Shader shader(glCreateShader(type));
+  const char* text = source.data();
+  const auto length = static_cast<GLint>(source.size());
+  glShaderSource(shader.get(), 1, &text, &length);
+  glCompileShader(shader.get());
+  GLint ok = GL_FALSE;
+  glGetShaderiv(shader.get(), GL_COMPILE_STATUS, &ok);
+  if (ok == GL_TRUE) return shader;
+  char log[2048] = {};
+  glGetShaderInfoLog(shader.get(), sizeof log, nullptr, log);
+  return Error{std::string("shader does not compile: ") + log};
+}
+
+}  // namespace
+
+Result<Program> link_program(std::string_view vertex_source, std::string_view fragment_source) {
+  auto vertex = compile(GL_VERTEX_SHADER, vertex_source);
+  if (!vertex) return Error{vertex.error()};
+  auto fragment = compile(GL_FRAGMENT_SHADER, fragment_source);
+  if (!fragment) return Error{fragment.error()};
+  Program program(glCreateProgram());
+  glAttachShader(program.get(), vertex.value().get());
+  glAttachShader(program.get(), fragment.value().get());
+  glLinkProgram(program.get());
+  GLint ok = GL_FALSE;
+  glGetProgramiv(program.get(), GL_LINK_STATUS, &ok);
+  if (ok == GL_TRUE) return program;
+  char log[2048] = {};
+  glGetProgramInfoLog(program.get(), sizeof log, nullptr, log);
+  return Error{std::string("shader program does not link: ") + log};
+}
+
+}  // namespace optique::render::glo

@@ -1,0 +1,44 @@
+#version 450 core
+// The scene in linear light. Blinn-Phong with a roughness-derived exponent and a
+// normalized specular lobe, Fresnel F0 from metallic: a cheap stand-in for
+// metallic/roughness. All linear: the base colour texture is sRGB8_ALPHA8, so
+// sampling it decodes to linear.
+in vec3 world_position;
+in vec3 world_normal;
+in vec2 texture_uv;
+uniform vec3 eye;
+uniform vec3 base_colour_factor;
+uniform bool has_base_colour_texture;
+layout(binding = 1) uniform sampler2D base_colour_texture;
+uniform float metallic;
+uniform float roughness;
+uniform vec3 emissive;
+uniform vec3 ambient;
+uniform int light_count;
+layout(std430, binding = 0) readonly buffer Lights { vec4 lights[]; };  // position, radiance
+out vec4 colour;
+const float kPi = 3.14159265358979;
+void main() {
+  vec3 base_colour = base_colour_factor;
+  if (has_base_colour_texture) base_colour *= texture(base_colour_texture, texture_uv).rgb;
+  vec3 n = normalize(world_normal);
+  if (!gl_FrontFacing) n = -n;
+  vec3 v = normalize(eye - world_position);
+  vec3 diffuse = base_colour * (1.0 - metallic) / kPi;
+  vec3 f0 = mix(vec3(0.04), base_colour, metallic);
+  float alpha = max(roughness * roughness, 0.02);
+  float shininess = 2.0 / (alpha * alpha) - 2.0;
+  float normalization = (shininess + 8.0) / (8.0 * kPi);
+  vec3 result = ambient * base_colour + emissive;
+  for (int i = 0; i < light_count; ++i) {
+    vec3 to_light = lights[2 * i].xyz - world_position;
+    float r2 = max(dot(to_light, to_light), 1e-8);
+    vec3 l = to_light * inversesqrt(r2);
+    float n_dot_l = dot(n, l);
+    if (n_dot_l <= 0.0) continue;
+    vec3 h = normalize(l + v);
+    vec3 specular = f0 * normalization * pow(max(dot(n, h), 0.0), shininess);
+    result += (diffuse + specular) * lights[2 * i + 1].rgb * (n_dot_l / r2);
+  }
+  colour = vec4(result, 1.0);
+}
