@@ -59,12 +59,6 @@ Result<Frustum> off_axis_frustum(const WorldRect& rect, const glm::dvec3& eye, d
   return f;
 }
 
-Eye parse_eye(const std::string& name) {
-  if (name == "left") return Eye::left;
-  if (name == "right") return Eye::right;
-  return Eye::mono;
-}
-
 glm::dvec3 eye_position(const glm::dvec3& centre, const glm::dvec3& head_right, double separation, Eye eye) {
   switch (eye) {
     case Eye::left:

@@ -40,7 +40,6 @@ struct Frustum {
 // Where one eye is: the centre of the eyes moved half the separation along
 // `head_right` (left eye to −, right eye to +; mono stays at the centre).
 enum class Eye { mono, left, right };
-[[nodiscard]] Eye parse_eye(const std::string& name);  // "left", "right", anything else mono
 [[nodiscard]] glm::dvec3 eye_position(const glm::dvec3& centre, const glm::dvec3& head_right, double separation,
                                       Eye eye);
 
