@@ -51,7 +51,9 @@ Result<void> Master::start() {
     if (!csv_) return Error{"cannot write " + csv_path.string()};
   }
   recorder_.emplace(ids, csv_.is_open() ? &csv_ : nullptr);
-  protocol_.emplace(installation, options_.scene, options_.run, *recorder_);
+  RunSettings run = options_.run;
+  run.send_clock = clock::monotonic_now;
+  protocol_.emplace(installation, options_.scene, std::move(run), *recorder_);
 
   // Listen.
   boost::system::error_code ec;

@@ -411,6 +411,10 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     rebalance_lights(false);
   }
 
+  // The record of the frame before last is written out now, before the send is
+  // stamped: a CSV row is not part of the barrier round.
+  if (frame > 1) recorder_.finalize_before(frame - 1);  // the previous frame may still get Presented
+  const clock::Nanos begin_sent = settings_.send_clock ? settings_.send_clock() : now;
   std::vector<std::size_t> sent;
   std::vector<std::size_t> waited;
   for (std::size_t i = 0; i < slots_.size(); ++i) {
@@ -434,8 +438,7 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     sent.push_back(i);
     if (session.phase == Phase::in_barrier) waited.push_back(i);
   }
-  recorder_.frame_begun(frame, now, sent);
-  if (frame > 0) recorder_.finalize_before(frame - 1);  // the previous frame may still get Presented
+  recorder_.frame_begun(frame, begin_sent, sent);
   next_frame_ = frame + 1;
   ready_for_swap_.clear();
   barrier_.begin(frame, std::move(waited));
@@ -502,11 +505,12 @@ void MasterProtocol::swap(clock::Nanos now, Actions& out) {
   wire::Envelope envelope;
   auto& swap = *envelope.mutable_swap();
   swap.set_frame_id(frame);
-  swap.set_present_deadline_ns(now + nanos(config_.present_lead));
+  const clock::Nanos sent = settings_.send_clock ? settings_.send_clock() : now;
+  swap.set_present_deadline_ns(sent + nanos(config_.present_lead));
   for (std::size_t slot : ready_for_swap_) {
     if (slots_[slot].peer) out.push_back(Send{*slots_[slot].peer, envelope});
   }
-  recorder_.swapped(frame, now, ready_for_swap_);
+  recorder_.swapped(frame, sent, ready_for_swap_);
   ready_for_swap_.clear();
   if (state_ == RunState::draining) {
     wait_for_last_presents(true, now, out);

@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -102,6 +103,10 @@ struct RunSettings {
   std::uint64_t capture_every = 0;  // ask nodes to capture every K-th frame (0: never)
   // Nodes must prove they hold it; without one only loopback peers are accepted.
   std::optional<net::Secret> secret;
+  // Reads the clock at the instant a FrameBegin goes out, once the frame's state
+  // is computed: a barrier round is from then to the Swap, not the master's own
+  // work on the frame. Unset (tests): the time of the event that began the frame.
+  std::function<clock::Nanos()> send_clock;
 };
 
 class MasterProtocol {

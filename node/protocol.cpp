@@ -76,6 +76,9 @@ Actions NodeProtocol::closed(const std::string& reason, clock::Nanos now) {
   phase_ = Phase::disconnected;
   pending_.reset();
   held_.clear();
+  round_open_ = false;
+  ping_owed_ = false;
+  last_begin_.reset();
   if (was_joined) {
     log(out, spdlog::level::warn,
         "lost the master: " + reason + "; " + (settings_.hold_last_frame ? "holding the last frame" : "showing black") +
@@ -153,7 +156,7 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
       if (pending_) {
         held_.push_back(message);
       } else {
-        on_frame_begin(message.frame_begin(), out);
+        on_frame_begin(message.frame_begin(), now, out);
       }
       break;
     case wire::Envelope::kSwap:
@@ -270,7 +273,9 @@ void NodeProtocol::on_resync(const wire::Resync& resync, clock::Nanos now, Actio
   send_ping(now, out);
 }
 
-void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, Actions& out) {
+void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos now, Actions& out) {
+  last_begin_ = now;
+  round_open_ = true;
   if (begin.frame_id() != next_frame_) {
     log(out, spdlog::level::warn,
         "frame ids jumped from " + std::to_string(next_frame_) + " to " + std::to_string(begin.frame_id()));
@@ -350,6 +355,7 @@ void NodeProtocol::on_swap(const wire::FrameSwap& swap, clock::Nanos now, Action
     log(out, spdlog::level::warn,
         "swap for frame " + std::to_string(swap.frame_id()) + " but the last rendered frame is " +
             std::to_string(last_rendered_) + "; not presenting");
+    end_round(now, out);
     return;
   }
   const std::optional<clock::ClockEstimate> estimate = estimator_.at(settings_.clock.to_local(now));
@@ -368,6 +374,7 @@ void NodeProtocol::on_swap(const wire::FrameSwap& swap, clock::Nanos now, Action
   // Checked here and again when the deadline comes: a stop can stretch the wait too.
   if (stale(now, out)) {
     pending_.reset();
+    end_round(now, out);
     return;
   }
   out.push_back(PresentAt{swap.frame_id(), deadline});
@@ -386,6 +393,7 @@ Actions NodeProtocol::present_due(clock::Nanos now) {
   if (!pending_ || pending_->due) return out;
   if (stale(now, out)) {
     pending_.reset();
+    end_round(now, out);
   } else {
     pending_->due = true;
     out.push_back(Present{});
@@ -437,6 +445,7 @@ Actions NodeProtocol::presented(clock::Nanos now) {
         fmt::format("presented frame {} at master time {} ns ({:+.1f} µs from the deadline)", shown.frame_id,
                     presented_at, static_cast<double>(presented_at - shown.master_deadline) / 1e3));
   }
+  end_round(now, out);
   release_held(now, out);
   return out;
 }
@@ -444,6 +453,7 @@ Actions NodeProtocol::presented(clock::Nanos now) {
 // ---------------------------------------------------------------- clock
 
 void NodeProtocol::send_ping(clock::Nanos now, Actions& out) {
+  ping_owed_ = false;
   if (phase_ != Phase::joined || !connection_open_) return;
   wire::Envelope envelope;
   envelope.mutable_ping()->set_t1(settings_.clock.to_local(now));
@@ -454,8 +464,26 @@ void NodeProtocol::send_ping(clock::Nanos now, Actions& out) {
 
 Actions NodeProtocol::ping_due(clock::Nanos now) {
   Actions out;
+  if (!ping_owed_ && pings_in_burst_ == 0 && in_round(now)) {
+    ping_owed_ = true;
+    out.push_back(PingIn{kPingDeferral});  // in case the round never ends here (no swap comes)
+    return out;
+  }
   send_ping(now, out);
   return out;
+}
+
+bool NodeProtocol::in_round(clock::Nanos now) const {
+  if (round_open_) return true;
+  if (!last_begin_ || frame_period_ <= 0) return false;
+  const clock::Nanos next_begin = *last_begin_ + frame_period_;
+  const clock::Nanos guard = std::chrono::nanoseconds(kRoundGuard).count();
+  return now >= next_begin - guard && now < next_begin + guard;
+}
+
+void NodeProtocol::end_round(clock::Nanos now, Actions& out) {
+  round_open_ = false;
+  if (ping_owed_) send_ping(now, out);
 }
 
 void NodeProtocol::on_pong(const wire::Pong& pong, clock::Nanos now, Actions& out) {

@@ -120,6 +120,13 @@ class NodeProtocol {
   // that its quietest is really quiet (the skewed-clock test's worst error fell
   // from 42 to 14 µs going from ten a second to forty).
   static constexpr std::chrono::milliseconds kPingInterval{25};
+  // A ping that falls due during a frame's round (from a millisecond before the
+  // next FrameBegin is expected until this node has presented) waits until the
+  // round is over, at most this long: the master answers it outside its barrier,
+  // so pings do not lengthen rounds (at forty a second they put the 8-node round
+  // p99 up by 15-25 % when sent whenever due).
+  static constexpr std::chrono::milliseconds kPingDeferral{10};
+  static constexpr std::chrono::microseconds kRoundGuard{1000};
 
   explicit NodeProtocol(NodeSettings settings);
 
@@ -147,10 +154,14 @@ class NodeProtocol {
   void on_challenge(const wire::Envelope& message, Actions& out);
   void on_welcome(const wire::Welcome& welcome, Actions& out);
   void on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out);
-  void on_frame_begin(const wire::FrameBegin& begin, Actions& out);
+  void on_frame_begin(const wire::FrameBegin& begin, clock::Nanos now, Actions& out);
   void on_swap(const wire::FrameSwap& swap, clock::Nanos now, Actions& out);
   void on_pong(const wire::Pong& pong, clock::Nanos now, Actions& out);
   void send_ping(clock::Nanos now, Actions& out);
+  // Between FrameBegin and presenting, or about to be.
+  [[nodiscard]] bool in_round(clock::Nanos now) const;
+  // The frame is shown or given up: a ping held back goes now.
+  void end_round(clock::Nanos now, Actions& out);
   // Held up past the next frame's time (the process was stopped, the machine
   // stalled): showing it would put an old frame beside its partners' new one.
   [[nodiscard]] bool stale(clock::Nanos now, Actions& out) const;
@@ -181,6 +192,9 @@ class NodeProtocol {
   std::chrono::milliseconds heartbeat_{250};
   std::chrono::milliseconds liveness_timeout_{3000};
   int pings_in_burst_ = 0;
+  bool ping_owed_ = false;                  // due during a round: goes when it ends
+  std::optional<clock::Nanos> last_begin_;  // when the last FrameBegin came
+  bool round_open_ = false;                 // a FrameBegin came; its frame is not yet shown or given up
   // A frame waiting for its present deadline, and the messages that came
   // meanwhile and must not touch the frame before it is shown.
   struct Pending {

@@ -387,5 +387,45 @@ TEST_F(NodeTest, PingsComeInABurstOnJoiningThenFortyASecond) {
   EXPECT_EQ(intervals, (std::vector<long>{5, 5, 5, 5, 5, 5, 25, 25, 25, 25}));
 }
 
+TEST_F(NodeTest, APingDueDuringARoundWaitsUntilTheFrameIsShown) {
+  NodeProtocol node(settings());
+  join(node);
+  for (int i = 1; i < NodeProtocol::kPingBurst; ++i) (void)node.ping_due(now_);  // the burst is over
+  (void)begin(node, 0);
+  Actions a = node.ping_due(now_);
+  EXPECT_TRUE(sent(a, wire::Envelope::kPing).empty()) << "not while the master waits for this node's ready";
+  ASSERT_NE(first<PingIn>(a), nullptr);
+  EXPECT_EQ(first<PingIn>(a)->after, NodeProtocol::kPingDeferral);
+  (void)node.rendered(0, kMs);
+  a = swap(node, 0, now_ + 2 * kMs);
+  now_ = first<PresentAt>(a)->deadline;
+  (void)node.present_due(now_);
+  a = node.presented(now_);
+  const auto presented = std::find_if(a.begin(), a.end(), [](const Action& x) {
+    return std::holds_alternative<Send>(x) && std::get<Send>(x).message.has_presented();
+  });
+  const auto ping = std::find_if(a.begin(), a.end(), [](const Action& x) {
+    return std::holds_alternative<Send>(x) && std::get<Send>(x).message.has_ping();
+  });
+  ASSERT_NE(ping, a.end()) << "the ping goes once the frame is shown";
+  EXPECT_LT(presented, ping) << "after the report";
+  ASSERT_NE(first<PingIn>(a), nullptr);
+  EXPECT_EQ(first<PingIn>(a)->after, NodeProtocol::kPingInterval);
+
+  // Mid-frame: sent at once.
+  now_ += 5 * kMs;
+  EXPECT_EQ(sent(node.ping_due(now_), wire::Envelope::kPing).size(), 1u);
+  // Half a millisecond before the next FrameBegin is expected: held back.
+  now_ += kPeriod - 2 * kMs - 5 * kMs - kMs / 2;
+  EXPECT_TRUE(sent(node.ping_due(now_), wire::Envelope::kPing).empty());
+
+  // A round that never ends here (the master dropped the frame: no swap comes)
+  // holds a ping back once, not forever.
+  (void)begin(node, 1);
+  (void)node.rendered(1, kMs);
+  now_ += NodeProtocol::kPingDeferral.count() * kMs;
+  EXPECT_EQ(sent(node.ping_due(now_), wire::Envelope::kPing).size(), 1u);
+}
+
 }  // namespace
 }  // namespace optique::node
