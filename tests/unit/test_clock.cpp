@@ -222,7 +222,7 @@ TEST(OffsetEstimator, FollowsA200PpmDriftWithin25MicrosecondsAfterTwoSeconds) {
       const DriftRun run = run_drifting({50 * kMs, drift}, 2 * kNanosPerSecond, seed);
       EXPECT_LE(std::abs(run.estimate_error), 25 * kUs) << "drift " << drift * 1e6 << " ppm, seed " << seed;
       EXPECT_NEAR(run.drift_ppm, drift * 1e6, 30.0) << "seed " << seed;
-      EXPECT_GE(run.points, 8u);
+      EXPECT_GE(run.points, 7u) << "the line goes through most of the 11 buckets (a few far off are left out)";
     }
   }
 }
@@ -249,6 +249,33 @@ TEST(OffsetEstimator, WithoutTheDriftTheQuietestSampleWouldBeFarOff) {
   const Nanos truth = node.true_offset(2 * kNanosPerSecond);
   EXPECT_GT(std::abs(estimator.best()->offset - truth), 350 * kUs);
   EXPECT_LE(std::abs(estimator.at(node.node_time(2 * kNanosPerSecond))->offset - truth), 2 * kUs);
+}
+
+TEST(OffsetEstimator, ABucketWhosePingsAllMetABusyLegDoesNotTiltTheLine) {
+  // Pings forty a second, 25 µs each way, on a node 200 ppm slow, except in the
+  // last bucket read: there every ping's way out took 80 µs longer (a busy
+  // master), so its quietest sample is 40 µs off. The line is read right there.
+  const DriftingNode node{50 * kMs, 200e-6};
+  const Nanos until = 3 * kNanosPerSecond;
+  const auto run = [&](bool busy_end) {
+    OffsetEstimator estimator;
+    for (Nanos m = 0; m <= until; m += 25 * kMs) {
+      const Nanos out = 25 * kUs + (busy_end && m > until - 200 * kMs ? 80 * kUs : 0);
+      PingSample s;
+      s.t1 = node.node_time(m);
+      s.t2 = m + out;
+      s.t3 = s.t2 + 5 * kUs;
+      s.t4 = node.node_time(s.t3 + 25 * kUs);
+      EXPECT_TRUE(estimator.add(s));
+    }
+    return *estimator.at(node.node_time(until));
+  };
+  const ClockEstimate clean = run(false);
+  EXPECT_LE(std::abs(clean.offset - node.true_offset(until)), 1 * kUs);
+  const ClockEstimate busy = run(true);
+  EXPECT_LE(std::abs(busy.offset - node.true_offset(until)), 3 * kUs) << "the busy bucket is left out of the fit";
+  EXPECT_EQ(busy.points + 1, clean.points);
+  EXPECT_NEAR(busy.drift_ppm, 200.0, 2.0);
 }
 
 TEST(OffsetEstimator, NoDriftUntilTheSamplesSpanHalfASecond) {
