@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Checks that optique's libraries follow their layers.
 
-Reads the layers file the build writes (one line per library: NAME FOLDER: DEPS,
-from optique_library() in CMakeLists.txt) and fails, naming file and line, when
+Reads the layers file the build writes (one line per library: NAME FOLDER: DEPS
+| OUTSIDE LIBRARIES, from optique_library() in CMakeLists.txt) and fails, naming file and line, when
   - the libraries' dependencies form a cycle, or
   - a source file includes a header of a library its own library does not
     depend on (directly or through others).
@@ -22,7 +22,8 @@ def read_layers(path):
             line = line.strip()
             if not line:
                 continue
-            head, _, deps = line.partition(":")
+            head, _, rest = line.partition(":")
+            deps = rest.partition("|")[0]  # after '|': outside libraries
             name, folder = head.split()
             libraries[name] = (folder, deps.split())
     return libraries
