@@ -140,7 +140,7 @@ else
   export TSAN_OPTIONS="${tsan_supp}second_deadlock_stack=1:history_size=4:log_path=$log_dir/tsan${TSAN_OPTIONS:+:$TSAN_OPTIONS}"
 fi
 # Bounds on how late things may happen are loosened by this factor (see
-# timing_scale() in tests/integration/process.h); what must happen is not.
+# timing_scale() in tests/support/process.h); what must happen is not.
 if [ "$mode" = address ]; then time_scale=4; else time_scale=10; fi
 export OPTIQUE_TEST_TIME_SCALE="${OPTIQUE_TEST_TIME_SCALE:-$time_scale}"
 
