@@ -85,9 +85,15 @@ tests_labelled() {
   local file folder
   for file in tests/*/CMakeLists.txt; do
     folder=$(basename "$(dirname "$file")")
-    grep -oE 'optique_test\([A-Za-z0-9_]+( LABEL [a-z]+)?' "$file" |
-      awk -v folder="$folder" -v re="^($1)\$" \
-        '{ sub(/optique_test\(/, ""); label = ($2 == "LABEL") ? $3 : folder; if (label ~ re) print $1 }'
+    # One awk, no grep: under pipefail a folder without tests (grep finding
+    # nothing) would end the loop early.
+    awk -v folder="$folder" -v re="^($1)\$" '
+      match($0, /optique_test\([A-Za-z0-9_]+/) {
+        name = substr($0, RSTART + 13, RLENGTH - 13)
+        label = folder
+        if (match($0, / LABEL [a-z]+/)) label = substr($0, RSTART + 7, RLENGTH - 7)
+        if (label ~ re) print name
+      }' "$file"
   done | sort -u
 }
 
