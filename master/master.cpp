@@ -147,7 +147,9 @@ void Master::on_accepted(asio::ip::tcp::socket socket) {
   auto connection = net::Connection::create(std::move(socket), kMaxHelloBytes);
   connections_[id] = connection;
   connection->start({
-      [this, id](wire::Envelope& message) { carry_out(protocol_->message(id, message, clock::monotonic_now())); },
+      [this, id](wire::Envelope& message, clock::Nanos received) {
+        carry_out(protocol_->message(id, message, received));
+      },
       [this, id](const std::string& reason) {
         connections_.erase(id);
         carry_out(protocol_->closed(id, reason, clock::monotonic_now()));

@@ -72,7 +72,9 @@ void Node::connect() {
               }
               connection_ = net::Connection::create(std::move(*socket), net::kDefaultMaxPayloadBytes);
               connection_->start({
-                  [this](wire::Envelope& message) { carry_out(protocol_.message(message, clock::monotonic_now())); },
+                  [this](wire::Envelope& message, clock::Nanos received) {
+                    carry_out(protocol_.message(message, received));
+                  },
                   [this](const std::string& reason) { carry_out(protocol_.closed(reason, clock::monotonic_now())); },
               });
               log_.debug("connected to the master at {}", connection_->peer());
@@ -88,7 +90,11 @@ void Node::carry_out(Actions actions) {
 void Node::carry_out(Action& action) {
   std::visit(util::Overloaded{
                  [&](Send& a) {
-                   if (connection_ && connection_->is_open()) connection_->send(a.message);
+                   if (!connection_ || !connection_->is_open()) return;
+                   // A ping's t1 is when it leaves, as the master's pong t3 is: the
+                   // legs are measured alike.
+                   if (a.message.has_ping()) a.message.mutable_ping()->set_t1(options_.protocol.clock.now());
+                   connection_->send(a.message);
                  },
                  [&](Close& a) {
                    if (!connection_ || !connection_->is_open()) return;

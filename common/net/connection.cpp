@@ -4,6 +4,7 @@
 #include <boost/asio/write.hpp>
 
 #include "net/envelope.h"
+#include "net/stamped_receive.h"
 
 namespace optique::net {
 
@@ -19,6 +20,8 @@ Connection::Connection(asio::ip::tcp::socket socket, std::uint32_t max_payload_b
       last_receive_(std::chrono::steady_clock::now()) {
   boost::system::error_code ec;
   socket_.set_option(asio::ip::tcp::no_delay(true), ec);
+  // Without stamps a message's time is when it is read: coarser, not wrong.
+  (void)enable_receive_stamps(socket_.native_handle());
   const auto endpoint = socket_.remote_endpoint(ec);
   peer_ = ec ? std::string("unknown peer") : endpoint.address().to_string() + ":" + std::to_string(endpoint.port());
 }
@@ -27,7 +30,8 @@ Connection::~Connection() = default;
 
 void Connection::start(Handlers handlers) {
   handlers_ = std::move(handlers);
-  read_more();
+  // Not read here: a message must not reach its handler before start() returns.
+  asio::post(socket_.get_executor(), [self = shared_from_this()] { self->read_available(); });
 }
 
 void Connection::send(wire::Envelope& message) {
@@ -67,23 +71,53 @@ void Connection::write_more() {
                     });
 }
 
-void Connection::read_more() {
-  socket_.async_read_some(asio::buffer(read_buffer_),
-                          [self = shared_from_this()](const boost::system::error_code& ec, std::size_t count) {
-                            if (ec) {
-                              if (ec == asio::error::eof) {
-                                self->finish("peer closed the connection");
-                              } else if (ec != asio::error::operation_aborted) {
-                                self->finish("read failed: " + ec.message());
-                              }
-                              return;
-                            }
-                            self->handle_bytes(count);
-                            if (self->open_) self->read_more();
-                          });
+// Readiness from Asio, the bytes from recvmsg(): Asio's reads drop the kernel's
+// receive stamp. A message then costs what it cost with Asio's reads: one wait
+// (Asio's async_wait re-arms epoll, which also reports bytes already there)
+// and one read, where Asio tried a read that found nothing before each wait.
+// A peek instead of async_wait costs one more read per message.
+void Connection::wait_for_bytes() {
+  socket_.async_wait(asio::ip::tcp::socket::wait_read,
+                     [self = shared_from_this()](const boost::system::error_code& ec) {
+                       if (ec) {
+                         if (ec != asio::error::operation_aborted) self->finish("read failed: " + ec.message());
+                         return;
+                       }
+                       self->read_available();
+                     });
 }
 
-void Connection::handle_bytes(std::size_t count) {
+void Connection::read_available() {
+  // A peer that sends without pause must not keep the io thread to itself:
+  // after this many full reads the rest waits behind what else is queued.
+  constexpr int kReadsPerTurn = 16;
+  for (int reads = 0; open_ && reads < kReadsPerTurn; ++reads) {
+    const StampedRead read = read_stamped(socket_.native_handle(), read_buffer_);
+    switch (read.status) {
+      case StampedRead::Status::data:
+        handle_bytes(read.count, read.received);
+        // Less than the buffer holds: the socket was empty. Bytes that came
+        // since wake the wait all the same (re-arming epoll reports them).
+        if (read.count < read_buffer_.size()) {
+          if (open_) wait_for_bytes();
+          return;
+        }
+        break;
+      case StampedRead::Status::would_block:
+        wait_for_bytes();
+        return;
+      case StampedRead::Status::closed:
+        finish("peer closed the connection");
+        return;
+      case StampedRead::Status::failed:
+        finish("read failed: " + boost::system::error_code(read.error, boost::system::system_category()).message());
+        return;
+    }
+  }
+  if (open_) asio::post(socket_.get_executor(), [self = shared_from_this()] { self->read_available(); });
+}
+
+void Connection::handle_bytes(std::size_t count, clock::Nanos received) {
   last_receive_ = std::chrono::steady_clock::now();
   if (closing_) return;  // draining: what the peer says no longer matters
   reader_.append({read_buffer_.data(), count});
@@ -105,7 +139,7 @@ void Connection::handle_bytes(std::size_t count) {
       return;
     }
     ++next_receive_sequence_;
-    if (handlers_.on_message) handlers_.on_message(message.value());
+    if (handlers_.on_message) handlers_.on_message(message.value(), received);
   }
 }
 

@@ -1,5 +1,6 @@
 #pragma once
-// One TCP connection carrying Envelopes: asynchronous reads through a FrameReader,
+// One TCP connection carrying Envelopes: asynchronous reads through a FrameReader
+// (each message with the kernel's receive time),
 // coalesced asynchronous writes, and deadlines owned by the session (a liveness
 // timeout and an optional one-shot deadline). Never a blocking read. Used on one
 // io_context thread; not thread-safe.
@@ -15,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "clock/clock.h"
 #include "net/framing.h"
 #include "optique/wire.pb.h"
 
@@ -25,7 +27,9 @@ namespace asio = boost::asio;
 class Connection : public std::enable_shared_from_this<Connection> {
  public:
   struct Handlers {
-    std::function<void(wire::Envelope& message)> on_message;
+    // `received`: when the kernel received the message's last bytes (monotonic
+    // clock; see stamped_receive.h), the time to use for anything measured on it.
+    std::function<void(wire::Envelope& message, clock::Nanos received)> on_message;
     // Called once, when the connection is gone for any reason.
     std::function<void(const std::string& reason)> on_closed;
   };
@@ -66,8 +70,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
  private:
   Connection(asio::ip::tcp::socket socket, std::uint32_t max_payload_bytes);
 
-  void read_more();
-  void handle_bytes(std::size_t count);
+  void wait_for_bytes();
+  void read_available();
+  void handle_bytes(std::size_t count, clock::Nanos received);
   void write_more();
   void arm_liveness();
   void finish(const std::string& reason);

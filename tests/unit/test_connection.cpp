@@ -1,0 +1,154 @@
+// net::Connection over a real loopback socket: messages whole and in order
+// however the bytes arrive, each with the kernel's receive time, and the close
+// reasons a peer's departure gives.
+
+#include <gtest/gtest.h>
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/write.hpp>
+
+#include <chrono>
+#include <functional>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "clock/clock.h"
+#include "net/connection.h"
+#include "net/envelope.h"
+
+namespace optique::net {
+namespace {
+
+namespace asio = boost::asio;
+using asio::ip::tcp;
+
+struct Received {
+  wire::Envelope message;
+  clock::Nanos received = 0;  // the kernel's stamp
+  clock::Nanos handled = 0;   // when the handler ran
+};
+
+// A Connection on the accepting side; the test writes raw frames to `client`.
+struct Loopback {
+  asio::io_context io;
+  tcp::socket client{io};
+  std::shared_ptr<Connection> server;
+  std::vector<Received> received;
+  std::string closed_reason;
+
+  Loopback() {
+    tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+    client.connect(acceptor.local_endpoint());
+    server = Connection::create(acceptor.accept(), kDefaultMaxPayloadBytes);
+    server->start({[this](wire::Envelope& message, clock::Nanos at) {
+                     received.push_back({message, at, clock::monotonic_now()});
+                   },
+                   [this](const std::string& reason) { closed_reason = reason; }});
+  }
+
+  // Frames `count` pings (t1 = 1, 2, …) with sequence numbers from `first`.
+  static std::vector<std::uint8_t> pings(std::uint64_t first, int count, std::size_t padding = 0) {
+    std::vector<std::uint8_t> bytes;
+    for (int i = 0; i < count; ++i) {
+      wire::Envelope envelope;
+      envelope.set_protocol_version(kProtocolVersion);
+      envelope.set_sequence(first + static_cast<std::uint64_t>(i));
+      envelope.mutable_ping()->set_t1(static_cast<std::int64_t>(first) + i);
+      if (padding > 0) {
+        // A hello is the one body with free text: padding for a large frame.
+        envelope.mutable_hello()->set_node_id(std::string(padding, 'x'));
+      }
+      append_envelope(bytes, envelope);
+    }
+    return bytes;
+  }
+
+  void run_until(const std::function<bool()>& done) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (!done() && std::chrono::steady_clock::now() < give_up) io.run_for(std::chrono::milliseconds(5));
+  }
+};
+
+TEST(Connection, AMessageCarriesTheTimeTheKernelReceivedItNotTheTimeItWasRead) {
+  Loopback loop;
+  // The kernel starts stamping a moment after the first socket in the system
+  // asks (it patches its receive path from a work queue); until then a message
+  // carries the time it was read.
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  const clock::Nanos before = clock::monotonic_now();
+  asio::write(loop.client, asio::buffer(Loopback::pings(1, 1)));
+  // The io thread is busy elsewhere for 50 ms before it reads.
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  loop.run_until([&] { return !loop.received.empty(); });
+  ASSERT_EQ(loop.received.size(), 1u);
+  const Received& r = loop.received[0];
+  EXPECT_EQ(r.message.ping().t1(), 1);
+  // Slack for mapping the kernel's wall-clock stamp onto the monotonic clock.
+  EXPECT_GE(r.received, before - 100 * clock::kNanosPerMicro);
+  EXPECT_LE(r.received, r.handled - 40 * clock::kNanosPerMilli)
+      << "stamped " << (r.handled - r.received) / 1e6 << " ms before it was handled";
+}
+
+TEST(Connection, ABurstLargerThanTheReadBufferArrivesWholeAndInOrder) {
+  Loopback loop;
+  // 2000 small frames and then frames of 200 KiB each, more than one read holds,
+  // written at once: the connection must read until the socket is empty.
+  std::vector<std::uint8_t> bytes = Loopback::pings(1, 2000);
+  const std::vector<std::uint8_t> large = Loopback::pings(2001, 5, 200 * 1024);
+  bytes.insert(bytes.end(), large.begin(), large.end());
+  std::thread writer([&] { asio::write(loop.client, asio::buffer(bytes)); });
+  loop.run_until([&] { return loop.received.size() == 2005; });
+  writer.join();
+  ASSERT_EQ(loop.received.size(), 2005u) << loop.closed_reason;
+  for (std::size_t i = 0; i < 2000; ++i) ASSERT_EQ(loop.received[i].message.ping().t1(), static_cast<int>(i) + 1);
+  for (std::size_t i = 2000; i < 2005; ++i) {
+    ASSERT_TRUE(loop.received[i].message.has_hello());
+    EXPECT_EQ(loop.received[i].message.hello().node_id().size(), 200u * 1024);
+  }
+  // In order, but for the jitter of mapping the kernel's wall-clock stamp onto
+  // the monotonic clock (two clock reads: tens of nanoseconds).
+  for (std::size_t i = 1; i < loop.received.size(); ++i) {
+    EXPECT_GE(loop.received[i].received, loop.received[i - 1].received - clock::kNanosPerMicro)
+        << "receive times go back at " << i;
+  }
+  EXPECT_TRUE(loop.closed_reason.empty()) << loop.closed_reason;
+}
+
+TEST(Connection, NoMessageReachesItsHandlerBeforeStartReturns) {
+  asio::io_context io;
+  tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
+  tcp::socket client(io);
+  client.connect(acceptor.local_endpoint());
+  asio::write(client, asio::buffer(Loopback::pings(1, 3)));
+  auto server = Connection::create(acceptor.accept(), kDefaultMaxPayloadBytes);
+  int handled = 0;
+  server->start({[&](wire::Envelope&, clock::Nanos) { ++handled; }, [](const std::string&) {}});
+  EXPECT_EQ(handled, 0);
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (handled < 3 && std::chrono::steady_clock::now() < give_up) io.run_for(std::chrono::milliseconds(5));
+  EXPECT_EQ(handled, 3) << "what was sent before start() is read after it";
+}
+
+TEST(Connection, APeerThatClosesIsReportedOnce) {
+  Loopback loop;
+  asio::write(loop.client, asio::buffer(Loopback::pings(1, 2)));
+  loop.client.close();
+  loop.run_until([&] { return !loop.closed_reason.empty(); });
+  EXPECT_EQ(loop.received.size(), 2u) << "what came before the close is still delivered";
+  EXPECT_EQ(loop.closed_reason, "peer closed the connection");
+  EXPECT_FALSE(loop.server->is_open());
+}
+
+TEST(Connection, BytesOutOfSequenceCloseTheConnectionWithTheReason) {
+  Loopback loop;
+  asio::write(loop.client, asio::buffer(Loopback::pings(2, 1)));
+  loop.run_until([&] { return !loop.closed_reason.empty(); });
+  EXPECT_TRUE(loop.received.empty());
+  EXPECT_EQ(loop.closed_reason, "message out of sequence (got 2, expected 1)");
+}
+
+}  // namespace
+}  // namespace optique::net
