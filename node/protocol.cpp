@@ -62,7 +62,8 @@ Actions NodeProtocol::connect_failed(const std::string& reason, clock::Nanos now
         fmt::format("master at {} not reachable ({}); retrying every {} ms, giving up after {} ms", settings_.master,
                     reason, backoff_.count(), settings_.give_up_after.count()));
   }
-  out.push_back(Reconnect{backoff_});
+  // The last try falls on the limit, not a whole backoff past it.
+  out.push_back(Reconnect{std::min(backoff_, settings_.give_up_after - waited)});
   backoff_ = std::min(backoff_ * 2, kMaxBackoff);
   return out;
 }

@@ -319,6 +319,28 @@ TEST_F(NodeTest, BadFrameInputClosesTheConnection) {
   EXPECT_NE(first<Close>(a)->reason.find("focus depth"), std::string::npos);
 }
 
+// --give-up-after-ms 10000 once gave up after 11.1 s: the backoff ran past it.
+TEST_F(NodeTest, GivingUpKeepsToTheLimitWhateverTheBackoff) {
+  for (const long limit : {10000L, 150L, 2500L, 7777L}) {
+    NodeSettings s = settings();
+    s.give_up_after = std::chrono::milliseconds(limit);
+    NodeProtocol node(s);
+    const clock::Nanos lost = now_;
+    Actions a = node.closed("connection refused", lost);
+    clock::Nanos t = lost;
+    int tries = 0;
+    while (first<Stop>(a) == nullptr && tries < 1000) {
+      const Reconnect* r = first<Reconnect>(a);
+      ASSERT_NE(r, nullptr) << "limit " << limit;
+      t += r->after.count() * kMs;  // each try is refused at once
+      a = node.connect_failed("connection refused", t);
+      ++tries;
+    }
+    ASSERT_NE(first<Stop>(a), nullptr) << "limit " << limit;
+    EXPECT_EQ((t - lost) / kMs, limit) << "gave up " << (t - lost) / kMs << " ms after the loss, " << tries << " tries";
+  }
+}
+
 TEST_F(NodeTest, LosingTheMasterShowsBlackAndReconnectsWithBackoffThenGivesUp) {
   NodeProtocol node(settings());
   join(node);
