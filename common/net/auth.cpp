@@ -93,13 +93,16 @@ Result<Secret> load_secret_file(const std::string& path) {
   if (!S_ISREG(info.st_mode)) {
     return Error{quoted(path) + " is not a regular file"};
   }
-  const bool world_readable = (info.st_mode & S_IROTH) != 0;
-  const bool world_writable = (info.st_mode & S_IWOTH) != 0;
-  if (world_readable || world_writable) {
-    const char* what = world_readable && world_writable ? "readable and writable"
-                       : world_readable                 ? "readable"
-                                                        : "writable";
-    return Error{quoted(path) + " is " + what + " by other users (mode " + octal_mode(info.st_mode) +
+  // As ssh with a private key: nobody but the owner may read or write it, the
+  // owner's group included (a group is other people too).
+  const bool readable = (info.st_mode & (S_IRGRP | S_IROTH)) != 0;
+  const bool writable = (info.st_mode & (S_IWGRP | S_IWOTH)) != 0;
+  if (readable || writable) {
+    const bool group = (info.st_mode & (S_IRGRP | S_IWGRP)) != 0;
+    const bool others = (info.st_mode & (S_IROTH | S_IWOTH)) != 0;
+    const char* what = readable && writable ? "readable and writable" : readable ? "readable" : "writable";
+    const char* who = group && others ? "its group and other users" : group ? "its group" : "other users";
+    return Error{quoted(path) + " is " + what + " by " + who + " (mode " + octal_mode(info.st_mode) +
                  "): chmod 600 it"};
   }
   if (info.st_size > static_cast<off_t>(kMaxSecretBytes)) {

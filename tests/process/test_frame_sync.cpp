@@ -410,7 +410,7 @@ TEST(Security, AWorldReadableSecretFileStopsTheMasterBeforeAnythingStarts) {
   EXPECT_NE(master.output().find("chmod 600"), std::string::npos) << master.output();
   Process check({master_binary(), "check-config", wall.config}, wall.dir + "/check.log");
   EXPECT_EQ(check.wait(20s).value_or(-1), 2);
-  EXPECT_NE(check.output().find("readable by other users"), std::string::npos) << check.output();
+  EXPECT_NE(check.output().find("readable by its group and other users"), std::string::npos) << check.output();
 }
 
 // Every kind of bad peer, while two healthy nodes run at 30 Hz for 12 s: each is refused
