@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -13,6 +14,7 @@
 
 #include "geometry/projection.h"
 #include "image/texture_decode.h"
+#include "optics/projector_model.h"
 #include "render/gl_context.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
@@ -34,9 +36,11 @@ const glm::dvec3 kEye{0.0, 0.0, 2.0};
 const std::vector<std::uint8_t> kChecker{255, 128, 64,  255, 0,   255, 128, 255,   // top-left, top-right
                                          64,  0,   255, 255, 128, 64,  0,   255};  // bottom-left, bottom-right
 
+// The sRGB curve as optique's projector model has it (its known values are
+// checked in tests/unit/test_projector_model.cpp); here GL's texture decoding
+// must agree with it.
 float srgb_to_linear(std::uint8_t encoded) {
-  const double c = encoded / 255.0;
-  return static_cast<float>(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
+  return static_cast<float>(optics::ProjectorModel().response(encoded / 255.0));
 }
 
 // The viewer 2 m in front of a 2 m × 2 m screen in the z = 0 plane.
@@ -106,13 +110,6 @@ class SceneRendererTest : public ::testing::Test {
   std::unique_ptr<GlContext> context_;
 };
 
-TEST(SrgbDecoding, ReferenceValues) {
-  EXPECT_NEAR(srgb_to_linear(0), 0.0f, 1e-7f);
-  EXPECT_NEAR(srgb_to_linear(64), 0.0512695f, 1e-6f);
-  EXPECT_NEAR(srgb_to_linear(128), 0.2158605f, 1e-6f);
-  EXPECT_NEAR(srgb_to_linear(255), 1.0f, 1e-7f);
-}
-
 TEST_F(SceneRendererTest, TextureIsDecodedFromSrgbAndTheRightWayUp) {
   scene::SceneDefinition scene;
   scene.name = "textured quad";
@@ -147,6 +144,80 @@ TEST_F(SceneRendererTest, TexturedQuadFromGltf) {
   ASSERT_EQ(scene.textures.size(), 1u);
   only_ambient(scene);
   expect_checker(scene);
+}
+
+// The output pass (GLSL) sends the signal the projector model (C++) says makes
+// the projector add the rendered light: for every pixel of a ramp through all
+// 256 texture codes, with each kind of response curve. The known values of the
+// curves are the unit test's; this holds the shader to them.
+TEST_F(SceneRendererTest, OutputPassSendsTheSignalTheProjectorModelGives) {
+  constexpr int kWidth = 256;
+  scene::SceneDefinition scene;
+  scene.meshes.push_back(textured_quad());
+  scene::Texture ramp{"ramp", kWidth, 1, {}};
+  for (int code = 0; code < kWidth; ++code) {
+    const auto c = static_cast<std::uint8_t>(code);
+    const auto d = static_cast<std::uint8_t>(255 - code);
+    ramp.rgba.insert(ramp.rgba.end(), {c, d, static_cast<std::uint8_t>((code * 7) % 256), 255});
+  }
+  scene.textures.push_back(ramp);
+  scene.materials.emplace_back(glm::vec3(1.0f), 0.0f, 1.0f, glm::vec3(0.0f), 0u);
+  scene.instances.push_back({0, 0, std::nullopt, glm::dmat4(1.0)});
+  only_ambient(scene);
+
+  struct Case {
+    const char* name;
+    config::ProjectorResponse response;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"sRGB, 8 bits", {}});
+  config::ProjectorResponse gamma;
+  gamma.curve = config::ResponseCurve::gamma;
+  gamma.gamma = 2.2;
+  gamma.bits = 10;
+  gamma.black_level = 0.05;
+  gamma.brightness = 0.8;
+  cases.push_back({"gamma 2.2, 10 bits, black 0.05, brightness 0.8", gamma});
+  config::ProjectorResponse table;
+  table.curve = config::ResponseCurve::table;
+  table.table = {0.0, 0.02, 0.2, 0.2, 0.6, 1.0};
+  table.bits = 12;
+  cases.push_back({"measured table, 12 bits", table});
+
+  auto created = SceneRenderer::create(scene, kWidth, 4);
+  ASSERT_TRUE(created.ok()) << created.error();
+  SceneRenderer& renderer = *created.value();
+  for (const Case& c : cases) {
+    OutputStage stage;
+    stage.projector = optics::ProjectorModel(c.response);
+    ASSERT_TRUE(renderer.set_output(stage).ok()) << c.name;
+    renderer.draw(scene::SceneState{}, 0.0, kEye, view_of_unit_square());
+    const image::FloatImage light = renderer.read_rendered();
+    const image::WordImage signal = renderer.read_signal();
+    ASSERT_EQ(signal.width, light.width);
+    ASSERT_EQ(signal.height, light.height);
+    const optics::ProjectorModel& model = stage.projector;
+    // One level: a light at a level's rounding edge may go either way in floats.
+    const double one_level = 1.0 / model.levels() + 1e-6;
+    double worst = 0.0;
+    double lowest = 1.0;
+    double highest = 0.0;
+    for (int y = 0; y < light.height; ++y) {
+      for (int x = 0; x < light.width; ++x) {
+        for (int ch = 0; ch < 3; ++ch) {
+          const double l = light.at(x, y, ch);
+          lowest = std::min(lowest, l);
+          highest = std::max(highest, l);
+          const double sent = signal.at(x, y, ch) / 65535.0;
+          worst = std::max(worst, std::abs(sent - model.signal_for(l)));
+        }
+      }
+    }
+    EXPECT_LE(worst, one_level) << c.name << ": the shader's signal is " << worst * model.levels()
+                                << " levels from the model's";
+    EXPECT_LT(lowest, 0.001) << c.name << ": the ramp should reach black";
+    EXPECT_GT(highest, 0.99) << c.name << ": the ramp should reach white";
+  }
 }
 
 TEST_F(SceneRendererTest, MaterialTextureOutOfRangeFailsCreate) {

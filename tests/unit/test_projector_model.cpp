@@ -29,6 +29,44 @@ TEST(ProjectorModel, DefaultIsEightBitSrgbWithoutBlack) {
   EXPECT_NEAR(model.inverse_response(0.2140), 0.5, 1e-4);
 }
 
+// Round trips pass whatever the curve is, a gamma swapped for its inverse on
+// both sides included: these are the curves' known values.
+TEST(ProjectorModel, CurvesHaveTheirKnownValues) {
+  const ProjectorModel srgb;
+  // IEC 61966-2-1: the linear and the power segment meet at 0.04045 → 0.0031308.
+  EXPECT_NEAR(srgb.response(0.04045), 0.0031308, 1e-7);
+  EXPECT_NEAR(srgb.response(0.04), 0.04 / 12.92, 1e-9);
+  EXPECT_NEAR(srgb.response(0.5), 0.2140411, 1e-7);
+  EXPECT_NEAR(srgb.response(64 / 255.0), 0.0512695, 1e-7);
+  EXPECT_NEAR(srgb.response(128 / 255.0), 0.2158605, 1e-7);
+  EXPECT_DOUBLE_EQ(srgb.response(1.0), 1.0);
+  EXPECT_NEAR(srgb.inverse_response(0.0031308), 0.04045, 1e-6);
+  EXPECT_NEAR(srgb.inverse_response(0.2140411), 0.5, 1e-7);
+
+  schema::Projector g;
+  g.mutable_response()->set_gamma(2.2);
+  const ProjectorModel gamma = model_of(g);
+  EXPECT_NEAR(gamma.response(0.5), 0.2176376, 1e-7);  // 0.5^2.2, not 0.5^(1/2.2) = 0.7297
+  EXPECT_NEAR(gamma.inverse_response(0.2176376), 0.5, 1e-7);
+  EXPECT_NEAR(gamma.response(0.25), 0.0473661, 1e-7);
+
+  schema::Projector t;
+  for (const double v : {0.0, 0.1, 0.5, 1.0}) t.mutable_response()->add_table(v);
+  const ProjectorModel table = model_of(t);
+  EXPECT_NEAR(table.response(1.0 / 3.0), 0.1, 1e-12);  // on an entry
+  EXPECT_NEAR(table.response(0.5), 0.3, 1e-12);        // halfway between 0.1 and 0.5
+  EXPECT_NEAR(table.inverse_response(0.3), 0.5, 1e-12);
+
+  // Black level and brightness: emitted = brightness · (black + (1 − black) · response).
+  schema::Projector dim = g;
+  dim.set_black_level(0.02);
+  dim.set_brightness(0.7);
+  const ProjectorModel d = model_of(dim);
+  EXPECT_NEAR(d.emitted(0.0), 0.014, 1e-12);
+  EXPECT_NEAR(d.emitted(0.5), 0.7 * (0.02 + 0.98 * 0.2176376), 1e-7);
+  EXPECT_NEAR(d.emitted(1.0), 0.7, 1e-12);
+}
+
 TEST(ProjectorModel, EmittedLightIsBlackPlusWhatWasRendered) {
   for (const double gamma : {1.0, 1.8, 2.2, 2.6}) {
     schema::Projector p;
