@@ -17,7 +17,12 @@ using std::chrono::milliseconds;
 
 clock::Nanos nanos(std::chrono::nanoseconds d) { return d.count(); }
 
-std::string format_us(double us) { return fmt::format("{:.0f} µs", us); }
+// "median 140 µs p99 260 µs", or why there is no number: a median over no
+// samples is not 0.
+std::string median_p99(const report::Distribution& d, const char* why_none) {
+  if (d.count() == 0) return fmt::format("n/a ({})", why_none);
+  return fmt::format("median {:.0f} µs p99 {:.0f} µs", d.median(), d.p99());
+}
 
 }  // namespace
 
@@ -595,11 +600,10 @@ void MasterProtocol::finish(Actions& out) {
   const report::RunReport summary = report();
   const auto& sync = summary.sync();
   out.push_back(Log{spdlog::level::info,
-                    fmt::format("{} frames; barrier round median {} p99 {}; present skew median {} p99 {}; {} frame(s) "
-                                "with a node missing",
-                                summary.frames(), format_us(sync.barrier_round_us().median()),
-                                format_us(sync.barrier_round_us().p99()), format_us(sync.present_skew_us().median()),
-                                format_us(sync.present_skew_us().p99()), sync.frames_with_missing_node())});
+                    fmt::format("{} frames; barrier round {}; present skew {}; {} frame(s) with a node missing",
+                                summary.frames(), median_p99(sync.barrier_round_us(), "no frame ran"),
+                                median_p99(sync.present_skew_us(), "no frame was presented by two nodes"),
+                                sync.frames_with_missing_node())});
   out.push_back(Finish{exit_code_});
 }
 

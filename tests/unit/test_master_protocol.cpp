@@ -336,6 +336,9 @@ TEST_F(MasterTest, AfterItsFramesItSaysGoodbyeAndFinishes) {
   a = master_->closed(4, "goodbye", now_);
   ASSERT_NE(first<Finish>(a), nullptr);
   EXPECT_EQ(first<Finish>(a)->exit_code, kExitOk);
+  EXPECT_TRUE(logged(a, "1 frames; barrier round median ")) << "one round was measured";
+  // No node reported a present: no skew, and the summary does not call that 0 µs.
+  EXPECT_TRUE(logged(a, "present skew n/a (no frame was presented by two nodes)"));
   EXPECT_EQ(master_->report().frames(), 1u);
   EXPECT_EQ(master_->report().stopped_because(), "ran 1 frames");
 }
