@@ -46,7 +46,10 @@ json output_document(const calib::Calibration& calibration, const geometry::Imag
   doc["residuals_px"] = fit.residuals_px;
   if (fit.oblique) {
     doc["oblique_depth_factor"] = fit.oblique->factor;
-    doc["depth_scale"] = fit.oblique->depth_scale;
+    // Over the whole image: the calibration knows nothing of the screen. What a
+    // node renders with is bounded over the part that lands on the screen
+    // (check-config's "depth scale over the lit area"), so it can be larger.
+    doc["depth_scale_whole_image"] = fit.oblique->depth_scale;
   }
   if (fit.coverage) doc["coverage"] = *fit.coverage;
   doc["warnings"] = fit.warnings;
@@ -93,8 +96,10 @@ void print_summary(const CalibrateOptions& options, const calib::Calibration& ca
     out << fmt::format("robust: {} inliers, {} outliers\n", fit.inliers.size(), fit.outliers.size());
   }
   if (fit.oblique) {
-    out << fmt::format("oblique depth factor |a31| + |a32|: {:.4f} (depth scale rendered with: {:.4f})\n",
-                       fit.oblique->factor, fit.oblique->depth_scale);
+    out << fmt::format(
+        "oblique depth factor |a31| + |a32|: {:.4f}; depth scale over the whole image {:.4f} (rendering bounds it "
+        "over the part on the screen: check-config shows that one)\n",
+        fit.oblique->factor, fit.oblique->depth_scale);
   }
   if (fit.coverage) out << fmt::format("the points span {:.0f}% of the image\n", 100.0 * *fit.coverage);
   if (calibration.tracker) {

@@ -17,7 +17,7 @@ std::string keystoned_summary(const config::Installation& inst, const config::Pr
   const auto& b = oblique.value().bounds;
   std::ostringstream text;
   text << std::setprecision(3) << "keystoned, lights (within the screen) [" << b.min.x << ", " << b.min.y << "] – ["
-       << b.max.x << ", " << b.max.y << "] m, " << config::to_string(p.rendering) << " (depth scale "
+       << b.max.x << ", " << b.max.y << "] m, " << config::to_string(p.rendering) << " (depth scale over the lit area "
        << oblique.value().depth_scale << ")";
   return text.str();
 }

@@ -93,8 +93,8 @@ void add_image_diagnostics(HomographyFit& fit, std::span<const geometry::Corresp
   if (f >= geometry::kDepthFactorWarning) {
     fit.warnings.push_back(fmt::format(
         "the oblique depth factor |a31| + |a32| is {:.3f} (≥ {}): Raskar's approximated depth (eq. 5) would keep "
-        "1 − |a31| − |a32| = {:.3f} of the depth range{}; optique bounds depth over the lit area instead and keeps "
-        "{:.3f} of it{}",
+        "1 − |a31| − |a32| = {:.3f} of the depth range{}; optique bounds depth over what the projector shows instead, "
+        "which keeps {:.3f} of it over the whole image (more over the part on the screen: see check-config){}",
         f, geometry::kDepthFactorWarning, 1.0 - f, f >= 1.0 ? " (nothing: single-pass depth would fail)" : "", k,
         k < 0.1 ? ", so depth precision drops: a less oblique projector helps" : ""));
   }
