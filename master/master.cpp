@@ -1,12 +1,11 @@
 #include "master/master.h"
 
-#include <google/protobuf/util/json_util.h>
-
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
+#include "master/report_json.h"
 #include "util/overloaded.h"
 
 namespace optique::master {
@@ -299,14 +298,7 @@ void Master::write_outputs() {
   report::RunReport report = protocol_->report();
   report.set_config_file(options_.config.path);
   report.set_config_sha256(options_.config.sha256);
-  std::string json;
-  google::protobuf::util::JsonPrintOptions print;
-  print.add_whitespace = true;
-  print.always_print_primitive_fields = true;
-  print.preserve_proto_field_names = true;
-  const auto status = google::protobuf::util::MessageToJsonString(report, &json, print);
-  assert(status.ok());
-  (void)status;
+  const std::string json = report_json(report);
   const auto path = std::filesystem::path(options_.out_dir) / "run.json";
   std::ofstream out(path);
   out << json;
