@@ -4,11 +4,14 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "config/parse.h"
+#include "config/schema_check.h"
 #include "util/sha256.h"
 
 namespace optique::config {
@@ -16,8 +19,9 @@ namespace optique::config {
 Result<schema::Installation> read_schema(const std::string& json, const std::string& origin) {
   // Protobuf's parser says what is wrong with JSON syntax but not where; a user
   // with a missing comma in a long file needs the line and column.
+  nlohmann::ordered_json document;
   try {
-    [[maybe_unused]] const auto document = nlohmann::json::parse(json);
+    document = nlohmann::ordered_json::parse(json);
   } catch (const nlohmann::json::parse_error& e) {
     std::string what = e.what();
     const auto detail = what.find(": ");
@@ -33,6 +37,11 @@ Result<schema::Installation> read_schema(const std::string& json, const std::str
       }
     }
     return Error{origin + ":" + std::to_string(line) + ":" + std::to_string(column) + ": not valid JSON: " + what};
+  }
+  // Every unknown field and value of the wrong kind at once, in our words;
+  // Protobuf's parser only sees what this check does not (and stops at the first).
+  if (const auto problems = schema_problems(document, *schema::Installation::descriptor()); !problems.empty()) {
+    return Error{describe_problems(problems, origin)};
   }
   schema::Installation installation;
   google::protobuf::util::JsonParseOptions options;
@@ -53,7 +62,10 @@ Result<Installation> parse_installation(const std::string& json, const std::stri
 
 Result<LoadedConfig> load_installation(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path + ": cannot open the config file"};
+  if (!in) {
+    const int error = errno;
+    return Error{path + ": cannot open the config file: " + std::strerror(error)};
+  }
   std::ostringstream text;
   text << in.rdbuf();
   if (in.bad()) return Error{path + ": cannot read the config file"};

@@ -16,6 +16,15 @@
 namespace optique::config {
 namespace {
 
+// A screen without an id is already an error of its own; a reference to a
+// screen then cannot be judged, and "unknown screen" would only add noise.
+bool every_screen_named(const schema::Installation& inst) {
+  for (const schema::Screen& s : inst.screens()) {
+    if (s.id().empty()) return false;
+  }
+  return true;
+}
+
 using util::number_text;
 
 class Checker {
@@ -248,7 +257,9 @@ void check_depth_of_field(Checker& check, const schema::Installation& inst) {
     for (const schema::Screen& s : inst.screens()) {
       if (s.id() == g.screen()) screen = &s;
     }
-    if (screen == nullptr) check.fail("depth_of_field.gaze.screen", "unknown screen '" + g.screen() + "'");
+    if (screen == nullptr && every_screen_named(inst)) {
+      check.fail("depth_of_field.gaze.screen", "unknown screen '" + g.screen() + "'");
+    }
     if (g.point().empty() == g.path().empty()) {
       check.fail("depth_of_field.gaze", "give either point [x, y] or a path of points");
     }
@@ -303,7 +314,7 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
     }
     if (p.screen().empty()) {
       check.fail(at + ".screen", "must name the screen this projector lights");
-    } else if (screen == nullptr) {
+    } else if (screen == nullptr && every_screen_named(inst)) {
       std::string known;
       for (const schema::Screen& s : inst.screens()) known += (known.empty() ? "" : ", ") + s.id();
       check.fail(at + ".screen", "unknown screen '" + p.screen() + "' (screens are: " + known + ")");
