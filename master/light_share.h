@@ -1,5 +1,6 @@
 #pragma once
-// The automatic light split of a stacked group (DESIGN.md, "Lighting split"):
+// The automatic light split of a stacked group (Majumder & Welch, "Computer Graphics
+// Optique"; docs/design.md, "The lighting split"):
 // each light drawn by exactly one node, the ambient and emissive terms by exactly
 // one, so that the projectors' optical sum is the full render. Pure partitioning;
 // no IO. (The lists configs write are config/light_list.h.)

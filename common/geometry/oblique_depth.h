@@ -1,6 +1,7 @@
 #pragma once
 // How much depth precision the single-pass oblique projection of Raskar's
-// method (seed 002, eq. 5) leaves for this projector. The renderer draws with
+// method (Raskar's approximated depth, eq. 5 of "Immersive Planar Display using
+// Roughly Aligned Projectors") leaves for this projector. The renderer draws with
 // A = N_p · H · N_u⁻¹ (user NDC through R → projector NDC, a33 = 1) and scales
 // depth by 1 − |a31| − |a32|: as |a31| + |a32| → 1 the depth range collapses.
 

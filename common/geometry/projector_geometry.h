@@ -1,7 +1,8 @@
 #pragma once
 // Where a projector's pixels land on its screen (its homography H, screen metres →
 // projector pixels), and the oblique projection that makes its image
-// perspectively correct for the viewer in one pass (Raskar, seed 002).
+// perspectively correct for the viewer in one pass (Raskar, "Immersive Planar
+// Display using Roughly Aligned Projectors"; docs/design.md).
 //
 // Conventions: screen coordinates are metres in the screen's own frame (origin at
 // its lower-left corner, y up); projector pixels have their origin at the image's

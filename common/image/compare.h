@@ -1,6 +1,6 @@
 #pragma once
 // Comparing two images of the same size: PSNR per channel, of luma, and the
-// seed-001 weighting (PSNR_Y = 0.299·PSNR_R + 0.587·PSNR_G + 0.114·PSNR_B), the
+// up-conversion paper's weighting (PSNR_Y = 0.299·PSNR_R + 0.587·PSNR_G + 0.114·PSNR_B), the
 // largest absolute difference, and a difference image to look at.
 
 #include <functional>

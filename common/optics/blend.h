@@ -1,5 +1,6 @@
 #pragma once
-// Intensity roll-off across overlapping projectors (Raskar, seed 002): each
+// Intensity roll-off across overlapping projectors (Raskar, "Immersive Planar
+// Display using Roughly Aligned Projectors"; docs/design.md, "Overlap"): each
 // projector of a group (the projectors that light one screen for one eye) scales
 // its light by a weight, and the weights of the group sum to 1 at every point of
 // the usable area that at least one projector lights. Outside the usable area

@@ -1,5 +1,6 @@
 #pragma once
-// Optical depth of field (Majumder & Welch, seed 004): a focused and a defocused
+// Optical depth of field (Majumder & Welch, "Computer
+// Graphics Optique"; docs/design.md): a focused and a defocused
 // projector light the same image area. The focused one shows (1 − c_r)·I, the
 // defocused one c_r·I, and the defocused projector's optics blur by the maximum
 // circle of confusion, so the sum on the screen approximates an image in which

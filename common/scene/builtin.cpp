@@ -145,7 +145,8 @@ SceneDefinition moving_square() {
   return scene;
 }
 
-// The seed-001 set: the test scenes of the frame-rate up-conversion paper. One
+// The up-conversion set: the test scenes of the motion-compensated frame-rate
+// up-conversion paper (docs/design.md). One
 // object each (the falling ring has a static plinth too), turning or moving at a
 // known rate, under one or two point lights.
 
@@ -331,7 +332,7 @@ constexpr std::array kScenes{
     Entry{"cubes-backdrop", cubes_backdrop},
     Entry{"many-lights-50", [] { return many_lights(50); }},
     Entry{"many-lights-100", [] { return many_lights(100); }},
-    // seed-001
+    // the up-conversion set
     Entry{"cube-fast-rotation", cube_fast_rotation},
     Entry{"cube-slow-rotation", cube_slow_rotation},
     Entry{"cube-zoom", cube_zoom},

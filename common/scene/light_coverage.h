@@ -1,7 +1,7 @@
 #pragma once
 // How much of what a node shows each light reaches: the master's estimate of a
-// light's cost to that node, for the automatic light split (DESIGN.md, "Lighting
-// split"). The node's shader evaluates every light at every pixel but stops early
+// light's cost to that node, for the automatic light split (docs/design.md, "The
+// lighting split"). The node's shader evaluates every light at every pixel but stops early
 // where the light does not reach, so a light's cost grows with the share of the
 // node's pixels it lights.
 

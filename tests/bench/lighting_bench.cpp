@@ -1,5 +1,5 @@
-// The lighting split across stacked projectors (Majumder & Welch, seed 004;
-// DESIGN.md, "Lighting split"): each node draws some of the scene's point lights,
+// The lighting split across stacked projectors (Majumder & Welch, "Computer
+// Graphics Optique"; docs/design.md, "The lighting split"): each node draws some of the scene's point lights,
 // one also the ambient and emissive terms, and the projectors' light adds up to
 // the full render on the screen. What the cluster buys: the frame time of the
 // slowest node against one node drawing everything; what it costs: the error of
@@ -646,7 +646,7 @@ int main(int argc, char** argv) {
     }
     std::ostringstream md;
     md << "# Lighting split: stacked nodes against one full render\n\n"
-       << "Majumder & Welch's lighting split (DESIGN.md, \"Lighting split\"): each node of a stacked group draws "
+       << "Majumder & Welch's lighting split ([docs/design.md](../design.md), \"The lighting split\"): each node of a stacked group draws "
           "some of the scene's point lights, one of them also the ambient and emissive terms, and the projectors' "
           "light adds up on the screen to the full render. What the cluster buys is the frame time of its slowest "
           "node against one node drawing every light; what it costs is the error of the optical sum.\n\n"

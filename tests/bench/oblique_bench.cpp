@@ -1,4 +1,5 @@
-// Single pass against two passes for keystoned projectors (Raskar, seed 002): the
+// Single pass against two passes for keystoned projectors (Raskar, "Immersive Planar
+// Display using Roughly Aligned Projectors"): the
 // same frames drawn both ways in one run, alternating, for each projector of an
 // installation. Frame time of each, and the PSNR of each against a 4×-supersampled
 // image of the same projector (drawn at 4× its pixels with the exact single-pass

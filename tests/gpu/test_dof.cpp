@@ -1,4 +1,4 @@
-// Depth of field by a focused and a defocused projector (DESIGN.md, Majumder &
+// Depth of field by a focused and a defocused projector (docs/design.md, Majumder &
 // Welch), measured on a headless context: configs/dof-pair.json rendered by the
 // nodes' own output stages, the defocused optics applied, and the sum compared
 // with the ideal per-pixel blur over a focal sweep (the experiment of

@@ -1,4 +1,4 @@
-// Depth order of the single-pass oblique projection (DESIGN.md, Raskar, Depth),
+// Depth order of the single-pass oblique projection (docs/design.md, "Depth"),
 // measured against exact visibility on a headless context: thin layers behind a
 // wall seen through a projector at growing incidence (the experiment of
 // optique-bench-oblique-depth, docs/bench/oblique-depth.md, on fewer frames).

@@ -1,7 +1,7 @@
 // The lighting split of configs/stacked-lighting-3.json drawn in-process: three
 // projectors, each with its share of the 20 lights and its own response, black
 // level and brightness, against one projector drawing everything (Majumder &
-// Welch, seed 004: the screen adds the light; m projectors show more levels).
+// Welch, "Computer Graphics Optique": the screen adds the light; m projectors show more levels).
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 #pragma once
-// Depth of field by optics (DESIGN.md, "Majumder & Welch: optical superposition"),
+// Depth of field by optics (docs/design.md, "Depth of field by optics"),
 // measured: the installation of configs/dof-pair.json (the depth-stack scene, a
 // focused and a defocused projector on one screen) rendered by the same
 // SceneRenderer output stages the nodes use, the defocused projector's optics
@@ -124,7 +124,7 @@ class Pair {
 };
 
 // How far c_r from the depth buffer is from c_r of the exact depth, over the
-// pixels off silhouettes, for a frustum and depth format (DESIGN.md's c_r in the
+// pixels off silhouettes, for a frustum and depth format (docs/design.md's c_r in the
 // window-depth form the output pass evaluates, optics::coc_from_window_depth).
 struct Precision {
   int counted = 0;   // pixels off silhouettes

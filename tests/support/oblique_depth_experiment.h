@@ -1,5 +1,5 @@
 #pragma once
-// Depth order of the single-pass oblique projection, measured (DESIGN.md,
+// Depth order of the single-pass oblique projection, measured (docs/design.md,
 // "Raskar: oblique projector", Depth): a synthetic wall, a viewer, a pinhole
 // projector at growing incidence, and thin layers behind the wall. Each
 // rendered pixel's object (read back as its emissive colour) is compared with

@@ -1,6 +1,6 @@
 // The built-in scenes (common/scene/builtin.h) as a node would draw them: every
 // reference resolves, every pose is one a node accepts, the motion is a pure
-// function of time, and the seed-001 set moves the way its names say.
+// function of time, and the up-conversion set moves the way its names say.
 
 #include <gtest/gtest.h>
 
@@ -26,7 +26,7 @@ constexpr double kPi = std::numbers::pi;
 const glm::dvec3 kStage{0.0, 1.2, -0.5};
 const std::vector<double> kTimes{0.0, 0.37, 5.0};
 
-// The seed-001 set: the test scenes of the frame-rate up-conversion paper.
+// The up-conversion set: the test scenes of the frame-rate up-conversion paper.
 const std::vector<std::string> kSeedScenes{
     "cube-fast-rotation",    "cube-slow-rotation", "cube-zoom",    "pyramid-fast-rotation",
     "pyramid-slow-rotation", "wheel-rotation",     "wheel-in-out", "falling-ring",
