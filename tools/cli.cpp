@@ -54,7 +54,8 @@ std::vector<std::uint64_t> captured_frames(const config::LoadedConfig& config, c
        std::filesystem::directory_iterator(std::filesystem::path(captures) / projectors.front().id, ec)) {
     const std::string name = entry.path().filename().string();
     std::uint64_t frame = 0;
-    if (std::sscanf(name.c_str(), "frame-%" SCNu64 ".exr", &frame) == 1 && name.ends_with(".exr")) {
+    // The signal captures, which compose reads (the .exr beside them is not needed).
+    if (std::sscanf(name.c_str(), "frame-%" SCNu64 ".png", &frame) == 1 && name.ends_with(".png")) {
       frames.push_back(frame);
     }
   }
