@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <filesystem>
 
-#include "config/projector_groups.h"
 #include "image/convert.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
@@ -11,30 +10,10 @@
 #include "optics/compose.h"
 #include "optics/defocus.h"
 #include "optics/projector_model.h"
+#include "tools/screen_images.h"
 
 namespace optique::tools {
 namespace {
-
-struct Group {
-  const config::Screen* screen = nullptr;
-  config::Eye eye = config::Eye::mono;
-  std::vector<const config::Projector*> projectors;
-};
-
-// The screen images (screen and eye), in the order their first projector appears.
-std::vector<Group> groups_of(const config::Installation& installation) {
-  std::vector<Group> groups;
-  for (const config::Projector& p : installation.projectors) {
-    auto group = std::find_if(groups.begin(), groups.end(),
-                              [&](const Group& g) { return config::same_screen_image(*g.projectors.front(), p); });
-    if (group != groups.end()) {
-      group->projectors.push_back(&p);
-    } else {
-      groups.push_back({&installation.screen_of(p), p.eye, {&p}});
-    }
-  }
-  return groups;
-}
 
 // The signal the node sent its projector: the simulator turns it into light with
 // the projector's model, as the projector would.
@@ -75,19 +54,17 @@ double covered_share(const std::vector<geometry::ProjectorGeometry>& geometries,
 
 }  // namespace
 
-std::string composite_folder(const std::string& screen_id, config::Eye eye) {
-  return eye == config::Eye::mono ? screen_id : screen_id + "." + std::string(config::to_string(eye));
-}
-
 Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::uint64_t frame,
                                      const std::string& captures_dir, const std::string& out_dir, spdlog::logger& log) {
-  const std::vector<Group> groups = groups_of(config.installation);
+  std::vector<ScreenImage> groups = screen_images(config.installation);
+  // A screen no projector lights has nothing to compose.
+  std::erase_if(groups, [](const ScreenImage& image) { return image.projectors.empty(); });
   if (groups.empty()) return Error{"the installation has no projectors on its screens: nothing to compose"};
 
   // Every capture must be there before anything is written: a half-composed
   // frame is worse than none.
   std::vector<std::string> missing;
-  for (const Group& group : groups) {
+  for (const ScreenImage& group : groups) {
     for (const config::Projector* p : group.projectors) {
       const std::string path = capture_path(captures_dir, *p, frame);
       if (!std::filesystem::is_regular_file(path)) missing.push_back(path);
@@ -104,12 +81,12 @@ Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::ui
 
   ComposeSummary summary;
   summary.frame = frame;
-  for (const Group& group : groups) {
+  for (const ScreenImage& group : groups) {
     const config::Screen& screen = *group.screen;
     std::vector<geometry::ProjectorGeometry> geometries;
     std::vector<image::FloatImage> captures;
     ComposedScreen composed;
-    composed.folder = composite_folder(screen.id, group.eye);
+    composed.folder = screen_image_folder(screen.id, group.eye);
     composed.screen = screen.id;
     composed.eye = group.eye;
     for (const config::Projector* p : group.projectors) {

@@ -36,9 +36,6 @@ struct ComposeSummary {
   std::vector<ComposedScreen> screens;
 };
 
-// The folder name of a screen's composite for one eye (mono: the screen id).
-[[nodiscard]] std::string composite_folder(const std::string& screen_id, config::Eye eye);
-
 // Reads CAPTURES/<projector-id>/frame-NNNNNN.png (the signal) for every projector (as the
 // nodes write them under OUT/nodes), composes each screen × eye group and writes
 // OUT_DIR/screens/<folder>/frame-NNNNNN.{exr,png}. Logs one line per composite.

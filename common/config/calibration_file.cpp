@@ -8,13 +8,25 @@
 
 namespace optique::config {
 
-Result<glm::dmat3> read_calibration_homography(const std::string& path) {
+Result<glm::dmat3> read_calibration_homography(const std::string& path, std::uint32_t width, std::uint32_t height) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return Error{path + ": cannot open the calibration file"};
   std::ostringstream text;
   text << in.rdbuf();
   const auto document = nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
   if (document.is_discarded()) return Error{path + ": not valid JSON"};
+  // Files from before calibrate wrote the image size say nothing: taken as they are.
+  if (const auto image = document.find("projector"); image != document.end() && image->is_object()) {
+    const auto w = image->find("width");
+    const auto h = image->find("height");
+    if (w != image->end() && h != image->end() && w->is_number_unsigned() && h->is_number_unsigned() &&
+        (w->get<std::uint64_t>() != width || h->get<std::uint64_t>() != height)) {
+      return Error{path + ": fitted for a " + std::to_string(w->get<std::uint64_t>()) + "×" +
+                   std::to_string(h->get<std::uint64_t>()) + " image, but this projector is " + std::to_string(width) +
+                   "×" + std::to_string(height) +
+                   ": calibrate it again at the projector's resolution, or correct its width and height"};
+    }
+  }
   const auto found = document.find("homography");
   if (found == document.end()) return Error{path + ": no \"homography\" (write it with optique-master calibrate)"};
   const auto& rows = *found;

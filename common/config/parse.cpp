@@ -106,7 +106,8 @@ void resolve_geometry(const schema::Installation& inst, Installation& out, const
     const Screen& screen = out.screen_of(projector);
     if (!p.calibration().empty()) {
       projector.geometry_source = GeometrySource::calibration;
-      auto h = read_calibration_homography((std::filesystem::path(config_dir) / p.calibration()).string());
+      auto h = read_calibration_homography((std::filesystem::path(config_dir) / p.calibration()).string(), p.width(),
+                                           p.height());
       if (!h) {
         problems.push_back({path_of(i) + ".calibration", h.error()});
         continue;

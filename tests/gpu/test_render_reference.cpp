@@ -91,5 +91,36 @@ TEST(RenderReference, RefusesAZeroFactor) {
   EXPECT_NE(written.error().find("supersample"), std::string::npos) << written.error();
 }
 
+// compose writes a stereo screen's composites as <screen>.left and .right: the
+// reference has one for each eye too, each seen from its eye.
+TEST(RenderReference, AStereoScreenHasAReferenceForEachEye) {
+  auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
+  ASSERT_TRUE(config.ok()) << config.error();
+  config::Installation& installation = config.value().installation;
+  ASSERT_FALSE(installation.projectors.empty());
+  config::Projector right = installation.projectors.front();
+  right.id += "-right";
+  right.eye = config::Eye::right;
+  installation.projectors.front().eye = config::Eye::left;
+  installation.projectors.push_back(right);
+  auto scene = scene::load_scene(installation.scene.builtin, installation.scene.gltf, image::decode_texture);
+  ASSERT_TRUE(scene.ok()) << scene.error();
+  std::string dir = (fs::temp_directory_path() / "optique-reference-XXXXXX").string();
+  ASSERT_NE(mkdtemp(dir.data()), nullptr);
+  spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
+  ASSERT_TRUE(render_reference(config.value(), scene.value(), 30, dir, log, ReferenceOptions{}).ok());
+  auto left = image::read_image(image::frame_path(dir + "/reference/front.left", 30, "exr"));
+  auto right_eye = image::read_image(image::frame_path(dir + "/reference/front.right", 30, "exr"));
+  const bool mono = fs::exists(dir + "/reference/front");
+  std::error_code ec;
+  fs::remove_all(dir, ec);
+  ASSERT_TRUE(left.ok()) << left.error();
+  ASSERT_TRUE(right_eye.ok()) << right_eye.error();
+  EXPECT_FALSE(mono) << "no mono reference for a screen seen only in stereo";
+  auto comparison = image::compare(left.value(), right_eye.value());
+  ASSERT_TRUE(comparison.ok()) << comparison.error();
+  EXPECT_GT(comparison.value().max_abs_error, 0.05) << "the two eyes see the cubes from 6.5 cm apart";
+}
+
 }  // namespace
 }  // namespace optique::tools

@@ -86,8 +86,13 @@ TEST_F(CalibrateCli, GoodInputWritesTheCalibrationFile) {
   EXPECT_FALSE(doc.contains("tracker_to_screen"));
 
   // Read back as a config reads it: close to the true H.
-  auto h = config::read_calibration_homography(out);
+  auto h = config::read_calibration_homography(out, 1920, 1080);
   ASSERT_TRUE(h.ok()) << h.error();
+  // On a projector of another size its pixels would land elsewhere: refused.
+  const auto other = config::read_calibration_homography(out, 1280, 720);
+  ASSERT_FALSE(other.ok());
+  EXPECT_NE(other.error().find("fitted for a 1920×1080 image, but this projector is 1280×720"), std::string::npos)
+      << other.error();
   EXPECT_LT(transfer_error(h.value(), truth, grid_points(truth, 1920, 1080, 5, 4)), 0.5);
 }
 

@@ -15,6 +15,7 @@
 #include "keystoned_wall.h"
 #include "optics/blend.h"
 #include "optics/compose.h"
+#include "tools/screen_images.h"
 
 namespace optique::tools {
 namespace {
@@ -199,9 +200,9 @@ TEST(ComposeFrame, UnreadableCaptureIsNamed) {
 }
 
 TEST(CompositeFolder, NamesEyes) {
-  EXPECT_EQ(composite_folder("front", config::Eye::mono), "front");
-  EXPECT_EQ(composite_folder("front", config::Eye::left), "front.left");
-  EXPECT_EQ(composite_folder("front", config::Eye::right), "front.right");
+  EXPECT_EQ(screen_image_folder("front", config::Eye::mono), "front");
+  EXPECT_EQ(screen_image_folder("front", config::Eye::left), "front.left");
+  EXPECT_EQ(screen_image_folder("front", config::Eye::right), "front.right");
 }
 
 }  // namespace

@@ -605,6 +605,18 @@ TEST(ProjectorGeometry, ACalibrationFileIsReadIntoTheHomography) {
   auto broken = parse(with(R"("screen": "front"})", R"("screen": "front", "calibration": "front.calibration.json"})"));
   ASSERT_FALSE(broken.ok());
   expect_problem(broken, "projectors[0].calibration", {"homography[0]", "3 numbers"});
+
+  // p-front is 640×320: a file fitted for another image size is refused, one for
+  // its own size is read.
+  std::ofstream(file) << R"({"homography": [[160, 0, 0], [0, -160, 320], [0, 0, 1]],
+                             "projector": {"width": 1024, "height": 768}})";
+  expect_problem(parse(with(R"("screen": "front"})", R"("screen": "front", "calibration": "front.calibration.json"})")),
+                 "projectors[0].calibration",
+                 {"fitted for a 1024×768 image, but this projector is 640×320", "calibrate it again"});
+  std::ofstream(file) << R"({"homography": [[160, 0, 0], [0, -160, 320], [0, 0, 1]],
+                             "projector": {"width": 640, "height": 320}})";
+  EXPECT_TRUE(
+      parse(with(R"("screen": "front"})", R"("screen": "front", "calibration": "front.calibration.json"})")).ok());
 }
 
 }  // namespace geometry_tests
