@@ -402,6 +402,13 @@ void check_master(Checker& check, const schema::MasterSettings& m) {
 // light switched off while off, or on while on). Whether the scene has those
 // lights is checked once it is loaded.
 void check_light_switches(Checker& check, const schema::Scene& scene) {
+  // What each switch changes depends on the ones before it in time: out of
+  // order, "light 3 is not off" would blame the wrong switch. Then only the
+  // order is reported.
+  bool in_order = true;
+  for (int i = 1; i < scene.light_switches_size(); ++i) {
+    if (scene.light_switches(i).time() < scene.light_switches(i - 1).time()) in_order = false;
+  }
   std::set<std::uint32_t> off;
   double previous_time = 0.0;
   for (int i = 0; i < scene.light_switches_size(); ++i) {
@@ -422,7 +429,7 @@ void check_light_switches(Checker& check, const schema::Scene& scene) {
     if (!going_off) check.fail(path + ".off", going_off.error());
     auto coming_on = parse_light_list(entry.on());
     if (!coming_on) check.fail(path + ".on", coming_on.error());
-    if (!going_off || !coming_on) continue;
+    if (!going_off || !coming_on || !in_order) continue;
     std::vector<std::uint32_t> already_off;
     for (std::uint32_t light : going_off.value()) {
       if (!off.insert(light).second) already_off.push_back(light);

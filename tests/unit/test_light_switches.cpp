@@ -63,6 +63,11 @@ TEST(LightSwitches, EachMistakeHasItsOwnMessage) {
   EXPECT_EQ(problems_of(R"({"time": 2, "off": "3"}, {"time": 1, "on": "3"})"),
             "show.json: scene.light_switches[1].time: switches must be in time order: 1 s comes before the switch "
             "above it at 2 s");
+  // Out of order, "is not off" would blame the first switch for the second's
+  // place: only the order is reported.
+  EXPECT_EQ(problems_of(R"({"time": 2, "on": "3"}, {"time": 1, "off": "3"})"),
+            "show.json: scene.light_switches[1].time: switches must be in time order: 1 s comes before the switch "
+            "above it at 2 s");
   EXPECT_EQ(problems_of(R"({"time": 1})"),
             "show.json: scene.light_switches[0]: switches nothing: give the lights that go \"off\" or come \"on\"");
   EXPECT_EQ(problems_of(R"({"time": 1, "off": "18-22"})"),
