@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include <algorithm>
 #include <memory>
 #include <optional>
@@ -88,8 +90,8 @@ class ObliqueDepthTest : public ::testing::Test {
 };
 
 // The claim: a 4×4 projective map keeps per-pixel depth order, and k only
-// compresses depth. At 1 mm every frame must be exact with either format, and
-// at least as good as the aligned frustum with 24 bits.
+// compresses depth. At 1 mm every frame must be exact with either format, as
+// the viewer's own aligned frustum is.
 TEST_F(ObliqueDepthTest, OneMillimetreLayersStayInOrderAtEveryIncidence) {
   for (const Placement& placement : {yaw(0), yaw(30), yaw(60), yaw(70), yaw(80), diagonal_rolled(70)}) {
     const auto found = projector(placement);
@@ -100,10 +102,15 @@ TEST_F(ObliqueDepthTest, OneMillimetreLayersStayInOrderAtEveryIncidence) {
     const Count aligned = measure(p, kMillimetre, Method::aligned, DepthFormat::fixed24);
     // The frame must mostly be counted, and the front layer must be in it, or a
     // zero would say nothing.
+    std::cout << name(placement) << ": k " << p.k << "; errors: float32 " << float32.errors << ", 24-bit "
+              << fixed24.errors << ", aligned 24-bit " << aligned.errors << " of " << fixed24.counted << "\n";
     EXPECT_GT(float32.counted, 150000) << name(placement);
     EXPECT_GT(float32.front_pixels, 50000) << name(placement);
     EXPECT_EQ(float32.errors, 0) << name(placement) << ", k " << p.k;
-    EXPECT_LE(fixed24.errors, aligned.errors + fixed24.counted / 1000) << name(placement) << ", k " << p.k;
+    // Measured: no error with 24 bits either, at every placement, nor for the
+    // viewer's aligned frustum.
+    EXPECT_EQ(fixed24.errors, 0) << name(placement) << ", k " << p.k;
+    EXPECT_EQ(aligned.errors, 0) << name(placement);
   }
 }
 

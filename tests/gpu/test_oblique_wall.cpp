@@ -24,6 +24,11 @@
 namespace optique::testing {
 namespace {
 
+// The keystoned wall's checks against the reference (see the test).
+constexpr double kPsnrBar = 52.0;   // dB over the usable area
+constexpr double kSeamBar = 0.001;  // relative brightness of the seams
+constexpr double kEdgeBar = 0.5;    // px, shift or widening of an edge in an overlap
+
 using namespace std::chrono_literals;
 
 const std::string kMaster = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
@@ -141,12 +146,15 @@ TEST(ObliqueWall, ComposedScreenMatchesTheReferenceWithoutSeams) {
             << wall.seam_edges.max_abs_px << " px, max widening " << wall.seam_edges.max_widening_px
             << " px; all edges " << wall.all_edges.edges << ", median shift " << wall.all_edges.median_abs_px
             << " px, max " << wall.all_edges.max_abs_px << " px\n";
-  EXPECT_GE(wall.psnr_db, 35.0);
+  // Bars with margin over what was measured (58.7-59.1 dB; seam -0.04 to
+  // +0.003 %; edges 0.41-0.42 px), each tight enough that the misregistered
+  // wall below fails it.
+  EXPECT_GE(wall.psnr_db, kPsnrBar);
   EXPECT_GT(wall.seam_pixels, 10000u);
-  EXPECT_LE(std::abs(wall.seam_brightness), 0.02);
+  EXPECT_LE(std::abs(wall.seam_brightness), kSeamBar);
   EXPECT_GT(wall.seam_edges.edges, 20u);
-  EXPECT_LE(wall.seam_edges.max_abs_px, 0.5);
-  EXPECT_LE(wall.seam_edges.max_widening_px, 0.5);
+  EXPECT_LE(wall.seam_edges.max_abs_px, kEdgeBar);
+  EXPECT_LE(wall.seam_edges.max_widening_px, kEdgeBar);
   // Elsewhere one projector draws alone: its aliasing (point samples at ~730 px/m
   // against a 4×4-supersampled reference at 400 px/m) moves the centroid of
   // one-pixel-thin features (a cube's side seen edge-on) by up to about a pixel;
@@ -166,8 +174,11 @@ TEST(ObliqueWall, ComposedScreenMatchesTheReferenceWithoutSeams) {
   std::cout << "misregistered: PSNR " << off.psnr_db << " dB; seam brightness " << 100.0 * off.seam_brightness
             << " %; seam edges max shift " << off.seam_edges.max_abs_px << " px, max widening "
             << off.seam_edges.max_widening_px << " px\n";
-  EXPECT_GT(std::max(off.seam_edges.max_abs_px, off.seam_edges.max_widening_px), 0.5);
-  EXPECT_LT(off.psnr_db, wall.psnr_db - 3.0);
+  // Measured: 47.1 dB, -0.16 %, edges 2.6 px. Each check sees it on its own.
+  EXPECT_LT(off.psnr_db, kPsnrBar) << "the PSNR check misses a projector 3 px off";
+  EXPECT_GT(std::abs(off.seam_brightness), kSeamBar) << "the seam brightness check misses a projector 3 px off";
+  EXPECT_GT(std::max(off.seam_edges.max_abs_px, off.seam_edges.max_widening_px), kEdgeBar)
+      << "the edge check misses a projector 3 px off";
 }
 
 }  // namespace

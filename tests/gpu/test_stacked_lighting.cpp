@@ -98,7 +98,10 @@ TEST_F(StackedLighting, TheOpticalSumIsTheFullRender) {
     brightest = std::max(brightest, static_cast<double>(full.rendered.pixels[k]));
   }
   std::cout << "optical sum before quantization: max abs error " << worst << " (brightest value " << brightest << ")\n";
-  EXPECT_LE(worst, 1e-3);
+  // Float rounding only: 4.8e-7 measured on llvmpipe; a GPU that sums the
+  // lights in another order or fuses the operations differs by a few ulps per
+  // light (20 lights, values up to ~1), hence the margin.
+  EXPECT_LE(worst, 1e-5);
   EXPECT_GT(brightest, 0.3) << "the scene should be lit";
 
   // After each projector's 8-bit signal: the emitted sum less the group's black
