@@ -122,5 +122,60 @@ TEST(RenderReference, AStereoScreenHasAReferenceForEachEye) {
   EXPECT_GT(comparison.value().max_abs_error, 0.05) << "the two eyes see the cubes from 6.5 cm apart";
 }
 
+// An analytic edge: a white emissive quad in the screen plane whose left edge
+// lies 0.3 px into pixel column 100 (wherever the viewer is, what lies in the
+// screen plane lands where it is). A box filter over 4 × 4 samples at offsets
+// 1/8, 3/8, 5/8, 7/8 sees it in 3 of 4 columns of samples: 0.75; one sample
+// per pixel (at 1/2) sees all of it: 1. The PNG holds 0.75 sRGB-encoded: 225.
+TEST(RenderReference, SupersamplingAveragesTheSamplesOfAPixel) {
+  auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
+  ASSERT_TRUE(config.ok()) << config.error();
+  const config::Screen& screen = config.value().installation.screens.front();
+  ASSERT_EQ(screen.pixels_per_metre, 160.0);
+  const double x0 = (100.0 + 0.3) / screen.pixels_per_metre;  // metres from the screen's left edge
+  const auto at = [&](double u, double v) { return glm::vec3(screen.origin + screen.right * u + screen.up * v); };
+  scene::LoadedScene edge;
+  scene::Mesh quad;
+  quad.name = "edge";
+  const glm::vec3 normal(glm::cross(screen.right, screen.up));
+  quad.vertices = {{at(x0, 0.0), normal, {}},
+                   {at(screen.width + 1.0, 0.0), normal, {}},
+                   {at(screen.width + 1.0, screen.height + 1.0), normal, {}},
+                   {at(x0, screen.height + 1.0), normal, {}}};
+  quad.indices = {0, 1, 2, 0, 2, 3};
+  edge.definition.name = "analytic edge";
+  edge.definition.meshes.push_back(quad);
+  edge.definition.materials.emplace_back(glm::vec3(0.0f), 0.0f, 1.0f, glm::vec3(1.0f));
+  edge.definition.instances.push_back({0, 0, std::nullopt, glm::dmat4(1.0)});
+  edge.definition.ambient = glm::vec3(0.0f);
+
+  const auto render = [&](int supersample, image::FloatImage& linear, image::FloatImage& encoded) {
+    std::string dir = (fs::temp_directory_path() / "optique-edge-XXXXXX").string();
+    ASSERT_NE(mkdtemp(dir.data()), nullptr);
+    spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
+    ReferenceOptions options;
+    options.supersample = supersample;
+    ASSERT_TRUE(render_reference(config.value(), edge, 0, dir, log, options).ok());
+    auto l = image::read_image(image::frame_path(dir + "/reference/front", 0, "exr"));
+    auto e = image::read_image(image::frame_path(dir + "/reference/front", 0, "png"));
+    std::error_code ec;
+    fs::remove_all(dir, ec);
+    ASSERT_TRUE(l.ok() && e.ok());
+    linear = std::move(l).value();
+    encoded = std::move(e).value();
+  };
+  image::FloatImage four_linear, four_encoded, one_linear, one_encoded;
+  render(4, four_linear, four_encoded);
+  render(1, one_linear, one_encoded);
+  ASSERT_EQ(four_linear.width, 640);
+  for (const int y : {10, 180, 350}) {
+    EXPECT_NEAR(four_linear.at(99, y, 0), 0.0f, 1e-6f) << "row " << y;
+    EXPECT_NEAR(four_linear.at(100, y, 0), 0.75f, 1e-3f) << "row " << y << ": 12 of 16 samples";
+    EXPECT_NEAR(four_linear.at(101, y, 0), 1.0f, 1e-3f) << "row " << y;
+    EXPECT_NEAR(four_encoded.at(100, y, 0) * 255.0f, 225.0f, 0.01f) << "row " << y << ": 0.75 in sRGB";
+    EXPECT_NEAR(one_linear.at(100, y, 0), 1.0f, 1e-3f) << "row " << y << ": the one sample at the centre is inside";
+  }
+}
+
 }  // namespace
 }  // namespace optique::tools
