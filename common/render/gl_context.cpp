@@ -23,7 +23,7 @@ class HeadlessContext final : public GlContext {
     eglDestroyContext(display_, context_);
     eglTerminate(display_);
   }
-  void present(unsigned, int, int) override {}
+  void present(unsigned, int, int, image::ByteImage*) override {}
   [[nodiscard]] bool has_window() const override { return false; }
 
  private:
@@ -38,13 +38,21 @@ class WindowContext final : public GlContext {
     glfwDestroyWindow(window_);
     glfwTerminate();
   }
-  void present(unsigned framebuffer, int width, int height) override {
+  void present(unsigned framebuffer, int width, int height, image::ByteImage* shown) override {
     int window_width = 0;
     int window_height = 0;
     glfwGetFramebufferSize(window_, &window_width, &window_height);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
     glBlitFramebuffer(0, 0, width, height, 0, 0, window_width, window_height, GL_COLOR_BUFFER_BIT, GL_LINEAR);
+    if (shown != nullptr) {
+      glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+      glReadBuffer(GL_BACK);
+      glPixelStorei(GL_PACK_ALIGNMENT, 1);
+      *shown = image::ByteImage(window_width, window_height, 4);
+      glReadPixels(0, 0, window_width, window_height, GL_RGBA, GL_UNSIGNED_BYTE, shown->pixels.data());
+      image::flip_rows(*shown);  // GL reads the bottom row first
+    }
     glfwSwapBuffers(window_);
     glfwPollEvents();
   }

@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "image/image.h"
 #include "util/result.h"
 
 namespace optique::render {
@@ -16,8 +17,10 @@ class GlContext {
  public:
   virtual ~GlContext() = default;
   // Shows `framebuffer` (width × height, already drawn): a blit to the window and a
-  // buffer swap; headless, nothing to show.
-  virtual void present(unsigned framebuffer, int width, int height) = 0;
+  // buffer swap; headless, nothing to show. With `shown`, a window also reads back
+  // what it is about to show (its back buffer after the blit, before the swap;
+  // RGBA8, top row first, the window's size), so tests can check the window itself.
+  virtual void present(unsigned framebuffer, int width, int height, image::ByteImage* shown = nullptr) = 0;
   [[nodiscard]] virtual bool has_window() const = 0;
   // "llvmpipe (LLVM 15.0.6, 256 bits)", for logs and benchmark tables.
   [[nodiscard]] std::string renderer_name() const;

@@ -26,6 +26,9 @@ class CaptureWriter {
 
   // `encoded` is the signal: 8 bits, or 16 (`deep`, non-empty) for deeper projectors.
   void submit(std::uint64_t frame, image::FloatImage linear, image::ByteImage encoded, image::WordImage deep = {});
+  // What the projector's window showed for `frame` (read back from the window):
+  // FOLDER/window/frame-NNNNNN.png.
+  void submit_shown(std::uint64_t frame, image::ByteImage shown);
   [[nodiscard]] const std::string& folder() const { return folder_; }
 
  private:
@@ -34,6 +37,7 @@ class CaptureWriter {
     image::FloatImage linear;
     image::ByteImage encoded;
     image::WordImage deep;
+    image::ByteImage shown;  // set for a window's read-back, alone
   };
   void run();
 

@@ -75,6 +75,7 @@ std::string GlRenderer::description() const {
 }
 
 void GlRenderer::render(const FrameInput& frame) {
+  read_back_shown_.reset();  // a captured frame that was never presented (stale) has no read-back
   // A new share comes once, with the frame it starts at: taken even when this
   // frame shows nothing, so it is not lost.
   if (frame.lights != nullptr) pipeline_->set_share(*frame.lights);
@@ -89,16 +90,25 @@ void GlRenderer::render(const FrameInput& frame) {
     captures_->submit(frame.frame_id, renderer.read_linear(),
                       deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
                       deep_signal_ ? renderer.read_signal() : image::WordImage{});
+    if (context_->has_window()) read_back_shown_ = frame.frame_id;
   }
 }
 
 void GlRenderer::present() {
   const render::SceneRenderer& renderer = pipeline_->renderer();
-  context_->present(renderer.output_framebuffer(), renderer.width(), renderer.height());
+  if (!read_back_shown_) {
+    context_->present(renderer.output_framebuffer(), renderer.width(), renderer.height());
+    return;
+  }
+  image::ByteImage shown;
+  context_->present(renderer.output_framebuffer(), renderer.width(), renderer.height(), &shown);
+  captures_->submit_shown(*read_back_shown_, std::move(shown));
+  read_back_shown_.reset();
 }
 
 void GlRenderer::show_black() {
-  if (!pipeline_) return;  // not configured yet: nothing is on the projector
+  if (!pipeline_) return;    // not configured yet: nothing is on the projector
+  read_back_shown_.reset();  // black is not the captured frame
   pipeline_->renderer().draw_black();
   present();
 }

@@ -201,7 +201,20 @@ TEST(Rendering, AWindowOnAProjectorShowsWhatHeadlessRenders) {
   EXPECT_NE(read_file(dir + "/out/logs/wall.log").find(", window"), std::string::npos)
       << read_file(dir + "/out/logs/wall.log");
   const std::string headless = run_and_capture(kConfigs + "/single-wall.json", 11, 10);
-  EXPECT_EQ(largest_difference(capture(dir + "/out", "wall", 10), capture(headless, "wall", 10)), 0.0);
+  const image::FloatImage sent = capture(dir + "/out", "wall", 10);
+  EXPECT_EQ(largest_difference(sent, capture(headless, "wall", 10)), 0.0);
+  // What the window itself showed (read back from it before the swap): the same
+  // pixels, the right way up, at the projector's size. A black, flipped or
+  // scaled window fails here; the captures above come from the framebuffer the
+  // window is drawn from, not from the window.
+  auto shown = image::read_image(image::frame_path(dir + "/out/nodes/wall/window", 10, "png"));
+  ASSERT_TRUE(shown.ok()) << shown.error();
+  ASSERT_EQ(shown.value().width, sent.width);
+  ASSERT_EQ(shown.value().height, sent.height);
+  float brightest = 0.0f;
+  for (const float v : sent.pixels) brightest = std::max(brightest, v);
+  EXPECT_GT(brightest, 0.5f) << "the frame should show something";
+  EXPECT_EQ(largest_difference(shown.value(), sent), 0.0);
 }
 
 // ------------------------------------------------------------- glTF scenes
