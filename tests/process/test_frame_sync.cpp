@@ -115,10 +115,13 @@ TEST(FrameSync, AStragglerIsWaitedForThenItsFrameIsDroppedEverywhere) {
   // time: the node then does not show it (never a stale frame), which counts as
   // incoherent; at most once per stop.
   EXPECT_LE(sync.frames_incoherent(), 2u);
-  // "Late" as the node's stale-frame guard defines it: more than one frame period
-  // (33 ms at 30 Hz) past the deadline. A tighter bound measured this VM: a 10 ms
-  // stall of a core failed a 5 ms bound once in about six runs.
-  EXPECT_LT(sync.present_skew_us().max(), 1e6 / 30.0 * timing_scale()) << "no frame shown late";
+  // No frame shown late. The node's stale-frame guard drops a frame one period
+  // (33 ms here) past its deadline (its edge: the unit test
+  // AFrameIsStaleOneFramePeriodAfterItsDeadline); this bound is below it, so a
+  // guard that fired late would fail here. Above it: what this VM does to a
+  // present on time (a core held back for up to 16 ms now and then; 5 ms failed
+  // once in about six runs).
+  EXPECT_LT(sync.present_skew_us().max(), 25'000.0 * timing_scale()) << "no frame shown late";
 }
 
 // The master killed mid-run: its nodes show black and reconnect with backoff; a
@@ -466,24 +469,24 @@ TEST(Security, IntrudersAreRefusedAndHealthyNodesKeepTheirFrameRate) {
     // An oversized length, garbage, and a truncated frame.
     RawClient oversized("127.0.0.1", port);
     oversized.send_bytes({0x7f, 0xff, 0xff, 0xff, 1, 2, 3});
-    EXPECT_TRUE(oversized.closed_within(3s));
+    EXPECT_TRUE(oversized.closed_within(scaled(3s)));
     RawClient garbage("127.0.0.1", port);
     garbage.send_bytes({0, 0, 0, 8, 0xde, 0xad, 0xbe, 0xef, 0xde, 0xad, 0xbe, 0xef});
-    EXPECT_TRUE(garbage.closed_within(3s));
+    EXPECT_TRUE(garbage.closed_within(scaled(3s)));
     RawClient truncated("127.0.0.1", port);
     truncated.send_bytes({0, 0, 1, 0, 0x08, 0x04});  // promises 256 bytes, sends 2, then nothing
-    EXPECT_TRUE(truncated.closed_within(3s)) << "a stalled frame must hit the handshake timeout (2 s)";
+    EXPECT_TRUE(truncated.closed_within(scaled(3s))) << "a stalled frame must hit the handshake timeout (2 s)";
     attempts += 3;
     // One byte a second: closed within the 2 s handshake timeout all the same.
     RawClient drip("127.0.0.1", port);
     const auto started = std::chrono::steady_clock::now();
     bool closed = false;
-    for (int i = 0; i < 4 && !closed; ++i) {
+    for (int i = 0; i < 4 * static_cast<int>(timing_scale()) && !closed; ++i) {
       drip.send_bytes({0});
       closed = drip.closed_within(1s);
     }
     EXPECT_TRUE(closed);
-    EXPECT_LT(std::chrono::steady_clock::now() - started, 3500ms);
+    EXPECT_LT(std::chrono::steady_clock::now() - started, scaled(3500ms));
     ++attempts;
     // 200 rapid connects that say nothing.
     std::vector<std::unique_ptr<RawClient>> crowd;
@@ -492,7 +495,7 @@ TEST(Security, IntrudersAreRefusedAndHealthyNodesKeepTheirFrameRate) {
       EXPECT_TRUE(crowd.back()->connected());
     }
     attempts += 200;
-    std::this_thread::sleep_for(2500ms);  // past the handshake timeout: every one closed
+    std::this_thread::sleep_for(scaled(2500ms));  // past the handshake timeout: every one closed
     std::size_t closed_crowd = 0;
     for (const auto& client : crowd) closed_crowd += client->closed_within(10ms) ? 1 : 0;
     EXPECT_EQ(closed_crowd, crowd.size());
@@ -502,7 +505,11 @@ TEST(Security, IntrudersAreRefusedAndHealthyNodesKeepTheirFrameRate) {
   const double disturbed = achieved_rate(attack, &refused, &log);
   std::cout << "healthy nodes at " << undisturbed << " Hz undisturbed, " << disturbed << " Hz under attack; " << refused
             << " connections refused of " << attempts + 1 << " bad ones\n";
-  EXPECT_GE(disturbed, undisturbed * 0.95);
+  // Measured: 29.9996-29.9999 Hz either way, within 0.001 %. The bar is the
+  // README's 0.1 % (a stall the attack causes would cost the frames it delays:
+  // the master does not catch up), loosened with the other lateness bounds
+  // under the sanitizers.
+  EXPECT_GE(disturbed, undisturbed * (1.0 - 0.001 * timing_scale()));
   // Every bad connection refused, the replay's first connection (which never
   // answered its challenge) included.
   EXPECT_EQ(refused, attempts + 1);
@@ -536,7 +543,7 @@ TEST(Security, WithoutASecretOnlyLoopbackPeersAreAccepted) {
   while (!port.empty() && port.back() == '\n') port.pop_back();
   RawClient outsider(address, port);
   ASSERT_TRUE(outsider.connected());
-  EXPECT_TRUE(outsider.closed_within(3s));
+  EXPECT_TRUE(outsider.closed_within(scaled(3s)));
   EXPECT_TRUE(master.wait_for_output("refused connection from " + address, 5s)) << master.output();
   EXPECT_NE(master.output().find("only nodes on this machine are accepted"), std::string::npos);
   master.signal(SIGINT);

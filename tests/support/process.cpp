@@ -82,6 +82,10 @@ double timing_scale() {
   return scale;
 }
 
+std::chrono::milliseconds scaled(std::chrono::milliseconds bound) {
+  return std::chrono::milliseconds(static_cast<std::int64_t>(static_cast<double>(bound.count()) * timing_scale()));
+}
+
 std::string make_temp_dir(const std::string& prefix) {
   std::random_device device;
   const auto dir = std::filesystem::temp_directory_path() /

@@ -47,6 +47,8 @@ class Process {
 // OPTIQUE_TEST_TIME_SCALE (scripts/sanitize.sh sets it), else 1. Bounds on how
 // late something may be are multiplied by it; bounds on what happened are not.
 [[nodiscard]] double timing_scale();
+// `bound` · timing_scale(): for a bound on how late something may happen.
+[[nodiscard]] std::chrono::milliseconds scaled(std::chrono::milliseconds bound);
 // Processes whose command line contains `needle` (from /proc), excluding this one.
 [[nodiscard]] std::vector<pid_t> processes_matching(const std::string& needle);
 

@@ -276,6 +276,26 @@ TEST_F(NodeTest, AStaleFrameIsNotShown) {
   EXPECT_TRUE(logged(a, "not showing a stale frame"));
 }
 
+// The guard's edge, to the microsecond: a frame is still shown a whole frame
+// period after its deadline, and not a microsecond later.
+TEST_F(NodeTest, AFrameIsStaleOneFramePeriodAfterItsDeadline) {
+  for (const clock::Nanos late : {kPeriod - 1000, kPeriod + 1000}) {
+    NodeProtocol node(settings());
+    join(node);
+    (void)begin(node, 0);
+    (void)node.rendered(0, kMs);
+    const clock::Nanos deadline = now_ + 2 * kMs;
+    ASSERT_NE(first<PresentAt>(swap(node, 0, deadline)), nullptr);
+    const Actions a = node.present_due(deadline + late);
+    if (late < kPeriod) {
+      EXPECT_NE(first<Present>(a), nullptr) << late << " ns late is still this frame's time";
+    } else {
+      EXPECT_EQ(first<Present>(a), nullptr) << late << " ns late is the next frame's time";
+      EXPECT_TRUE(logged(a, "not showing a stale frame"));
+    }
+  }
+}
+
 TEST_F(NodeTest, ASwapForAFrameNotRenderedIsNotShown) {
   NodeProtocol node(settings());
   join(node);
