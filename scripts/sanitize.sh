@@ -5,8 +5,8 @@
 #   scripts/sanitize.sh thread    [ctest args...]   TSan         -> build-tsan
 #
 # Environment:
-#   SANITIZE_LABELS   test labels (the test folders), a regex (default 'unit|process';
-#                     under TSan 'unit'). The gpu tests need llvmpipe, see
+#   SANITIZE_LABELS   test labels (the test folders), a regex (default 'unit|process|gpu';
+#                     under TSan 'unit'). The gpu tests draw with llvmpipe, see
 #                     tests/sanitizers/README.md; the timing tests measure time, which
 #                     a sanitizer's slowdown fails, not a bug. Unit tests run one
 #                     process per test executable (all its cases at once: cheaper
@@ -57,7 +57,9 @@ else
 fi
 # Under TSan (5-15x slower) nodes that draw with llvmpipe on 2 cores cannot answer
 # within the master's 500 ms frame timeout: only the unit tests by default.
-default_labels='unit|process'
+# Under ASan every label but timing: glTF loading, light splits, depth of field
+# and oblique rendering run sanitized in-process (gpu) and as nodes (process).
+default_labels='unit|process|gpu'
 if [ "$mode" = thread ]; then default_labels='unit'; fi
 labels="${SANITIZE_LABELS:-$default_labels}"
 exclude="${SANITIZE_EXCLUDE:-}"
