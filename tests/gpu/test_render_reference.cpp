@@ -9,6 +9,7 @@
 #include <stdlib.h>
 
 #include <filesystem>
+#include <map>
 
 #include "image/compare.h"
 #include "image/convert.h"
@@ -26,27 +27,44 @@ struct Rendered {
   image::FloatImage encoded;
 };
 
+// render-reference of `frame` into a temporary folder; the folders it wrote
+// under reference/ and, for each, its EXR and PNG read back.
+struct References {
+  std::map<std::string, Rendered> images;  // by folder: "front", "front.left", …
+};
+
+References render_references(const config::LoadedConfig& config, const scene::LoadedScene& scene, std::uint64_t frame,
+                             int supersample) {
+  References out;
+  std::string dir = (fs::temp_directory_path() / "optique-reference-XXXXXX").string();
+  EXPECT_NE(mkdtemp(dir.data()), nullptr);
+  spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
+  ReferenceOptions options;
+  options.supersample = supersample;
+  const auto written = render_reference(config, scene, frame, dir, log, options);
+  EXPECT_TRUE(written.ok()) << written.error();
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir + "/reference", ec)) {
+    const std::string folder = entry.path().string();
+    auto linear = image::read_image(image::frame_path(folder, frame, "exr"));
+    auto encoded = image::read_image(image::frame_path(folder, frame, "png"));
+    EXPECT_TRUE(linear.ok() && encoded.ok()) << folder;
+    if (linear.ok() && encoded.ok()) {
+      out.images[entry.path().filename().string()] = {std::move(linear).value(), std::move(encoded).value()};
+    }
+  }
+  fs::remove_all(dir, ec);
+  return out;
+}
+
 Rendered render(int supersample) {
   auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
   EXPECT_TRUE(config.ok()) << config.error();
   auto scene = scene::load_scene(config.value().installation.scene.builtin, config.value().installation.scene.gltf,
                                  image::decode_texture);
   EXPECT_TRUE(scene.ok()) << scene.error();
-  std::string dir = (fs::temp_directory_path() / "optique-reference-XXXXXX").string();
-  EXPECT_NE(mkdtemp(dir.data()), nullptr);
-  spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
-  ReferenceOptions options;
-  options.supersample = supersample;
-  auto written = render_reference(config.value(), scene.value(), 30, dir, log, options);
-  EXPECT_TRUE(written.ok()) << written.error();
-  const std::string folder = dir + "/reference/front";
-  auto linear = image::read_image(image::frame_path(folder, 30, "exr"));
-  auto encoded = image::read_image(image::frame_path(folder, 30, "png"));
-  EXPECT_TRUE(linear.ok() && encoded.ok());
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  if (!linear.ok() || !encoded.ok()) return {};
-  return {std::move(linear).value(), std::move(encoded).value()};
+  if (!config.ok() || !scene.ok()) return {};
+  return render_references(config.value(), scene.value(), 30, supersample).images["front"];
 }
 
 TEST(RenderReference, SupersampledHasTheScreensPixelsAndAveragesThem) {
@@ -105,19 +123,11 @@ TEST(RenderReference, AStereoScreenHasAReferenceForEachEye) {
   installation.projectors.push_back(right);
   auto scene = scene::load_scene(installation.scene.builtin, installation.scene.gltf, image::decode_texture);
   ASSERT_TRUE(scene.ok()) << scene.error();
-  std::string dir = (fs::temp_directory_path() / "optique-reference-XXXXXX").string();
-  ASSERT_NE(mkdtemp(dir.data()), nullptr);
-  spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
-  ASSERT_TRUE(render_reference(config.value(), scene.value(), 30, dir, log, ReferenceOptions{}).ok());
-  auto left = image::read_image(image::frame_path(dir + "/reference/front.left", 30, "exr"));
-  auto right_eye = image::read_image(image::frame_path(dir + "/reference/front.right", 30, "exr"));
-  const bool mono = fs::exists(dir + "/reference/front");
-  std::error_code ec;
-  fs::remove_all(dir, ec);
-  ASSERT_TRUE(left.ok()) << left.error();
-  ASSERT_TRUE(right_eye.ok()) << right_eye.error();
-  EXPECT_FALSE(mono) << "no mono reference for a screen seen only in stereo";
-  auto comparison = image::compare(left.value(), right_eye.value());
+  References refs = render_references(config.value(), scene.value(), 30, 1);
+  ASSERT_EQ(refs.images.count("front.left"), 1u);
+  ASSERT_EQ(refs.images.count("front.right"), 1u);
+  EXPECT_EQ(refs.images.count("front"), 0u) << "no mono reference for a screen seen only in stereo";
+  auto comparison = image::compare(refs.images["front.left"].linear, refs.images["front.right"].linear);
   ASSERT_TRUE(comparison.ok()) << comparison.error();
   EXPECT_GT(comparison.value().max_abs_error, 0.05) << "the two eyes see the cubes from 6.5 cm apart";
 }
@@ -149,24 +159,13 @@ TEST(RenderReference, SupersamplingAveragesTheSamplesOfAPixel) {
   edge.definition.instances.push_back({0, 0, std::nullopt, glm::dmat4(1.0)});
   edge.definition.ambient = glm::vec3(0.0f);
 
-  const auto render = [&](int supersample, image::FloatImage& linear, image::FloatImage& encoded) {
-    std::string dir = (fs::temp_directory_path() / "optique-edge-XXXXXX").string();
-    ASSERT_NE(mkdtemp(dir.data()), nullptr);
-    spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
-    ReferenceOptions options;
-    options.supersample = supersample;
-    ASSERT_TRUE(render_reference(config.value(), edge, 0, dir, log, options).ok());
-    auto l = image::read_image(image::frame_path(dir + "/reference/front", 0, "exr"));
-    auto e = image::read_image(image::frame_path(dir + "/reference/front", 0, "png"));
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-    ASSERT_TRUE(l.ok() && e.ok());
-    linear = std::move(l).value();
-    encoded = std::move(e).value();
-  };
-  image::FloatImage four_linear, four_encoded, one_linear, one_encoded;
-  render(4, four_linear, four_encoded);
-  render(1, one_linear, one_encoded);
+  References four = render_references(config.value(), edge, 0, 4);
+  References one = render_references(config.value(), edge, 0, 1);
+  ASSERT_EQ(four.images.count("front"), 1u);
+  ASSERT_EQ(one.images.count("front"), 1u);
+  const image::FloatImage& four_linear = four.images["front"].linear;
+  const image::FloatImage& four_encoded = four.images["front"].encoded;
+  const image::FloatImage& one_linear = one.images["front"].linear;
   ASSERT_EQ(four_linear.width, 640);
   for (const int y : {10, 180, 350}) {
     EXPECT_NEAR(four_linear.at(99, y, 0), 0.0f, 1e-6f) << "row " << y;
