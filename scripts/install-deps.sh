@@ -20,7 +20,8 @@ packages=(
   libgtest-dev libgmock-dev          # tests
   xvfb xauth                         # a virtual display for the window tests
   libssl-dev                         # SHA-256 of configs, HMAC (libcrypto)
-  python3                            # bench plots and helper scripts
+  python3                            # helper scripts, bench plot series
+  gnuplot-nox                        # bench plots (scripts/plot-bench.sh)
 )
 # scripts/install-deps.sh --fuzz: also what scripts/fuzz.sh needs (CI runs it).
 if [ "${1:-}" = --fuzz ]; then

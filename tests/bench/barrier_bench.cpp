@@ -13,9 +13,8 @@
 #include <sstream>
 
 #include "cluster_run.h"
-#include "image/image_io.h"
+#include "draw_plot.h"
 #include "metrics/distribution.h"
-#include "plot.h"
 #include "process.h"
 #include "ready_go_baseline.h"
 #include "spread.h"
@@ -126,11 +125,6 @@ int main(int argc, char** argv) {
   table << "| nodes | optique barrier round median µs | p99 µs | present skew median µs | p99 µs | "
            "ready/go baseline median µs | p99 µs | optique / baseline (median) | frames presented by all nodes % |\n"
         << "|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-  // One point per node count for each curve of the plot: median over the repeats.
-  struct Point {
-    double nodes, barrier_median, barrier_p99, skew_median, skew_p99;
-  };
-  std::vector<Point> points;
   for (std::size_t nodes : node_counts) {
     std::vector<double> bm, bp, sm, sp, gm, gp, ratio, all;
     for (std::size_t r = 0; r < repeats; ++r) {
@@ -158,44 +152,17 @@ int main(int argc, char** argv) {
     table << "| " << nodes << " | " << cell(barrier_median, 0) << " | " << cell(barrier_p99, 0) << " | "
           << cell(skew_median, 0) << " | " << cell(skew_p99, 0) << " | " << cell(spread(gm), 0) << " | "
           << cell(spread(gp), 0) << " | " << cell(spread(ratio), 2) << " | " << cell(spread(all), 1) << " |\n";
-    points.push_back(
-        {static_cast<double>(nodes), barrier_median.median, barrier_p99.median, skew_median.median, skew_p99.median});
   }
 
-  // Left: barrier round, right: present skew; both µs on log axes (10 µs – 100 ms)
-  // against the node count (log). Dark: median, light: p99.
-  using bench::Plot;
-  Plot plot(960, 400);
-  const double max_nodes = static_cast<double>(std::max<std::size_t>(2, node_counts.back())) * 1.3;
-  const Plot::Panel barrier_panel{50, 30, 400, 330, 0.8, max_nodes, 10.0, 1e5};
-  const Plot::Panel skew_panel{530, 30, 400, 330, 0.8, max_nodes, 10.0, 1e5};
-  std::vector<double> ticks;
-  for (const std::size_t n : node_counts) ticks.push_back(static_cast<double>(n));
-  plot.frame(barrier_panel, ticks);
-  plot.frame(skew_panel, ticks);
-  const auto draw = [&](const Plot::Panel& panel, double Point::*value, glm::u8vec3 colour) {
-    const auto at = [&](const Point& p) { return panel.at(p.nodes, std::clamp(p.*value, panel.y_lo, panel.y_hi)); };
-    std::vector<glm::dvec2> pixels;
-    for (const Point& p : points) pixels.push_back(at(p));
-    plot.curve(pixels, colour);
-  };
-  draw(barrier_panel, &Point::barrier_median, {20, 60, 160});
-  draw(barrier_panel, &Point::barrier_p99, {130, 170, 230});
-  draw(skew_panel, &Point::skew_median, {170, 40, 30});
-  draw(skew_panel, &Point::skew_p99, {240, 150, 130});
-  if (auto written = image::write_png(out + "/barrier.png", plot.image()); !written) {
-    std::cerr << "optique-bench-barrier: " << written.error() << "\n";
-    return 1;
-  }
   std::ofstream md(out + "/barrier.md");
   md << "Barrier benchmark: " << frames << " frames at " << rate << " Hz, " << repeats
      << " runs per row; each cell is the median over runs with the min–max in brackets. "
         "Null-render nodes, all on this machine; a frame counts as presented by all nodes when every node reported "
         "its present.\n\n"
-     << table.str()
-     << "\n![barrier round (left, blue) and present skew (right, red) against the node count, log axes "
-        "10 µs – 100 ms; dark: median, light: p99](barrier.png)\n";
+     << table.str() << "\n![barrier round and present skew against the node count](barrier.png)\n";
+  md.close();
+  csv.close();
   std::cout << table.str();
   std::filesystem::remove_all(work);
-  return 0;
+  return bench::draw_plot(out, "barrier") ? 0 : 1;
 }

@@ -18,14 +18,12 @@
 
 #include "calib/fit.h"
 #include "clock/clock.h"
-#include "image/image_io.h"
+#include "draw_plot.h"
 #include "pinhole_projector.h"
-#include "plot.h"
 #include "spread.h"
 
 namespace {
 
-using optique::bench::Plot;
 using namespace optique;
 
 constexpr double kSigma = 0.5;
@@ -123,18 +121,6 @@ Sample run_repeat(const testing::PinholeProjector& p, const Case& c, Method m, i
   return s;
 }
 
-glm::u8vec3 colour_of(Method m) {
-  switch (m) {
-    case Method::kDlt:
-      return {31, 119, 180};  // blue
-    case Method::kRefined:
-      return {255, 127, 14};  // orange
-    case Method::kRobust:
-      return {44, 160, 44};  // green
-  }
-  return {0, 0, 0};
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -157,12 +143,6 @@ int main(int argc, char** argv) {
   table << "| points | gross outliers | method | time per fit µs | transfer error at the points px | optimum px | "
            "ratio | transfer error over the image px |\n"
         << "|---:|---:|---|---:|---:|---:|---:|---:|\n";
-
-  struct Point {
-    double n, time, ratio;
-  };
-  std::vector<std::vector<Point>> clean_curves(3);
-  std::vector<std::vector<Point>> outlier_curves(3);
 
   std::uint64_t seed = 1000;
   for (const Case& c : cases) {
@@ -195,35 +175,8 @@ int main(int argc, char** argv) {
                     failures ? (" " + std::to_string(failures) + " fits failed").c_str() : "");
       table << row;
       std::cout << row << std::flush;
-      auto& curves = c.outlier_fraction == 0.0 ? clean_curves : outlier_curves;
-      curves[static_cast<std::size_t>(m)].push_back({static_cast<double>(c.points()), time.median, transfer / optimum});
     }
     seed += 100;
-  }
-
-  // Left: time per fit, clean points (1 µs – 10 ms). Right: transfer error ÷
-  // optimum with 10 % gross outliers (0.5 – 500).
-  Plot plot(960, 400);
-  const Plot::Panel time_panel{50, 30, 400, 330, 3.0, 260.0, 1.0, 1e4};
-  const Plot::Panel error_panel{530, 30, 400, 330, 3.0, 260.0, 0.5, 500.0};
-  plot.frame(time_panel, {4.0, 20.0, 200.0});
-  plot.frame(error_panel, {4.0, 20.0, 200.0});
-  plot.line(error_panel.at(3.0, 1.0), error_panel.at(260.0, 1.0), {120, 120, 120}, 1);
-  const auto draw = [&](const Plot::Panel& panel, const std::vector<Point>& curve, bool time, glm::u8vec3 colour) {
-    const auto at = [&](const Point& p) {
-      return panel.at(p.n, time ? p.time : std::clamp(p.ratio, panel.y_lo, panel.y_hi));
-    };
-    std::vector<glm::dvec2> pixels;
-    for (const Point& p : curve) pixels.push_back(at(p));
-    plot.curve(pixels, colour);
-  };
-  for (const Method m : kMethods) {
-    draw(time_panel, clean_curves[static_cast<std::size_t>(m)], true, colour_of(m));
-    draw(error_panel, outlier_curves[static_cast<std::size_t>(m)], false, colour_of(m));
-  }
-  if (auto written = image::write_png(out + "/calibration.png", plot.image()); !written) {
-    std::cerr << "optique-bench-calib: " << written.error() << "\n";
-    return 1;
   }
 
   std::ofstream md(out + "/calibration.md");
@@ -239,10 +192,10 @@ int main(int argc, char** argv) {
         "(nothing to vote on). One thread, on a machine with "
      << std::thread::hardware_concurrency() << " hardware threads (shared with other work: the min–max shows it).\n\n"
      << table.str()
-     << "\nPlot (`calibration.png`, log–log, no labels): left, time per fit on clean points against the number of "
-        "points (vertical lines at 4, 20, 200; horizontal at 1 µs, 10 µs, 100 µs, 1 ms, 10 ms); right, transfer "
-        "error ÷ optimum with 10 % gross outliers (20 and 200 points; horizontal lines at 1, 10, 100, the darker "
-        "one at 1). Blue: DLT only; orange: DLT + refinement; green: robust.\n";
-  std::cout << "wrote " << out << "/calibration.md, .csv, .png\n";
-  return 0;
+     << "\n![time per fit on clean points, and transfer error ÷ optimum with 10 % gross outliers, against the "
+        "number of points](calibration.png)\n";
+  md.close();
+  csv.close();
+  std::cout << "wrote " << out << "/calibration.md, .csv\n";
+  return bench::draw_plot(out, "calibration") ? 0 : 1;
 }

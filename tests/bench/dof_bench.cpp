@@ -4,7 +4,7 @@
 // beside the all-in-focus image and a computational gather DOF on one node
 // (a GLSL pass written here); the precision of c_r from a 24-bit or 32F depth
 // buffer at far/near = 10⁴; and each method's time per frame. Writes dof.md,
-// dof.csv and dof.png to --out.
+// dof.csv, dof.png (the plot) and dof-images.png to --out.
 //
 //   optique-bench-dof [--out DIR] [--runs R] [--frames F] [--config FILE]
 
@@ -27,10 +27,10 @@
 #include <epoxy/gl.h>
 
 #include "dof_experiment.h"
+#include "draw_plot.h"
 #include "image/compare.h"
 #include "image/convert.h"
 #include "image/image_io.h"
-#include "plot.h"
 #include "render/gl_context.h"
 #include "render/gl_objects.h"
 #include "shaders.h"
@@ -243,11 +243,11 @@ int main(int argc, char** argv) {
   int runs = 5;
   int frames = 12;
   double image_focus = 2.5;
-  app.add_option("--out", out, "folder for dof.md, dof.csv and dof.png");
+  app.add_option("--out", out, "folder for dof.md, dof.csv, dof.png and dof-images.png");
   app.add_option("--config", config, "the installation (a focus and a defocus projector)");
   app.add_option("--runs", runs, "timing runs; a cell is the median over runs with their min–max");
   app.add_option("--frames", frames, "frames per run, each method once per frame in rotating order");
-  app.add_option("--image-focus", image_focus, "focal depth of the images in dof.png (m)");
+  app.add_option("--image-focus", image_focus, "focal depth of the images in dof-images.png (m)");
   CLI11_PARSE(app, argc, argv);
 
   try {
@@ -565,9 +565,8 @@ int main(int argc, char** argv) {
                    << " |\n";
     }
 
-    // ---- dof.png: PSNR over the sweep, the gain by c_r, and the images.
-    // The tiles show the part of the image with the objects and their blur, at
-    // full resolution.
+    // ---- dof-images.png: the part of the image with the objects and their blur,
+    // at full resolution (dof.png, the plot, is drawn from dof.csv at the end).
     int seen_x0 = width;
     int seen_x1 = 0;
     int seen_y0 = height;
@@ -595,42 +594,13 @@ int main(int argc, char** argv) {
       }
       return part;
     };
-    const int canvas_w = std::max(1000, 4 * (tile_w + 10) + 10);
-    const int panel_w = canvas_w / 2 - 60;
-    const int tiles_y = 330;
-    Plot plot(canvas_w, tiles_y + 2 * (tile_h + 10));
-    constexpr double kLowDb = 30.0;
-    constexpr double kHighDb = 70.0;
-    Plot::Panel sweep_panel{40, 20, panel_w, 280, setup.range.near, setup.range.far, kLowDb, kHighDb, true, false};
-    std::vector<double> ticks;
-    for (double t = 1.0; t <= 10.0; t += 1.0) ticks.push_back(t);
-    plot.frame(sweep_panel, ticks, {30, 40, 50, 60, 70});
-    auto curve = [&](const std::function<double(const Row&)>& f, glm::u8vec3 colour, int radius) {
-      for (std::size_t i = 0; i < rows.size(); ++i) {
-        const double v = std::clamp(f(rows[i]), kLowDb, kHighDb);
-        plot.dot(sweep_panel.at(rows[i].b, v), colour, radius);
-        if (i > 0) {
-          plot.line(sweep_panel.at(rows[i - 1].b, std::clamp(f(rows[i - 1]), kLowDb, kHighDb)),
-                    sweep_panel.at(rows[i].b, v), colour, 1);
-        }
-      }
-    };
-    curve([](const Row& r) { return r.scores16.sharp_away; }, {120, 120, 120}, 3);
-    curve([](const Row& r) { return r.gather_away; }, {230, 120, 20}, 3);
-    curve([](const Row& r) { return r.pair8_away; }, {120, 170, 255}, 5);  // under the 16-bit pair: they coincide
-    curve([](const Row& r) { return r.scores16.pair_away; }, {30, 60, 200}, 3);
-    constexpr double kLowGain = -4.0;
-    constexpr double kHighGain = 24.0;
-    Plot::Panel gain_panel{canvas_w / 2 + 40, 20, panel_w, 280, 0.0, 1.0, kLowGain, kHighGain, false, false};
-    plot.frame(gain_panel, {0.0, 0.25, 0.5, 0.75, 1.0}, {-4, 0, 4, 8, 12, 16, 20, 24});
-    plot.line(gain_panel.at(0.0, 0.0), gain_panel.at(1.0, 0.0), {0, 0, 0}, 0);
-    for (const ObjectScore& o : objects) {
-      if (o.coc < sharp_limit || !std::isfinite(o.pair - o.sharp)) continue;
-      plot.dot(gain_panel.at(o.coc, std::clamp(o.pair - o.sharp, kLowGain, kHighGain)), {30, 60, 200}, 2);
-    }
+    // White margins of 10 px around and between the tiles.
+    const int canvas_w = 4 * (tile_w + 10) + 10;
+    image::ByteImage canvas(canvas_w, 2 * (tile_h + 10) + 10, 3);
+    std::fill(canvas.pixels.begin(), canvas.pixels.end(), std::uint8_t{255});
+    const int tiles_y = 10;
     const float gain = brightest > 0.0f ? 0.9f / brightest : 1.0f;
     constexpr float kErrorGain = 8.0f;  // the differences, brighter still
-    image::ByteImage canvas = plot.image();
     const std::array<const image::FloatImage*, 4> shown{&shown_sharp, &shown_pair, &shown_ideal, &shown_gather};
     for (std::size_t i = 0; i < shown.size(); ++i) {
       const int x0 = 10 + static_cast<int>(i) * (tile_w + 10);
@@ -639,7 +609,7 @@ int main(int argc, char** argv) {
         paste(canvas, crop(image::difference(*shown[i], shown_ideal, kErrorGain)), gain, x0, tiles_y + tile_h + 10);
       }
     }
-    if (auto written = image::write_png(out + "/dof.png", canvas); !written) {
+    if (auto written = image::write_png(out + "/dof-images.png", canvas); !written) {
       throw std::runtime_error(written.error());
     }
 
@@ -668,7 +638,8 @@ int main(int argc, char** argv) {
     std::ofstream md(out + "/dof.md");
     md << "# Depth of field by a focused and a defocused projector, measured\n\n"
        << "Generated by `optique-bench-dof` on " << gl
-       << ". [docs/design.md](../design.md) (Majumder & Welch, depth of field by optics) gives the pair: the focus projector shows "
+       << ". [docs/design.md](../design.md) (Majumder & Welch, depth of field by optics) gives the pair: the focus "
+          "projector shows "
           "(1 − c_r)·I, the defocus projector c_r·I through optics that blur by the largest circle of confusion "
           "c_max, so the sum on the screen approximates the ideal image in which every pixel is blurred by its own "
           "circle c_r·c_max. This measures how close it gets, what the depth buffer does to c_r, and what the pair "
@@ -724,16 +695,16 @@ int main(int argc, char** argv) {
           "runs. Each method ends with glFinish. The nodes of the pair run on two machines at once, so the pair's "
           "frame time is the slower node's, taken frame by frame.\n\n"
        << timing_table.str() << "\n"
-       << "## Plot\n\n`dof.png`. Top left: PSNR away from focus (dB, 30–70) against b (1–10 m, log): grey "
-          "all-in-focus, dark blue the pair (16-bit) over light blue the pair (8-bit, the same to 0.02 dB), "
-          "orange the normalized gather (the disc-weight gather is off the scale). Top right: the pair's gain "
-          "over all-in-focus per object and b (dB, −4…24; the black line is 0) against the object's c_r (0–1), "
-          "objects whose ideal blur is under half a pixel left out. Middle row, at b = "
+       << "## Plots\n\n![PSNR away from focus against the focal depth b; the pair's gain over all-in-focus per "
+          "object and b against the object's c_r](dof.png)\n\n"
+          "The disc-weight gather is the ideal to float rounding and is left out of the plot. `dof-images.png`, "
+          "top row, at b = "
        << fixed(shown_b, 2) << " m, the " << tile_w << "×" << tile_h
        << " pixels around the objects, full resolution, brightened ×" << fixed(gain, 1)
        << ": all-in-focus, the pair on the screen (16-bit), the ideal, the normalized gather. Bottom row: each "
           "one's difference from the ideal, ×"
-       << fixed(kErrorGain * gain, 0) << " (none under the ideal).\n\n"
+       << fixed(kErrorGain * gain, 0) << " (none under the ideal).\n\n![the images at b = " << fixed(shown_b, 2)
+       << " m and their differences from the ideal](dof-images.png)\n\n"
        << "## Findings\n\n"
        << "- **The pair against all-in-focus.** Away from focus the pair is "
        << (least_margin > 0.0 ? "closer to the ideal at every b of the sweep, by "
@@ -805,6 +776,9 @@ int main(int argc, char** argv) {
               << object_table.str() << '\n'
               << precision_table.str() << '\n'
               << timing_table.str();
+    md.close();
+    csv.close();
+    if (!bench::draw_plot(out, "dof")) return 1;
   } catch (const std::exception& e) {
     std::cerr << "optique-bench-dof: " << e.what() << "\n";
     return 1;

@@ -36,12 +36,12 @@
 #include "config/job.h"
 #include "config/light_list.h"
 #include "config/load.h"
+#include "draw_plot.h"
 #include "image/compare.h"
 #include "image/image_io.h"
 #include "master/light_share.h"
 #include "master/scene_authority.h"
 #include "master/stacked_groups.h"
-#include "plot.h"
 #include "render/gl_context.h"
 #include "render/projector_pipeline.h"
 #include "scene/builtin.h"
@@ -458,10 +458,6 @@ int main(int argc, char** argv) {
                       "PSNR Σ 8-bit vs one 8-bit, dB | max abs | levels along row " +
                           std::to_string(row) + " (exact)\n"
                    << "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
-    // Medians for the plot: [scene][nodes − 1].
-    std::vector<std::array<double, kMaxNodes>> speedups(scenes.size());
-    std::vector<std::array<double, kMaxNodes>> model_speedups(scenes.size());
-    std::vector<std::array<double, kMaxNodes>> psnrs(scenes.size());
     double brightest = 0.0;
     double clipped = 0.0;
     for (std::size_t i = 0; i < stacks.size(); ++i) {
@@ -489,8 +485,6 @@ int main(int argc, char** argv) {
       time_table << "| " << kLightCounts[stack.scene] << " | " << n << " | " << shares << " | " << node_ms << " | "
                  << cell(times.slowest, 1) << " | " << cell(speedup, 2) << " | " << fixed(model_speedup, 2) << " | "
                  << cell(overhead, 2) << " |\n";
-      speedups[stack.scene][n - 1] = median(speedup);
-      model_speedups[stack.scene][n - 1] = model_speedup;
 
       std::vector<double> split, exact_psnr, exact_max, one_psnr, one_max, levels, exact_levels;
       for (const Accuracy& a : accuracy[i]) {
@@ -504,7 +498,6 @@ int main(int argc, char** argv) {
         brightest = std::max(brightest, a.brightest);
         clipped = std::max(clipped, a.clipped);
       }
-      psnrs[stack.scene][n - 1] = median(exact_psnr);
       accuracy_table << "| " << kLightCounts[stack.scene] << " | " << n << " | " << scientific(median(split)) << " ("
                      << scientific(*std::max_element(split.begin(), split.end())) << ") | " << cell(exact_psnr, 1)
                      << " | " << cell(exact_max, 4) << " | " << cell(one_psnr, 1) << " | " << cell(one_max, 4) << " | "
@@ -587,47 +580,6 @@ int main(int argc, char** argv) {
       }
     }
 
-    // Plot: left, speed-up against nodes (x 1…4, y 0…4, grid at each integer;
-    // grey: ideal, speed-up = nodes); right, PSNR of the composite against the
-    // exact render (x 1…4, y grid every 2 dB). One colour per light count.
-    double db_lo = 1e9;
-    double db_hi = 0.0;
-    for (const auto& p : psnrs) {
-      for (double v : p) {
-        db_lo = std::min(db_lo, v);
-        db_hi = std::max(db_hi, v);
-      }
-    }
-    db_lo = 2.0 * std::floor((db_lo - 1.0) / 2.0);
-    db_hi = 2.0 * std::ceil((db_hi + 1.0) / 2.0);
-    bench::Plot plot(760, 360);
-    const bench::Plot::Panel left{40, 20, 320, 310, 0.75, 4.25, 0.0, 4.25, false, false};
-    const bench::Plot::Panel right{420, 20, 320, 310, 0.75, 4.25, db_lo, db_hi, false, false};
-    const std::vector<double> n_ticks{1.0, 2.0, 3.0, 4.0};
-    std::vector<double> db_ticks;
-    for (double d = db_lo + 2.0; d < db_hi; d += 2.0) db_ticks.push_back(d);
-    plot.frame(left, n_ticks, n_ticks);
-    plot.frame(right, n_ticks, db_ticks);
-    plot.line(left.at(1.0, 1.0), left.at(4.0, 4.0), {160, 160, 160}, 0);
-    const std::array<glm::u8vec3, 3> colours{glm::u8vec3(31, 119, 180), glm::u8vec3(255, 127, 14),
-                                             glm::u8vec3(214, 39, 40)};
-    for (std::size_t s = 0; s < scenes.size(); ++s) {
-      for (int n = 1; n <= kMaxNodes; ++n) {
-        const auto i = static_cast<std::size_t>(n - 1);
-        if (n > 1) {
-          const glm::u8vec3 pale((glm::ivec3(colours[s]) + 255) / 2);
-          plot.line(left.at(n - 1, model_speedups[s][i - 1]), left.at(n, model_speedups[s][i]), pale, 0);
-          plot.line(left.at(n - 1, speedups[s][i - 1]), left.at(n, speedups[s][i]), colours[s], 1);
-          plot.line(right.at(n - 1, psnrs[s][i - 1]), right.at(n, psnrs[s][i]), colours[s], 1);
-        }
-        plot.dot(left.at(n, speedups[s][i]), colours[s], 4);
-        plot.dot(right.at(n, psnrs[s][i]), colours[s], 4);
-      }
-    }
-    if (auto written = image::write_png(out + "/lighting.png", plot.image()); !written) {
-      throw std::runtime_error(written.error());
-    }
-
     // The reading below the tables is written by hand from a run's numbers; a
     // re-run keeps it (and should be read again against the new tables).
     std::string reading;
@@ -646,7 +598,8 @@ int main(int argc, char** argv) {
     }
     std::ostringstream md;
     md << "# Lighting split: stacked nodes against one full render\n\n"
-       << "Majumder & Welch's lighting split ([docs/design.md](../design.md), \"The lighting split\"): each node of a stacked group draws "
+       << "Majumder & Welch's lighting split ([docs/design.md](../design.md), \"The lighting split\"): each node of a "
+          "stacked group draws "
           "some of the scene's point lights, one of them also the ambient and emissive terms, and the projectors' "
           "light adds up on the screen to the full render. What the cluster buys is the frame time of its slowest "
           "node against one node drawing every light; what it costs is the error of the optical sum.\n\n"
@@ -705,10 +658,8 @@ int main(int argc, char** argv) {
           "Frames at which automatic_shares alone (without the master's hysteresis: it shares out again only for a "
           "worthwhile modelled gain) would split differently from its first split (20/50/100 lights): "
        << auto_changes[0] << "/" << auto_changes[1] << "/" << auto_changes[2] << " of " << frames - 1 << ".\n"
-       << "- Plot (`lighting.png`, no labels). Left: speed-up (y, 0 to 4.25, grid at each integer) against nodes "
-          "(x, 1 to 4); grey, the ideal speed-up = nodes; thin pale lines, the fitted model's speed-up. Right: PSNR of "
-          "Σ 8-bit vs exact (y, "
-       << db_lo << " to " << db_hi << " dB, grid every 2 dB) against nodes. Blue: 20 lights, orange: 50, red: 100.\n\n"
+       << "- Plot (`lighting.png`): the speed-up per light count with the ideal (= nodes), and the PSNR of Σ 8-bit vs "
+          "exact, against the node count; the fitted model's speed-up is in the table.\n\n"
        << "## Identical nodes, naive split\n\n"
        << time_table.str() << "\n"
        << accuracy_table.str() << "\n"
@@ -718,6 +669,8 @@ int main(int argc, char** argv) {
     if (!reading.empty()) md << reading;
     std::ofstream(out + "/lighting.md") << md.str();
     std::cout << md.str();
+    csv.close();
+    if (!bench::draw_plot(out, "lighting")) return 1;
   } catch (const std::exception& e) {
     std::cerr << "optique-bench-lighting: " << e.what() << "\n";
     return 1;

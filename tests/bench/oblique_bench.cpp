@@ -21,13 +21,12 @@
 #include "clock/clock.h"
 #include "config/job.h"
 #include "config/load.h"
+#include "draw_plot.h"
 #include "image/compare.h"
 #include "image/convert.h"
-#include "image/image_io.h"
 #include "image/texture_decode.h"
 #include "master/scene_authority.h"
 #include "metrics/distribution.h"
-#include "plot.h"
 #include "render/gl_context.h"
 #include "render/projector_pipeline.h"
 #include "scene/load_scene.h"
@@ -119,7 +118,6 @@ int main(int argc, char** argv) {
     table << "| projector | k | method | texture | frame ms | time ratio to single | PSNR dB |\n"
           << "|---|---:|---|---|---:|---:|---:|\n";
     // One point per (projector, method): median frame time, median PSNR.
-    std::vector<std::array<glm::dvec2, 3>> points;
     for (std::size_t index = 0; index < installation.projectors.size(); ++index) {
       const config::Projector& projector = installation.projectors[index];
       const config::ProjectorJob job = config::job_for(installation, index);
@@ -191,58 +189,22 @@ int main(int argc, char** argv) {
               << (ratio.empty() ? std::string("1") : bench::cell(bench::spread(ratio), 2)) << " | "
               << bench::cell(bench::spread(psnrs), 1) << " |\n";
       };
-      auto median = [](const std::vector<double>& v) { return bench::spread(v).median; };
-      points.push_back({glm::dvec2(median(single_medians), median(single_psnrs)),
-                        glm::dvec2(median(two_medians), median(two_psnrs)),
-                        glm::dvec2(median(equal_medians), median(equal_psnrs))});
       row("single pass", single, single_medians, {}, single_psnrs);
       row("two passes, texels at the densest pixel pitch", two, two_medians, ratios, two_psnrs);
       row("two passes, as many texels as pixels", two_equal, equal_medians, equal_ratios, equal_psnrs);
     }
-    // Plot: x frame time (ms, linear, grid every 10 ms), y PSNR (dB, linear, grid
-    // every 2 dB); per projector a grey line through its three methods.
-    double t_max = 10.0;
-    double db_lo = 1e9;
-    double db_hi = 0.0;
-    for (const auto& p : points) {
-      for (const auto& m : p) {
-        t_max = std::max(t_max, m.x);
-        db_lo = std::min(db_lo, m.y);
-        db_hi = std::max(db_hi, m.y);
-      }
-    }
-    t_max = 10.0 * std::ceil(t_max * 1.1 / 10.0);
-    db_lo = 2.0 * std::floor((db_lo - 1.0) / 2.0);
-    db_hi = 2.0 * std::ceil((db_hi + 1.0) / 2.0);
-    bench::Plot plot(640, 400);
-    bench::Plot::Panel panel{50, 20, 560, 350, 0.0, t_max, db_lo, db_hi, false, false};
-    std::vector<double> x_ticks;
-    for (double t = 10.0; t < t_max; t += 10.0) x_ticks.push_back(t);
-    std::vector<double> y_ticks;
-    for (double d = db_lo + 2.0; d < db_hi; d += 2.0) y_ticks.push_back(d);
-    plot.frame(panel, x_ticks, y_ticks);
-    const std::array<glm::u8vec3, 3> colours{glm::u8vec3(31, 119, 180), glm::u8vec3(214, 39, 40),
-                                             glm::u8vec3(255, 127, 14)};
-    for (const auto& p : points) {
-      plot.line(panel.at(p[0].x, p[0].y), panel.at(p[2].x, p[2].y), {170, 170, 170}, 0);
-      plot.line(panel.at(p[2].x, p[2].y), panel.at(p[1].x, p[1].y), {170, 170, 170}, 0);
-      for (std::size_t m = 0; m < 3; ++m) plot.dot(panel.at(p[m].x, p[m].y), colours[m], 4);
-    }
-    if (auto written = image::write_png(out + "/oblique.png", plot.image()); !written) {
-      throw std::runtime_error(written.error());
-    }
-
     std::ofstream md(out + "/oblique.md");
     md << "Single pass vs two passes on " << gl << ", " << config_path.substr(config_path.rfind('/') + 1) << ", "
        << frames << " frames × " << repeats
        << " runs, alternating. Times: median per run, then median (min–max) over runs; ratio per run. PSNR (luma, "
           "linear light, over the screen's usable area) against the 4×-supersampled image of the same projector: "
           "median (min–max) over frames.\n\n"
-       << table.str() << "\nPlot (`oblique.png`, no labels): x frame time, 0 to " << t_max
-       << " ms (grid every 10 ms); y PSNR, " << db_lo << " to " << db_hi
-       << " dB (grid every 2 dB). Blue: single pass; orange: two passes, as many texels as pixels; red: two passes "
-          "at the densest pitch; a grey line joins one projector's three.\n";
+       << table.str()
+       << "\n![frame time against PSNR per projector: single pass and the two two-pass variants](oblique.png)\n";
+    md.close();
+    csv.close();
     std::cout << "renderer: " << gl << "\n" << table.str();
+    if (!bench::draw_plot(out, "oblique")) return 1;
   } catch (const std::exception& e) {
     std::cerr << "optique-bench-oblique: " << e.what() << "\n";
     return 1;
