@@ -56,6 +56,14 @@ std::size_t MasterProtocol::nodes_up() const {
   return static_cast<std::size_t>(std::count_if(slots_.begin(), slots_.end(), [&](const Slot& s) { return up(s); }));
 }
 
+std::vector<std::size_t> MasterProtocol::slots_configuring() const {
+  std::vector<std::size_t> configuring;
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    if (slots_[i].peer && sessions_.at(*slots_[i].peer).phase == Phase::configuring) configuring.push_back(i);
+  }
+  return configuring;
+}
+
 std::string MasterProtocol::slot_id(std::size_t slot) const { return installation_.projectors[slot].id; }
 
 MasterProtocol::Session* MasterProtocol::session_of(std::size_t slot) {
@@ -258,7 +266,8 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
   out.push_back(
       Log{spdlog::level::info, fmt::format("node '{}' joined from {} with {} ({}/{} up)", slot_id(*session.slot),
                                            session.peer_text, configured.renderer(), nodes_up(), slots_.size())});
-  if (state_ == RunState::starting && nodes_up() == slots_.size()) start_frames(now, out);
+  if (state_ == RunState::starting && (nodes_up() == slots_.size() || (startup_passed_ && slots_configuring().empty())))
+    start_frames(now, out);
 }
 
 // The state as of the last frame begun; the next FrameBegin's delta applies to it.
@@ -295,6 +304,13 @@ Actions MasterProtocol::closed(PeerId peer, const std::string& reason, clock::Na
     } else {
       out.push_back(Log{spdlog::level::debug, "node '" + slot_id(slot) + "' closed: " + reason});
     }
+    if (state_ == RunState::starting && startup_passed_ && slots_configuring().empty()) {
+      if (nodes_up() == 0) {
+        fail("no node came up: '" + slot_id(slot) + "', the last one configuring, left: " + reason, now, out);
+      } else {
+        start_frames(now, out);
+      }
+    }
     std::erase(ready_for_swap_, slot);  // a node that is gone is not told to swap
     if (state_ != RunState::closing && state_ != RunState::done) rebalance_lights(true);
     if (barrier_.active()) {
@@ -314,7 +330,21 @@ Actions MasterProtocol::timer(Timer timer, clock::Nanos now) {
     case Timer::startup:
       if (state_ != RunState::starting) break;
       if (nodes_up() == 0) {
-        fail("no node connected within " + std::to_string(config_.startup_timeout.count()) + " ms", now, out);
+        const std::vector<std::size_t> configuring = slots_configuring();
+        if (configuring.empty()) {
+          fail("no node connected within " + std::to_string(config_.startup_timeout.count()) + " ms", now, out);
+          break;
+        }
+        // Connected nodes still setting up are working, not missing: on a loaded
+        // machine, or with a large scene, that takes longer than the timeout.
+        // Their own configure deadline bounds the wait.
+        startup_passed_ = true;
+        std::string ids;
+        for (const std::size_t slot : configuring) ids += (ids.empty() ? "" : ", ") + slot_id(slot);
+        out.push_back(Log{spdlog::level::warn,
+                          fmt::format("no node ready after {} ms; waiting for {} (connected, still configuring, "
+                                      "at most {} s each) before starting",
+                                      config_.startup_timeout.count(), ids, kConfigureTimeout.count())});
         break;
       }
       {

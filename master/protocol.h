@@ -183,6 +183,8 @@ class MasterProtocol {
   void rebalance_lights(bool force);
   void log_light_switches(std::uint64_t frame, const wire::StateDelta& delta, Actions& out) const;
   [[nodiscard]] bool up(const Slot& slot) const;  // through the handshake and configured
+  // The projectors whose node has said hello and is setting up (GL, scene, shaders).
+  [[nodiscard]] std::vector<std::size_t> slots_configuring() const;
   [[nodiscard]] std::string slot_id(std::size_t slot) const;
   [[nodiscard]] Session* session_of(std::size_t slot);
 
@@ -208,6 +210,9 @@ class MasterProtocol {
   std::uint64_t schedule_origin_frame_ = 0;
 
   RunState state_ = RunState::starting;
+  // The startup timeout passed while nodes were still configuring: the frames
+  // start once each of those is up or gone.
+  bool startup_passed_ = false;
   bool terminating_ = false;  // goodbye's grace is over: SIGTERM sent, SIGKILL next
   std::string stopped_because_;
   std::uint64_t refused_connections_ = 0;
