@@ -354,11 +354,20 @@ TEST_F(MasterTest, NoNodeBeforeTheStartupTimeoutFails) {
 // A node that has said hello and is setting up (GL, scene, shaders) is not
 // missing: on a loaded machine that outlasts the startup timeout (a fresh clone's
 // run-local.sh beside a compile once failed "no node connected" this way).
-TEST_F(MasterTest, NodesStillConfiguringAtTheStartupTimeoutAreWaitedFor) {
-  load("powerwall-2x2.json");
-  (void)hello(1, "bottom-left");
-  (void)hello(2, "top-left");
-  Actions a = master_->timer(Timer::startup, now_ + 10'000 * kMs);
+class StartupTest : public MasterTest {
+ protected:
+  // bottom-left (1) and top-left (2) said hello and are configuring when the
+  // startup timeout passes; the other two never came.
+  Actions two_configuring_at_the_timeout() {
+    load("powerwall-2x2.json");
+    (void)hello(1, "bottom-left");
+    (void)hello(2, "top-left");
+    return master_->timer(Timer::startup, now_ + 10'000 * kMs);
+  }
+};
+
+TEST_F(StartupTest, NodesStillConfiguringAtTheStartupTimeoutAreWaitedFor) {
+  Actions a = two_configuring_at_the_timeout();
   EXPECT_EQ(first<Finish>(a), nullptr);
   EXPECT_FALSE(logged(a, "no node connected"));
   EXPECT_TRUE(logged(a, "no node ready after 10000 ms; waiting for bottom-left, top-left"));
@@ -372,11 +381,8 @@ TEST_F(MasterTest, NodesStillConfiguringAtTheStartupTimeoutAreWaitedFor) {
   EXPECT_EQ(sent_to(a, 2, wire::Envelope::kFrameBegin).size(), 1u);
 }
 
-TEST_F(MasterTest, AConfiguringNodeLeavingAfterTheStartupTimeoutStartsTheOthers) {
-  load("powerwall-2x2.json");
-  (void)hello(1, "bottom-left");
-  (void)hello(2, "top-left");
-  (void)master_->timer(Timer::startup, now_ + 10'000 * kMs);
+TEST_F(StartupTest, AConfiguringNodeLeavingAfterTheStartupTimeoutStartsTheOthers) {
+  (void)two_configuring_at_the_timeout();
   (void)configured(1);
   EXPECT_FALSE(master_->running());
   const Actions a = master_->closed(2, "node did not finish configuring within 30 s", now_ + 30'000 * kMs);
@@ -384,11 +390,8 @@ TEST_F(MasterTest, AConfiguringNodeLeavingAfterTheStartupTimeoutStartsTheOthers)
   EXPECT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u);
 }
 
-TEST_F(MasterTest, TheLastConfiguringNodeLeavingAfterTheStartupTimeoutFails) {
-  load("powerwall-2x2.json");
-  (void)hello(1, "bottom-left");
-  (void)hello(2, "top-left");
-  (void)master_->timer(Timer::startup, now_ + 10'000 * kMs);
+TEST_F(StartupTest, TheLastConfiguringNodeLeavingAfterTheStartupTimeoutFails) {
+  (void)two_configuring_at_the_timeout();
   Actions a = master_->closed(1, "node did not finish configuring within 30 s", now_ + 30'000 * kMs);
   EXPECT_EQ(first<Finish>(a), nullptr) << "top-left is still configuring";
   EXPECT_FALSE(logged(a, "no node came up"));
