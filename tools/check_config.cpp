@@ -1,5 +1,7 @@
 #include "tools/check_config.h"
 
+#include <algorithm>
+#include <cctype>
 #include <iomanip>
 #include <map>
 #include <sstream>
@@ -19,6 +21,26 @@ std::string keystoned_summary(const config::Installation& inst, const config::Pr
   text << std::setprecision(3) << "keystoned, lights (within the screen) [" << b.min.x << ", " << b.min.y << "] – ["
        << b.max.x << ", " << b.max.y << "] m, " << config::to_string(p.rendering) << " (depth scale over the lit area "
        << oblique.value().depth_scale << ")";
+  return text.str();
+}
+
+// A DLP projector's fields in display order, with their times in milliseconds
+// at the master's frame rate: "colour fields (per-field): B −1.67 ms, R 0 ms, …".
+std::string color_fields_summary(const config::ColorFields& c, const config::MasterSettings& master) {
+  std::vector<config::ColorField> fields = c.fields;
+  std::sort(fields.begin(), fields.end(), [](const auto& a, const auto& b) { return a.offset < b.offset; });
+  const double period_ms = 1000.0 / master.frame_rate;
+  std::ostringstream text;
+  text << std::setprecision(3) << "colour fields (" << config::to_string(c.method) << ", " << c.images
+       << (c.images == 1 ? " image" : " images") << " per frame): ";
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const std::string_view name = config::to_string(fields[i].channel);
+    text << (i ? ", " : "") << static_cast<char>(std::toupper(name.front()));
+    if (c.images > 1) text << fields[i].image;
+    text << " " << fields[i].offset * period_ms << " ms (" << fields[i].duration * period_ms << " ms long)";
+  }
+  text << " from the display time";
+  if (c.velocity_threshold > 0.0) text << "; not offset above " << c.velocity_threshold << " px per frame";
   return text.str();
 }
 
@@ -49,6 +71,7 @@ std::string summarize(const config::LoadedConfig& config) {
     }
     out << ", host " << p.host << ", " << config::to_string(p.output.kind) << ", eye " << config::to_string(p.eye)
         << "\n";
+    if (!p.color_fields.fields.empty()) out << "      " << color_fields_summary(p.color_fields, inst.master) << "\n";
   }
   const config::Viewer& v = inst.viewer;
   out << "  viewer: ";

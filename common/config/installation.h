@@ -16,6 +16,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "config/color_fields.h"
 #include "config/defaults.h"
 #include "config/response.h"
 #include "geometry/projection.h"
@@ -109,6 +110,7 @@ struct Projector {
   double blend_ramp = 0.0;  // metres of roll-off inside its edges; 0: across the whole overlap
   ProjectorResponse response;
   Content content;
+  ColorFields color_fields;  // a single-chip DLP projector's colour fields; empty: all colours at once
 
   // Its geometry on the screen (checked when parsed: this cannot fail then).
   [[nodiscard]] geometry::ProjectorGeometry geometry() const;

@@ -90,6 +90,11 @@ Projector build_projector(const schema::Projector& p, const std::vector<Screen>&
   assert(response);
   if (response) projector.response = std::move(response).value();
   projector.content = build_content(p.content());
+  if (p.has_color_fields()) {
+    std::vector<Problem> problems;
+    projector.color_fields = parse_color_fields(p.color_fields(), "color_fields", problems);
+    assert(problems.empty());
+  }
   if (p.has_camera()) projector.camera = CameraView{p.camera().camera(), matrix3(p.camera().homography())};
   return projector;
 }

@@ -75,6 +75,18 @@ schema::Projector to_schema(const Projector& p, const std::vector<Screen>& scree
     content.set_ambient(p.content.ambient);
   }
   content.set_blur_radius(p.content.blur_radius);
+  if (!p.color_fields.fields.empty()) {  // the fields themselves, a preset expanded
+    auto& fields = *out.mutable_color_fields();
+    for (const ColorField& f : p.color_fields.fields) {
+      auto& field = *fields.add_fields();
+      field.set_channel(std::string(to_string(f.channel)));
+      field.set_image(static_cast<std::uint32_t>(f.image));
+      field.set_offset(f.offset);
+      field.set_duration(f.duration);
+    }
+    fields.set_method(std::string(to_string(p.color_fields.method)));
+    fields.set_velocity_threshold(p.color_fields.velocity_threshold);
+  }
   return out;
 }
 

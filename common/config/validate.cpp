@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <set>
 
+#include "config/color_fields.h"
 #include "config/defaults.h"
 #include "config/light_list.h"
 #include "config/response.h"
@@ -32,6 +33,7 @@ class Checker {
   explicit Checker(std::vector<Problem>& problems) : problems_(problems) {}
 
   void fail(const std::string& path, const std::string& message) { problems_.push_back({path, message}); }
+  [[nodiscard]] std::vector<Problem>& problems() { return problems_; }
 
   bool finite(const std::string& path, double v) {
     if (std::isfinite(v)) return true;
@@ -332,6 +334,7 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
       check.fail(at + "." + e.substr(0, colon), colon == std::string::npos ? e : e.substr(colon + 2));
     }
     check_content(check, at + ".content", p.content());
+    if (p.has_color_fields()) (void)parse_color_fields(p.color_fields(), at + ".color_fields", check.problems());
   }
   if (scope == Scope::installation) check_stacked_pairs(check, inst);
 }

@@ -8,14 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "config/problem.h"
 #include "optique/config.pb.h"
 
 namespace optique::config {
-
-struct Problem {
-  std::string path;     // e.g. "projectors[2].region.width"
-  std::string message;  // e.g. "must be > 0 (got -1)"
-};
 
 // One line per problem: "ORIGIN: PATH: MESSAGE".
 [[nodiscard]] std::string describe_problems(const std::vector<Problem>& problems, const std::string& origin);

@@ -1,0 +1,57 @@
+#pragma once
+// A projector's colour fields, checked and typed: a single-chip DLP projector
+// shows red, green and blue one after another, each for part of the frame, and
+// each field is drawn for the moment it is on screen (Lancelle, Voß & Fellner,
+// "Fast Motion Rendering for Single-Chip Stereo DLP Projectors").
+// Times are in frame periods from the frame's display time.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "config/problem.h"
+#include "optique/config.pb.h"
+
+namespace optique::config {
+
+enum class Channel { red, green, blue };
+// per_field: one render per field; off: every colour at the display time.
+enum class FieldMethod { per_field, off };
+
+[[nodiscard]] std::string_view to_string(Channel channel);
+[[nodiscard]] std::string_view to_string(FieldMethod method);
+
+struct ColorField {
+  Channel channel = Channel::red;
+  int image = 0;          // which of the frame's images (a stereo projector used as mono shows two)
+  double offset = 0.0;    // the centre of its window, frame periods from the display time
+  double duration = 0.0;  // frame periods
+
+  [[nodiscard]] double start() const { return offset - 0.5 * duration; }
+  [[nodiscard]] double end() const { return offset + 0.5 * duration; }
+  friend bool operator==(const ColorField&, const ColorField&) = default;
+};
+
+struct ColorFields {
+  std::vector<ColorField> fields;  // in the order given; empty: all colours at once
+  int images = 1;                  // images per frame: 1, or 2 for a stereo projector used as mono
+  FieldMethod method = FieldMethod::per_field;
+  double velocity_threshold = 0.0;  // screen pixels per frame period; 0: none
+
+  // Whether the projector draws its fields at their own times.
+  [[nodiscard]] bool sequential() const { return !fields.empty() && method != FieldMethod::off; }
+  friend bool operator==(const ColorFields&, const ColorFields&) = default;
+};
+
+// The presets' names, for messages and docs.
+[[nodiscard]] const std::vector<std::string>& color_field_presets();
+
+// Checks `fields` (a projector's `color_fields`, at `path` in the file) and types
+// it, the preset expanded. Every problem goes to `problems`, each with its own
+// message: an unknown preset or name, a preset and fields together, a channel
+// twice in one image or missing from it, a window outside the frame
+// [−½, ½], durations that add to more than a frame, fields that overlap.
+[[nodiscard]] ColorFields parse_color_fields(const schema::ColorFields& fields, const std::string& path,
+                                             std::vector<Problem>& problems);
+
+}  // namespace optique::config

@@ -1,0 +1,14 @@
+#pragma once
+// One thing wrong with a config, where it is: what the checks of config/ collect,
+// all of them at once, so a user can fix a file in one go.
+
+#include <string>
+
+namespace optique::config {
+
+struct Problem {
+  std::string path;     // e.g. "projectors[2].region.width"
+  std::string message;  // e.g. "must be > 0 (got -1)"
+};
+
+}  // namespace optique::config
