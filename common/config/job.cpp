@@ -30,4 +30,15 @@ ProjectorJob job_for(const Installation& installation, std::size_t projector) {
   return job;
 }
 
+ProjectorJob supersampled(ProjectorJob job, int factor) {
+  assert(factor >= 1);
+  Projector& p = job.installation.projectors[job.projector];
+  const double f = factor;
+  p.homography = glm::dmat3(f, 0.0, 0.0, 0.0, f, 0.0, 0.0, 0.0, 1.0) * p.homography;
+  p.width *= factor;
+  p.height *= factor;
+  p.region.reset();  // the homography says where it lands
+  return job;
+}
+
 }  // namespace optique::config

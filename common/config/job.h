@@ -22,4 +22,8 @@ struct ProjectorJob {
 
 [[nodiscard]] ProjectorJob job_for(const Installation& installation, std::size_t projector);
 
+// The same projector with factor² as many pixels over the same part of the
+// screen: references and measurements finer than a pixel.
+[[nodiscard]] ProjectorJob supersampled(ProjectorJob job, int factor);
+
 }  // namespace optique::config

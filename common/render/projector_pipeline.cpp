@@ -1,5 +1,6 @@
 #include "render/projector_pipeline.h"
 
+#include <cassert>
 #include <vector>
 
 #include "optics/blend.h"
@@ -31,12 +32,17 @@ ProjectorPipeline::ProjectorPipeline(ProjectorView view, std::unique_ptr<SceneRe
       eye_(job.self().eye),
       viewer_(job.installation.viewer),
       focus_role_(focus_role(job.self().content.role)),
-      depth_of_field_(job.installation.depth_of_field) {}
+      depth_of_field_(job.installation.depth_of_field),
+      color_fields_(job.self().color_fields) {}
 
 Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config::ProjectorJob& job,
                                                                    const scene::SceneDefinition& scene,
                                                                    const PipelineOptions& options) {
   const config::Projector& self = job.self();
+  if (self.color_fields.sequential() && self.color_fields.images > 1) {
+    return Error{"projector '" + self.id +
+                 "': colour fields in two images per frame (a stereo projector used as mono) are not drawn yet"};
+  }
   auto view = ProjectorView::make(job.screen(), self.geometry(), self.rendering, options.two_pass_pixels_per_metre);
   if (!view) return Error{"projector '" + self.id + "': " + view.error()};
   auto renderer =
@@ -73,13 +79,36 @@ glm::dvec3 ProjectorPipeline::eye(const glm::dvec3& centre) const {
 }
 
 Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double fraction) {
-  const glm::dvec3 at = eye(state.eye_now);
+  const glm::dvec3 at = eye(glm::mix(state.eye_now, state.eye_next, fraction));
   auto frustum = view_.frustum(at, viewer_.near, viewer_.far);
   if (!frustum) {
     renderer_->draw_black();
     return Error{frustum.error()};
   }
   renderer_->draw(state, fraction, at, frustum.value(), terms_);
+  return {};
+}
+
+Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state) {
+  if (!color_fields_.sequential()) return draw(state, 0.0);
+  std::vector<FieldPass> passes;
+  for (const config::ColorField& field : color_fields_.fields) {
+    assert(field.image == 0);  // make() refused more images
+    FieldPass pass;
+    pass.red = field.channel == config::Channel::red;
+    pass.green = field.channel == config::Channel::green;
+    pass.blue = field.channel == config::Channel::blue;
+    pass.fraction = field.offset;
+    pass.eye = eye(glm::mix(state.eye_now, state.eye_next, field.offset));
+    auto frustum = view_.frustum(pass.eye, viewer_.near, viewer_.far);
+    if (!frustum) {
+      renderer_->draw_black();
+      return Error{frustum.error()};
+    }
+    pass.frustum = frustum.value();
+    passes.push_back(pass);
+  }
+  renderer_->draw_fields(state, passes, terms_);
   return {};
 }
 

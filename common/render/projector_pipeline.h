@@ -47,11 +47,16 @@ class ProjectorPipeline {
 
   // Where this projector's eye is when the viewer's eyes are centred at `centre`.
   [[nodiscard]] glm::dvec3 eye(const glm::dvec3& centre) const;
-  // Draws the scene in `state` (objects `fraction` of the way to their next
-  // pose) from this projector's eye. When the eye is not in front of the screen,
-  // nothing of the scene can be seen through it: the projector shows black and
-  // the reason comes back.
+  // Draws the scene in `state` as it is `fraction` of a frame after the display
+  // time (objects and the viewer's eyes that far towards their next pose) from
+  // this projector's eye. When the eye is not in front of the screen, nothing of
+  // the scene can be seen through it: the projector shows black and the reason
+  // comes back.
   [[nodiscard]] Result<void> draw(const scene::SceneState& state, double fraction = 0.0);
+  // The frame as this projector shows it: with colour fields (a single-chip DLP
+  // projector), each field's channel drawn at the moment it is on screen; else
+  // the whole image at the display time.
+  [[nodiscard]] Result<void> draw_frame(const scene::SceneState& state);
   // One draw of an empty scene from a metre in front of the screen: drivers
   // compile shaders lazily, and the first frame should not pay for it.
   void warm_up();
@@ -72,6 +77,7 @@ class ProjectorPipeline {
   config::Viewer viewer_;
   FocusRole focus_role_;
   std::optional<config::DepthOfField> depth_of_field_;
+  config::ColorFields color_fields_;
   LightTerms terms_;
 };
 

@@ -315,6 +315,26 @@ void SceneRenderer::set_focus(const FocusFrame& frame) {
 
 void SceneRenderer::draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                          const geometry::Frustum& frustum, const LightTerms& terms) {
+  begin_linear();
+  draw_scene(state, fraction, eye, frustum, terms);
+  encode();
+}
+
+void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
+                                const LightTerms& terms) {
+  begin_linear();
+  for (const FieldPass& pass : passes) {
+    // Each pass sees the whole scene at its moment: depth starts over, the other
+    // passes' colours stay. Alpha keeps the clear's 1.
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glColorMask(pass.red, pass.green, pass.blue, GL_FALSE);
+    draw_scene(state, pass.fraction, pass.eye, pass.frustum, terms);
+  }
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  encode();
+}
+
+void SceneRenderer::begin_linear() {
   Gl& gl = *gl_;
   glBindFramebuffer(GL_FRAMEBUFFER, gl.linear_framebuffer.get());
   glViewport(0, 0, gl.width, gl.height);
@@ -324,7 +344,11 @@ void SceneRenderer::draw(const scene::SceneState& state, double fraction, const 
   glClearColor(gl.background.r, gl.background.g, gl.background.b, 1.0f);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+}
 
+void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                               const geometry::Frustum& frustum, const LightTerms& terms) {
+  Gl& gl = *gl_;
   upload_shining_lights(state.lights_off);
   glUseProgram(gl.scene_program.get());
   glBindVertexArray(gl.vertex_array.get());
@@ -362,8 +386,6 @@ void SceneRenderer::draw(const scene::SceneState& state, double fraction, const 
     glDrawElementsBaseVertex(GL_TRIANGLES, mesh.count, GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(mesh.first_index * sizeof(std::uint32_t)), mesh.base_vertex);
   }
-
-  encode();
 }
 
 void SceneRenderer::draw_black() {

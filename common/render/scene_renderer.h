@@ -51,6 +51,18 @@ struct FocusFrame {
   double inset_radius = 0.0;
 };
 
+// One colour field's pass (config/color_fields.h): the channels it writes, and
+// the moment it shows — objects `fraction` of the way to their next pose, seen
+// from `eye` through `frustum`.
+struct FieldPass {
+  bool red = false;
+  bool green = false;
+  bool blue = false;
+  double fraction = 0.0;
+  glm::dvec3 eye{0.0};
+  geometry::Frustum frustum;
+};
+
 // The depth buffer's format: 32-bit float by default; 24-bit fixed point to
 // measure what a common hardware default does to depth order.
 enum class DepthFormat { float32, fixed24 };
@@ -87,6 +99,12 @@ class SceneRenderer {
   void draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye, const geometry::Frustum& frustum,
             const LightTerms& terms = {});
 
+  // A single-chip DLP projector's frame: the scene drawn once per pass into one
+  // image, each pass writing only its channels, so each colour shows the scene at
+  // the moment its field is on screen; then the output stage, once. Returns when
+  // the GPU is done.
+  void draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes, const LightTerms& terms = {});
+
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);
 
@@ -115,6 +133,9 @@ class SceneRenderer {
  private:
   struct Gl;
   explicit SceneRenderer(std::unique_ptr<Gl> gl);
+  void begin_linear();  // binds and clears the linear image and depth
+  void draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                  const geometry::Frustum& frustum, const LightTerms& terms);
   void encode();
   void upload_shining_lights(const std::set<std::uint32_t>& off);
   std::unique_ptr<Gl> gl_;

@@ -80,7 +80,7 @@ void GlRenderer::render(const FrameInput& frame) {
   // frame shows nothing, so it is not lost.
   if (frame.lights != nullptr) pipeline_->set_share(*frame.lights);
   if (frame.focus) pipeline_->set_focus(*frame.focus);
-  if (auto drawn = pipeline_->draw(*frame.state); !drawn) {
+  if (auto drawn = pipeline_->draw_frame(*frame.state); !drawn) {
     // The eye left the space in front of this screen: the projector shows black
     // rather than a wrong picture.
     log_.debug("frame {}: {}", frame.frame_id, drawn.error());

@@ -131,13 +131,7 @@ int main(int argc, char** argv) {
       Method two_equal = make_method(job, definition, render::RenderMethod::two_pass, equal_density);
       const std::vector<bool> inside = usable_pixels(geometry, job.screen().area());
       // The reference: the same projector with kSupersample² as many pixels.
-      config::ProjectorJob fine = job;
-      config::Projector& fine_projector = fine.installation.projectors[fine.projector];
-      const glm::dmat3 scale(kSupersample, 0.0, 0.0, 0.0, kSupersample, 0.0, 0.0, 0.0, 1.0);
-      fine_projector.homography = scale * fine_projector.homography;
-      fine_projector.width *= kSupersample;
-      fine_projector.height *= kSupersample;
-      fine_projector.region.reset();
+      const config::ProjectorJob fine = config::supersampled(job, kSupersample);
       Method reference = make_method(fine, definition, render::RenderMethod::single_pass);
 
       std::vector<double> single_medians, two_medians, equal_medians, ratios, equal_ratios, single_psnrs, two_psnrs,

@@ -11,12 +11,10 @@
 
 #include "config/job.h"
 #include "config/load.h"
-#include "image/texture_decode.h"
+#include "gl_installation.h"
 #include "master/stacked_groups.h"
 #include "optics/projector_model.h"
-#include "render/gl_context.h"
 #include "render/projector_pipeline.h"
-#include "scene/load_scene.h"
 
 namespace optique {
 namespace {
@@ -31,16 +29,9 @@ struct Drawn {
 class StackedLighting : public ::testing::Test {
  protected:
   void SetUp() override {
-    auto context = render::make_headless_context();
-    ASSERT_TRUE(context) << context.error();
-    context_ = std::move(context).value();
-    auto loaded = config::load_installation(kConfig);
-    ASSERT_TRUE(loaded) << loaded.error();
-    config_ = std::move(loaded).value();
-    auto scene =
-        scene::load_scene(config_.installation.scene.builtin, config_.installation.scene.gltf, image::decode_texture);
-    ASSERT_TRUE(scene) << scene.error();
-    scene_ = std::move(scene).value().definition;
+    auto opened = testing::open_gl_installation(kConfig);
+    ASSERT_TRUE(opened) << opened.error();
+    gl_ = std::move(opened).value();
     for (const auto& object : scene_.objects) {
       state_.objects[object.id] = {object.pose_at(1.0), object.pose_at(1.0)};
     }
@@ -62,9 +53,9 @@ class StackedLighting : public ::testing::Test {
     return {pipeline.value()->renderer().read_rendered(), pipeline.value()->renderer().read_linear()};
   }
 
-  std::unique_ptr<render::GlContext> context_;
-  config::LoadedConfig config_;
-  scene::SceneDefinition scene_;
+  testing::GlInstallation gl_;
+  const config::LoadedConfig& config_ = gl_.config;
+  scene::SceneDefinition& scene_ = gl_.scene;
   scene::SceneState state_;
 };
 

@@ -1,0 +1,23 @@
+#include "gl_installation.h"
+
+#include "image/texture_decode.h"
+#include "scene/load_scene.h"
+
+namespace optique::testing {
+
+Result<GlInstallation> open_gl_installation(const std::string& config_path) {
+  GlInstallation out;
+  auto context = render::make_headless_context();
+  if (!context) return Error{context.error()};
+  out.context = std::move(context).value();
+  auto loaded = config::load_installation(config_path);
+  if (!loaded) return Error{loaded.error()};
+  out.config = std::move(loaded).value();
+  const config::SceneSource& source = out.config.installation.scene;
+  auto scene = scene::load_scene(source.builtin, source.gltf, image::decode_texture);
+  if (!scene) return Error{scene.error()};
+  out.scene = std::move(scene).value().definition;
+  return out;
+}
+
+}  // namespace optique::testing
