@@ -16,7 +16,7 @@ struct Comparison {
   double psnr_g = 0.0;
   double psnr_b = 0.0;
   double psnr_luma = 0.0;        // of Rec. 601 luma, 0.299 R + 0.587 G + 0.114 B
-  double psnr_y_weighted = 0.0;  // the seed's weighted sum of channel PSNRs
+  double psnr_y_weighted = 0.0;  // 0.299·PSNR_R + 0.587·PSNR_G + 0.114·PSNR_B, the up-conversion paper's PSNR_Y
   double max_abs_error = 0.0;
 };
 
