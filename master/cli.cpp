@@ -31,6 +31,7 @@ constexpr Tool kTools[] = {
     {"check-config", "validate installation files and print a summary of each"},
     {"render-reference", "draw what a viewer should see on each screen at one frame"},
     {"compose", "what each screen receives at one frame, from the nodes' captures"},
+    {"perceive", "what an eye that follows motion sees on each screen around one frame, colour fields and all"},
     {"calibrate", "fit a projector's homography (screen → pixels) from measured points"},
 };
 

@@ -14,6 +14,7 @@
 #include "tools/calibrate.h"
 #include "tools/check_config.h"
 #include "tools/compose.h"
+#include "tools/perceive.h"
 #include "tools/render_reference.h"
 
 namespace optique::tools {
@@ -106,6 +107,22 @@ int run_cli(int argc, char** argv) {
   compose->add_option("--captures", compose_captures,
                       "folder with <projector-id>/frame-NNNNNN.png (default: OUT/nodes, where --local runs put them)");
 
+  std::string perceive_config;
+  std::string perceive_out;
+  std::string perceive_track;
+  PerceiveOptions perceive_options;
+  auto* perceive_command = app.add_subcommand(
+      "perceive", "what an eye that follows motion sees on each screen around one frame, colour fields and all");
+  perceive_command->add_option("--config", perceive_config, "installation file")->required();
+  perceive_command->add_option("--frame", perceive_options.frame,
+                               "the exposure is centred on this frame's display time");
+  perceive_command
+      ->add_option("--track", perceive_track,
+                   "what the eye follows: a scene object's name, or vx,vy in screen pixels per frame (y down)")
+      ->required();
+  perceive_command->add_option("--exposure", perceive_options.exposure, "seconds; default one 60 Hz frame");
+  perceive_command->add_option("--out", perceive_out, "writes OUT/perceived/<screen>/ and <screen>.ideal/")->required();
+
   CalibrateOptions calibrate_options;
   auto* calibrate_command =
       app.add_subcommand("calibrate", "fit a projector's homography (screen → pixels) from measured points");
@@ -126,6 +143,24 @@ int run_cli(int argc, char** argv) {
   }
 
   if (check->parsed()) return check_config(check_files);
+  if (perceive_command->parsed()) {
+    if (auto track = parse_track(perceive_track, perceive_options); !track) {
+      std::cerr << track.error() << "\n";
+      return kExitUsage;
+    }
+    auto loaded = load_with_images(perceive_config);
+    if (!loaded) {
+      std::cerr << loaded.error() << "\n";
+      return kExitUsage;
+    }
+    auto logger = log::make_logger("perceive", log_level, log_file, log::FileMode::append);
+    auto seen = perceive(loaded.value().config, loaded.value().scene, perceive_options, perceive_out, *logger);
+    if (!seen) {
+      logger->error("{}", seen.error());
+      return kExitUsage;
+    }
+    return kExitOk;
+  }
   if (calibrate_command->parsed()) return calibrate(calibrate_options, std::cout, std::cerr);
   if (compose->parsed()) {
     auto loaded = config::load_installation(compose_config);

@@ -10,6 +10,7 @@
 #include "optics/compose.h"
 #include "render/gl_context.h"
 #include "render/scene_renderer.h"
+#include "tools/reference_view.h"
 #include "tools/screen_images.h"
 
 namespace optique::tools {
@@ -27,32 +28,20 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
 
   auto context = render::make_headless_context();
   if (!context) return Error{"cannot render: " + context.error()};
-  const config::Viewer& viewer = installation.viewer;
   // One reference per screen image, as compose writes one composite: a stereo
   // screen gets one for each eye, seen from that eye.
   for (const ScreenImage& image : screen_images(installation)) {
-    const config::Screen& screen = *image.screen;
-    const std::string name = screen_image_folder(screen.id, image.eye);
-    // The composite's raster, so the two compare pixel for pixel.
-    const int width = optics::screen_pixels(screen.width, screen.pixels_per_metre);
-    const int height = optics::screen_pixels(screen.height, screen.pixels_per_metre);
-    auto renderer = render::SceneRenderer::create(scene.definition, width * s, height * s);
-    if (!renderer) return Error{"screen '" + name + "': " + renderer.error()};
-    const glm::dvec3 eye = geometry::eye_position(state.eye_now, viewer.head_right, viewer.eye_separation, image.eye);
-    auto frustum = geometry::off_axis_frustum(screen.world(), eye, viewer.near, viewer.far);
-    if (!frustum) return Error{"screen '" + name + "' at frame " + std::to_string(frame) + ": " + frustum.error()};
-    renderer.value()->draw(state, 0.0, eye, frustum.value());
+    const std::string name = screen_image_folder(image.screen->id, image.eye);
+    auto view = ReferenceView::make(installation, scene.definition, image, s);
+    if (!view) return Error{"screen '" + name + "': " + view.error()};
+    auto linear = view.value().draw(state, 0.0);
+    if (!linear) return Error{"screen '" + name + "' at frame " + std::to_string(frame) + ": " + linear.error()};
     const std::string folder = (std::filesystem::path(out_dir) / "reference" / name).string();
-    Result<void> written;
-    if (s == 1) {
-      written = image::write_frame(folder, frame, renderer.value()->read_rendered(), renderer.value()->read_encoded());
-    } else {
-      const image::FloatImage linear = image::box_downsample(renderer.value()->read_rendered(), s);
-      written = image::write_frame(folder, frame, linear, image::encode_srgb(linear));
-    }
-    if (!written) return written;
-    log.info("screen '{}': {}×{} px ({}×{} samples per pixel) → {}", name, width, height, s, s,
-             image::frame_path(folder, frame, "png"));
+    // One sample per pixel: the renderer's own encoding; else the averaged light's.
+    const image::ByteImage png = s == 1 ? view.value().encoded() : image::encode_srgb(linear.value());
+    if (auto written = image::write_frame(folder, frame, linear.value(), png); !written) return written;
+    log.info("screen '{}': {}×{} px ({}×{} samples per pixel) → {}", name, view.value().width(), view.value().height(),
+             s, s, image::frame_path(folder, frame, "png"));
   }
   return {};
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <vector>
 
 #include <glm/geometric.hpp>
 
@@ -67,34 +68,48 @@ image::FloatImage perceive(std::span<const Emission> emissions, int width, int h
   return out;
 }
 
-double fringe_width(const image::FloatImage& image, int x0, int y0, int x1, int y1, double threshold) {
+double fringe_width(const image::FloatImage& image, int x0, int y0, int x1, int y1, bool along_x) {
   x0 = std::clamp(x0, 0, image.width);
   x1 = std::clamp(x1, 0, image.width);
   y0 = std::clamp(y0, 0, image.height);
   y1 = std::clamp(y1, 0, image.height);
-  float peak = 0.0f;
+  // Each channel's edges cross half of that channel's brightest value in the box.
+  float peak[3] = {0.0f, 0.0f, 0.0f};
   for (int y = y0; y < y1; ++y) {
     for (int x = x0; x < x1; ++x) {
-      for (int c = 0; c < 3; ++c) peak = std::max(peak, image.at(x, y, c));
+      for (int c = 0; c < 3; ++c) peak[c] = std::max(peak[c], image.at(x, y, c));
     }
   }
-  if (peak <= 0.0f) return 0.0;
-  const auto limit = static_cast<float>(threshold) * peak;
-  long fringed = 0;
-  long runs = 0;
-  for (int y = y0; y < y1; ++y) {
-    bool inside = false;
-    for (int x = x0; x < x1; ++x) {
-      const float r = image.at(x, y, 0);
-      const float g = image.at(x, y, 1);
-      const float b = image.at(x, y, 2);
-      const bool apart = std::max({r, g, b}) - std::min({r, g, b}) > limit;
-      fringed += apart ? 1 : 0;
-      runs += apart && !inside ? 1 : 0;
-      inside = apart;
+  if (std::min({peak[0], peak[1], peak[2]}) <= 0.0f) return 0.0;
+  const int lines_from = along_x ? y0 : x0;
+  const int lines_to = along_x ? y1 : x1;
+  const int steps_from = along_x ? x0 : y0;
+  const int steps_to = along_x ? x1 : y1;
+  double spread = 0.0;
+  long edges = 0;
+  std::vector<double> crossings[3];
+  for (int line = lines_from; line < lines_to; ++line) {
+    for (int c = 0; c < 3; ++c) {
+      crossings[c].clear();
+      const float half = 0.5f * peak[c];
+      for (int k = steps_from; k + 1 < steps_to; ++k) {
+        const float a = along_x ? image.at(k, line, c) : image.at(line, k, c);
+        const float b = along_x ? image.at(k + 1, line, c) : image.at(line, k + 1, c);
+        if ((a < half) == (b < half)) continue;
+        // Between the two pixel centres, where the line through them meets half.
+        crossings[c].push_back(k + 0.5 + (half - a) / (b - a));
+      }
+    }
+    // Edges every channel has: the i-th crossing of each is the same edge.
+    if (crossings[0].size() != crossings[1].size() || crossings[0].size() != crossings[2].size()) continue;
+    for (std::size_t i = 0; i < crossings[0].size(); ++i) {
+      const double lo = std::min({crossings[0][i], crossings[1][i], crossings[2][i]});
+      const double hi = std::max({crossings[0][i], crossings[1][i], crossings[2][i]});
+      spread += hi - lo;
+      ++edges;
     }
   }
-  return runs == 0 ? 0.0 : static_cast<double>(fringed) / static_cast<double>(runs);
+  return edges == 0 ? 0.0 : spread / static_cast<double>(edges);
 }
 
 }  // namespace optique::optics

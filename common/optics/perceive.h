@@ -47,11 +47,11 @@ struct Exposure {
 [[nodiscard]] image::FloatImage perceive(std::span<const Emission> emissions, int width, int height,
                                          const Exposure& exposure);
 
-// How wide the colour fringes in `image` are within the box [x0, x1) × [y0, y1):
-// the pixels where the channels disagree by more than `threshold` of the box's
-// brightest channel value, per run of such pixels along a row (one run per
-// fringed edge), in pixels; 0 without fringes.
-[[nodiscard]] double fringe_width(const image::FloatImage& image, int x0, int y0, int x1, int y1,
-                                  double threshold = 0.1);
+// How far apart the channels' edges are in `image` within the box [x0, x1) ×
+// [y0, y1), in pixels: along each row (`along_x`; else each column), every edge
+// that all three channels have, where each crosses half its brightest value in
+// the box (sub-pixel, between pixel centres); the mean over those edges of the
+// largest distance between the channels' crossings. 0 without fringes.
+[[nodiscard]] double fringe_width(const image::FloatImage& image, int x0, int y0, int x1, int y1, bool along_x = true);
 
 }  // namespace optique::optics

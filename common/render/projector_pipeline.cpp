@@ -45,8 +45,9 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
   }
   auto view = ProjectorView::make(job.screen(), self.geometry(), self.rendering, options.two_pass_pixels_per_metre);
   if (!view) return Error{"projector '" + self.id + "': " + view.error()};
+  const int samples = options.samples > 0 ? options.samples : self.color_fields.sequential() ? kFieldSamples : 1;
   auto renderer =
-      SceneRenderer::create(scene, view.value().render_width(), view.value().render_height(), options.depth);
+      SceneRenderer::create(scene, view.value().render_width(), view.value().render_height(), options.depth, samples);
   if (!renderer) return Error{renderer.error()};
   const FocusRole role = focus_role(self.content.role);
   OutputStage stage = view.value().output_stage(options.blend ? blend_weights(job) : image::FloatImage{}, role);

@@ -29,7 +29,15 @@ struct PipelineOptions {
   // No blend weights (1 everywhere inside the screen's area): for experiments
   // that look at one projector alone.
   bool blend = true;
+  // Samples per pixel (multisampling); 0: the projector's own, which is
+  // kFieldSamples with colour fields and 1 without.
+  int samples = 0;
 };
+
+// A field's edge must land within a fraction of a pixel of where its moment puts
+// it, and the other fields' edges are drawn at other moments: one sample per
+// pixel would put each channel's edge on a different pixel boundary.
+inline constexpr int kFieldSamples = 4;
 
 class ProjectorPipeline {
  public:

@@ -44,6 +44,11 @@ struct SceneRenderer::Gl {
   glo::Framebuffer linear_framebuffer;
   glo::Texture linear_colour;
   glo::Texture depth;
+  // With multisampling, the scene is drawn here and resolved into the above.
+  int samples = 1;
+  glo::Framebuffer multisample_framebuffer;
+  glo::Texture multisample_colour;
+  glo::Texture multisample_depth;
   glo::Framebuffer encoded_framebuffer;  // the signal: drawn by the output pass, blitted to a window
   glo::Texture encoded_colour;
   glo::Texture weights;
@@ -74,8 +79,9 @@ SceneRenderer::SceneRenderer(std::unique_ptr<Gl> gl) : gl_(std::move(gl)) {}
 SceneRenderer::~SceneRenderer() = default;
 
 Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneDefinition& scene, int width, int height,
-                                                             DepthFormat depth) {
+                                                             DepthFormat depth, int samples) {
   if (width <= 0 || height <= 0) return Error{"the image size must be positive"};
+  if (samples < 1) return Error{"the samples per pixel must be at least 1, not " + std::to_string(samples)};
   auto gl = std::make_unique<Gl>();
   gl->width = width;
   gl->height = height;
@@ -184,6 +190,26 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   gl->linear_framebuffer = glo::make_framebuffer();
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl->linear_colour.get(), 0);
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl->depth.get(), 0);
+  if (samples > 1) {
+    GLint most = 1;
+    glGetIntegerv(GL_MAX_SAMPLES, &most);
+    if (samples > most) {
+      return Error{std::to_string(samples) + " samples per pixel asked for; this GL driver draws at most " +
+                   std::to_string(most)};
+    }
+    gl->samples = samples;
+    const GLenum depth_format = depth == DepthFormat::fixed24 ? GL_DEPTH_COMPONENT24 : GL_DEPTH_COMPONENT32F;
+    gl->multisample_colour = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
+    glTextureStorage2DMultisample(gl->multisample_colour.get(), samples, GL_RGBA32F, width, height, GL_TRUE);
+    gl->multisample_depth = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
+    glTextureStorage2DMultisample(gl->multisample_depth.get(), samples, depth_format, width, height, GL_TRUE);
+    gl->multisample_framebuffer = glo::make_framebuffer();
+    glNamedFramebufferTexture(gl->multisample_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl->multisample_colour.get(), 0);
+    glNamedFramebufferTexture(gl->multisample_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl->multisample_depth.get(), 0);
+    if (glCheckNamedFramebufferStatus(gl->multisample_framebuffer.get(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      return Error{"this GL driver cannot draw " + std::to_string(samples) + " samples per pixel into RGBA32F"};
+    }
+  }
   auto renderer = std::unique_ptr<SceneRenderer>(new SceneRenderer(std::move(gl)));
   renderer->set_all_lights();
   if (auto output = renderer->set_output({}); !output) return Error{output.error()};
@@ -317,6 +343,7 @@ void SceneRenderer::draw(const scene::SceneState& state, double fraction, const 
                          const geometry::Frustum& frustum, const LightTerms& terms) {
   begin_linear();
   draw_scene(state, fraction, eye, frustum, terms);
+  resolve();
   encode();
 }
 
@@ -331,12 +358,24 @@ void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const 
     draw_scene(state, pass.fraction, pass.eye, pass.frustum, terms);
   }
   glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  resolve();
   encode();
+}
+
+void SceneRenderer::resolve() {
+  const Gl& gl = *gl_;
+  if (gl.samples == 1) return;
+  // Each pixel's samples averaged (linear light); depth from one sample, for the
+  // passes that read it.
+  glBlitNamedFramebuffer(gl.multisample_framebuffer.get(), gl.linear_framebuffer.get(), 0, 0, gl.width, gl.height, 0, 0,
+                         gl.width, gl.height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitNamedFramebuffer(gl.multisample_framebuffer.get(), gl.linear_framebuffer.get(), 0, 0, gl.width, gl.height, 0, 0,
+                         gl.width, gl.height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
 }
 
 void SceneRenderer::begin_linear() {
   Gl& gl = *gl_;
-  glBindFramebuffer(GL_FRAMEBUFFER, gl.linear_framebuffer.get());
+  glBindFramebuffer(GL_FRAMEBUFFER, gl.samples > 1 ? gl.multisample_framebuffer.get() : gl.linear_framebuffer.get());
   glViewport(0, 0, gl.width, gl.height);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);

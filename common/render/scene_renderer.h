@@ -84,12 +84,14 @@ struct OutputStage {
 
 class SceneRenderer {
  public:
-  // Uploads the scene's static content; draws `width` × `height` pixels. Fails
-  // with the GL driver's message when a shader does not build or a framebuffer is
-  // incomplete.
+  // Uploads the scene's static content; draws `width` × `height` pixels, each
+  // the average of `samples` (multisampling; 1: one at the pixel's centre).
+  // Fails with the GL driver's message when a shader does not build or a
+  // framebuffer is incomplete, or when the driver cannot draw that many samples.
   [[nodiscard]] static Result<std::unique_ptr<SceneRenderer>> create(const scene::SceneDefinition& scene, int width,
                                                                      int height,
-                                                                     DepthFormat depth = DepthFormat::float32);
+                                                                     DepthFormat depth = DepthFormat::float32,
+                                                                     int samples = 1);
   ~SceneRenderer();
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;
@@ -133,7 +135,8 @@ class SceneRenderer {
  private:
   struct Gl;
   explicit SceneRenderer(std::unique_ptr<Gl> gl);
-  void begin_linear();  // binds and clears the linear image and depth
+  void begin_linear();  // binds and clears the image and depth the scene is drawn into
+  void resolve();       // multisampled: averages the samples into the linear image
   void draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                   const geometry::Frustum& frustum, const LightTerms& terms);
   void encode();

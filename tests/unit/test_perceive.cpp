@@ -99,13 +99,12 @@ TEST(Perceive, ATrackedBarShowsFringesOfSpeedTimesFieldSpacing) {
   // frame apart, 2 px at 6 px per frame, the other way than the bar moves.
   EXPECT_NEAR(centre_of(conventional, 0) - centre_of(conventional, 1), 2.0, 1e-3);
   EXPECT_NEAR(centre_of(conventional, 2) - centre_of(conventional, 1), -2.0, 1e-3);
-  // A fringe at each edge: R and B 4 px apart (⅔ of a frame), each smeared over
-  // the 2 px the eye moves while its field shows: 6 px.
-  EXPECT_NEAR(fringe_width(conventional, 0, 0, kWidth, kHeight), 6.0, 0.5);
+  // At each edge, R's and B's halfway points 4 px apart (⅔ of a frame).
+  EXPECT_NEAR(fringe_width(conventional, 0, 0, kWidth, kHeight), 4.0, 1e-3);
 
   const image::FloatImage fields = tracked(speed, true);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre_of(fields, c), centre_of(fields, 1), 1e-3) << c;
-  EXPECT_EQ(fringe_width(fields, 0, 0, kWidth, kHeight), 0.0);
+  EXPECT_LT(fringe_width(fields, 0, 0, kWidth, kHeight), 1e-3);
   // Drawn per field and tracked, the bar is sharp: its edge within a pixel.
   EXPECT_GT(fields.at(100, kHeight / 2, 0), 0.99f);
   EXPECT_LT(fields.at(88, kHeight / 2, 0), 0.01f);

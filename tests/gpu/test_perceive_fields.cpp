@@ -1,0 +1,101 @@
+// What an eye that follows the square of configs/dlp-120hz.json sees
+// (tools/perceive.h: the projector's frames drawn as its node draws them, put on
+// the screen, integrated field by field on a moving retina), at 6 px per frame:
+// drawn per field against every colour drawn at the display time.
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <regex>
+#include <sstream>
+
+#include <spdlog/sinks/null_sink.h>
+
+#include "image/texture_decode.h"
+#include "master/run_config.h"
+#include "process.h"
+#include "tools/perceive.h"
+
+namespace optique {
+namespace {
+
+namespace fs = std::filesystem;
+
+// configs/dlp-120hz.json with its projector and screen raster 1.65× as fine (the
+// square then crosses 6 px per frame) and its fields drawn by `method`.
+std::string config_with(const std::string& dir, const std::string& method) {
+  std::ifstream in(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-120hz.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string json = text.str();
+  json = std::regex_replace(json, std::regex(R"("width": 640, "height": 360)"), R"("width": 1056, "height": 594)");
+  json = std::regex_replace(json, std::regex(R"("pixels_per_metre": 160)"), R"("pixels_per_metre": 264)");
+  json = std::regex_replace(json, std::regex(R"(\{"preset": "dlp-brg-120hz"\})"),
+                            R"({"preset": "dlp-brg-120hz", "method": ")" + method + R"("})");
+  const std::string path = dir + "/dlp-" + method + ".json";
+  std::ofstream(path) << json;
+  return path;
+}
+
+struct Seen {
+  tools::PerceivedScreen screen;
+  std::string out;
+};
+
+Seen perceive(const std::string& config, const std::string& track, const std::string& out) {
+  auto loaded = master::load_run_config(config, image::decode_texture);
+  EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
+  if (!loaded) return {};
+  tools::PerceiveOptions options;
+  options.frame = 60;
+  EXPECT_TRUE(tools::parse_track(track, options));
+  auto logger = std::make_shared<spdlog::logger>("perceive", std::make_shared<spdlog::sinks::null_sink_mt>());
+  auto seen = tools::perceive(loaded.value().config, loaded.value().scene, options, out, *logger);
+  EXPECT_TRUE(seen) << (seen ? "" : seen.error());
+  if (!seen || seen.value().size() != 1) return {};
+  return {seen.value().front(), out};
+}
+
+TEST(PerceiveFields, PerFieldRemovesTheFringesThatOneMomentPerFrameShows) {
+  const std::string dir = testing::make_temp_dir("optique-perceive");
+  const Seen fields = perceive(config_with(dir, "per-field"), "square", dir + "/per-field");
+  const Seen one_moment = perceive(config_with(dir, "off"), "square", dir + "/off");
+  const double speed = fields.screen.velocity.x / 120.0;
+  std::cout << "eye at " << speed << " px/frame; per-field: fringe " << fields.screen.fringe_px << " px, PSNR_Y "
+            << fields.screen.psnr_y_db << " dB; all colours at the display time: fringe " << one_moment.screen.fringe_px
+            << " px, PSNR_Y " << one_moment.screen.psnr_y_db << " dB\n";
+  EXPECT_NEAR(speed, 6.0, 0.05);
+  // One moment per frame: the channels land where the eye was when each field
+  // showed, B −0.2 and G +0.32 of a frame: about speed × 0.52 apart.
+  EXPECT_NEAR(one_moment.screen.fringe_px, speed * 0.52, 0.25 * speed * 0.52);
+  EXPECT_LE(fields.screen.fringe_px, 0.5);
+  EXPECT_EQ(fields.screen.ideal_fringe_px, 0.0);
+  EXPECT_GE(fields.screen.psnr_y_db - one_moment.screen.psnr_y_db, 10.0);
+  // What it wrote: the perceived image, the ideal beside it, and the measures.
+  for (const std::string file : {"/perceived/front/frame-000060.png", "/perceived/front/frame-000060.exr",
+                                 "/perceived/front.ideal/frame-000060.png", "/perceived/frame-000060.json"}) {
+    EXPECT_TRUE(fs::exists(fields.out + file)) << file;
+  }
+  fs::remove_all(dir);
+}
+
+TEST(PerceiveFields, AnUnknownObjectIsNamedWithTheOnesThereAre) {
+  auto loaded =
+      master::load_run_config(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-120hz.json", image::decode_texture);
+  ASSERT_TRUE(loaded) << loaded.error();
+  tools::PerceiveOptions options;
+  ASSERT_TRUE(tools::parse_track("ball", options));
+  auto logger = std::make_shared<spdlog::logger>("perceive", std::make_shared<spdlog::sinks::null_sink_mt>());
+  const auto seen = tools::perceive(loaded.value().config, loaded.value().scene, options, "/nonexistent", *logger);
+  ASSERT_FALSE(seen);
+  EXPECT_NE(seen.error().find("no object 'ball' (its moving objects: square)"), std::string::npos) << seen.error();
+  EXPECT_FALSE(tools::parse_track("3,x", options));
+  EXPECT_TRUE(tools::parse_track("-2.5,1", options));
+  ASSERT_TRUE(options.velocity);
+  EXPECT_EQ(*options.velocity, glm::dvec2(-2.5, 1.0));
+}
+
+}  // namespace
+}  // namespace optique
