@@ -40,7 +40,10 @@ std::string color_fields_summary(const config::ColorFields& c, const config::Mas
     text << " " << fields[i].offset * period_ms << " ms (" << fields[i].duration * period_ms << " ms long)";
   }
   text << " from the display time";
-  if (c.velocity_threshold > 0.0) text << "; not offset above " << c.velocity_threshold << " px per frame";
+  if (c.velocity_threshold > 0.0) {
+    text << "; velocity_threshold " << c.velocity_threshold
+         << " px per frame is read but not applied yet: every moving object gets its field offsets";
+  }
   return text.str();
 }
 
