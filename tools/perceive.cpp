@@ -244,7 +244,9 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
          {"fringe_px", result.fringe_px},
          {"ideal_fringe_px", result.ideal_fringe_px},
          {"psnr_y_db", finite ? nlohmann::json(result.psnr_y_db) : nlohmann::json("inf")}});
-    results.push_back(result);
+    result.seen = seen;
+    result.ideal = ideal;
+    results.push_back(std::move(result));
   }
   if (!options.object.empty()) report["tracked_object"] = options.object;
   const std::string json =

@@ -19,6 +19,7 @@
 #include <glm/vec2.hpp>
 
 #include "config/load.h"
+#include "image/image.h"
 #include "scene/load_scene.h"
 #include "util/result.h"
 
@@ -43,6 +44,8 @@ struct PerceivedScreen {
   double fringe_px = 0.0;     // optics::fringe_width of what the eye sees, across the motion
   double ideal_fringe_px = 0.0;
   double psnr_y_db = 0.0;  // PSNR_Y against the ideal
+  image::FloatImage seen;  // what the eye sees, linear RGBA, the screen's raster
+  image::FloatImage ideal;
 };
 
 // Fails, naming it, on an object the scene does not have, a non-positive

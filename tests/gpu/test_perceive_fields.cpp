@@ -13,6 +13,7 @@
 
 #include <spdlog/sinks/null_sink.h>
 
+#include "image/compare.h"
 #include "image/texture_decode.h"
 #include "master/run_config.h"
 #include "process.h"
@@ -78,6 +79,38 @@ TEST(PerceiveFields, PerFieldRemovesTheFringesThatOneMomentPerFrameShows) {
                                  "/perceived/front.ideal/frame-000060.png", "/perceived/frame-000060.json"}) {
     EXPECT_TRUE(fs::exists(fields.out + file)) << file;
   }
+  fs::remove_all(dir);
+}
+
+// Two DLP projectors side by side (configs/dlp-wall-2.json), the square crossing
+// their seam at frame 60: each draws its half of every field at the same moments,
+// so the eye sees what one projector of the whole wall would show it.
+TEST(PerceiveFields, TheSquareCrossesTheSeamOfTwoDlpTilesWithoutABreak) {
+  const std::string dir = testing::make_temp_dir("optique-perceive");
+  const std::string configs = std::string(OPTIQUE_SOURCE_DIR) + "/configs/";
+  const Seen tiles = perceive(configs + "dlp-wall-2.json", "square", dir + "/tiles");
+  const Seen single = perceive(configs + "dlp-120hz.json", "square", dir + "/single");
+  ASSERT_FALSE(tiles.screen.seen.empty());
+  ASSERT_EQ(tiles.screen.seen.width, single.screen.seen.width);
+  const int* box = single.screen.box;
+  ASSERT_LT(box[0], 320);  // the seam is at x = 320 of the 640 px raster: inside the neighbourhood
+  ASSERT_GT(box[2], 320);
+  image::FloatImage a(box[2] - box[0], box[3] - box[1], 4);
+  image::FloatImage b = a;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      for (int c = 0; c < 4; ++c) {
+        a.at(x, y, c) = tiles.screen.seen.at(box[0] + x, box[1] + y, c);
+        b.at(x, y, c) = single.screen.seen.at(box[0] + x, box[1] + y, c);
+      }
+    }
+  }
+  const auto compared = image::compare(a, b);
+  ASSERT_TRUE(compared) << compared.error();
+  std::cout << "two tiles against one projector, around the square on the seam: PSNR_Y "
+            << compared.value().psnr_y_weighted << " dB; fringe " << tiles.screen.fringe_px << " px\n";
+  EXPECT_GE(compared.value().psnr_y_weighted, 35.0);
+  EXPECT_LE(tiles.screen.fringe_px, 0.5);
   fs::remove_all(dir);
 }
 
