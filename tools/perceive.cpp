@@ -154,7 +154,9 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
     for (const config::Projector* projector : screen_image.projectors) {
       const std::size_t index = static_cast<std::size_t>(projector - installation.projectors.data());
       const config::ProjectorJob job = config::job_for(installation, index);
-      auto pipeline = render::ProjectorPipeline::make(job, scene);
+      render::PipelineOptions pipeline_options;
+      pipeline_options.samples = options.samples;
+      auto pipeline = render::ProjectorPipeline::make(job, scene, pipeline_options);
       if (!pipeline) return Error{pipeline.error()};
       const geometry::ProjectorGeometry geometry = projector->geometry();
       optics::ComposeOptions compose;

@@ -33,6 +33,7 @@ struct PerceiveOptions {
   std::optional<glm::dvec2> velocity;
   double exposure = 1.0 / 60.0;  // seconds
   int ideal_moments = 32;
+  int samples = 0;  // per projector pixel; 0: each projector's own (render::PipelineOptions)
 };
 
 struct PerceivedScreen {

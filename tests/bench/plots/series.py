@@ -4,8 +4,8 @@ plot draws: the medians its tables quote, with the min and max over runs as the
 error. Writes gnuplot data: one block per series group, blocks apart by two blank
 lines (gnuplot's `index`), one number per column, NaN where there is none.
 
-usage: series.py NAME CSV OUT.dat   (NAME: barrier, calibration, dof, lighting,
-                                     oblique, oblique-depth)
+usage: series.py NAME CSV OUT.dat   (NAME: barrier, calibration, dof, fields,
+                                     lighting, oblique, oblique-depth)
 
 The drawing is tests/bench/plots/NAME.gp; scripts/plot-bench.sh runs both."""
 
@@ -206,8 +206,32 @@ def oblique_depth(rows):
     return blocks
 
 
-SERIES = {"barrier": barrier, "calibration": calibration, "dof": dof, "lighting": lighting, "oblique": oblique,
-          "oblique-depth": oblique_depth}
+def fields(rows):
+    """One block per wall, one line per method in the order run: method index,
+    draw ms and ratio to one moment per frame (median, min, max over runs), the
+    fringe width and PSNR_Y (one perceive each)."""
+    walls, methods = [], []
+    for r in rows:
+        if r["wall"] not in walls:
+            walls.append(r["wall"])
+        if r["method"] not in methods:
+            methods.append(r["method"])
+    blocks = []
+    for wall in walls:
+        block = []
+        for i, method in enumerate(methods):
+            mine = [r for r in rows if r["wall"] == wall and r["method"] == method]
+            if not mine:
+                fail(f"fields: no rows for {wall} / {method}")
+            block.append([i, *spread([float(r["draw_ms_median"]) for r in mine]),
+                          *spread([float(r["ratio_to_one_moment"]) for r in mine]),
+                          float(mine[0]["fringe_px"]), float(mine[0]["psnr_y_db"])])
+        blocks.append(block)
+    return blocks
+
+
+SERIES = {"barrier": barrier, "calibration": calibration, "dof": dof, "fields": fields, "lighting": lighting,
+          "oblique": oblique, "oblique-depth": oblique_depth}
 
 
 def main():
