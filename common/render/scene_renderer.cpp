@@ -49,6 +49,11 @@ struct SceneRenderer::Gl {
   glo::Framebuffer multisample_framebuffer;
   glo::Texture multisample_colour;
   glo::Texture multisample_depth;
+  GLenum depth_format = GL_DEPTH_COMPONENT32F;
+  // Colour fields seen from one eye: the still objects' depth, drawn once and
+  // brought back before each field's moving objects (made when first needed).
+  glo::Framebuffer still_depth_framebuffer;
+  glo::Texture still_depth;
   glo::Framebuffer encoded_framebuffer;  // the signal: drawn by the output pass, blitted to a window
   glo::Texture encoded_colour;
   glo::Texture weights;
@@ -187,6 +192,7 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   gl->depth = glo::make_texture();
   glTextureStorage2D(gl->depth.get(), 1, depth == DepthFormat::fixed24 ? GL_DEPTH_COMPONENT24 : GL_DEPTH_COMPONENT32F,
                      width, height);
+  gl->depth_format = depth == DepthFormat::fixed24 ? GL_DEPTH_COMPONENT24 : GL_DEPTH_COMPONENT32F;
   gl->linear_framebuffer = glo::make_framebuffer();
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl->linear_colour.get(), 0);
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl->depth.get(), 0);
@@ -350,16 +356,60 @@ void SceneRenderer::draw(const scene::SceneState& state, double fraction, const 
 void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
                                 const LightTerms& terms) {
   begin_linear();
-  for (const FieldPass& pass : passes) {
-    // Each pass sees the whole scene at its moment: depth starts over, the other
-    // passes' colours stay. Alpha keeps the clear's 1.
-    glClear(GL_DEPTH_BUFFER_BIT);
-    glColorMask(pass.red, pass.green, pass.blue, GL_FALSE);
-    draw_scene(state, pass.fraction, pass.eye, pass.frustum, terms);
+  // Seen from one place in every field (the viewer does not move), what does not
+  // move looks the same in each: it is drawn once, in every channel, and each
+  // field draws only the moving objects over it, on the still objects' depth.
+  const bool one_view = std::all_of(passes.begin(), passes.end(), [&](const FieldPass& p) {
+    return p.eye == passes.front().eye && p.frustum.view == passes.front().frustum.view &&
+           p.frustum.projection == passes.front().frustum.projection;
+  });
+  const bool still_once = !passes.empty() && one_view;
+  if (still_once) {
+    const FieldPass& first = passes.front();
+    draw_scene(state, first.fraction, first.eye, first.frustum, terms, Objects::still);
+    keep_still_depth();
   }
-  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  for (const FieldPass& pass : passes) {
+    // Each pass sees the scene at its moment: depth starts over (from the still
+    // objects'), the other passes' colours stay. Alpha keeps the clear's 1.
+    if (still_once) {
+      bring_back_still_depth();
+    } else {
+      glClear(GL_DEPTH_BUFFER_BIT);
+    }
+    glColorMask(pass.red, pass.green, pass.blue, GL_FALSE);
+    draw_scene(state, pass.fraction, pass.eye, pass.frustum, terms, still_once ? Objects::moving : Objects::all);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+  }
   resolve();
   encode();
+}
+
+void SceneRenderer::keep_still_depth() {
+  Gl& gl = *gl_;
+  if (gl.still_depth_framebuffer.get() == 0) {
+    const bool multisampled = gl.samples > 1;
+    gl.still_depth = glo::make_texture(multisampled ? GL_TEXTURE_2D_MULTISAMPLE : GL_TEXTURE_2D);
+    if (multisampled) {
+      glTextureStorage2DMultisample(gl.still_depth.get(), gl.samples, gl.depth_format, gl.width, gl.height, GL_TRUE);
+    } else {
+      glTextureStorage2D(gl.still_depth.get(), 1, gl.depth_format, gl.width, gl.height);
+    }
+    gl.still_depth_framebuffer = glo::make_framebuffer();
+    glNamedFramebufferTexture(gl.still_depth_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl.still_depth.get(), 0);
+  }
+  glBlitNamedFramebuffer(draw_framebuffer(), gl.still_depth_framebuffer.get(), 0, 0, gl.width, gl.height, 0, 0,
+                         gl.width, gl.height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+}
+
+void SceneRenderer::bring_back_still_depth() {
+  const Gl& gl = *gl_;
+  glBlitNamedFramebuffer(gl.still_depth_framebuffer.get(), draw_framebuffer(), 0, 0, gl.width, gl.height, 0, 0,
+                         gl.width, gl.height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+}
+
+unsigned SceneRenderer::draw_framebuffer() const {
+  return gl_->samples > 1 ? gl_->multisample_framebuffer.get() : gl_->linear_framebuffer.get();
 }
 
 void SceneRenderer::resolve() {
@@ -375,7 +425,7 @@ void SceneRenderer::resolve() {
 
 void SceneRenderer::begin_linear() {
   Gl& gl = *gl_;
-  glBindFramebuffer(GL_FRAMEBUFFER, gl.samples > 1 ? gl.multisample_framebuffer.get() : gl.linear_framebuffer.get());
+  glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer());
   glViewport(0, 0, gl.width, gl.height);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -386,7 +436,7 @@ void SceneRenderer::begin_linear() {
 }
 
 void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
-                               const geometry::Frustum& frustum, const LightTerms& terms) {
+                               const geometry::Frustum& frustum, const LightTerms& terms, Objects which) {
   Gl& gl = *gl_;
   upload_shining_lights(state.lights_off);
   glUseProgram(gl.scene_program.get());
@@ -400,6 +450,7 @@ void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, 
   const glm::dmat4 view_projection = frustum.projection * frustum.view;
 
   for (const auto& instance : gl.instances) {
+    if ((which == Objects::still && instance.object) || (which == Objects::moving && !instance.object)) continue;
     glm::dmat4 model = instance.transform;
     if (instance.object) {
       const auto found = state.objects.find(*instance.object);

@@ -103,8 +103,9 @@ class SceneRenderer {
 
   // A single-chip DLP projector's frame: the scene drawn once per pass into one
   // image, each pass writing only its channels, so each colour shows the scene at
-  // the moment its field is on screen; then the output stage, once. Returns when
-  // the GPU is done.
+  // the moment its field is on screen; then the output stage, once. When every
+  // pass sees the scene from the same place, what does not move is drawn once for
+  // all of them. Returns when the GPU is done.
   void draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes, const LightTerms& terms = {});
 
   // Fails when the weights do not match the output size.
@@ -135,10 +136,16 @@ class SceneRenderer {
  private:
   struct Gl;
   explicit SceneRenderer(std::unique_ptr<Gl> gl);
+  // Which of the scene's instances a draw takes: all, those on no animated
+  // object, or those on one.
+  enum class Objects { all, still, moving };
   void begin_linear();  // binds and clears the image and depth the scene is drawn into
   void resolve();       // multisampled: averages the samples into the linear image
   void draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
-                  const geometry::Frustum& frustum, const LightTerms& terms);
+                  const geometry::Frustum& frustum, const LightTerms& terms, Objects which = Objects::all);
+  void keep_still_depth();        // copies the depth drawn so far aside
+  void bring_back_still_depth();  // and back
+  [[nodiscard]] unsigned draw_framebuffer() const;
   void encode();
   void upload_shining_lights(const std::set<std::uint32_t>& off);
   std::unique_ptr<Gl> gl_;
