@@ -29,10 +29,14 @@ namespace {
 constexpr int kIdealSupersample = 4;
 
 // A world point seen from `eye` on the screen, in its raster's pixels (x right,
-// y down, as compose and render-reference lay it out).
+// y down, as compose and render-reference lay it out); NaN when the screen's
+// plane is not ahead of the eye towards it.
 glm::dvec2 on_raster(const config::Screen& screen, const glm::dvec3& eye, const glm::dvec3& point) {
   const glm::dvec3 normal = glm::cross(screen.right, screen.up);
   const double t = glm::dot(normal, screen.origin - eye) / glm::dot(normal, point - eye);
+  // The screen's plane must lie between the eye and the point, or at least
+  // ahead of the eye on the way to it: otherwise the point is not seen through it.
+  if (!(t > 0.0)) return glm::dvec2(std::numeric_limits<double>::quiet_NaN());
   const glm::dvec3 hit = eye + t * (point - eye);
   const double x = glm::dot(hit - screen.origin, screen.right);
   const double y = glm::dot(hit - screen.origin, screen.up);
@@ -52,12 +56,13 @@ std::optional<std::pair<glm::dvec2, glm::dvec2>> footprint(const scene::SceneDef
     const glm::dmat4 model = scene::model_matrix(pose) * instance.transform;
     for (const scene::Vertex& v : scene.meshes[instance.mesh].vertices) {
       const glm::dvec2 p = on_raster(screen, eye, glm::dvec3(model * glm::dvec4(glm::dvec3(v.position), 1.0)));
+      if (!std::isfinite(p.x) || !std::isfinite(p.y)) continue;  // not seen through this screen
       lo = glm::min(lo, p);
       hi = glm::max(hi, p);
       any = true;
     }
   }
-  if (!any) return std::nullopt;
+  if (!any || lo.x > hi.x) return std::nullopt;
   return std::make_pair(lo, hi);
 }
 
@@ -137,12 +142,17 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
     } else {
       const auto place = [&](double t) { return on_raster(screen, eye_now, tracked->pose_at(t).position); };
       result.velocity = (place(centre + 0.5 * period) - place(centre - 0.5 * period)) / period;
-      if (const auto box = footprint(scene, tracked->id, tracked->pose_at(centre), screen, eye_now)) {
+      if (!std::isfinite(result.velocity.x) || !std::isfinite(result.velocity.y)) {
+        // Not seen through this screen: a still eye here, and nothing to measure.
+        result.velocity = glm::dvec2(0.0);
+        result.box[2] = result.box[0];
+      } else if (const auto box = footprint(scene, tracked->id, tracked->pose_at(centre), screen, eye_now)) {
         const double grow = 0.5 * glm::length(result.velocity) * options.exposure + 4.0;
-        result.box[0] = std::max(0, static_cast<int>(std::floor(box->first.x - grow)));
-        result.box[1] = std::max(0, static_cast<int>(std::floor(box->first.y - grow)));
-        result.box[2] = std::min(width, static_cast<int>(std::ceil(box->second.x + grow)));
-        result.box[3] = std::min(height, static_cast<int>(std::ceil(box->second.y + grow)));
+        const auto inside = [](double v, int size) { return static_cast<int>(std::clamp(v, 0.0, double(size))); };
+        result.box[0] = inside(std::floor(box->first.x - grow), width);
+        result.box[1] = inside(std::floor(box->first.y - grow), height);
+        result.box[2] = inside(std::ceil(box->second.x + grow), width);
+        result.box[3] = inside(std::ceil(box->second.y + grow), height);
       }
     }
     const optics::Exposure exposure{centre, options.exposure, result.velocity};
@@ -216,14 +226,19 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
       }
       return part;
     };
-    // Fringes lie across the motion: measured along its main axis.
-    const bool along_x = std::abs(result.velocity.x) >= std::abs(result.velocity.y);
-    result.fringe_px = optics::fringe_width(seen, result.box[0], result.box[1], result.box[2], result.box[3], along_x);
-    result.ideal_fringe_px =
-        optics::fringe_width(ideal, result.box[0], result.box[1], result.box[2], result.box[3], along_x);
-    auto compared = image::compare(crop(seen), crop(ideal));
-    if (!compared) return Error{compared.error()};
-    result.psnr_y_db = compared.value().psnr_y_weighted;
+    // On a screen where the tracked object is not, there is nothing to measure.
+    result.measured = result.box[2] > result.box[0] && result.box[3] > result.box[1];
+    if (result.measured) {
+      // Fringes lie across the motion: measured along its main axis.
+      const bool along_x = std::abs(result.velocity.x) >= std::abs(result.velocity.y);
+      result.fringe_px =
+          optics::fringe_width(seen, result.box[0], result.box[1], result.box[2], result.box[3], along_x);
+      result.ideal_fringe_px =
+          optics::fringe_width(ideal, result.box[0], result.box[1], result.box[2], result.box[3], along_x);
+      auto compared = image::compare(crop(seen), crop(ideal));
+      if (!compared) return Error{compared.error()};
+      result.psnr_y_db = compared.value().psnr_y_weighted;
+    }
 
     const std::string folder = (std::filesystem::path(out_dir) / "perceived" / result.folder).string();
     if (auto written = image::write_frame(folder, options.frame, seen, image::encode_srgb(seen)); !written) {
@@ -233,19 +248,26 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
         !written) {
       return Error{written.error()};
     }
-    log.info(
-        "screen '{}': the eye at ({:.1f}, {:.1f}) px/frame over {:.4f} s: colour fringes {:.2f} px (ideal {:.2f}), "
-        "PSNR_Y {:.2f} dB against the ideal → {}",
-        result.folder, result.velocity.x * period, result.velocity.y * period, options.exposure, result.fringe_px,
-        result.ideal_fringe_px, result.psnr_y_db, image::frame_path(folder, options.frame, "png"));
-    const bool finite = std::isfinite(result.psnr_y_db);
-    report["screens"].push_back(
-        {{"screen", result.folder},
-         {"eye_velocity_px_per_frame", {result.velocity.x * period, result.velocity.y * period}},
-         {"box", {result.box[0], result.box[1], result.box[2], result.box[3]}},
-         {"fringe_px", result.fringe_px},
-         {"ideal_fringe_px", result.ideal_fringe_px},
-         {"psnr_y_db", finite ? nlohmann::json(result.psnr_y_db) : nlohmann::json("inf")}});
+    const std::string png = image::frame_path(folder, options.frame, "png");
+    const glm::dvec2 per_frame = result.velocity * period;
+    nlohmann::json entry = {{"screen", result.folder},
+                            {"eye_velocity_px_per_frame", {per_frame.x, per_frame.y}},
+                            {"measured", result.measured}};
+    if (result.measured) {
+      log.info(
+          "screen '{}': the eye at ({:.1f}, {:.1f}) px/frame over {:.4f} s: colour fringes {:.2f} px (ideal "
+          "{:.2f}), PSNR_Y {:.2f} dB against the ideal → {}",
+          result.folder, per_frame.x, per_frame.y, options.exposure, result.fringe_px, result.ideal_fringe_px,
+          result.psnr_y_db, png);
+      entry["box"] = {result.box[0], result.box[1], result.box[2], result.box[3]};
+      entry["fringe_px"] = result.fringe_px;
+      entry["ideal_fringe_px"] = result.ideal_fringe_px;
+      entry["psnr_y_db"] = std::isfinite(result.psnr_y_db) ? nlohmann::json(result.psnr_y_db) : nlohmann::json("inf");
+    } else {
+      log.info("screen '{}': '{}' is not on it at frame {}: nothing measured → {}", result.folder, options.object,
+               options.frame, png);
+    }
+    report["screens"].push_back(entry);
     result.seen = seen;
     result.ideal = ideal;
     results.push_back(std::move(result));

@@ -42,6 +42,7 @@ struct PerceivedScreen {
   // The measures, over the tracked object's neighbourhood (its footprint at the
   // frame, grown by the eye's travel and 4 px; with a velocity, the whole screen).
   int box[4] = {0, 0, 0, 0};  // x0, y0, x1, y1
+  bool measured = true;       // false: the tracked object is not on this screen
   double fringe_px = 0.0;     // optics::fringe_width of what the eye sees, across the motion
   double ideal_fringe_px = 0.0;
   double psnr_y_db = 0.0;  // PSNR_Y against the ideal
