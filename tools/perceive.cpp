@@ -218,13 +218,8 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
 
     // The measures, over the neighbourhood.
     const auto crop = [&](const image::FloatImage& image) {
-      image::FloatImage part(result.box[2] - result.box[0], result.box[3] - result.box[1], 4);
-      for (int y = 0; y < part.height; ++y) {
-        for (int x = 0; x < part.width; ++x) {
-          for (int c = 0; c < 4; ++c) part.at(x, y, c) = image.at(result.box[0] + x, result.box[1] + y, c);
-        }
-      }
-      return part;
+      return image::crop(image, result.box[0], result.box[1], result.box[2] - result.box[0],
+                         result.box[3] - result.box[1]);
     };
     // On a screen where the tracked object is not, there is nothing to measure.
     result.measured = result.box[2] > result.box[0] && result.box[3] > result.box[1];

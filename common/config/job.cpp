@@ -1,6 +1,7 @@
 #include "config/job.h"
 
 #include <cassert>
+#include <cmath>
 
 #include "config/projector_groups.h"
 
@@ -30,14 +31,17 @@ ProjectorJob job_for(const Installation& installation, std::size_t projector) {
   return job;
 }
 
+void scale_pixels(Projector& projector, double factor) {
+  assert(factor > 0.0);
+  projector.homography = glm::dmat3(factor, 0.0, 0.0, 0.0, factor, 0.0, 0.0, 0.0, 1.0) * projector.homography;
+  projector.width = static_cast<int>(std::lround(projector.width * factor));
+  projector.height = static_cast<int>(std::lround(projector.height * factor));
+  projector.region.reset();  // the homography says where it lands
+}
+
 ProjectorJob supersampled(ProjectorJob job, int factor) {
   assert(factor >= 1);
-  Projector& p = job.installation.projectors[job.projector];
-  const double f = factor;
-  p.homography = glm::dmat3(f, 0.0, 0.0, 0.0, f, 0.0, 0.0, 0.0, 1.0) * p.homography;
-  p.width *= factor;
-  p.height *= factor;
-  p.region.reset();  // the homography says where it lands
+  scale_pixels(job.installation.projectors[job.projector], factor);
   return job;
 }
 

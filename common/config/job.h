@@ -22,6 +22,10 @@ struct ProjectorJob {
 
 [[nodiscard]] ProjectorJob job_for(const Installation& installation, std::size_t projector);
 
+// The same projector with `factor` times as many pixels along each axis (rounded)
+// over the same part of its screen: the homography says where it lands.
+void scale_pixels(Projector& projector, double factor);
+
 // The same projector with factor² as many pixels over the same part of the
 // screen: references and measurements finer than a pixel.
 [[nodiscard]] ProjectorJob supersampled(ProjectorJob job, int factor);

@@ -66,6 +66,17 @@ FloatImage difference(const FloatImage& a, const FloatImage& b, float gain) {
   return out;
 }
 
+FloatImage crop(const FloatImage& source, int x, int y, int width, int height) {
+  assert(x >= 0 && y >= 0 && width >= 0 && height >= 0 && x + width <= source.width && y + height <= source.height);
+  FloatImage part(width, height, source.channels);
+  for (int row = 0; row < height; ++row) {
+    for (int col = 0; col < width; ++col) {
+      for (int c = 0; c < source.channels; ++c) part.at(col, row, c) = source.at(x + col, y + row, c);
+    }
+  }
+  return part;
+}
+
 void paste(FloatImage& target, const FloatImage& source, int x, int y) {
   assert(target.channels == source.channels);
   for (int row = 0; row < source.height; ++row) {

@@ -37,4 +37,8 @@ struct Comparison {
 // Copies `source` into `target` with its top-left corner at (x, y).
 void paste(FloatImage& target, const FloatImage& source, int x, int y);
 
+// The `width` × `height` part of `source` whose top-left corner is (x, y); it
+// must lie inside `source`.
+[[nodiscard]] FloatImage crop(const FloatImage& source, int x, int y, int width, int height);
+
 }  // namespace optique::image

@@ -79,14 +79,23 @@ glm::dvec3 ProjectorPipeline::eye(const glm::dvec3& centre) const {
   return geometry::eye_position(centre, viewer_.head_right, viewer_.eye_separation, eye_);
 }
 
+Result<FieldPass> ProjectorPipeline::moment(const scene::SceneState& state, double fraction) const {
+  FieldPass pass;
+  pass.fraction = fraction;
+  pass.eye = eye(glm::mix(state.eye_now, state.eye_next, fraction));
+  auto frustum = view_.frustum(pass.eye, viewer_.near, viewer_.far);
+  if (!frustum) return Error{frustum.error()};
+  pass.frustum = frustum.value();
+  return pass;
+}
+
 Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double fraction) {
-  const glm::dvec3 at = eye(glm::mix(state.eye_now, state.eye_next, fraction));
-  auto frustum = view_.frustum(at, viewer_.near, viewer_.far);
-  if (!frustum) {
+  const auto seen = moment(state, fraction);
+  if (!seen) {
     renderer_->draw_black();
-    return Error{frustum.error()};
+    return Error{seen.error()};
   }
-  renderer_->draw(state, fraction, at, frustum.value(), terms_);
+  renderer_->draw(state, fraction, seen.value().eye, seen.value().frustum, terms_);
   return {};
 }
 
@@ -95,19 +104,15 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state) {
   std::vector<FieldPass> passes;
   for (const config::ColorField& field : color_fields_.fields) {
     assert(field.image == 0);  // make() refused more images
-    FieldPass pass;
-    pass.red = field.channel == config::Channel::red;
-    pass.green = field.channel == config::Channel::green;
-    pass.blue = field.channel == config::Channel::blue;
-    pass.fraction = field.offset;
-    pass.eye = eye(glm::mix(state.eye_now, state.eye_next, field.offset));
-    auto frustum = view_.frustum(pass.eye, viewer_.near, viewer_.far);
-    if (!frustum) {
+    auto pass = moment(state, field.offset);
+    if (!pass) {
       renderer_->draw_black();
-      return Error{frustum.error()};
+      return Error{pass.error()};
     }
-    pass.frustum = frustum.value();
-    passes.push_back(pass);
+    pass.value().red = field.channel == config::Channel::red;
+    pass.value().green = field.channel == config::Channel::green;
+    pass.value().blue = field.channel == config::Channel::blue;
+    passes.push_back(pass.value());
   }
   renderer_->draw_fields(state, passes, terms_);
   return {};

@@ -77,6 +77,9 @@ class ProjectorPipeline {
  private:
   ProjectorPipeline(ProjectorView view, std::unique_ptr<SceneRenderer> renderer, const config::ProjectorJob& job,
                     optics::ProjectorModel model);
+  // Where the scene is seen from `fraction` of a frame after the display time:
+  // this projector's eye then, and its frustum through the screen.
+  [[nodiscard]] Result<FieldPass> moment(const scene::SceneState& state, double fraction) const;
 
   ProjectorView view_;
   std::unique_ptr<SceneRenderer> renderer_;

@@ -586,13 +586,7 @@ int main(int argc, char** argv) {
     const int tile_w = std::max(1, std::min(width, seen_x1 + pad + 1) - crop_x);
     const int tile_h = std::max(1, std::min(height, seen_y1 + pad + 1) - crop_y);
     const auto crop = [&](const image::FloatImage& image) {
-      image::FloatImage part(tile_w, tile_h, image.channels);
-      for (int y = 0; y < tile_h; ++y) {
-        for (int x = 0; x < tile_w; ++x) {
-          for (int c = 0; c < image.channels; ++c) part.at(x, y, c) = image.at(crop_x + x, crop_y + y, c);
-        }
-      }
-      return part;
+      return image::crop(image, crop_x, crop_y, tile_w, tile_h);
     };
     // White margins of 10 px around and between the tiles.
     const int canvas_w = 4 * (tile_w + 10) + 10;

@@ -59,10 +59,8 @@ master::RunConfig load(const Wall& wall, const Method& method) {
   config::Installation& inst = run.config.installation;
   config::Projector& p = inst.projectors.front();
   const double scale = static_cast<double>(wall.width) / p.width;
-  p.homography = glm::dmat3(scale, 0, 0, 0, scale, 0, 0, 0, 1) * p.homography;
-  p.width = wall.width;
-  p.height = wall.height;
-  p.region.reset();
+  config::scale_pixels(p, scale);
+  if (p.height != wall.height) throw std::logic_error("the wall's pixels are not those of dlp-120hz scaled");
   inst.screens.front().pixels_per_metre *= scale;
   p.color_fields.method = method.fields;
   return run;
