@@ -13,6 +13,18 @@
 namespace optique::render {
 namespace {
 
+// A depth attachment of `format`, multisampled when `samples` > 1.
+glo::Texture depth_texture(GLenum format, int samples, int width, int height) {
+  if (samples == 1) {
+    glo::Texture texture = glo::make_texture();
+    glTextureStorage2D(texture.get(), 1, format, width, height);
+    return texture;
+  }
+  glo::Texture texture = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
+  glTextureStorage2DMultisample(texture.get(), samples, format, width, height, GL_TRUE);
+  return texture;
+}
+
 // The output pass's choices for a stage, as the preprocessor constants it is
 // built with (the enums' values are the shader's numbers).
 std::string output_stage_defines(const OutputStage& stage) {
@@ -189,10 +201,8 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   glTextureParameteri(gl->linear_colour.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   glTextureParameteri(gl->linear_colour.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTextureParameteri(gl->linear_colour.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  gl->depth = glo::make_texture();
-  glTextureStorage2D(gl->depth.get(), 1, depth == DepthFormat::fixed24 ? GL_DEPTH_COMPONENT24 : GL_DEPTH_COMPONENT32F,
-                     width, height);
   gl->depth_format = depth == DepthFormat::fixed24 ? GL_DEPTH_COMPONENT24 : GL_DEPTH_COMPONENT32F;
+  gl->depth = depth_texture(gl->depth_format, 1, width, height);
   gl->linear_framebuffer = glo::make_framebuffer();
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl->linear_colour.get(), 0);
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl->depth.get(), 0);
@@ -204,11 +214,9 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
                    std::to_string(most)};
     }
     gl->samples = samples;
-    const GLenum depth_format = depth == DepthFormat::fixed24 ? GL_DEPTH_COMPONENT24 : GL_DEPTH_COMPONENT32F;
     gl->multisample_colour = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
     glTextureStorage2DMultisample(gl->multisample_colour.get(), samples, GL_RGBA32F, width, height, GL_TRUE);
-    gl->multisample_depth = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
-    glTextureStorage2DMultisample(gl->multisample_depth.get(), samples, depth_format, width, height, GL_TRUE);
+    gl->multisample_depth = depth_texture(gl->depth_format, samples, width, height);
     gl->multisample_framebuffer = glo::make_framebuffer();
     glNamedFramebufferTexture(gl->multisample_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl->multisample_colour.get(), 0);
     glNamedFramebufferTexture(gl->multisample_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl->multisample_depth.get(), 0);
@@ -388,13 +396,7 @@ void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const 
 void SceneRenderer::keep_still_depth() {
   Gl& gl = *gl_;
   if (gl.still_depth_framebuffer.get() == 0) {
-    const bool multisampled = gl.samples > 1;
-    gl.still_depth = glo::make_texture(multisampled ? GL_TEXTURE_2D_MULTISAMPLE : GL_TEXTURE_2D);
-    if (multisampled) {
-      glTextureStorage2DMultisample(gl.still_depth.get(), gl.samples, gl.depth_format, gl.width, gl.height, GL_TRUE);
-    } else {
-      glTextureStorage2D(gl.still_depth.get(), 1, gl.depth_format, gl.width, gl.height);
-    }
+    gl.still_depth = depth_texture(gl.depth_format, gl.samples, gl.width, gl.height);
     gl.still_depth_framebuffer = glo::make_framebuffer();
     glNamedFramebufferTexture(gl.still_depth_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl.still_depth.get(), 0);
   }
