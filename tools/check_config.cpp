@@ -40,9 +40,15 @@ std::string color_fields_summary(const config::ColorFields& c, const config::Mas
     text << " " << fields[i].offset * period_ms << " ms (" << fields[i].duration * period_ms << " ms long)";
   }
   text << " from the display time";
+  if (c.method == config::FieldMethod::gather) text << "; " << c.gather_samples << " samples per field and pixel";
   if (c.velocity_threshold > 0.0) {
-    text << "; velocity_threshold " << c.velocity_threshold
-         << " px per frame is read but not applied yet: every moving object gets its field offsets";
+    text << "; velocity_threshold " << c.velocity_threshold << " px per frame";
+    if (c.method != config::FieldMethod::gather) {
+      text << " applies to method gather only: with " << config::to_string(c.method)
+           << " every moving object gets its field offsets";
+    } else {
+      text << ": faster pixels get motion blur over the frame instead";
+    }
   }
   return text.str();
 }

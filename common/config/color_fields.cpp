@@ -67,7 +67,17 @@ std::string_view to_string(Channel channel) {
   return "?";
 }
 
-std::string_view to_string(FieldMethod method) { return method == FieldMethod::off ? "off" : "per-field"; }
+std::string_view to_string(FieldMethod method) {
+  switch (method) {
+    case FieldMethod::per_field:
+      return "per-field";
+    case FieldMethod::gather:
+      return "gather";
+    case FieldMethod::off:
+      return "off";
+  }
+  return "?";
+}
 
 const std::vector<std::string>& color_field_presets() {
   static const std::vector<std::string> names = [] {
@@ -82,8 +92,20 @@ ColorFields parse_color_fields(const schema::ColorFields& c, const std::string& 
   ColorFields out;
   if (c.method() == "off") {
     out.method = FieldMethod::off;
+  } else if (c.method() == "gather") {
+    out.method = FieldMethod::gather;
   } else if (!c.method().empty() && c.method() != "per-field") {
-    problems.push_back({path + ".method", "must be per-field or off (got '" + c.method() + "')"});
+    problems.push_back({path + ".method", "must be per-field, gather or off (got '" + c.method() + "')"});
+  }
+  if (c.gather_samples() != 0) {
+    if (c.gather_samples() < kMinGatherSamples || c.gather_samples() > kMaxGatherSamples) {
+      problems.push_back({path + ".gather_samples", "must be " + std::to_string(kMinGatherSamples) + "…" +
+                                                        std::to_string(kMaxGatherSamples) + ", or 0 for " +
+                                                        std::to_string(kDefaultGatherSamples) + " (got " +
+                                                        std::to_string(c.gather_samples()) + ")"});
+    } else {
+      out.gather_samples = static_cast<int>(c.gather_samples());
+    }
   }
   if (!std::isfinite(c.velocity_threshold()) || c.velocity_threshold() < 0.0) {
     problems.push_back({path + ".velocity_threshold", "must be 0 (none) or more, screen pixels per frame period (got " +

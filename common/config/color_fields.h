@@ -15,8 +15,10 @@
 namespace optique::config {
 
 enum class Channel { red, green, blue };
-// per_field: one render per field; off: every colour at the display time.
-enum class FieldMethod { per_field, off };
+// per_field: one render per field; gather: one render with screen-space
+// velocity and depth, each field gathered from it along the motion; off: every
+// colour at the display time.
+enum class FieldMethod { per_field, gather, off };
 
 [[nodiscard]] std::string_view to_string(Channel channel);
 [[nodiscard]] std::string_view to_string(FieldMethod method);
@@ -32,11 +34,16 @@ struct ColorField {
   friend bool operator==(const ColorField&, const ColorField&) = default;
 };
 
+inline constexpr int kDefaultGatherSamples = 8;
+inline constexpr int kMinGatherSamples = 2;
+inline constexpr int kMaxGatherSamples = 32;
+
 struct ColorFields {
   std::vector<ColorField> fields;  // in the order given; empty: all colours at once
   int images = 1;                  // images per frame: 1, or 2 for a stereo projector used as mono
   FieldMethod method = FieldMethod::per_field;
-  double velocity_threshold = 0.0;  // screen pixels per frame period; 0: none
+  double velocity_threshold = 0.0;             // screen pixels per frame period; 0: none (gather only)
+  int gather_samples = kDefaultGatherSamples;  // per field and pixel, along the motion
 
   // Whether the projector draws its fields at their own times.
   [[nodiscard]] bool sequential() const { return !fields.empty() && method != FieldMethod::off; }

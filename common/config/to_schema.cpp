@@ -86,6 +86,7 @@ schema::Projector to_schema(const Projector& p, const std::vector<Screen>& scree
     }
     fields.set_method(std::string(to_string(p.color_fields.method)));
     fields.set_velocity_threshold(p.color_fields.velocity_threshold);
+    fields.set_gather_samples(static_cast<std::uint32_t>(p.color_fields.gather_samples));
   }
   return out;
 }

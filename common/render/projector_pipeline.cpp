@@ -1,5 +1,6 @@
 #include "render/projector_pipeline.h"
 
+#include <algorithm>
 #include <cassert>
 #include <vector>
 
@@ -54,6 +55,11 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
   stage.focus.inset = job.installation.depth_of_field && job.installation.depth_of_field->inset_radius > 0.0;
   stage.projector = optics::ProjectorModel(self.response);
   if (auto output = renderer.value()->set_output(stage); !output) return Error{output.error()};
+  if (self.color_fields.sequential() && self.color_fields.method == config::FieldMethod::gather) {
+    if (auto gather = renderer.value()->prepare_gather(); !gather) {
+      return Error{"projector '" + self.id + "': " + gather.error()};
+    }
+  }
   std::unique_ptr<ProjectorPipeline> pipeline(
       new ProjectorPipeline(std::move(view).value(), std::move(renderer).value(), job, stage.projector));
   if (self.content.role == config::ContentRole::lights) pipeline->set_share({});
@@ -100,7 +106,9 @@ Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double frac
 }
 
 Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state) {
+  gather_report_ = {};
   if (!color_fields_.sequential()) return draw(state, 0.0);
+  if (color_fields_.method == config::FieldMethod::gather) return draw_gathered(state);
   std::vector<FieldPass> passes;
   for (const config::ColorField& field : color_fields_.fields) {
     assert(field.image == 0);  // make() refused more images
@@ -115,6 +123,40 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state) {
     passes.push_back(pass.value());
   }
   renderer_->draw_fields(state, passes, terms_);
+  return {};
+}
+
+Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state) {
+  // Rendered at the green field's moment: green carries most of what the eye
+  // sees as sharpness (and of PSNR_Y), and it is then shown as drawn, not
+  // resampled.
+  const auto green = std::find_if(color_fields_.fields.begin(), color_fields_.fields.end(),
+                                  [](const config::ColorField& f) { return f.channel == config::Channel::green; });
+  assert(green != color_fields_.fields.end());  // every image has each channel (config/color_fields.h)
+  const double rendered = green->offset;
+  const auto seen = moment(state, rendered);
+  const auto now = moment(state, 0.0);
+  const auto next = moment(state, 1.0);
+  for (const auto* m : {&seen, &now, &next}) {
+    if (!*m) {
+      renderer_->draw_black();
+      return Error{m->error()};
+    }
+  }
+  GatherFrame frame;
+  frame.seen = seen.value();
+  frame.view_projection_now = now.value().frustum.projection * now.value().frustum.view;
+  frame.view_projection_next = next.value().frustum.projection * next.value().frustum.view;
+  for (const config::ColorField& field : color_fields_.fields) {
+    assert(field.image == 0);  // make() refused more images
+    frame.fields.push_back({field.channel == config::Channel::red, field.channel == config::Channel::green,
+                            field.channel == config::Channel::blue, field.offset - rendered});
+  }
+  frame.settings.samples = color_fields_.gather_samples;
+  frame.settings.velocity_threshold = color_fields_.velocity_threshold;
+  frame.settings.frame_start = -0.5 - rendered;
+  frame.settings.frame_end = 0.5 - rendered;
+  gather_report_ = renderer_->draw_gathered(state, frame, terms_);
   return {};
 }
 

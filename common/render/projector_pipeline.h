@@ -62,9 +62,13 @@ class ProjectorPipeline {
   // comes back.
   [[nodiscard]] Result<void> draw(const scene::SceneState& state, double fraction = 0.0);
   // The frame as this projector shows it: with colour fields (a single-chip DLP
-  // projector), each field's channel drawn at the moment it is on screen; else
-  // the whole image at the display time.
+  // projector), each field's channel drawn at the moment it is on screen (one
+  // render per field, or gathered from one render); else the whole image at the
+  // display time.
   [[nodiscard]] Result<void> draw_frame(const scene::SceneState& state);
+  // What the last frame's gather found (zero for other methods): how fast the
+  // scene moved, and whether the gather radius cut a motion short.
+  [[nodiscard]] const GatherReport& gather_report() const { return gather_report_; }
   // One draw of an empty scene from a metre in front of the screen: drivers
   // compile shaders lazily, and the first frame should not pay for it.
   void warm_up();
@@ -80,6 +84,7 @@ class ProjectorPipeline {
   // Where the scene is seen from `fraction` of a frame after the display time:
   // this projector's eye then, and its frustum through the screen.
   [[nodiscard]] Result<FieldPass> moment(const scene::SceneState& state, double fraction) const;
+  [[nodiscard]] Result<void> draw_gathered(const scene::SceneState& state);
 
   ProjectorView view_;
   std::unique_ptr<SceneRenderer> renderer_;
@@ -90,6 +95,7 @@ class ProjectorPipeline {
   std::optional<config::DepthOfField> depth_of_field_;
   config::ColorFields color_fields_;
   LightTerms terms_;
+  GatherReport gather_report_;
 };
 
 }  // namespace optique::render

@@ -7,6 +7,7 @@
 #include <glm/gtc/type_ptr.hpp>
 #include <glm/mat3x3.hpp>
 
+#include "render/field_gather.h"
 #include "render/gl_objects.h"
 #include "render/shaders.h"
 
@@ -33,6 +34,37 @@ std::string output_stage_defines(const OutputStage& stage) {
          std::to_string(static_cast<int>(stage.focus.role)) + "\n#define INSET " +
          std::to_string(stage.focus.inset ? 1 : 0) + "\n#define WEIGHTS " +
          std::to_string(stage.weights.empty() ? 0 : 1) + "\n";
+}
+
+struct SceneUniforms {
+  GLint model_view_projection, model, normal_matrix, eye, base_colour, has_base_colour_texture, metallic, roughness,
+      emissive, ambient, light_count;
+  GLint model_view_projection_now, model_view_projection_next, half_size;  // velocity only
+};
+
+// The scene program, with velocity or without: its sources come without a
+// #version line, so that the choice goes first.
+Result<glo::Program> scene_program(bool velocity, SceneUniforms& uniforms) {
+  const std::string head = std::string("#version 450 core\n") + (velocity ? "#define VELOCITY 1\n" : "");
+  auto program = glo::link_program(head + std::string(shaders::scene_vert), head + std::string(shaders::scene_frag));
+  if (!program) return Error{program.error()};
+  const GLuint p = program.value().get();
+  const auto at = [p](const char* name) { return glGetUniformLocation(p, name); };
+  uniforms = {at("model_view_projection"),
+              at("model"),
+              at("normal_matrix"),
+              at("eye"),
+              at("base_colour_factor"),
+              at("has_base_colour_texture"),
+              at("metallic"),
+              at("roughness"),
+              at("emissive"),
+              at("ambient"),
+              at("light_count"),
+              at("model_view_projection_0"),
+              at("model_view_projection_1"),
+              at("half_size")};
+  return program;
 }
 
 struct MeshRange {
@@ -86,10 +118,14 @@ struct SceneRenderer::Gl {
   struct {
     GLint coc, inset_disc;
   } focus_uniforms{};
-  struct {
-    GLint model_view_projection, model, normal_matrix, eye, base_colour, has_base_colour_texture, metallic, roughness,
-        emissive, ambient, light_count;
-  } uniforms{};
+  SceneUniforms uniforms{};
+  // The gather's (prepare_gather): the scene program that also writes velocity,
+  // the passes, and the image the fields are gathered into.
+  glo::Program velocity_program;
+  SceneUniforms velocity_uniforms{};
+  std::unique_ptr<FieldGather> gather;
+  glo::Texture gathered_colour;
+  glo::Framebuffer gathered_framebuffer;
 };
 
 SceneRenderer::SceneRenderer(std::unique_ptr<Gl> gl) : gl_(std::move(gl)) {}
@@ -102,21 +138,9 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   auto gl = std::make_unique<Gl>();
   gl->width = width;
   gl->height = height;
-  auto scene_program = glo::link_program(shaders::scene_vert, shaders::scene_frag);
-  if (!scene_program) return Error{scene_program.error()};
-  gl->scene_program = std::move(scene_program).value();
-  const GLuint p = gl->scene_program.get();
-  gl->uniforms = {glGetUniformLocation(p, "model_view_projection"),
-                  glGetUniformLocation(p, "model"),
-                  glGetUniformLocation(p, "normal_matrix"),
-                  glGetUniformLocation(p, "eye"),
-                  glGetUniformLocation(p, "base_colour_factor"),
-                  glGetUniformLocation(p, "has_base_colour_texture"),
-                  glGetUniformLocation(p, "metallic"),
-                  glGetUniformLocation(p, "roughness"),
-                  glGetUniformLocation(p, "emissive"),
-                  glGetUniformLocation(p, "ambient"),
-                  glGetUniformLocation(p, "light_count")};
+  auto program = scene_program(false, gl->uniforms);
+  if (!program) return Error{program.error()};
+  gl->scene_program = std::move(program).value();
 
   // All meshes in one vertex and one index buffer.
   std::vector<scene::Vertex> vertices;
@@ -393,6 +417,46 @@ void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const 
   encode();
 }
 
+Result<void> SceneRenderer::prepare_gather() {
+  Gl& gl = *gl_;
+  if (gl.gather) return {};
+  auto program = scene_program(true, gl.velocity_uniforms);
+  if (!program) return Error{program.error()};
+  auto gather = FieldGather::create(gl.width, gl.height, gl.samples);
+  if (!gather) return Error{gather.error()};
+  gl.gathered_colour = glo::make_texture();
+  glTextureStorage2D(gl.gathered_colour.get(), 1, GL_RGBA32F, gl.width, gl.height);
+  glTextureParameteri(gl.gathered_colour.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(gl.gathered_colour.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(gl.gathered_colour.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(gl.gathered_colour.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  gl.gathered_framebuffer = glo::make_framebuffer();
+  glNamedFramebufferTexture(gl.gathered_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl.gathered_colour.get(), 0);
+  glNamedFramebufferTexture(draw_framebuffer(), GL_COLOR_ATTACHMENT1, gather.value()->motion_target(), 0);
+  for (GLuint fb : {draw_framebuffer(), gl.gathered_framebuffer.get()}) {
+    if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      return Error{"this GL driver cannot draw the scene's velocity beside its colour"};
+    }
+  }
+  gl.velocity_program = std::move(program).value();
+  gl.gather = std::move(gather).value();
+  return {};
+}
+
+GatherReport SceneRenderer::draw_gathered(const scene::SceneState& state, const GatherFrame& frame,
+                                          const LightTerms& terms) {
+  Gl& gl = *gl_;
+  assert(gl.gather);  // prepare_gather first
+  begin_linear(true);
+  const Motion motion{frame.view_projection_now, frame.view_projection_next};
+  draw_scene(state, frame.seen.fraction, frame.seen.eye, frame.seen.frustum, terms, Objects::all, &motion);
+  resolve();
+  const GatherReport report =
+      gl.gather->run(gl.linear_colour.get(), frame.fields, frame.settings, gl.gathered_framebuffer.get());
+  encode(gl.gathered_colour.get());
+  return report;
+}
+
 void SceneRenderer::keep_still_depth() {
   Gl& gl = *gl_;
   if (gl.still_depth_framebuffer.get() == 0) {
@@ -425,9 +489,14 @@ void SceneRenderer::resolve() {
                          gl.width, gl.height, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
 }
 
-void SceneRenderer::begin_linear() {
+void SceneRenderer::begin_linear(bool with_motion) {
   Gl& gl = *gl_;
-  glBindFramebuffer(GL_FRAMEBUFFER, draw_framebuffer());
+  const GLuint framebuffer = draw_framebuffer();
+  if (gl.gather) {  // the velocity target is attached: drawn into only by a gather
+    static constexpr GLenum kBoth[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glNamedFramebufferDrawBuffers(framebuffer, with_motion ? 2 : 1, kBoth);
+  }
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
   glViewport(0, 0, gl.width, gl.height);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -435,16 +504,19 @@ void SceneRenderer::begin_linear() {
   glClearColor(gl.background.r, gl.background.g, gl.background.b, 1.0f);
   glClearDepth(1.0);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  if (with_motion) FieldGather::clear_motion(framebuffer);  // after: glClear cleared it to the background
 }
 
 void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
-                               const geometry::Frustum& frustum, const LightTerms& terms, Objects which) {
+                               const geometry::Frustum& frustum, const LightTerms& terms, Objects which,
+                               const Motion* motion) {
   Gl& gl = *gl_;
   upload_shining_lights(state.lights_off);
-  glUseProgram(gl.scene_program.get());
+  glUseProgram(motion ? gl.velocity_program.get() : gl.scene_program.get());
   glBindVertexArray(gl.vertex_array.get());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl.light_buffer.get());
-  const auto& u = gl.uniforms;
+  const SceneUniforms& u = motion ? gl.velocity_uniforms : gl.uniforms;
+  if (motion) glUniform2f(u.half_size, 0.5f * static_cast<float>(gl.width), 0.5f * static_cast<float>(gl.height));
   glUniform3f(u.eye, static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z));
   const glm::vec3 ambient = terms.ambient ? gl.ambient : glm::vec3(0.0f);
   glUniform3fv(u.ambient, 1, glm::value_ptr(ambient));
@@ -464,6 +536,20 @@ void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, 
     const glm::mat4 model_f(model);
     const glm::mat3 normal_matrix(glm::transpose(glm::inverse(glm::dmat3(model))));
     glUniformMatrix4fv(u.model_view_projection, 1, GL_FALSE, glm::value_ptr(mvp));
+    if (motion) {
+      // Where this instance is at the display time and a frame later.
+      glm::dmat4 now = instance.transform;
+      glm::dmat4 next = instance.transform;
+      if (instance.object) {
+        const scene::ObjectState& object = state.objects.find(*instance.object)->second;
+        now = scene::model_matrix(scene::interpolate(object, 0.0)) * instance.transform;
+        next = scene::model_matrix(scene::interpolate(object, 1.0)) * instance.transform;
+      }
+      const glm::mat4 mvp_now(motion->view_projection_now * now);
+      const glm::mat4 mvp_next(motion->view_projection_next * next);
+      glUniformMatrix4fv(u.model_view_projection_now, 1, GL_FALSE, glm::value_ptr(mvp_now));
+      glUniformMatrix4fv(u.model_view_projection_next, 1, GL_FALSE, glm::value_ptr(mvp_next));
+    }
     glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(model_f));
     glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
     const scene::Material& m = gl.materials[instance.material];
@@ -489,14 +575,16 @@ void SceneRenderer::draw_black() {
   encode();
 }
 
+void SceneRenderer::encode() { encode(gl_->linear_colour.get()); }
+
 // The projector's response, last: linear light → what is sent to it.
-void SceneRenderer::encode() {
+void SceneRenderer::encode(unsigned texture) {
   Gl& gl = *gl_;
   glBindFramebuffer(GL_FRAMEBUFFER, gl.encoded_framebuffer.get());
   glViewport(0, 0, gl.output_width, gl.output_height);
   glDisable(GL_DEPTH_TEST);
   glUseProgram(gl.encode_program.get());
-  glBindTextureUnit(0, gl.linear_colour.get());
+  glBindTextureUnit(0, texture);
   if (gl.weights) glBindTextureUnit(2, gl.weights.get());
   glBindTextureUnit(3, gl.depth.get());
   glBindTextureUnit(4, gl.response_table.get());

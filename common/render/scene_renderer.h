@@ -15,6 +15,7 @@
 #include "image/image.h"
 #include "optics/defocus.h"
 #include "optics/projector_model.h"
+#include "render/fields.h"
 #include "scene/definition.h"
 #include "scene/state.h"
 #include "util/result.h"
@@ -49,18 +50,6 @@ struct FocusFrame {
   optics::CocFromWindowDepth coc;  // from the frame's focal depth
   glm::dvec2 gaze{0.0};            // screen metres
   double inset_radius = 0.0;
-};
-
-// One colour field's pass (config/color_fields.h): the channels it writes, and
-// the moment it shows — objects `fraction` of the way to their next pose, seen
-// from `eye` through `frustum`.
-struct FieldPass {
-  bool red = false;
-  bool green = false;
-  bool blue = false;
-  double fraction = 0.0;
-  glm::dvec3 eye{0.0};
-  geometry::Frustum frustum;
 };
 
 // The depth buffer's format: 32-bit float by default; 24-bit fixed point to
@@ -108,6 +97,14 @@ class SceneRenderer {
   // all of them. Returns when the GPU is done.
   void draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes, const LightTerms& terms = {});
 
+  // The same by the gather method; prepare_gather first. Returns when the GPU is
+  // done, with what the gather found.
+  [[nodiscard]] GatherReport draw_gathered(const scene::SceneState& state, const GatherFrame& frame,
+                                           const LightTerms& terms = {});
+  // Makes the velocity target, tiles and passes draw_gathered needs (only
+  // projectors that gather have them); fails with the driver's message.
+  [[nodiscard]] Result<void> prepare_gather();
+
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);
 
@@ -139,14 +136,24 @@ class SceneRenderer {
   // Which of the scene's instances a draw takes: all, those on no animated
   // object, or those on one.
   enum class Objects { all, still, moving };
-  void begin_linear();  // binds and clears the image and depth the scene is drawn into
-  void resolve();       // multisampled: averages the samples into the linear image
+  // Binds and clears the image and depth the scene is drawn into (and the
+  // velocity target, for a gather).
+  void begin_linear(bool with_motion = false);
+  void resolve();  // multisampled: averages the samples into the linear image
+  // With `motion`, also each fragment's screen velocity between those two views
+  // (the gather's program and target).
+  struct Motion {
+    glm::dmat4 view_projection_now;
+    glm::dmat4 view_projection_next;
+  };
   void draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
-                  const geometry::Frustum& frustum, const LightTerms& terms, Objects which = Objects::all);
+                  const geometry::Frustum& frustum, const LightTerms& terms, Objects which = Objects::all,
+                  const Motion* motion = nullptr);
   void keep_still_depth();        // copies the depth drawn so far aside
   void bring_back_still_depth();  // and back
   [[nodiscard]] unsigned draw_framebuffer() const;
-  void encode();
+  void encode();                  // the linear image
+  void encode(unsigned texture);  // or another of its size
   void upload_shining_lights(const std::set<std::uint32_t>& off);
   std::unique_ptr<Gl> gl_;
 };

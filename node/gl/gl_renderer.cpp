@@ -85,6 +85,13 @@ void GlRenderer::render(const FrameInput& frame) {
     // rather than a wrong picture.
     log_.debug("frame {}: {}", frame.frame_id, drawn.error());
   }
+  if (const render::GatherReport& gather = pipeline_->gather_report(); gather.clamped && !warned_gather_radius_) {
+    warned_gather_radius_ = true;  // once: it would repeat every frame of the motion
+    log_.warn(
+        "frame {}: the scene moves {:.1f} px per frame; the gather moves a surface at most {} px per colour "
+        "field, so faster motion is cut short there (its fields lag; method per-field has no such limit)",
+        frame.frame_id, gather.fastest, render::kGatherRadius);
+  }
   if (frame.capture) {
     const render::SceneRenderer& renderer = pipeline_->renderer();
     captures_->submit(frame.frame_id, renderer.read_linear(),

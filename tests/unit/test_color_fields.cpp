@@ -166,6 +166,23 @@ TEST(ColorFields, BadNamesAndNumbersEachHaveTheirMessage) {
   EXPECT_EQ(problems_at(parsed, ".velocity_threshold").size(), 1u) << parsed.error();
 }
 
+TEST(ColorFields, GatherAndItsSamples) {
+  const auto parsed = parse(R"({"preset": "dlp-brg-120hz", "method": "gather", "gather_samples": 16})");
+  ASSERT_TRUE(parsed) << parsed.error();
+  const ColorFields& c = parsed.value().projectors[0].color_fields;
+  EXPECT_EQ(c.method, FieldMethod::gather);
+  EXPECT_TRUE(c.sequential());
+  EXPECT_EQ(c.gather_samples, 16);
+  const auto by_default = parse(R"({"preset": "dlp-brg-120hz", "method": "gather"})");
+  ASSERT_TRUE(by_default) << by_default.error();
+  EXPECT_EQ(by_default.value().projectors[0].color_fields.gather_samples, kDefaultGatherSamples);
+  for (const char* samples : {"1", "33"}) {
+    expect_one(
+        parse(std::string(R"({"preset": "dlp-brg-120hz", "method": "gather", "gather_samples": )") + samples + "}"),
+        ".gather_samples", "must be 2…32, or 0 for 8 (got " + std::string(samples) + ")");
+  }
+}
+
 TEST(ColorFields, UnknownPresetListsThePresets) {
   const auto parsed = parse(R"({"preset": "dlp"})");
   expect_one(parsed, ".preset", "(presets are: dlp-brg-120hz, dlp-stereo-as-mono)");
@@ -177,7 +194,8 @@ TEST(ColorFields, PresetAndFieldsTogether) {
 }
 
 TEST(ColorFields, AWelcomeCarriesTheFieldsAndTheirSettings) {
-  const auto parsed = parse(R"({"preset": "dlp-stereo-as-mono", "velocity_threshold": 24})");
+  const auto parsed =
+      parse(R"({"preset": "dlp-stereo-as-mono", "method": "gather", "velocity_threshold": 24, "gather_samples": 4})");
   ASSERT_TRUE(parsed) << parsed.error();
   const auto again = parse_installation(to_schema(parsed.value()), ::testing::TempDir(), "welcome");
   ASSERT_TRUE(again) << again.error();

@@ -1,8 +1,8 @@
-#version 450 core
 // The scene in linear light. Blinn-Phong with a roughness-derived exponent and a
 // normalized specular lobe, Fresnel F0 from metallic: a cheap stand-in for
 // metallic/roughness. All linear: the base colour texture is sRGB8_ALPHA8, so
-// sampling it decodes to linear.
+// sampling it decodes to linear. Built with "#version 450 core" first, and VELOCITY
+// for the gather (render/field_gather.h): then also each fragment's screen velocity.
 in vec3 world_position;
 in vec3 world_normal;
 in vec2 texture_uv;
@@ -16,7 +16,16 @@ uniform vec3 emissive;
 uniform vec3 ambient;
 uniform int light_count;
 layout(std430, binding = 0) readonly buffer Lights { vec4 lights[]; };  // position, radiance
-out vec4 colour;
+layout(location = 0) out vec4 colour;
+#ifdef VELOCITY
+// Clip positions are linear in the surface point, so interpolated they are the
+// fragment's own at both moments: its velocity is exact, not a vertex average.
+in vec4 clip_0;
+in vec4 clip_1;
+uniform vec2 half_size;  // pixels per unit of NDC
+// Screen velocity (pixels per frame period, rows up) and linear depth.
+layout(location = 1) out vec4 motion;
+#endif
 const float kPi = 3.14159265358979;
 void main() {
   vec3 base_colour = base_colour_factor;
@@ -41,4 +50,9 @@ void main() {
     result += (diffuse + specular) * lights[2 * i + 1].rgb * (n_dot_l / r2);
   }
   colour = vec4(result, 1.0);
+#ifdef VELOCITY
+  vec2 velocity = vec2(0.0);
+  if (clip_0.w > 1e-6 && clip_1.w > 1e-6) velocity = (clip_1.xy / clip_1.w - clip_0.xy / clip_0.w) * half_size;
+  motion = vec4(velocity, 1.0 / gl_FragCoord.w, 1.0);
+#endif
 }

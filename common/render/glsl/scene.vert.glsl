@@ -1,5 +1,5 @@
-#version 450 core
 // The scene: world position, normal and texture coordinates for the fragment shader.
+// Built with "#version 450 core" first, and VELOCITY for the gather (render/field_gather.h).
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;
@@ -9,9 +9,21 @@ uniform mat3 normal_matrix;
 out vec3 world_position;
 out vec3 world_normal;
 out vec2 texture_uv;
+#ifdef VELOCITY
+// The vertex seen at the frame's display time and a frame later (each moment
+// with its own eye): the fragment's screen velocity comes from these.
+uniform mat4 model_view_projection_0;
+uniform mat4 model_view_projection_1;
+out vec4 clip_0;
+out vec4 clip_1;
+#endif
 void main() {
   world_position = (model * vec4(position, 1.0)).xyz;
   world_normal = normal_matrix * normal;
   texture_uv = uv;
   gl_Position = model_view_projection * vec4(position, 1.0);
+#ifdef VELOCITY
+  clip_0 = model_view_projection_0 * vec4(position, 1.0);
+  clip_1 = model_view_projection_1 * vec4(position, 1.0);
+#endif
 }

@@ -1,0 +1,150 @@
+#include "render/field_gather.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "render/shaders.h"
+
+namespace optique::render {
+namespace {
+
+constexpr std::string_view kVersion = "#version 450 core\n";
+
+Result<glo::Program> fullscreen_program(std::string_view fragment) {
+  return glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(fragment));
+}
+
+// A single-sample float texture and a framebuffer that draws into it.
+void make_target(GLenum format, int width, int height, glo::Texture& texture, glo::Framebuffer& framebuffer) {
+  texture = glo::make_texture();
+  glTextureStorage2D(texture.get(), 1, format, width, height);
+  glTextureParameteri(texture.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(texture.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  framebuffer = glo::make_framebuffer();
+  glNamedFramebufferTexture(framebuffer.get(), GL_COLOR_ATTACHMENT0, texture.get(), 0);
+}
+
+}  // namespace
+
+Result<std::unique_ptr<FieldGather>> FieldGather::create(int width, int height, int samples) {
+  assert(width > 0 && height > 0 && samples >= 1);
+  std::unique_ptr<FieldGather> g(new FieldGather());
+  g->width_ = width;
+  g->height_ = height;
+  g->samples_ = samples;
+  g->tiles_x_ = (width + kGatherRadius - 1) / kGatherRadius;
+  g->tiles_y_ = (height + kGatherRadius - 1) / kGatherRadius;
+  struct Built {
+    glo::Program* program;
+    std::string_view source;
+    const char* name;
+  };
+  for (const Built& b : {Built{&g->resolve_program_, shaders::motion_resolve_frag, "motion resolve"},
+                         Built{&g->tile_max_program_, shaders::tile_max_frag, "tile max"},
+                         Built{&g->neighbour_max_program_, shaders::neighbour_max_frag, "neighbour max"},
+                         Built{&g->gather_program_, shaders::field_gather_frag, "field gather"}}) {
+    auto program = fullscreen_program(b.source);
+    if (!program) return Error{std::string("the ") + b.name + " pass: " + program.error()};
+    *b.program = std::move(program).value();
+  }
+  // Velocity in pixels and depth in metres: 32-bit floats, like the colour.
+  make_target(GL_RGBA32F, width, height, g->motion_, g->motion_framebuffer_);
+  if (samples > 1) {
+    g->motion_samples_ = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
+    glTextureStorage2DMultisample(g->motion_samples_.get(), samples, GL_RGBA32F, width, height, GL_TRUE);
+  }
+  make_target(GL_RG32F, g->tiles_x_, g->tiles_y_, g->tile_max_, g->tile_max_framebuffer_);
+  make_target(GL_RG32F, g->tiles_x_, g->tiles_y_, g->neighbour_max_, g->neighbour_max_framebuffer_);
+  for (GLuint fb :
+       {g->motion_framebuffer_.get(), g->tile_max_framebuffer_.get(), g->neighbour_max_framebuffer_.get()}) {
+    if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      return Error{"this GL driver cannot draw the gather's velocity targets (RGBA32F, RG32F)"};
+    }
+  }
+  g->empty_vertex_array_ = glo::make_vertex_array();
+  glProgramUniform1i(g->resolve_program_.get(), glGetUniformLocation(g->resolve_program_.get(), "samples"), samples);
+  glProgramUniform1i(g->tile_max_program_.get(), glGetUniformLocation(g->tile_max_program_.get(), "tile"),
+                     kGatherRadius);
+  const GLuint gather = g->gather_program_.get();
+  glProgramUniform1i(gather, glGetUniformLocation(gather, "tile"), kGatherRadius);
+  glProgramUniform1f(gather, glGetUniformLocation(gather, "radius"), static_cast<float>(kGatherRadius));
+  return g;
+}
+
+GLuint FieldGather::motion_target() const { return samples_ > 1 ? motion_samples_.get() : motion_.get(); }
+
+void FieldGather::clear_motion(GLuint framebuffer) {
+  const GLfloat still_and_far[4] = {0.0f, 0.0f, 3.0e38f, 0.0f};
+  glClearNamedFramebufferfv(framebuffer, GL_COLOR, 1, still_and_far);
+}
+
+GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings,
+                              GLuint out) {
+  assert(fields.size() <= static_cast<std::size_t>(kMaxGatherFields));
+  assert(settings.samples >= 2);
+  glDisable(GL_DEPTH_TEST);
+  glBindVertexArray(empty_vertex_array_.get());
+  const auto pass = [&](GLuint program, GLuint framebuffer, int width, int height) {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glViewport(0, 0, width, height);
+    glUseProgram(program);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+  };
+  if (samples_ > 1) {
+    glBindTextureUnit(0, motion_samples_.get());
+    pass(resolve_program_.get(), motion_framebuffer_.get(), width_, height_);
+  }
+  glBindTextureUnit(0, motion_.get());
+  pass(tile_max_program_.get(), tile_max_framebuffer_.get(), tiles_x_, tiles_y_);
+  glBindTextureUnit(0, tile_max_.get());
+  pass(neighbour_max_program_.get(), neighbour_max_framebuffer_.get(), tiles_x_, tiles_y_);
+
+  const GLuint gather = gather_program_.get();
+  const auto uniform = [gather](const char* name) { return glGetUniformLocation(gather, name); };
+  std::vector<GLfloat> channels;
+  std::vector<GLfloat> shifts;
+  double farthest_shift = 0.0;
+  for (const GatherField& f : fields) {
+    channels.insert(channels.end(), {f.red ? 1.0f : 0.0f, f.green ? 1.0f : 0.0f, f.blue ? 1.0f : 0.0f});
+    shifts.push_back(static_cast<GLfloat>(f.shift));
+    farthest_shift = std::max(farthest_shift, std::abs(f.shift));
+  }
+  const auto count = static_cast<GLsizei>(fields.size());
+  glProgramUniform1i(gather, uniform("field_count"), count);
+  if (count > 0) {
+    glProgramUniform3fv(gather, uniform("field_channels"), count, channels.data());
+    glProgramUniform1fv(gather, uniform("field_shift"), count, shifts.data());
+  }
+  glProgramUniform1i(gather, uniform("samples"), settings.samples);
+  const double threshold = settings.velocity_threshold;
+  glProgramUniform2f(gather, uniform("blur_band"), static_cast<float>(kBlurBandFrom * threshold),
+                     static_cast<float>(kBlurBandTo * threshold));
+  glProgramUniform2f(gather, uniform("frame_shift"), static_cast<float>(settings.frame_start),
+                     static_cast<float>(settings.frame_end));
+  glBindTextureUnit(0, colour);
+  glBindTextureUnit(1, motion_.get());
+  glBindTextureUnit(2, neighbour_max_.get());
+  pass(gather, out, width_, height_);
+
+  // The tiles' fastest (a few thousand values) tell whether the radius cut a
+  // field's motion short.
+  std::vector<GLfloat> tiles(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_) * 2);
+  glGetTextureImage(tile_max_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(tiles.size() * sizeof(GLfloat)),
+                    tiles.data());
+  GatherReport report;
+  for (std::size_t i = 0; i + 1 < tiles.size(); i += 2) {
+    report.fastest = std::max(report.fastest, std::hypot(double{tiles[i]}, double{tiles[i + 1]}));
+  }
+  if (threshold > 0.0 && report.fastest > kBlurBandFrom * threshold) {  // some pixels blurred
+    farthest_shift = std::max({farthest_shift, std::abs(settings.frame_start), std::abs(settings.frame_end)});
+  }
+  report.clamped = report.fastest * farthest_shift > kGatherRadius;
+  return report;
+}
+
+}  // namespace optique::render
