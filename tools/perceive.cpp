@@ -161,7 +161,9 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
     std::vector<image::FloatImage> lights;
     lights.reserve(screen_image.projectors.size() * static_cast<std::size_t>(last - first + 1));
     std::vector<optics::Emission> emissions;
+    double white = 0.0;  // the most light one projector of this screen shows
     for (const config::Projector* projector : screen_image.projectors) {
+      white = std::max(white, optics::ProjectorModel(projector->response).white());
       const std::size_t index = static_cast<std::size_t>(projector - installation.projectors.data());
       const config::ProjectorJob job = config::job_for(installation, index);
       render::PipelineOptions pipeline_options;
@@ -198,7 +200,9 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
     const image::FloatImage seen = optics::perceive(emissions, width, height, exposure);
 
     // The ideal: the same eye before a display that shows every colour at every
-    // moment, at `ideal_moments` moments of the exposure.
+    // moment, at `ideal_moments` moments of the exposure — as bright as the
+    // projectors can be (a highlight beyond their white is clipped there too, and
+    // is no error of the fields).
     auto view = ReferenceView::make(installation, scene, screen_image, kIdealSupersample);
     if (!view) return Error{"screen '" + result.folder + "': " + view.error()};
     std::vector<image::FloatImage> moments;
@@ -212,6 +216,11 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
           view.value().draw(authority.state_at_frame(static_cast<std::uint64_t>(nearest)), t / period - nearest);
       if (!light) return Error{"screen '" + result.folder + "': " + light.error()};
       moments.push_back(std::move(light).value());
+      image::FloatImage& moment = moments.back();
+      const auto channels = static_cast<std::size_t>(moment.channels);
+      for (std::size_t i = 0; i < moment.pixels.size(); ++i) {
+        if (i % channels < 3) moment.pixels[i] = std::min(moment.pixels[i], static_cast<float>(white));
+      }
       continuous.push_back({&moments.back(), true, true, true, t - 0.5 * step, t + 0.5 * step, 1.0});
     }
     const image::FloatImage ideal = optics::perceive(continuous, width, height, exposure);

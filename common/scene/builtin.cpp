@@ -41,6 +41,12 @@ void add_animated(SceneDefinition& scene, std::uint32_t mesh, std::uint32_t mate
   scene.instances.push_back({mesh, material, id, glm::dmat4(1.0)});
 }
 
+// A still instance's transform: scaled by `size`, rolled about z, then moved to `position`.
+glm::dmat4 placed(const glm::dvec3& position, const glm::dvec3& size, double roll = 0.0) {
+  return glm::translate(glm::dmat4(1.0), position) * glm::rotate(glm::dmat4(1.0), roll, glm::dvec3(0, 0, 1)) *
+         glm::scale(glm::dmat4(1.0), size);
+}
+
 SceneDefinition cubes() {
   // Five unit cubes (scaled to 25 cm) on a ring, each turning about its own axis at
   // its own rate, under three white-ish point lights.
@@ -142,6 +148,97 @@ SceneDefinition moving_square() {
     const double phase = t - std::floor(t);
     return Pose{glm::dvec3(-1.5 + 3.0 * phase, 1.2, -0.2), kUpright, glm::dvec3(0.2)};
   });
+  return scene;
+}
+
+// Back and forth between −amplitude and +amplitude at `speed`, starting at 0
+// going up: a triangle wave, so the motion never jumps.
+double to_and_fro(double t, double amplitude, double speed) {
+  const double period = 4.0 * amplitude / speed;
+  const double from_low = t + 0.25 * period;  // −amplitude a quarter period before t = 0
+  const double phase = from_low - period * std::floor(from_low / period);
+  const double travelled = speed * phase;
+  return travelled <= 2.0 * amplitude ? travelled - amplitude : 3.0 * amplitude - travelled;
+}
+
+// An sRGB8 texture of `width` × `height` texels, each `texel(x, y)`'s colour.
+Texture make_texture(std::string name, int width, int height, const std::function<glm::u8vec3(int, int)>& texel) {
+  Texture texture{std::move(name), width, height, {}};
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const glm::u8vec3 c = texel(x, y);
+      texture.rgba.insert(texture.rgba.end(), {c.r, c.g, c.b, 255});
+    }
+  }
+  return texture;
+}
+
+SceneDefinition scrolling_stripes() {
+  // A 2 m × 0.5 m panel of black and white stripes of several widths (like the
+  // strokes of large text), lit evenly by ambient light alone, sliding left and
+  // right at 1.5 m/s: edges across the motion everywhere, the hardest case for
+  // colour fields.
+  SceneDefinition scene;
+  scene.name = "scrolling-stripes";
+  scene.ambient = glm::vec3(1.0f);
+  // 4 texels per 5 cm; runs of 1, 2, 3 and 2 texels, white then black.
+  constexpr std::array<int, 8> kRuns{2, 2, 4, 2, 6, 4, 4, 8};
+  scene.textures.push_back(make_texture("stripes", 160, 4, [&](int x, int) {
+    int at = x % 32;
+    for (std::size_t i = 0; i < kRuns.size(); ++i) {
+      if (at < kRuns[i]) return i % 2 == 0 ? glm::u8vec3(255) : glm::u8vec3(0);
+      at -= kRuns[i];
+    }
+    return glm::u8vec3(0);
+  }));
+  const auto panel = add_mesh(scene, make_quad(2.0f, 0.5f));
+  const auto stripes = add_material(scene, {glm::vec3(1.0f), 0.0f, 1.0f, {}, 0u});
+  add_animated(scene, panel, stripes, "stripes", [](double t) {
+    return Pose{glm::dvec3(to_and_fro(t, 0.8, 1.5), 1.2, -0.2), kUpright, glm::dvec3(1.0)};
+  });
+  return scene;
+}
+
+SceneDefinition pinball() {
+  // The fast-motion paper's pinball: a small bright steel ball bouncing across a
+  // playfield at about 3 m/s, in front of a checkered board and its bumpers and
+  // behind three posts, under eight coloured lights: a small fast object, things
+  // it uncovers at other depths, and shading that costs something to draw.
+  SceneDefinition scene;
+  scene.name = "pinball";
+  scene.ambient = glm::vec3(0.15f);
+  // 10 cm squares, 8 texels each: sharp enough edges for the eye to lose.
+  scene.textures.push_back(make_texture("board", 256, 144, [](int x, int y) {
+    return (x / 8 + y / 8) % 2 == 0 ? glm::u8vec3(60, 100, 190) : glm::u8vec3(50, 160, 90);
+  }));
+  const auto board = add_mesh(scene, make_quad(3.2f, 1.8f));
+  const auto checker = add_material(scene, {glm::vec3(1.0f), 0.0f, 0.7f, {}, 0u});
+  scene.instances.push_back({board, checker, std::nullopt, placed({0.0, 1.2, -0.6}, glm::dvec3(1.0))});
+  const auto bumper = add_mesh(scene, make_uv_sphere(1.0f, 32, 16));
+  const auto red = add_material(scene, {glm::vec3(0.8f, 0.1f, 0.1f), 0.0f, 0.3f, {}});
+  const auto yellow = add_material(scene, {glm::vec3(0.9f, 0.8f, 0.1f), 0.0f, 0.3f, {}});
+  for (int i = 0; i < 6; ++i) {
+    const glm::dvec3 where(-1.1 + 0.45 * i, 1.2 + (i % 2 == 0 ? 0.35 : -0.3), -0.45);
+    scene.instances.push_back({bumper, i % 2 == 0 ? red : yellow, std::nullopt, placed(where, glm::dvec3(0.1))});
+  }
+  const auto post = add_mesh(scene, make_box(glm::vec3(1.0f)));
+  const auto white = add_material(scene, {glm::vec3(0.85f), 0.0f, 0.5f, {}});
+  for (int i = 0; i < 3; ++i) {
+    scene.instances.push_back({post, white, std::nullopt, placed({-0.8 + 0.8 * i, 1.2, -0.1}, {0.04, 0.6, 0.04})});
+  }
+  const auto ball = add_mesh(scene, make_uv_sphere(1.0f, 32, 16));
+  const auto steel = add_material(scene, {glm::vec3(0.9f), 1.0f, 0.15f, glm::vec3(0.8f)});
+  add_animated(scene, ball, steel, "ball", [](double t) {
+    return Pose{glm::dvec3(to_and_fro(t, 1.4, 2.6), 1.2 + to_and_fro(t + 0.3, 0.7, 1.9), -0.3), kUpright,
+                glm::dvec3(0.035)};
+  });
+  for (int i = 0; i < 8; ++i) {
+    const double angle = 2.0 * std::numbers::pi * i / 8.0;
+    const float h = static_cast<float>(i) / 8.0f;
+    const glm::vec3 colour(0.6f + 0.4f * std::cos(6.2832f * h), 0.6f + 0.4f * std::cos(6.2832f * (h - 0.333f)),
+                           0.6f + 0.4f * std::cos(6.2832f * (h - 0.667f)));
+    scene.lights.push_back({{1.5 * std::cos(angle), 1.2 + 0.8 * std::sin(angle), 0.6}, colour, 3.0f});
+  }
   return scene;
 }
 
@@ -294,11 +391,6 @@ SceneDefinition probe(std::string name) {
   return scene;
 }
 
-glm::dmat4 placed(const glm::dvec3& position, const glm::dvec3& size, double roll = 0.0) {
-  return glm::translate(glm::dmat4(1.0), position) * glm::rotate(glm::dmat4(1.0), roll, glm::dvec3(0, 0, 1)) *
-         glm::scale(glm::dmat4(1.0), size);
-}
-
 SceneDefinition stereo_probe() {
   // A 10 cm square 1 m behind a wall at z = 0, at eye height: its two eyes' images
   // are apart by the parallax of that depth.
@@ -329,6 +421,8 @@ constexpr std::array kScenes{
     Entry{"many-lights", [] { return many_lights(20); }},
     Entry{"depth-stack", depth_stack},
     Entry{"moving-square", moving_square},
+    Entry{"scrolling-stripes", scrolling_stripes},
+    Entry{"pinball", pinball},
     Entry{"cubes-backdrop", cubes_backdrop},
     Entry{"many-lights-50", [] { return many_lights(50); }},
     Entry{"many-lights-100", [] { return many_lights(100); }},

@@ -11,6 +11,7 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -144,7 +145,8 @@ TEST_P(EveryBuiltinScene, IsLit) {
   const bool emissive = std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) {
     return std::max({m.emissive.r, m.emissive.g, m.emissive.b}) > 0.0f;
   });
-  EXPECT_TRUE(!scene.lights.empty() || emissive);
+  const bool ambient = std::max({scene.ambient.r, scene.ambient.g, scene.ambient.b}) > 0.0f;
+  EXPECT_TRUE(!scene.lights.empty() || emissive || ambient);
   for (const PointLight& light : scene.lights) {
     EXPECT_TRUE(finite(light.position));
     EXPECT_GT(light.intensity, 0.0f);
@@ -188,6 +190,25 @@ TEST(BuiltinScenes, OriginalScenesKeepTheirShape) {
   EXPECT_EQ(cubes.objects.size(), 5u);
   EXPECT_EQ(cubes.lights.size(), 3u);
   EXPECT_GE(load("many-lights").lights.size(), 20u);
+}
+
+// The colour-field scenes move fast but never jump: a jump would be a velocity
+// no eye follows (and the gather would clamp it).
+TEST(BuiltinScenes, TheColourFieldScenesMoveWithoutJumps) {
+  for (const auto& [name, object, speed] :
+       {std::tuple{"scrolling-stripes", "stripes", 1.5}, std::tuple{"pinball", "ball", std::hypot(2.6, 1.9)}}) {
+    const SceneDefinition scene = load(name);
+    const auto found = std::find_if(scene.objects.begin(), scene.objects.end(),
+                                    [&](const AnimatedObject& o) { return o.name == object; });
+    ASSERT_NE(found, scene.objects.end()) << name;
+    constexpr double kStep = 1.0 / 240.0;
+    double fastest = 0.0;
+    for (double t = 0.0; t < 6.0; t += kStep) {
+      fastest = std::max(fastest, glm::length(found->pose_at(t + kStep).position - found->pose_at(t).position) / kStep);
+    }
+    EXPECT_LE(fastest, speed * 1.0001) << name;
+    EXPECT_GE(fastest, speed * 0.9) << name;
+  }
 }
 
 class SeedScene : public ::testing::TestWithParam<std::string> {};
