@@ -17,6 +17,9 @@ Result<glo::Program> fullscreen_program(std::string_view fragment) {
   return glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(fragment));
 }
 
+// Two triangles per tile, in NDC: 12 floats.
+constexpr std::size_t kFloatsPerTile = 12;
+
 // A single-sample float texture and a framebuffer that draws into it.
 void make_target(GLenum format, int width, int height, glo::Texture& texture, glo::Framebuffer& framebuffer) {
   texture = glo::make_texture();
@@ -46,24 +49,43 @@ Result<std::unique_ptr<FieldGather>> FieldGather::create(int width, int height, 
   };
   for (const Built& b : {Built{&g->resolve_program_, shaders::motion_resolve_frag, "motion resolve"},
                          Built{&g->tile_max_program_, shaders::tile_max_frag, "tile max"},
-                         Built{&g->neighbour_max_program_, shaders::neighbour_max_frag, "neighbour max"},
-                         Built{&g->gather_program_, shaders::field_gather_frag, "field gather"}}) {
+                         Built{&g->neighbour_max_program_, shaders::neighbour_max_frag, "neighbour max"}}) {
     auto program = fullscreen_program(b.source);
     if (!program) return Error{std::string("the ") + b.name + " pass: " + program.error()};
     *b.program = std::move(program).value();
   }
+  auto gather_program = glo::link_program(std::string(kVersion) + std::string(shaders::tiles_vert),
+                                          std::string(kVersion) + std::string(shaders::field_gather_frag));
+  if (!gather_program) return Error{"the field gather pass: " + gather_program.error()};
+  g->gather_program_ = std::move(gather_program).value();
   // Velocity in pixels and depth in metres: 32-bit floats, like the colour.
-  make_target(GL_RGBA32F, width, height, g->motion_, g->motion_framebuffer_);
+  make_target(GL_RGBA16F, width, height, g->motion_, g->motion_framebuffer_);
   if (samples > 1) {
     g->motion_samples_ = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
-    glTextureStorage2DMultisample(g->motion_samples_.get(), samples, GL_RGBA32F, width, height, GL_TRUE);
+    glTextureStorage2DMultisample(g->motion_samples_.get(), samples, GL_RGBA16F, width, height, GL_TRUE);
   }
+  make_target(GL_RGBA32F, width, height, g->gathered_, g->gathered_framebuffer_);
+  // Read by the output pass like the linear image: bilinear for a two-pass warp.
+  glTextureParameteri(g->gathered_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(g->gathered_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
   make_target(GL_RG32F, g->tiles_x_, g->tiles_y_, g->tile_max_, g->tile_max_framebuffer_);
   make_target(GL_RG32F, g->tiles_x_, g->tiles_y_, g->neighbour_max_, g->neighbour_max_framebuffer_);
-  for (GLuint fb :
-       {g->motion_framebuffer_.get(), g->tile_max_framebuffer_.get(), g->neighbour_max_framebuffer_.get()}) {
+  g->tile_quads_ = glo::make_buffer();
+  glNamedBufferStorage(
+      g->tile_quads_.get(),
+      static_cast<GLsizeiptr>(static_cast<std::size_t>(g->tiles_x_) * static_cast<std::size_t>(g->tiles_y_) *
+                              kFloatsPerTile * sizeof(GLfloat)),
+      nullptr, GL_DYNAMIC_STORAGE_BIT);
+  g->tile_vertex_array_ = glo::make_vertex_array();
+  const GLuint va = g->tile_vertex_array_.get();
+  glVertexArrayVertexBuffer(va, 0, g->tile_quads_.get(), 0, 2 * sizeof(GLfloat));
+  glEnableVertexArrayAttrib(va, 0);
+  glVertexArrayAttribFormat(va, 0, 2, GL_FLOAT, GL_FALSE, 0);
+  glVertexArrayAttribBinding(va, 0, 0);
+  for (GLuint fb : {g->motion_framebuffer_.get(), g->tile_max_framebuffer_.get(), g->neighbour_max_framebuffer_.get(),
+                    g->gathered_framebuffer_.get()}) {
     if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      return Error{"this GL driver cannot draw the gather's velocity targets (RGBA32F, RG32F)"};
+      return Error{"this GL driver cannot draw the gather's targets (RGBA16F, RG32F, RGBA32F)"};
     }
   }
   g->empty_vertex_array_ = glo::make_vertex_array();
@@ -83,8 +105,7 @@ void FieldGather::clear_motion(GLuint framebuffer) {
   glClearNamedFramebufferfv(framebuffer, GL_COLOR, 1, still_and_far);
 }
 
-GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings,
-                              GLuint out) {
+GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings) {
   assert(fields.size() <= static_cast<std::size_t>(kMaxGatherFields));
   assert(settings.samples >= 2);
   glDisable(GL_DEPTH_TEST);
@@ -104,15 +125,58 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
   glBindTextureUnit(0, tile_max_.get());
   pass(neighbour_max_program_.get(), neighbour_max_framebuffer_.get(), tiles_x_, tiles_y_);
 
+  // The tiles' fastest (a few thousand values): which tiles have something
+  // moving within reach, and whether the radius cut a field's motion short.
+  std::vector<GLfloat> tiles(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_) * 2);
+  glGetTextureImage(tile_max_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(tiles.size() * sizeof(GLfloat)),
+                    tiles.data());
+  double farthest_shift = 0.0;
+  for (const GatherField& f : fields) farthest_shift = std::max(farthest_shift, std::abs(f.shift));
+  const double threshold = settings.velocity_threshold;
+  GatherReport report;
+  std::vector<double> speed(tiles.size() / 2);
+  for (std::size_t i = 0; i < speed.size(); ++i) {
+    speed[i] = std::hypot(double{tiles[2 * i]}, double{tiles[2 * i + 1]});
+    report.fastest = std::max(report.fastest, speed[i]);
+  }
+  const bool blurs = threshold > 0.0 && report.fastest > kBlurBandFrom * threshold;
+  const double reach = std::max(
+      {farthest_shift, blurs ? std::abs(settings.frame_start) : 0.0, blurs ? std::abs(settings.frame_end) : 0.0});
+  report.clamped = report.fastest * reach > kGatherRadius;
+
+  // The render as it is; then, over it, the tiles where a field moves something
+  // (the shader's own test: a neighbour max that moves a surface 1e-3 px).
+  glCopyImageSubData(colour, GL_TEXTURE_2D, 0, 0, 0, 0, gathered_.get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_, height_, 1);
+  std::vector<GLfloat> quads;
+  const auto ndc = [](int pixel, int size) { return static_cast<GLfloat>(2.0 * pixel / size - 1.0); };
+  for (int ty = 0; ty < tiles_y_; ++ty) {
+    for (int tx = 0; tx < tiles_x_; ++tx) {
+      double near = 0.0;
+      for (int y = std::max(ty - 1, 0); y <= std::min(ty + 1, tiles_y_ - 1); ++y) {
+        for (int x = std::max(tx - 1, 0); x <= std::min(tx + 1, tiles_x_ - 1); ++x) {
+          near = std::max(
+              near,
+              speed[static_cast<std::size_t>(y) * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(x)]);
+        }
+      }
+      if (near * reach < 1e-3) continue;
+      const GLfloat x0 = ndc(tx * kGatherRadius, width_);
+      const GLfloat x1 = ndc(std::min((tx + 1) * kGatherRadius, width_), width_);
+      const GLfloat y0 = ndc(ty * kGatherRadius, height_);
+      const GLfloat y1 = ndc(std::min((ty + 1) * kGatherRadius, height_), height_);
+      quads.insert(quads.end(), {x0, y0, x1, y0, x1, y1, x0, y0, x1, y1, x0, y1});
+    }
+  }
+  report.gathered_tiles = static_cast<int>(quads.size() / kFloatsPerTile);
+  if (quads.empty()) return report;
+
   const GLuint gather = gather_program_.get();
   const auto uniform = [gather](const char* name) { return glGetUniformLocation(gather, name); };
   std::vector<GLfloat> channels;
   std::vector<GLfloat> shifts;
-  double farthest_shift = 0.0;
   for (const GatherField& f : fields) {
     channels.insert(channels.end(), {f.red ? 1.0f : 0.0f, f.green ? 1.0f : 0.0f, f.blue ? 1.0f : 0.0f});
     shifts.push_back(static_cast<GLfloat>(f.shift));
-    farthest_shift = std::max(farthest_shift, std::abs(f.shift));
   }
   const auto count = static_cast<GLsizei>(fields.size());
   glProgramUniform1i(gather, uniform("field_count"), count);
@@ -121,7 +185,6 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
     glProgramUniform1fv(gather, uniform("field_shift"), count, shifts.data());
   }
   glProgramUniform1i(gather, uniform("samples"), settings.samples);
-  const double threshold = settings.velocity_threshold;
   glProgramUniform2f(gather, uniform("blur_band"), static_cast<float>(kBlurBandFrom * threshold),
                      static_cast<float>(kBlurBandTo * threshold));
   glProgramUniform2f(gather, uniform("frame_shift"), static_cast<float>(settings.frame_start),
@@ -129,21 +192,12 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
   glBindTextureUnit(0, colour);
   glBindTextureUnit(1, motion_.get());
   glBindTextureUnit(2, neighbour_max_.get());
-  pass(gather, out, width_, height_);
-
-  // The tiles' fastest (a few thousand values) tell whether the radius cut a
-  // field's motion short.
-  std::vector<GLfloat> tiles(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_) * 2);
-  glGetTextureImage(tile_max_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(tiles.size() * sizeof(GLfloat)),
-                    tiles.data());
-  GatherReport report;
-  for (std::size_t i = 0; i + 1 < tiles.size(); i += 2) {
-    report.fastest = std::max(report.fastest, std::hypot(double{tiles[i]}, double{tiles[i + 1]}));
-  }
-  if (threshold > 0.0 && report.fastest > kBlurBandFrom * threshold) {  // some pixels blurred
-    farthest_shift = std::max({farthest_shift, std::abs(settings.frame_start), std::abs(settings.frame_end)});
-  }
-  report.clamped = report.fastest * farthest_shift > kGatherRadius;
+  glNamedBufferSubData(tile_quads_.get(), 0, static_cast<GLsizeiptr>(quads.size() * sizeof(GLfloat)), quads.data());
+  glBindFramebuffer(GL_FRAMEBUFFER, gathered_framebuffer_.get());
+  glViewport(0, 0, width_, height_);
+  glUseProgram(gather);
+  glBindVertexArray(tile_vertex_array_.get());
+  glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(quads.size() / 2));
   return report;
 }
 

@@ -28,10 +28,11 @@ class FieldGather {
   static void clear_motion(GLuint framebuffer);
 
   // After the scene is drawn and its colour resolved into `colour` (one sample
-  // per pixel): each field's channels into `out` (the same size). At most
-  // kMaxGatherFields fields, each channel in one of them.
-  [[nodiscard]] GatherReport run(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings,
-                                 GLuint out);
+  // per pixel, this size): each field's channels into output(). At most
+  // kMaxGatherFields fields, each channel in one of them. Only the tiles where
+  // something moves are gathered; the others are the render as it is.
+  [[nodiscard]] GatherReport run(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings);
+  [[nodiscard]] GLuint output() const { return gathered_.get(); }
 
  private:
   FieldGather() = default;
@@ -52,6 +53,10 @@ class FieldGather {
   glo::Program neighbour_max_program_;
   glo::Program gather_program_;
   glo::VertexArray empty_vertex_array_;
+  glo::Texture gathered_;
+  glo::Framebuffer gathered_framebuffer_;
+  glo::Buffer tile_quads_;  // the moving tiles' triangles, NDC, rewritten per frame
+  glo::VertexArray tile_vertex_array_;
 };
 
 }  // namespace optique::render

@@ -49,8 +49,9 @@ inline constexpr double kBlurBandTo = 1.2;
 
 // What one gather found.
 struct GatherReport {
-  double fastest = 0.0;  // the fastest screen velocity drawn, pixels per frame period
-  bool clamped = false;  // some field moved a surface farther than kGatherRadius: cut short
+  double fastest = 0.0;    // the fastest screen velocity drawn, pixels per frame period
+  bool clamped = false;    // some field moved a surface farther than kGatherRadius: cut short
+  int gathered_tiles = 0;  // of kGatherRadius² pixels; the others show the render as it is
 };
 
 // The farthest a field moves a surface (pixels): also the tile size.

@@ -63,6 +63,7 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
   std::unique_ptr<ProjectorPipeline> pipeline(
       new ProjectorPipeline(std::move(view).value(), std::move(renderer).value(), job, stage.projector));
   if (self.content.role == config::ContentRole::lights) pipeline->set_share({});
+  pipeline->still_once_ = options.still_once;
   return pipeline;
 }
 
@@ -122,7 +123,7 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state) {
     pass.value().blue = field.channel == config::Channel::blue;
     passes.push_back(pass.value());
   }
-  renderer_->draw_fields(state, passes, terms_);
+  renderer_->draw_fields(state, passes, terms_, still_once_);
   return {};
 }
 

@@ -32,6 +32,9 @@ struct PipelineOptions {
   // Samples per pixel (multisampling); 0: the projector's own, which is
   // kFieldSamples with colour fields and 1 without.
   int samples = 0;
+  // Per-field colour fields: what does not move drawn once for all fields (when
+  // the viewer is still). Off only to measure what it saves.
+  bool still_once = true;
 };
 
 // A field's edge must land within a fraction of a pixel of where its moment puts
@@ -96,6 +99,7 @@ class ProjectorPipeline {
   config::ColorFields color_fields_;
   LightTerms terms_;
   GatherReport gather_report_;
+  bool still_once_ = true;
 };
 
 }  // namespace optique::render

@@ -120,12 +120,10 @@ struct SceneRenderer::Gl {
   } focus_uniforms{};
   SceneUniforms uniforms{};
   // The gather's (prepare_gather): the scene program that also writes velocity,
-  // the passes, and the image the fields are gathered into.
+  // and the passes (which hold the image the fields are gathered into).
   glo::Program velocity_program;
   SceneUniforms velocity_uniforms{};
   std::unique_ptr<FieldGather> gather;
-  glo::Texture gathered_colour;
-  glo::Framebuffer gathered_framebuffer;
 };
 
 SceneRenderer::SceneRenderer(std::unique_ptr<Gl> gl) : gl_(std::move(gl)) {}
@@ -386,7 +384,7 @@ void SceneRenderer::draw(const scene::SceneState& state, double fraction, const 
 }
 
 void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
-                                const LightTerms& terms) {
+                                const LightTerms& terms, bool still_once_allowed) {
   begin_linear();
   // Seen from one place in every field (the viewer does not move), what does not
   // move looks the same in each: it is drawn once, in every channel, and each
@@ -395,7 +393,7 @@ void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const 
     return p.eye == passes.front().eye && p.frustum.view == passes.front().frustum.view &&
            p.frustum.projection == passes.front().frustum.projection;
   });
-  const bool still_once = !passes.empty() && one_view;
+  const bool still_once = still_once_allowed && !passes.empty() && one_view;
   if (still_once) {
     const FieldPass& first = passes.front();
     draw_scene(state, first.fraction, first.eye, first.frustum, terms, Objects::still);
@@ -424,19 +422,9 @@ Result<void> SceneRenderer::prepare_gather() {
   if (!program) return Error{program.error()};
   auto gather = FieldGather::create(gl.width, gl.height, gl.samples);
   if (!gather) return Error{gather.error()};
-  gl.gathered_colour = glo::make_texture();
-  glTextureStorage2D(gl.gathered_colour.get(), 1, GL_RGBA32F, gl.width, gl.height);
-  glTextureParameteri(gl.gathered_colour.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-  glTextureParameteri(gl.gathered_colour.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-  glTextureParameteri(gl.gathered_colour.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(gl.gathered_colour.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  gl.gathered_framebuffer = glo::make_framebuffer();
-  glNamedFramebufferTexture(gl.gathered_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl.gathered_colour.get(), 0);
   glNamedFramebufferTexture(draw_framebuffer(), GL_COLOR_ATTACHMENT1, gather.value()->motion_target(), 0);
-  for (GLuint fb : {draw_framebuffer(), gl.gathered_framebuffer.get()}) {
-    if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      return Error{"this GL driver cannot draw the scene's velocity beside its colour"};
-    }
+  if (glCheckNamedFramebufferStatus(draw_framebuffer(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    return Error{"this GL driver cannot draw the scene's velocity beside its colour"};
   }
   gl.velocity_program = std::move(program).value();
   gl.gather = std::move(gather).value();
@@ -451,9 +439,8 @@ GatherReport SceneRenderer::draw_gathered(const scene::SceneState& state, const 
   const Motion motion{frame.view_projection_now, frame.view_projection_next};
   draw_scene(state, frame.seen.fraction, frame.seen.eye, frame.seen.frustum, terms, Objects::all, &motion);
   resolve();
-  const GatherReport report =
-      gl.gather->run(gl.linear_colour.get(), frame.fields, frame.settings, gl.gathered_framebuffer.get());
-  encode(gl.gathered_colour.get());
+  const GatherReport report = gl.gather->run(gl.linear_colour.get(), frame.fields, frame.settings);
+  encode(gl.gather->output());
   return report;
 }
 

@@ -94,8 +94,10 @@ class SceneRenderer {
   // image, each pass writing only its channels, so each colour shows the scene at
   // the moment its field is on screen; then the output stage, once. When every
   // pass sees the scene from the same place, what does not move is drawn once for
-  // all of them. Returns when the GPU is done.
-  void draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes, const LightTerms& terms = {});
+  // all of them (unless `still_once` is false: to measure what that saves).
+  // Returns when the GPU is done.
+  void draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes, const LightTerms& terms = {},
+                   bool still_once = true);
 
   // The same by the gather method; prepare_gather first. Returns when the GPU is
   // done, with what the gather found.

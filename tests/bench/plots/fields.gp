@@ -1,21 +1,27 @@
-# Colour fields (series.py fields): one block per wall (640×360, 1056×594); rows
-# per method (one moment per frame, per-field at 1 and at 4 samples per pixel);
-# columns method, draw ms (median, min, max), ratio (median, min, max), fringe px,
-# PSNR_Y dB.
-width = 1200; height = 480
+# Colour fields (series.py fields): one block per scene (moving square, pinball,
+# scrolling stripes); rows per method in the bench's order (0 one moment per
+# frame, 1 per-field at 1 sample per pixel, 2 per-field shipped, 3 per-field with
+# still objects per field, 4–6 gather at 4, 8, 16 samples along the motion, 7
+# gather at 1 sample per pixel);
+# columns method, draw ms (median, min, max), ratio to one moment (median, min,
+# max), ratio to per-field (median, min, max), fringe px, PSNR_Y dB, worst
+# channel dB against per-field (NaN: identical).
+width = 1200; height = 620
 load dir.'/style.gp'
-set multiplot layout 1,2 title "Single-chip DLP projector: cost of drawing each colour field for its moment, against what a tracking eye sees"
-method(i) = i == 0 ? 'one moment per frame' : i == 1 ? 'per-field, 1 sample/px' : 'per-field, 4 samples/px'
-set xlabel 'draw time ÷ one moment per frame (median over runs, bars min–max)'
+set multiplot layout 1,2 title "Single-chip DLP projector: each colour field at its moment, per-field or gathered from one render"
+method(i) = i == 0 ? 'one moment' : i == 1 ? 'per-field 1 spp' : i == 2 ? 'per-field' : i == 3 ? 'per-field, still per field' : i == 4 ? 'gather 4' : i == 5 ? 'gather 8' : i == 6 ? 'gather 16' : 'gather 8, 1 spp'
+scene(b) = b == 0 ? 'square' : b == 1 ? 'pinball' : 'stripes'
 set offsets graph 0.08, graph 0.08, graph 0.1, graph 0.1
-set title 'PSNR_Y against the ideal, around the tracked square'
+set bmargin 9
+set xlabel 'draw time ÷ one moment per frame (median over runs, bars min–max)'
+set title "PSNR_Y of what a tracking eye sees, against the ideal\n(■ square, ● pinball, ▲ stripes)"
 set ylabel 'PSNR_Y (dB)'
-set key bottom right
-plot for [m = 0:2] data index 0 using ($1 == m ? $5 : NaN):9:6:7 with xerrorbars lt (m + 1) pt 7 title method(m).', 3.6 px/frame', \
-     for [m = 0:2] data index 1 using ($1 == m ? $5 : NaN):9:6:7 with xerrorbars lt (m + 1) pt 5 title method(m).', 6 px/frame'
-set title "Colour fringe: spread of the channels' edges across the motion"
-set ylabel 'fringe (px)'
-set key top right
-plot for [m = 0:2] data index 0 using ($1 == m ? $5 : NaN):8:6:7 with xerrorbars lt (m + 1) pt 7 title method(m).', 3.6 px/frame', \
-     for [m = 0:2] data index 1 using ($1 == m ? $5 : NaN):8:6:7 with xerrorbars lt (m + 1) pt 5 title method(m).', 6 px/frame'
+set key outside bottom center horizontal maxcols 3 font ',9'
+plot for [b = 0:2] for [m = 0:7] data index b using ($1 == m ? $5 : NaN):12:6:7 with xerrorbars lt (m + 1) pt (5 + 2 * b) title (b == 0 ? method(m) : '')
+set xlabel 'draw time ÷ per-field (median over runs, bars min–max)'
+set title "Against per-field's perceived image (worst channel)\n(■ square, ● pinball, ▲ stripes)"
+set ylabel 'PSNR (dB)'
+set key outside bottom center horizontal maxcols 3 font ',9'
+# per-field's own rows are identical to it (no point): the others only
+plot for [b = 0:2] for [k in "0 1 4 5 6 7"] data index b using ($1 == k + 0 ? $8 : NaN):13:9:10 with xerrorbars lt (k + 1) pt (5 + 2 * b) title (b == 0 ? method(k + 0) : '')
 unset multiplot

@@ -207,25 +207,29 @@ def oblique_depth(rows):
 
 
 def fields(rows):
-    """One block per wall, one line per method in the order run: method index,
-    draw ms and ratio to one moment per frame (median, min, max over runs), the
-    fringe width and PSNR_Y (one perceive each)."""
-    walls, methods = [], []
+    """One block per scene, one line per method in the order run: method index,
+    draw ms, ratio to one moment per frame and ratio to per-field (median, min,
+    max over runs each), the fringe width, PSNR_Y against the ideal and the worst
+    channel's PSNR against per-field (one perceive each; NaN where identical)."""
+    scenes, methods = [], []
     for r in rows:
-        if r["wall"] not in walls:
-            walls.append(r["wall"])
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
         if r["method"] not in methods:
             methods.append(r["method"])
     blocks = []
-    for wall in walls:
+    for scene in scenes:
         block = []
         for i, method in enumerate(methods):
-            mine = [r for r in rows if r["wall"] == wall and r["method"] == method]
+            mine = [r for r in rows if r["scene"] == scene and r["method"] == method]
             if not mine:
-                fail(f"fields: no rows for {wall} / {method}")
+                fail(f"fields: no rows for {scene} / {method}")
+            worst = float(mine[0]["worst_channel_db_vs_per_field"])
             block.append([i, *spread([float(r["draw_ms_median"]) for r in mine]),
                           *spread([float(r["ratio_to_one_moment"]) for r in mine]),
-                          float(mine[0]["fringe_px"]), float(mine[0]["psnr_y_db"])])
+                          *spread([float(r["ratio_to_per_field"]) for r in mine]),
+                          float(mine[0]["fringe_px"]), float(mine[0]["psnr_y_db"]),
+                          worst if math.isfinite(worst) else math.nan])
         blocks.append(block)
     return blocks
 
