@@ -1,0 +1,279 @@
+// The gather method's hard cases (render/field_gather.h): every colour field of a
+// single-chip DLP projector's frame built from one render and its screen
+// velocity. Each case draws what the node draws (ProjectorPipeline) and measures
+// the emitted frame against per-field (one render per field) or against itself.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <sstream>
+
+#include <spdlog/sinks/ostream_sink.h>
+
+#include "config/job.h"
+#include "gl_installation.h"
+#include "image/compare.h"
+#include "master/scene_authority.h"
+#include "node/gl/gl_renderer.h"
+#include "render/projector_pipeline.h"
+#include "scene/builtin.h"
+
+namespace optique {
+namespace {
+
+const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs/";
+
+class FieldGather : public ::testing::Test {
+ protected:
+  void open(const std::string& config) {
+    auto opened = testing::open_gl_installation(kConfigs + config);
+    ASSERT_TRUE(opened) << opened.error();
+    gl_ = std::move(opened).value();
+  }
+  config::Installation& installation() { return gl_.config.installation; }
+  config::ColorFields& fields() { return installation().projectors.front().color_fields; }
+
+  [[nodiscard]] scene::SceneState state_at(std::uint64_t frame) const {
+    const config::Installation& inst = gl_.config.installation;
+    const master::SceneAuthority authority(gl_.scene.objects, inst.viewer, inst.master.frame_rate);
+    return authority.state_at_frame(frame);
+  }
+
+  // The frame as the projector emits it, drawn by `method`; the gather's report.
+  image::FloatImage emitted(config::FieldMethod method, std::uint64_t frame, double threshold = 0.0,
+                            render::GatherReport* report = nullptr) {
+    fields().method = method;
+    fields().velocity_threshold = threshold;
+    auto pipeline = render::ProjectorPipeline::make(config::job_for(installation(), 0), gl_.scene);
+    EXPECT_TRUE(pipeline) << (pipeline ? "" : pipeline.error());
+    if (!pipeline) return {};
+    const auto drawn = pipeline.value()->draw_frame(state_at(frame));
+    EXPECT_TRUE(drawn) << (drawn ? "" : drawn.error());
+    if (report) *report = pipeline.value()->gather_report();
+    return pipeline.value()->renderer().read_linear();
+  }
+
+  testing::GlInstallation gl_;
+};
+
+double l1(const image::FloatImage& a, const image::FloatImage& b) {
+  double sum = 0.0;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+    if (i % 4 != 3) sum += std::abs(a.pixels[i] - b.pixels[i]);
+  }
+  return sum;
+}
+
+// Where motion shows: the pixels where per-field differs from one moment per
+// frame by more than an 8-bit step, grown by 2 px — the moving edges and what
+// they uncover.
+std::vector<bool> motion_band(const image::FloatImage& per_field, const image::FloatImage& one_moment) {
+  const int w = per_field.width;
+  const int h = per_field.height;
+  std::vector<bool> moved(static_cast<std::size_t>(w) * static_cast<std::size_t>(h));
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        if (std::abs(per_field.at(x, y, c) - one_moment.at(x, y, c)) > 2.0f / 255.0f) {
+          moved[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = true;
+        }
+      }
+    }
+  }
+  std::vector<bool> band(moved.size());
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      for (int dy = -2; dy <= 2; ++dy) {
+        for (int dx = -2; dx <= 2; ++dx) {
+          const int sx = std::clamp(x + dx, 0, w - 1);
+          const int sy = std::clamp(y + dy, 0, h - 1);
+          if (moved[static_cast<std::size_t>(sy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(sx)]) {
+            band[static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)] = true;
+          }
+        }
+      }
+    }
+  }
+  return band;
+}
+
+struct Band {
+  std::size_t pixels = 0;
+  double psnr_r = 0.0;  // dB, peak 1; +infinity when equal
+  double psnr_b = 0.0;
+  [[nodiscard]] double worst() const { return std::min(psnr_r, psnr_b); }
+};
+
+// Red's and blue's PSNR of `a` against `b` over the band (green is drawn alike by
+// gather and per-field: both at its own moment).
+Band band_psnr(const image::FloatImage& a, const image::FloatImage& b, const std::vector<bool>& band) {
+  Band result;
+  double sum_r = 0.0;
+  double sum_b = 0.0;
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    if (!band[i]) continue;
+    ++result.pixels;
+    sum_r += std::pow(a.pixels[4 * i] - b.pixels[4 * i], 2.0);
+    sum_b += std::pow(a.pixels[4 * i + 2] - b.pixels[4 * i + 2], 2.0);
+  }
+  const auto db = [&](double sum) {
+    return sum == 0.0 ? INFINITY : 10.0 * std::log10(static_cast<double>(result.pixels) / sum);
+  };
+  result.psnr_r = db(sum_r);
+  result.psnr_b = db(sum_b);
+  return result;
+}
+
+// How coloured the image is where it is lit: Σ (max − min channel) / Σ max.
+double chroma(const image::FloatImage& image) {
+  double spread = 0.0;
+  double lit = 0.0;
+  for (std::size_t i = 0; i + 3 < image.pixels.size(); i += 4) {
+    const float* p = &image.pixels[i];
+    spread += std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]});
+    lit += std::max({p[0], p[1], p[2]});
+  }
+  return lit > 0.0 ? spread / lit : 0.0;
+}
+
+// The square of configs/dlp-120hz.json crosses 3.6 px per frame. With the
+// velocity threshold just above and just below that speed (as a speed that
+// wavers across it would be from one frame to the next), the image changes by a
+// small part of the way from fields to blur: no pop.
+TEST_F(FieldGather, ASpeedAtTheThresholdDoesNotPop) {
+  open("dlp-120hz.json");
+  constexpr std::uint64_t kFrame = 60;
+  render::GatherReport report;
+  const image::FloatImage fields_only = emitted(config::FieldMethod::gather, kFrame, 0.0, &report);
+  const double speed = report.fastest;
+  ASSERT_NEAR(speed, 3.6, 0.1);
+  const image::FloatImage blurred = emitted(config::FieldMethod::gather, kFrame, speed / 2.0);
+  const image::FloatImage just_above = emitted(config::FieldMethod::gather, kFrame, speed / 1.02);
+  const image::FloatImage just_below = emitted(config::FieldMethod::gather, kFrame, speed / 0.98);
+  const double whole_way = l1(fields_only, blurred);
+  const double step = l1(just_above, just_below) / whole_way;
+  std::cout << "threshold ±2 % around the speed: the image moves " << 100.0 * step
+            << " % of the way from fields to blur\n";
+  ASSERT_GT(whole_way, 0.0);
+  EXPECT_LE(step, 0.25);  // a hard switch: 100 %
+  EXPECT_GT(step, 0.0);
+}
+
+// A white wheel turning: with a threshold below its rim's speed, the rim gets
+// motion blur, the same in every channel — no colour fringes added.
+TEST_F(FieldGather, AWheelFasterThanTheThresholdIsBlurredWithoutFringes) {
+  open("dlp-120hz.json");
+  auto wheel = scene::builtin_scene("wheel-rotation");
+  ASSERT_TRUE(wheel) << wheel.error();
+  gl_.scene = std::move(wheel).value();
+  for (scene::Material& m : gl_.scene.materials) m = {glm::vec3(0.0f), 0.0f, 1.0f, glm::vec3(1.0f)};
+  constexpr std::uint64_t kFrame = 30;
+  render::GatherReport report;
+  const image::FloatImage fields_only = emitted(config::FieldMethod::gather, kFrame, 0.0, &report);
+  const image::FloatImage blurred = emitted(config::FieldMethod::gather, kFrame, report.fastest / 4.0);
+  const image::FloatImage per_field = emitted(config::FieldMethod::per_field, kFrame);
+  std::cout << "white wheel, rim " << report.fastest << " px/frame: chroma per-field " << chroma(per_field)
+            << ", gather " << chroma(fields_only) << ", gather above a threshold of " << report.fastest / 4.0
+            << " px/frame " << chroma(blurred) << "\n";
+  EXPECT_GT(chroma(fields_only), 0.02);
+  EXPECT_LE(chroma(blurred), 0.25 * chroma(fields_only));
+}
+
+// A field that would move a surface farther than the gather radius is cut short:
+// the pipeline says so, and a node warns once, not every frame.
+TEST_F(FieldGather, MotionBeyondTheGatherRadiusIsClampedAndWarnedOnce) {
+  open("dlp-120hz.json");
+  fields().method = config::FieldMethod::gather;
+  render::GatherReport report;
+  (void)emitted(config::FieldMethod::gather, 60, 0.0, &report);
+  EXPECT_FALSE(report.clamped) << report.fastest;
+  // At 10 frames per second the square crosses 48 px per frame; drawn at green's
+  // moment, blue's field (0.52 of a frame earlier) would move it 25 px.
+  installation().master.frame_rate = 10.0;
+  (void)emitted(config::FieldMethod::gather, 5, 0.0, &report);
+  EXPECT_TRUE(report.clamped) << report.fastest;
+  EXPECT_GT(report.fastest * 0.52, render::kGatherRadius);
+
+  std::ostringstream log_text;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_st>(log_text);
+  spdlog::logger log("node", sink);
+  node::GlRenderer renderer(log, ::testing::TempDir());
+  protocol::NodeJob job;
+  job.job = config::job_for(installation(), 0);
+  job.light_count = static_cast<std::uint32_t>(gl_.scene.lights.size());
+  ASSERT_TRUE(renderer.configure(job));
+  for (std::uint64_t frame = 2; frame < 6; ++frame) {
+    const scene::SceneState state = state_at(frame);
+    node::FrameInput input;
+    input.frame_id = frame;
+    input.state = &state;
+    renderer.render(input);
+  }
+  const std::string text = log_text.str();
+  std::size_t warnings = 0;
+  for (std::size_t at = text.find("the gather moves a surface at most"); at != std::string::npos;
+       at = text.find("the gather moves a surface at most", at + 1)) {
+    ++warnings;
+  }
+  EXPECT_EQ(warnings, 1u) << text;
+}
+
+// The pinball passes in front of bumpers and behind posts: where it uncovers
+// what the one render did not see, the gather fills from behind. Measured
+// against per-field in the band where motion shows, over a second of frames; the
+// one-moment frame beside it.
+TEST_F(FieldGather, AnObjectCrossingOthersAtOtherDepths) {
+  open("dlp-pinball.json");
+  Band worst{0, INFINITY, INFINITY};
+  Band worst_off{0, INFINITY, INFINITY};
+  std::uint64_t worst_frame = 0;
+  for (std::uint64_t frame = 60; frame < 180; frame += 12) {
+    const image::FloatImage gathered = emitted(config::FieldMethod::gather, frame);
+    const image::FloatImage per_field = emitted(config::FieldMethod::per_field, frame);
+    const image::FloatImage one_moment = emitted(config::FieldMethod::off, frame);
+    const std::vector<bool> band = motion_band(per_field, one_moment);
+    const Band b = band_psnr(gathered, per_field, band);
+    ASSERT_GT(b.pixels, 100u) << frame;
+    if (b.worst() < worst.worst()) {
+      worst = b;
+      worst_frame = frame;
+    }
+    const Band off = band_psnr(one_moment, per_field, band);
+    if (off.worst() < worst_off.worst()) worst_off = off;
+  }
+  std::cout << "pinball, around the moving ball (" << worst.pixels << " px): gather against per-field worst R "
+            << worst.psnr_r << " B " << worst.psnr_b << " dB at frame " << worst_frame
+            << "; one moment per frame worst " << worst_off.worst() << " dB\n";
+  EXPECT_GE(worst.worst(), 25.0);
+  EXPECT_GE(worst.worst(), worst_off.worst() + 6.0);
+}
+
+// The viewer walks sideways past slabs at five depths that stand still: every
+// pixel moves by its own parallax, and the near slabs uncover the far ones.
+TEST_F(FieldGather, TheViewerMovesWhileTheObjectsStandStill) {
+  open("dlp-pinball.json");
+  auto stack = scene::builtin_scene("depth-stack");
+  ASSERT_TRUE(stack) << stack.error();
+  gl_.scene = std::move(stack).value();
+  // 3 m/s sideways: the farthest slab moves about 5 px per frame.
+  installation().viewer.path = {{0.0, {-1.5, 1.2, 2.0}}, {1.0, {1.5, 1.2, 2.0}}, {2.0, {-1.5, 1.2, 2.0}}};
+  constexpr std::uint64_t kFrame = 60;
+  render::GatherReport report;
+  const image::FloatImage gathered = emitted(config::FieldMethod::gather, kFrame, 0.0, &report);
+  const image::FloatImage per_field = emitted(config::FieldMethod::per_field, kFrame);
+  const image::FloatImage one_moment = emitted(config::FieldMethod::off, kFrame);
+  const std::vector<bool> band = motion_band(per_field, one_moment);
+  const Band against = band_psnr(gathered, per_field, band);
+  const Band off = band_psnr(one_moment, per_field, band);
+  std::cout << "viewer at 3 m/s, slabs still (" << report.fastest << " px/frame at most, " << report.gathered_tiles
+            << " tiles gathered, " << against.pixels << " px where motion shows): gather against per-field R "
+            << against.psnr_r << " B " << against.psnr_b << " dB; one moment " << off.worst() << " dB\n";
+  EXPECT_GT(report.fastest, 3.0);
+  EXPECT_GE(against.worst(), 25.0);
+  EXPECT_GE(against.worst(), off.worst() + 6.0);
+}
+
+}  // namespace
+}  // namespace optique
