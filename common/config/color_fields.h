@@ -42,7 +42,7 @@ struct ColorFields {
   std::vector<ColorField> fields;  // in the order given; empty: all colours at once
   int images = 1;                  // images per frame: 1, or 2 for a stereo projector used as mono
   FieldMethod method = FieldMethod::per_field;
-  double velocity_threshold = 0.0;             // screen pixels per frame period; 0: none (gather only)
+  double velocity_threshold = 0.0;             // drawn image's pixels per frame period; 0: none (gather only)
   int gather_samples = kDefaultGatherSamples;  // per field and pixel, along the motion
 
   // Whether the projector draws its fields at their own times.

@@ -58,7 +58,8 @@ Result<std::unique_ptr<FieldGather>> FieldGather::create(int width, int height, 
                                           std::string(kVersion) + std::string(shaders::field_gather_frag));
   if (!gather_program) return Error{"the field gather pass: " + gather_program.error()};
   g->gather_program_ = std::move(gather_program).value();
-  // Velocity in pixels and depth in metres: 32-bit floats, like the colour.
+  // Velocity in pixels and depth in metres as half floats: 0.01 px at 20 px per
+  // frame, about 4 mm at 5 m (surfaces closer than that in depth are one layer).
   make_target(GL_RGBA16F, width, height, g->motion_, g->motion_framebuffer_);
   if (samples > 1) {
     g->motion_samples_ = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
@@ -198,6 +199,9 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
   glUseProgram(gather);
   glBindVertexArray(tile_vertex_array_.get());
   glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(quads.size() / 2));
+  // With one sample per pixel the motion texture is also the scene's second
+  // attachment: left bound, the next scene pass would sample what it draws into.
+  glBindTextureUnit(1, 0);
   return report;
 }
 

@@ -165,6 +165,16 @@ void ProjectorPipeline::warm_up() {
   const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
   if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
     renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
+    if (color_fields_.sequential() && color_fields_.method == config::FieldMethod::gather) {
+      // The velocity program and the tile passes too (the field pass itself
+      // first runs when something moves).
+      GatherFrame frame;
+      frame.seen.eye = in_front;
+      frame.seen.frustum = frustum.value();
+      frame.view_projection_now = frustum.value().projection * frustum.value().view;
+      frame.view_projection_next = frame.view_projection_now;
+      (void)renderer_->draw_gathered(scene::SceneState{}, frame);
+    }
   }
 }
 

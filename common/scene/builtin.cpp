@@ -181,7 +181,8 @@ SceneDefinition scrolling_stripes() {
   SceneDefinition scene;
   scene.name = "scrolling-stripes";
   scene.ambient = glm::vec3(1.0f);
-  // 4 texels per 5 cm; runs of 1, 2, 3 and 2 texels, white then black.
+  // 4 texels per 5 cm; white runs of 2, 4, 6 and 4 texels between black ones of
+  // 2, 2, 4 and 8, repeated every 32.
   constexpr std::array<int, 8> kRuns{2, 2, 4, 2, 6, 4, 4, 8};
   scene.textures.push_back(make_texture("stripes", 160, 4, [&](int x, int) {
     int at = x % 32;

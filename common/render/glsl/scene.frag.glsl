@@ -23,6 +23,7 @@ layout(location = 0) out vec4 colour;
 in vec4 clip_0;
 in vec4 clip_1;
 uniform vec2 half_size;  // pixels per unit of NDC
+const float kMostSpeed = 16384.0;  // pixels per frame
 // Screen velocity (pixels per frame period, rows up) and linear depth.
 layout(location = 1) out vec4 motion;
 #endif
@@ -53,6 +54,10 @@ void main() {
 #ifdef VELOCITY
   vec2 velocity = vec2(0.0);
   if (clip_0.w > 1e-6 && clip_1.w > 1e-6) velocity = (clip_1.xy / clip_1.w - clip_0.xy / clip_0.w) * half_size;
+  // A point that passes close to the eye plane moves without bound on screen: kept
+  // finite in the half-float target (the gather clamps far below this anyway).
+  float speed = length(velocity);
+  if (speed > kMostSpeed) velocity *= kMostSpeed / speed;
   motion = vec4(velocity, 1.0 / gl_FragCoord.w, 1.0);
 #endif
 }
