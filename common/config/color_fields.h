@@ -47,6 +47,8 @@ struct ColorFields {
 
   // Whether the projector draws its fields at their own times.
   [[nodiscard]] bool sequential() const { return !fields.empty() && method != FieldMethod::off; }
+  // Whether they are gathered from one render (the velocity target and tiles).
+  [[nodiscard]] bool gathers() const { return sequential() && method == FieldMethod::gather; }
   friend bool operator==(const ColorFields&, const ColorFields&) = default;
 };
 

@@ -126,20 +126,21 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
   glBindTextureUnit(0, tile_max_.get());
   pass(neighbour_max_program_.get(), neighbour_max_framebuffer_.get(), tiles_x_, tiles_y_);
 
-  // The tiles' fastest (a few thousand values): which tiles have something
-  // moving within reach, and whether the radius cut a field's motion short.
+  // Each tile's fastest within reach (a few thousand values, the neighbour max
+  // the shader reads): which tiles to gather, and whether the radius cut a
+  // field's motion short.
   std::vector<GLfloat> tiles(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_) * 2);
-  glGetTextureImage(tile_max_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(tiles.size() * sizeof(GLfloat)),
+  glGetTextureImage(neighbour_max_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(tiles.size() * sizeof(GLfloat)),
                     tiles.data());
+  std::vector<double> near(tiles.size() / 2);
+  GatherReport report;
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    near[i] = std::hypot(double{tiles[2 * i]}, double{tiles[2 * i + 1]});
+    report.fastest = std::max(report.fastest, near[i]);
+  }
   double farthest_shift = 0.0;
   for (const GatherField& f : fields) farthest_shift = std::max(farthest_shift, std::abs(f.shift));
   const double threshold = settings.velocity_threshold;
-  GatherReport report;
-  std::vector<double> speed(tiles.size() / 2);
-  for (std::size_t i = 0; i < speed.size(); ++i) {
-    speed[i] = std::hypot(double{tiles[2 * i]}, double{tiles[2 * i + 1]});
-    report.fastest = std::max(report.fastest, speed[i]);
-  }
   const bool blurs = threshold > 0.0 && report.fastest > kBlurBandFrom * threshold;
   const double reach = std::max(
       {farthest_shift, blurs ? std::abs(settings.frame_start) : 0.0, blurs ? std::abs(settings.frame_end) : 0.0});
@@ -152,15 +153,11 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
   const auto ndc = [](int pixel, int size) { return static_cast<GLfloat>(2.0 * pixel / size - 1.0); };
   for (int ty = 0; ty < tiles_y_; ++ty) {
     for (int tx = 0; tx < tiles_x_; ++tx) {
-      double near = 0.0;
-      for (int y = std::max(ty - 1, 0); y <= std::min(ty + 1, tiles_y_ - 1); ++y) {
-        for (int x = std::max(tx - 1, 0); x <= std::min(tx + 1, tiles_x_ - 1); ++x) {
-          near = std::max(
-              near,
-              speed[static_cast<std::size_t>(y) * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(x)]);
-        }
+      if (near[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(tx)] *
+              reach <
+          1e-3) {
+        continue;
       }
-      if (near * reach < 1e-3) continue;
       const GLfloat x0 = ndc(tx * kGatherRadius, width_);
       const GLfloat x1 = ndc(std::min((tx + 1) * kGatherRadius, width_), width_);
       const GLfloat y0 = ndc(ty * kGatherRadius, height_);

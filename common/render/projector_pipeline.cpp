@@ -55,7 +55,7 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
   stage.focus.inset = job.installation.depth_of_field && job.installation.depth_of_field->inset_radius > 0.0;
   stage.projector = optics::ProjectorModel(self.response);
   if (auto output = renderer.value()->set_output(stage); !output) return Error{output.error()};
-  if (self.color_fields.sequential() && self.color_fields.method == config::FieldMethod::gather) {
+  if (self.color_fields.gathers()) {
     if (auto gather = renderer.value()->prepare_gather(); !gather) {
       return Error{"projector '" + self.id + "': " + gather.error()};
     }
@@ -109,7 +109,7 @@ Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double frac
 Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state) {
   gather_report_ = {};
   if (!color_fields_.sequential()) return draw(state, 0.0);
-  if (color_fields_.method == config::FieldMethod::gather) return draw_gathered(state);
+  if (color_fields_.gathers()) return draw_gathered(state);
   std::vector<FieldPass> passes;
   for (const config::ColorField& field : color_fields_.fields) {
     assert(field.image == 0);  // make() refused more images
@@ -165,7 +165,7 @@ void ProjectorPipeline::warm_up() {
   const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
   if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
     renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
-    if (color_fields_.sequential() && color_fields_.method == config::FieldMethod::gather) {
+    if (color_fields_.gathers()) {
       // The velocity program and the tile passes too (the field pass itself
       // first runs when something moves).
       GatherFrame frame;
