@@ -123,8 +123,8 @@ void Node::carry_out(Action& action) {
                    carry_out(protocol_.rendered(a.frame.frame_id, clock::monotonic_now() - started));
                  },
                  [&](PresentAt& a) { wait_for_present(a.deadline); },
-                 [&](Present&) {
-                   renderer_.present();
+                 [&](Present& a) {
+                   renderer_.present(a.image);
                    const clock::Nanos shown = clock::monotonic_now();
                    // Nodes sharing a machine present at the same instant: let the others
                    // on this core show theirs before this one does its bookkeeping.

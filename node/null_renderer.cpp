@@ -12,6 +12,8 @@ void NullRenderer::render(const FrameInput& frame) {
   ++rendered_;
 }
 
-void NullRenderer::present() { ++presented_; }
+void NullRenderer::present(int image) {
+  if (image == 0) ++presented_;
+}
 
 }  // namespace optique::node

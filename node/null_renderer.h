@@ -11,11 +11,11 @@ class NullRenderer final : public Renderer {
   [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
   [[nodiscard]] std::string description() const override { return "null renderer (draws nothing)"; }
   void render(const FrameInput& frame) override;
-  void present() override;
+  void present(int image) override;
   void show_black() override {}
 
   [[nodiscard]] std::uint64_t frames_rendered() const { return rendered_; }
-  [[nodiscard]] std::uint64_t frames_presented() const { return presented_; }
+  [[nodiscard]] std::uint64_t frames_presented() const { return presented_; }  // their first images
 
  private:
   std::uint64_t rendered_ = 0;

@@ -226,6 +226,7 @@ Actions NodeProtocol::configured(const Result<void>& result, const std::string& 
     return out;
   }
   frame_period_ = job_->frame_period;
+  images_ = job_->job.self().color_fields.images;
   heartbeat_ = std::max(job_->heartbeat, milliseconds(10));
   liveness_timeout_ = job_->liveness_timeout;
   wire::Envelope envelope;
@@ -372,35 +373,56 @@ void NodeProtocol::on_swap(const wire::FrameSwap& swap, clock::Nanos now, Action
     deadline = now + longest;
   }
   pending_ = Pending{swap.frame_id(), deadline, swap.present_deadline_ns(), false};
-  // Checked here and again when the deadline comes: a stop can stretch the wait too.
-  if (stale(now, out)) {
-    pending_.reset();
-    end_round(now, out);
-    return;
-  }
-  out.push_back(PresentAt{swap.frame_id(), deadline});
+  wait_for_pending(now, out);
 }
 
+// Checked when the swap comes and again when the deadline does: a stop can
+// stretch the wait too. An image is stale once the next one's time has come.
 bool NodeProtocol::stale(clock::Nanos now, Actions& out) const {
-  if (now <= pending_->deadline + frame_period_) return false;
+  if (now <= pending_->deadline + frame_period_ / images_) return false;
   log(out, spdlog::level::warn,
-      fmt::format("frame {}'s present deadline passed {:.1f} ms ago: not showing a stale frame", pending_->frame_id,
+      fmt::format("frame {}{}'s present deadline passed {:.1f} ms ago: not showing a stale frame", pending_->frame_id,
+                  images_ > 1 ? fmt::format(" image {}", pending_->image) : "",
                   static_cast<double>(now - pending_->deadline) / 1e6));
   return true;
+}
+
+bool NodeProtocol::next_image() {
+  if (pending_->image + 1 >= images_) return false;
+  const clock::Nanos later = frame_period_ / images_;
+  pending_->image += 1;
+  pending_->deadline += later;
+  pending_->master_deadline += later;
+  pending_->due = false;
+  return true;
+}
+
+void NodeProtocol::wait_for_pending(clock::Nanos now, Actions& out) {
+  do {
+    if (!stale(now, out)) {
+      out.push_back(PresentAt{pending_->frame_id, pending_->deadline});
+      return;
+    }
+  } while (next_image());
+  pending_.reset();
+  end_round(now, out);
 }
 
 Actions NodeProtocol::present_due(clock::Nanos now) {
   Actions out;
   if (!pending_ || pending_->due) return out;
-  if (stale(now, out)) {
-    pending_.reset();
-    end_round(now, out);
-  } else {
+  if (!stale(now, out)) {
     pending_->due = true;
-    out.push_back(Present{});
+    out.push_back(Present{pending_->image});
     return out;
   }
-  release_held(now, out);  // not shown: what waited behind it goes on
+  if (next_image()) {
+    wait_for_pending(now, out);
+  } else {
+    pending_.reset();
+    end_round(now, out);
+  }
+  if (!pending_) release_held(now, out);  // not shown: what waited behind it goes on
   return out;
 }
 
@@ -419,35 +441,45 @@ Actions NodeProtocol::presented(clock::Nanos now) {
   Actions out;
   if (!pending_ || !pending_->due) return out;
   const Pending shown = *pending_;
-  pending_.reset();
   const clock::Nanos local = settings_.clock.to_local(now);
   // The offset drifts while the node waits for the deadline: convert at this instant.
   const std::optional<clock::ClockEstimate> estimate = estimator_.at(local);
   const clock::Nanos offset = estimate ? estimate->offset : 0;
   const clock::Nanos presented_at = local + offset;
   if (connection_open_ && phase_ == Phase::joined) {
-    wire::Envelope envelope;
-    auto& report = *envelope.mutable_presented();
-    report.set_frame_id(shown.frame_id);
-    report.set_presented_ns(presented_at);
-    report.set_content_frame_id(last_content_frame_);
-    report.set_clock_offset_ns(offset);
-    if (estimate) {
-      report.set_clock_rtt_ns(estimate->round_trip);
-      report.set_clock_drift_ppm(estimate->drift_ppm);
-      report.set_clock_error_bound_ns(estimate->error_bound);
+    // The frame's first image is what the master's deadline is for, and what
+    // it measures sync by: one report per frame.
+    if (shown.image == 0) {
+      wire::Envelope envelope;
+      auto& report = *envelope.mutable_presented();
+      report.set_frame_id(shown.frame_id);
+      report.set_presented_ns(presented_at);
+      report.set_content_frame_id(last_content_frame_);
+      report.set_clock_offset_ns(offset);
+      if (estimate) {
+        report.set_clock_rtt_ns(estimate->round_trip);
+        report.set_clock_drift_ppm(estimate->drift_ppm);
+        report.set_clock_error_bound_ns(estimate->error_bound);
+      }
+      if (settings_.clock.skewed()) {
+        report.set_clock_truth_known(true);
+        report.set_clock_true_error_ns(offset - (now - local));
+      }
+      out.push_back(Send{std::move(envelope)});
     }
-    if (settings_.clock.skewed()) {
-      report.set_clock_truth_known(true);
-      report.set_clock_true_error_ns(offset - (now - local));
-    }
-    out.push_back(Send{std::move(envelope)});
     log(out, spdlog::level::debug,
-        fmt::format("presented frame {} at master time {} ns ({:+.1f} µs from the deadline)", shown.frame_id,
-                    presented_at, static_cast<double>(presented_at - shown.master_deadline) / 1e3));
+        fmt::format("presented frame {}{} at master time {} ns ({:+.1f} µs from the deadline)", shown.frame_id,
+                    images_ > 1 ? fmt::format(" image {}", shown.image) : "", presented_at,
+                    static_cast<double>(presented_at - shown.master_deadline) / 1e3));
   }
-  end_round(now, out);
-  release_held(now, out);
+  // The next image, its share of the frame later; what came meanwhile waits for it.
+  if (next_image()) {
+    wait_for_pending(now, out);
+  } else {
+    pending_.reset();
+    end_round(now, out);
+  }
+  if (!pending_) release_held(now, out);
   return out;
 }
 

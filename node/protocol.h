@@ -86,8 +86,12 @@ struct PresentAt {
   std::uint64_t frame_id = 0;
   clock::Nanos deadline = 0;
 };
-// Show the rendered frame now; answer with presented().
-struct Present {};
+// Show image `image` of the rendered frame now; answer with presented(). A
+// projector that shows two images per frame (a stereo one used as mono) shows
+// the second half a frame after the first.
+struct Present {
+  int image = 0;
+};
 struct ShowBlack {};
 struct PingIn {
   std::chrono::milliseconds after{0};
@@ -165,6 +169,12 @@ class NodeProtocol {
   // Held up past the next frame's time (the process was stopped, the machine
   // stalled): showing it would put an old frame beside its partners' new one.
   [[nodiscard]] bool stale(clock::Nanos now, Actions& out) const;
+  // The pending frame's next image (a projector that shows two per frame), its
+  // share of the frame later; false when it was the last.
+  [[nodiscard]] bool next_image();
+  // Waits for the pending image's deadline; a stale one gives way to the frame's
+  // next image, and a frame with none left ends its round.
+  void wait_for_pending(clock::Nanos now, Actions& out);
   void release_held(clock::Nanos now, Actions& out);
   void stop(int exit_code, const std::string& reason, Actions& out);
   void log(Actions& out, spdlog::level::level_enum level, std::string text) const;
@@ -189,6 +199,7 @@ class NodeProtocol {
   std::uint64_t last_hash_ = 0;
   clock::OffsetEstimator estimator_;
   clock::Nanos frame_period_ = 0;
+  int images_ = 1;  // per frame, from the job
   std::chrono::milliseconds heartbeat_{250};
   std::chrono::milliseconds liveness_timeout_{3000};
   int pings_in_burst_ = 0;
@@ -202,6 +213,7 @@ class NodeProtocol {
     clock::Nanos deadline = 0;         // monotonic, clamped
     clock::Nanos master_deadline = 0;  // as the master gave it
     bool due = false;                  // present_due() came; presented() is next
+    int image = 0;                     // which of the frame's images is next
   };
   std::optional<Pending> pending_;
   std::deque<wire::Envelope> held_;

@@ -36,8 +36,9 @@ class Renderer {
   [[nodiscard]] virtual std::string description() const = 0;
   // Draws the frame into the back buffer; returns when it is ready to show.
   virtual void render(const FrameInput& frame) = 0;
-  // Shows the last rendered frame (swap buffers).
-  virtual void present() = 0;
+  // Shows image `image` of the last rendered frame (swap buffers): 0, or 1 for
+  // a projector that shows two images per frame (a stereo one used as mono).
+  virtual void present(int image) = 0;
   // Shows black at once (the master is gone and the picture would freeze).
   virtual void show_black() = 0;
 };

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -158,8 +159,7 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
     const optics::Exposure exposure{centre, options.exposure, result.velocity};
 
     // What the projectors put on the screen, frame by frame, field by field.
-    std::vector<image::FloatImage> lights;
-    lights.reserve(screen_image.projectors.size() * static_cast<std::size_t>(last - first + 1));
+    std::deque<image::FloatImage> lights;  // the emissions point into it
     std::vector<optics::Emission> emissions;
     double white = 0.0;  // the most light one projector of this screen shows
     for (const config::Projector* projector : screen_image.projectors) {
@@ -175,25 +175,34 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
       compose.pixels_per_metre = screen.pixels_per_metre;
       for (std::int64_t f = first; f <= last; ++f) {
         if (f < 0) continue;  // before the run's first frame: nothing was shown
-        if (auto drawn = pipeline.value()->draw_frame(authority.state_at_frame(static_cast<std::uint64_t>(f)));
+        const double shown = static_cast<double>(f) * period;
+        // Each of the frame's images (a stereo projector used as mono shows
+        // two) emits during its own fields.
+        const auto emit = [&](int image) {
+          const image::FloatImage emitted = pipeline.value()->renderer().read_linear();
+          const optics::ProjectedImage placed{&geometry, &emitted};
+          lights.push_back(optics::compose_screen({&placed, 1}, screen.width, screen.height, compose));
+          if (projector->color_fields.fields.empty()) {
+            emissions.push_back({&lights.back(), true, true, true, shown - 0.5 * period, shown + 0.5 * period, 1.0});
+            return;
+          }
+          for (const config::ColorField& field : projector->color_fields.fields) {
+            if (field.image != image) continue;
+            optics::Emission e{&lights.back(), field.channel == config::Channel::red,
+                               field.channel == config::Channel::green, field.channel == config::Channel::blue};
+            e.start = shown + field.start() * period;
+            e.end = shown + field.end() * period;
+            // The share of the frame its channel is on, over all the frame's images.
+            e.on_fraction = 0.0;
+            for (const config::ColorField& other : projector->color_fields.fields) {
+              if (other.channel == field.channel) e.on_fraction += other.duration;
+            }
+            emissions.push_back(e);
+          }
+        };
+        if (auto drawn = pipeline.value()->draw_frame(authority.state_at_frame(static_cast<std::uint64_t>(f)), emit);
             !drawn) {
           return Error{"projector '" + projector->id + "' at frame " + std::to_string(f) + ": " + drawn.error()};
-        }
-        const image::FloatImage emitted = pipeline.value()->renderer().read_linear();
-        const optics::ProjectedImage placed{&geometry, &emitted};
-        lights.push_back(optics::compose_screen({&placed, 1}, screen.width, screen.height, compose));
-        const double shown = static_cast<double>(f) * period;
-        if (projector->color_fields.fields.empty()) {
-          emissions.push_back({&lights.back(), true, true, true, shown - 0.5 * period, shown + 0.5 * period, 1.0});
-          continue;
-        }
-        for (const config::ColorField& field : projector->color_fields.fields) {
-          optics::Emission e{&lights.back(), field.channel == config::Channel::red,
-                             field.channel == config::Channel::green, field.channel == config::Channel::blue};
-          e.start = shown + field.start() * period;
-          e.end = shown + field.end() * period;
-          e.on_fraction = field.duration;
-          emissions.push_back(e);
         }
       }
     }

@@ -106,9 +106,7 @@ void FieldGather::clear_motion(GLuint framebuffer) {
   glClearNamedFramebufferfv(framebuffer, GL_COLOR, 1, still_and_far);
 }
 
-GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings) {
-  assert(fields.size() <= static_cast<std::size_t>(kMaxGatherFields));
-  assert(settings.samples >= 2);
+void FieldGather::measure() {
   glDisable(GL_DEPTH_TEST);
   glBindVertexArray(empty_vertex_array_.get());
   const auto pass = [&](GLuint program, GLuint framebuffer, int width, int height) {
@@ -132,12 +130,20 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
   std::vector<GLfloat> tiles(static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_) * 2);
   glGetTextureImage(neighbour_max_.get(), 0, GL_RG, GL_FLOAT, static_cast<GLsizei>(tiles.size() * sizeof(GLfloat)),
                     tiles.data());
-  std::vector<double> near(tiles.size() / 2);
-  GatherReport report;
-  for (std::size_t i = 0; i < near.size(); ++i) {
-    near[i] = std::hypot(double{tiles[2 * i]}, double{tiles[2 * i + 1]});
-    report.fastest = std::max(report.fastest, near[i]);
+  near_.assign(tiles.size() / 2, 0.0);
+  fastest_ = 0.0;
+  for (std::size_t i = 0; i < near_.size(); ++i) {
+    near_[i] = std::hypot(double{tiles[2 * i]}, double{tiles[2 * i + 1]});
+    fastest_ = std::max(fastest_, near_[i]);
   }
+}
+
+GatherReport FieldGather::gather(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings) {
+  assert(fields.size() <= static_cast<std::size_t>(kMaxGatherFields));
+  assert(settings.samples >= 2);
+  assert(near_.size() == static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_));  // measure() first
+  GatherReport report;
+  report.fastest = fastest_;
   double farthest_shift = 0.0;
   for (const GatherField& f : fields) farthest_shift = std::max(farthest_shift, std::abs(f.shift));
   const double threshold = settings.velocity_threshold;
@@ -153,7 +159,7 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
   const auto ndc = [](int pixel, int size) { return static_cast<GLfloat>(2.0 * pixel / size - 1.0); };
   for (int ty = 0; ty < tiles_y_; ++ty) {
     for (int tx = 0; tx < tiles_x_; ++tx) {
-      if (near[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(tx)] *
+      if (near_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(tx)] *
               reach <
           1e-3) {
         continue;
@@ -193,6 +199,7 @@ GatherReport FieldGather::run(GLuint colour, std::span<const GatherField> fields
   glNamedBufferSubData(tile_quads_.get(), 0, static_cast<GLsizeiptr>(quads.size() * sizeof(GLfloat)), quads.data());
   glBindFramebuffer(GL_FRAMEBUFFER, gathered_framebuffer_.get());
   glViewport(0, 0, width_, height_);
+  glDisable(GL_DEPTH_TEST);
   glUseProgram(gather);
   glBindVertexArray(tile_vertex_array_.get());
   glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(quads.size() / 2));

@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <span>
+#include <vector>
 
 #include <epoxy/gl.h>
 
@@ -27,11 +28,15 @@ class FieldGather {
   // The value a pixel the scene does not cover holds: still, infinitely far.
   static void clear_motion(GLuint framebuffer);
 
-  // After the scene is drawn and its colour resolved into `colour` (one sample
-  // per pixel, this size): each field's channels into output(). At most
-  // kMaxGatherFields fields, each channel in one of them. Only the tiles where
-  // something moves are gathered; the others are the render as it is.
-  [[nodiscard]] GatherReport run(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings);
+  // After the scene is drawn: its velocity resolved (multisampled), the tile
+  // max and neighbour max, and how fast each tile's neighbourhood moves.
+  void measure();
+  // Then, from its colour resolved into `colour` (one sample per pixel, this
+  // size): each field's channels into output(). At most kMaxGatherFields fields,
+  // each channel in one of them. Only the tiles where something moves are
+  // gathered; the others are the render as it is. Again for another image's
+  // fields from the same render (a stereo projector used as mono).
+  [[nodiscard]] GatherReport gather(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings);
   [[nodiscard]] GLuint output() const { return gathered_.get(); }
 
  private:
@@ -41,6 +46,8 @@ class FieldGather {
   int samples_ = 1;
   int tiles_x_ = 0;
   int tiles_y_ = 0;
+  std::vector<double> near_;  // per tile: its neighbour max's length (measure())
+  double fastest_ = 0.0;
   glo::Texture motion_samples_;  // multisampled only
   glo::Texture motion_;          // one per pixel
   glo::Framebuffer motion_framebuffer_;

@@ -40,10 +40,6 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
                                                                    const scene::SceneDefinition& scene,
                                                                    const PipelineOptions& options) {
   const config::Projector& self = job.self();
-  if (self.color_fields.sequential() && self.color_fields.images > 1) {
-    return Error{"projector '" + self.id +
-                 "': colour fields in two images per frame (a stereo projector used as mono) are not drawn yet"};
-  }
   auto view = ProjectorView::make(job.screen(), self.geometry(), self.rendering, options.two_pass_pixels_per_metre);
   if (!view) return Error{"projector '" + self.id + "': " + view.error()};
   const int samples = options.samples > 0 ? options.samples : self.color_fields.sequential() ? kFieldSamples : 1;
@@ -106,13 +102,32 @@ Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double frac
   return {};
 }
 
-Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state) {
+Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state, const ImageDrawn& drawn) {
   gather_report_ = {};
-  if (!color_fields_.sequential()) return draw(state, 0.0);
-  if (color_fields_.gathers()) return draw_gathered(state);
+  Result<void> result;
+  for (int image = 0; image < images(); ++image) {
+    if (image > 0) renderer_->hold_output();  // shown while this one is drawn
+    // A frame that cannot be seen is black in every image.
+    if (result) result = draw_image(state, image);
+    if (drawn) drawn(image);
+  }
+  return result;
+}
+
+unsigned ProjectorPipeline::image_framebuffer(int image) const {
+  assert(image >= 0 && image < images() && images() <= 2);
+  return image + 1 < images() ? renderer_->held_framebuffer() : renderer_->output_framebuffer();
+}
+
+Result<void> ProjectorPipeline::draw_image(const scene::SceneState& state, int image) {
+  if (!color_fields_.sequential()) {
+    // Every image the same, drawn at the display time: the output holds it already.
+    return image == 0 ? draw(state, 0.0) : Result<void>{};
+  }
+  if (color_fields_.gathers()) return draw_gathered(state, image);
   std::vector<FieldPass> passes;
   for (const config::ColorField& field : color_fields_.fields) {
-    assert(field.image == 0);  // make() refused more images
+    if (field.image != image) continue;
     auto pass = moment(state, field.offset);
     if (!pass) {
       renderer_->draw_black();
@@ -127,37 +142,60 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state) {
   return {};
 }
 
-Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state) {
-  // Rendered at the green field's moment: green carries most of what the eye
-  // sees as sharpness (and of PSNR_Y), and it is then shown as drawn, not
-  // resampled.
-  const auto green = std::find_if(color_fields_.fields.begin(), color_fields_.fields.end(),
-                                  [](const config::ColorField& f) { return f.channel == config::Channel::green; });
-  assert(green != color_fields_.fields.end());  // every image has each channel (config/color_fields.h)
-  const double rendered = green->offset;
-  const auto seen = moment(state, rendered);
-  const auto now = moment(state, 0.0);
-  const auto next = moment(state, 1.0);
-  for (const auto* m : {&seen, &now, &next}) {
-    if (!*m) {
-      renderer_->draw_black();
-      return Error{m->error()};
-    }
-  }
-  GatherFrame frame;
-  frame.seen = seen.value();
-  frame.view_projection_now = now.value().frustum.projection * now.value().frustum.view;
-  frame.view_projection_next = next.value().frustum.projection * next.value().frustum.view;
+double ProjectorPipeline::gather_moment() const {
+  // Green carries most of what the eye sees as sharpness (and of PSNR_Y): the
+  // scene is drawn at the green field's moment, so green is shown as drawn, not
+  // resampled; with two images, halfway between their greens.
+  double sum = 0.0;
+  int greens = 0;
   for (const config::ColorField& field : color_fields_.fields) {
-    assert(field.image == 0);  // make() refused more images
-    frame.fields.push_back({field.channel == config::Channel::red, field.channel == config::Channel::green,
-                            field.channel == config::Channel::blue, field.offset - rendered});
+    if (field.channel != config::Channel::green) continue;
+    sum += field.offset;
+    ++greens;
   }
-  frame.settings.samples = color_fields_.gather_samples;
-  frame.settings.velocity_threshold = color_fields_.velocity_threshold;
-  frame.settings.frame_start = -0.5 - rendered;
-  frame.settings.frame_end = 0.5 - rendered;
-  gather_report_ = renderer_->draw_gathered(state, frame, terms_);
+  assert(greens == images());  // every image has each channel (config/color_fields.h)
+  return sum / greens;
+}
+
+Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state, int image) {
+  const double rendered = gather_moment();
+  std::vector<GatherField> fields;
+  for (const config::ColorField& field : color_fields_.fields) {
+    if (field.image != image) continue;
+    fields.push_back({field.channel == config::Channel::red, field.channel == config::Channel::green,
+                      field.channel == config::Channel::blue, field.offset - rendered});
+  }
+  GatherSettings settings;
+  settings.samples = color_fields_.gather_samples;
+  settings.velocity_threshold = color_fields_.velocity_threshold;
+  // Above the threshold, motion blur over the time this image is on screen.
+  const double share = 1.0 / images();
+  settings.frame_start = -0.5 + image * share - rendered;
+  settings.frame_end = -0.5 + (image + 1) * share - rendered;
+  GatherReport report;
+  if (image > 0) {
+    report = renderer_->gather_again(fields, settings);  // from the render image 0 made
+  } else {
+    const auto seen = moment(state, rendered);
+    const auto now = moment(state, 0.0);
+    const auto next = moment(state, 1.0);
+    for (const auto* m : {&seen, &now, &next}) {
+      if (!*m) {
+        renderer_->draw_black();
+        return Error{m->error()};
+      }
+    }
+    GatherFrame frame;
+    frame.seen = seen.value();
+    frame.view_projection_now = now.value().frustum.projection * now.value().frustum.view;
+    frame.view_projection_next = next.value().frustum.projection * next.value().frustum.view;
+    frame.fields = std::move(fields);
+    frame.settings = settings;
+    report = renderer_->draw_gathered(state, frame, terms_);
+  }
+  gather_report_.fastest = std::max(gather_report_.fastest, report.fastest);
+  gather_report_.clamped = gather_report_.clamped || report.clamped;
+  gather_report_.gathered_tiles += report.gathered_tiles;
   return {};
 }
 

@@ -6,6 +6,7 @@
 // field. The node's GL renderer builds one per welcome; tests and benches build
 // theirs from config::job_for, the same way.
 
+#include <functional>
 #include <memory>
 #include <optional>
 
@@ -67,10 +68,20 @@ class ProjectorPipeline {
   // The frame as this projector shows it: with colour fields (a single-chip DLP
   // projector), each field's channel drawn at the moment it is on screen (one
   // render per field, or gathered from one render); else the whole image at the
-  // display time.
-  [[nodiscard]] Result<void> draw_frame(const scene::SceneState& state);
+  // display time. A projector that shows two images per frame (a stereo one used
+  // as mono) draws both, one after the other, into the output: `drawn(image)`
+  // is called when each is there to read (a capture, the screen simulator), and
+  // image_framebuffer() then shows either. An image that cannot be seen (the eye
+  // is not in front of the screen) is black, and so is the rest of the frame.
+  using ImageDrawn = std::function<void(int image)>;
+  [[nodiscard]] Result<void> draw_frame(const scene::SceneState& state, const ImageDrawn& drawn = {});
+  // Images per frame: 1, or 2 (config::ColorFields::images).
+  [[nodiscard]] int images() const { return color_fields_.images; }
+  // Where image `image` of the last frame drawn is, to show it.
+  [[nodiscard]] unsigned image_framebuffer(int image) const;
   // What the last frame's gather found (zero for other methods): how fast the
-  // scene moved, and whether the gather radius cut a motion short.
+  // scene moved, and whether the gather radius cut a motion short (over all
+  // its images).
   [[nodiscard]] const GatherReport& gather_report() const { return gather_report_; }
   // One draw of an empty scene from a metre in front of the screen: drivers
   // compile shaders lazily, and the first frame should not pay for it.
@@ -87,7 +98,10 @@ class ProjectorPipeline {
   // Where the scene is seen from `fraction` of a frame after the display time:
   // this projector's eye then, and its frustum through the screen.
   [[nodiscard]] Result<FieldPass> moment(const scene::SceneState& state, double fraction) const;
-  [[nodiscard]] Result<void> draw_gathered(const scene::SceneState& state);
+  [[nodiscard]] Result<void> draw_image(const scene::SceneState& state, int image);
+  // When the gather's one render shows the scene, frame periods from the display time.
+  [[nodiscard]] double gather_moment() const;
+  [[nodiscard]] Result<void> draw_gathered(const scene::SceneState& state, int image);
 
   ProjectorView view_;
   std::unique_ptr<SceneRenderer> renderer_;

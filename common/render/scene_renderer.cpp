@@ -100,6 +100,9 @@ struct SceneRenderer::Gl {
   glo::Texture still_depth;
   glo::Framebuffer encoded_framebuffer;  // the signal: drawn by the output pass, blitted to a window
   glo::Texture encoded_colour;
+  // A copy of the output, shown while the next image is drawn (hold_output).
+  glo::Framebuffer held_framebuffer;
+  glo::Texture held_colour;
   glo::Texture weights;
   glo::Texture response_table;
   optics::ProjectorModel projector;  // of the output stage
@@ -310,6 +313,8 @@ Result<void> SceneRenderer::set_output(const OutputStage& stage) {
   glProgramUniform1f(program, uniform("screen_metres_per_pixel"), static_cast<float>(focus.screen_metres_per_pixel));
   set_focus({});
 
+  gl.held_framebuffer = {};  // made again at this size when needed
+  gl.held_colour = {};
   gl.encoded_colour = glo::make_texture();
   // The signal at the projector's depth: 8 bits, or 16 to hold up to 16.
   glTextureStorage2D(gl.encoded_colour.get(), 1, model.bits() <= 8 ? GL_RGBA8 : GL_RGBA16, width, height);
@@ -395,8 +400,8 @@ void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const 
   });
   // With nothing still, keeping depth aside would only cost (measured: 0.86× the
   // frame time without it on the moving square).
-  const bool anything_still = std::any_of(gl_->instances.begin(), gl_->instances.end(),
-                                          [](const scene::Instance& i) { return !i.object; });
+  const bool anything_still =
+      std::any_of(gl_->instances.begin(), gl_->instances.end(), [](const scene::Instance& i) { return !i.object; });
   const bool still_once = still_once_allowed && anything_still && !passes.empty() && one_view;
   if (still_once) {
     const FieldPass& first = passes.front();
@@ -443,10 +448,34 @@ GatherReport SceneRenderer::draw_gathered(const scene::SceneState& state, const 
   const Motion motion{frame.view_projection_now, frame.view_projection_next};
   draw_scene(state, frame.seen.fraction, frame.seen.eye, frame.seen.frustum, terms, Objects::all, &motion);
   resolve();
-  const GatherReport report = gl.gather->run(gl.linear_colour.get(), frame.fields, frame.settings);
+  gl.gather->measure();
+  return gather_again(frame.fields, frame.settings);
+}
+
+GatherReport SceneRenderer::gather_again(std::span<const GatherField> fields, const GatherSettings& settings) {
+  Gl& gl = *gl_;
+  assert(gl.gather);
+  const GatherReport report = gl.gather->gather(gl.linear_colour.get(), fields, settings);
   encode(gl.gather->output());
   return report;
 }
+
+void SceneRenderer::hold_output() {
+  Gl& gl = *gl_;
+  if (gl.held_framebuffer.get() == 0) {
+    gl.held_colour = glo::make_texture();
+    GLint format = 0;
+    glGetTextureLevelParameteriv(gl.encoded_colour.get(), 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+    glTextureStorage2D(gl.held_colour.get(), 1, static_cast<GLenum>(format), gl.output_width, gl.output_height);
+    gl.held_framebuffer = glo::make_framebuffer();
+    glNamedFramebufferTexture(gl.held_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl.held_colour.get(), 0);
+  }
+  glCopyImageSubData(gl.encoded_colour.get(), GL_TEXTURE_2D, 0, 0, 0, 0, gl.held_colour.get(), GL_TEXTURE_2D, 0, 0, 0,
+                     0, gl.output_width, gl.output_height, 1);
+  glFinish();
+}
+
+unsigned SceneRenderer::held_framebuffer() const { return gl_->held_framebuffer.get(); }
 
 void SceneRenderer::keep_still_depth() {
   Gl& gl = *gl_;

@@ -103,6 +103,9 @@ class SceneRenderer {
   // done, with what the gather found.
   [[nodiscard]] GatherReport draw_gathered(const scene::SceneState& state, const GatherFrame& frame,
                                            const LightTerms& terms = {});
+  // Other fields from the render draw_gathered made last (the second image of a
+  // stereo projector used as mono), into the output.
+  [[nodiscard]] GatherReport gather_again(std::span<const GatherField> fields, const GatherSettings& settings);
   // Makes the velocity target, tiles and passes draw_gathered needs (only
   // projectors that gather have them); fails with the driver's message.
   [[nodiscard]] Result<void> prepare_gather();
@@ -126,7 +129,11 @@ class SceneRenderer {
   [[nodiscard]] image::ByteImage read_encoded() const;  // RGBA8, the signal (8 bits deep at most)
   [[nodiscard]] image::WordImage read_signal() const;   // RGBA16: the signal at any depth, ·65535
   [[nodiscard]] unsigned output_framebuffer() const;    // the encoded image, for a window blit
-  [[nodiscard]] int width() const;                      // of the output
+  // Copies the output aside, to be shown while the next image is drawn into it
+  // (a projector that shows two images per frame); returns when it is copied.
+  void hold_output();
+  [[nodiscard]] unsigned held_framebuffer() const;  // the copy; 0 before the first hold_output
+  [[nodiscard]] int width() const;                  // of the output
   [[nodiscard]] int height() const;
   // The rendered image before the output stage, and its depth (window z in [0, 1]).
   [[nodiscard]] image::FloatImage read_rendered() const;

@@ -16,6 +16,8 @@ Result<void> write_shown_file(const std::string& folder, std::uint64_t frame, co
   return image::write_png(image::frame_path(window, frame, "png"), shown);
 }
 
+constexpr const char* kSecondImageFolder = "second-image";
+
 }  // namespace
 
 CaptureWriter::CaptureWriter(std::string folder, spdlog::logger& log, std::size_t max_queued)
@@ -30,14 +32,14 @@ CaptureWriter::~CaptureWriter() {
   worker_.join();
 }
 
-void CaptureWriter::submit(std::uint64_t frame, image::FloatImage linear, image::ByteImage encoded,
+void CaptureWriter::submit(std::uint64_t frame, int image, image::FloatImage linear, image::ByteImage encoded,
                            image::WordImage deep) {
   std::unique_lock lock(mutex_);
   if (jobs_.size() >= max_queued_) {
     log_.warn("capture writer is {} frames behind; waiting for it", jobs_.size());
     changed_.wait(lock, [this] { return jobs_.size() < max_queued_; });
   }
-  jobs_.push_back({frame, std::move(linear), std::move(encoded), std::move(deep), {}});
+  jobs_.push_back({frame, image, std::move(linear), std::move(encoded), std::move(deep), {}});
   lock.unlock();
   changed_.notify_all();
 }
@@ -45,7 +47,7 @@ void CaptureWriter::submit(std::uint64_t frame, image::FloatImage linear, image:
 void CaptureWriter::submit_shown(std::uint64_t frame, image::ByteImage shown) {
   std::unique_lock lock(mutex_);
   changed_.wait(lock, [this] { return jobs_.size() < max_queued_; });
-  jobs_.push_back({frame, {}, {}, {}, std::move(shown)});
+  jobs_.push_back({frame, 0, {}, {}, {}, std::move(shown)});
   lock.unlock();
   changed_.notify_all();
 }
@@ -60,15 +62,17 @@ void CaptureWriter::run() {
     lock.unlock();
     changed_.notify_all();
     Result<void> written;
+    const std::string folder =
+        job.image == 0 ? folder_ : (std::filesystem::path(folder_) / kSecondImageFolder).string();
     if (!job.shown.empty()) {
       written = write_shown_file(folder_, job.frame, job.shown);
     } else if (job.deep.empty()) {
-      written = image::write_frame(folder_, job.frame, job.linear, job.encoded);
+      written = image::write_frame(folder, job.frame, job.linear, job.encoded);
     } else {
-      written = image::write_frame(folder_, job.frame, job.linear, job.deep);
+      written = image::write_frame(folder, job.frame, job.linear, job.deep);
     }
     if (!written) {
-      log_.error("capture of frame {} lost: {}", job.frame, written.error());
+      log_.error("capture of frame {}{} lost: {}", job.frame, job.image == 0 ? "" : "'s second image", written.error());
     }
   }
 }

@@ -24,8 +24,11 @@ class CaptureWriter {
   CaptureWriter(const CaptureWriter&) = delete;
   CaptureWriter& operator=(const CaptureWriter&) = delete;
 
-  // `encoded` is the signal: 8 bits, or 16 (`deep`, non-empty) for deeper projectors.
-  void submit(std::uint64_t frame, image::FloatImage linear, image::ByteImage encoded, image::WordImage deep = {});
+  // `encoded` is the signal: 8 bits, or 16 (`deep`, non-empty) for deeper
+  // projectors. Image 1 of a frame (a projector that shows two per frame) goes
+  // to FOLDER/second-image/frame-NNNNNN.{exr,png}.
+  void submit(std::uint64_t frame, int image, image::FloatImage linear, image::ByteImage encoded,
+              image::WordImage deep = {});
   // What the projector's window showed for `frame` (read back from the window):
   // FOLDER/window/frame-NNNNNN.png.
   void submit_shown(std::uint64_t frame, image::ByteImage shown);
@@ -34,6 +37,7 @@ class CaptureWriter {
  private:
   struct Job {
     std::uint64_t frame;
+    int image;
     image::FloatImage linear;
     image::ByteImage encoded;
     image::WordImage deep;

@@ -80,7 +80,15 @@ void GlRenderer::render(const FrameInput& frame) {
   // frame shows nothing, so it is not lost.
   if (frame.lights != nullptr) pipeline_->set_share(*frame.lights);
   if (frame.focus) pipeline_->set_focus(*frame.focus);
-  if (auto drawn = pipeline_->draw_frame(*frame.state); !drawn) {
+  // Each image captured as it is drawn (a stereo projector used as mono draws two).
+  const auto capture = [&](int image) {
+    if (!frame.capture) return;
+    const render::SceneRenderer& renderer = pipeline_->renderer();
+    captures_->submit(frame.frame_id, image, renderer.read_linear(),
+                      deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
+                      deep_signal_ ? renderer.read_signal() : image::WordImage{});
+  };
+  if (auto drawn = pipeline_->draw_frame(*frame.state, capture); !drawn) {
     // The eye left the space in front of this screen: the projector shows black
     // rather than a wrong picture.
     log_.debug("frame {}: {}", frame.frame_id, drawn.error());
@@ -92,23 +100,18 @@ void GlRenderer::render(const FrameInput& frame) {
         "field, so faster motion is cut short there (its fields lag; method per-field has no such limit)",
         frame.frame_id, gather.fastest, render::kGatherRadius);
   }
-  if (frame.capture) {
-    const render::SceneRenderer& renderer = pipeline_->renderer();
-    captures_->submit(frame.frame_id, renderer.read_linear(),
-                      deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
-                      deep_signal_ ? renderer.read_signal() : image::WordImage{});
-    if (context_->has_window()) read_back_shown_ = frame.frame_id;
-  }
+  if (frame.capture && context_->has_window()) read_back_shown_ = frame.frame_id;
 }
 
-void GlRenderer::present() {
+void GlRenderer::present(int image) {
+  const unsigned framebuffer = pipeline_->image_framebuffer(image);
   const render::SceneRenderer& renderer = pipeline_->renderer();
-  if (!read_back_shown_) {
-    context_->present(renderer.output_framebuffer(), renderer.width(), renderer.height());
+  if (!read_back_shown_ || image != 0) {  // a window's read-back: of the frame's first image
+    context_->present(framebuffer, renderer.width(), renderer.height());
     return;
   }
   image::ByteImage shown;
-  context_->present(renderer.output_framebuffer(), renderer.width(), renderer.height(), &shown);
+  context_->present(framebuffer, renderer.width(), renderer.height(), &shown);
   captures_->submit_shown(*read_back_shown_, std::move(shown));
   read_back_shown_.reset();
 }
@@ -116,8 +119,9 @@ void GlRenderer::present() {
 void GlRenderer::show_black() {
   if (!pipeline_) return;    // not configured yet: nothing is on the projector
   read_back_shown_.reset();  // black is not the captured frame
-  pipeline_->renderer().draw_black();
-  present();
+  render::SceneRenderer& renderer = pipeline_->renderer();
+  renderer.draw_black();
+  context_->present(renderer.output_framebuffer(), renderer.width(), renderer.height());
 }
 
 }  // namespace optique::node

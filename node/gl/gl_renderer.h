@@ -18,14 +18,15 @@ namespace optique::node {
 
 class GlRenderer final : public Renderer {
  public:
-  // Captures go to `capture_folder`/frame-NNNNNN.{exr,png}.
+  // Captures go to `capture_folder`/frame-NNNNNN.{exr,png} (a second image per
+  // frame to `capture_folder`/second-image/).
   GlRenderer(spdlog::logger& log, std::string capture_folder);
   ~GlRenderer() override;
 
   [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
   [[nodiscard]] std::string description() const override;
   void render(const FrameInput& frame) override;
-  void present() override;
+  void present(int image) override;
   void show_black() override;
 
  private:

@@ -10,7 +10,9 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <iterator>
 
+#include "config/color_fields.h"
 #include "config/job.h"
 #include "geometry/homography.h"
 #include "gl_installation.h"
@@ -188,14 +190,46 @@ TEST_F(FieldRendering, StillObjectsDrawnOnceAreAsDrawnInEveryField) {
   EXPECT_LE(worst, 1e-5f);
 }
 
-TEST_F(FieldRendering, TwoImagesPerFrameAreRefusedWithTheReason) {
+// The stereo projector used as mono: six fields in two images per frame, each
+// image's channels where the square is during their fields, both drawn by one
+// draw_frame (the second after the first was read, as a node captures them).
+TEST_F(FieldRendering, EachOfTwoImagesShowsItsOwnThreeFields) {
   config::ProjectorJob job = config::job_for(installation_, 0);
-  config::ColorFields& c = job.installation.projectors[job.projector].color_fields;
-  c.images = 2;
-  c.fields.push_back({config::Channel::red, 1, 0.4, 0.1});
-  const auto pipeline = render::ProjectorPipeline::make(job, scene_);
-  ASSERT_FALSE(pipeline);
-  EXPECT_NE(pipeline.error().find("two images per frame"), std::string::npos) << pipeline.error();
+  schema::ColorFields preset;
+  preset.set_preset("dlp-stereo-as-mono");
+  std::vector<config::Problem> problems;
+  job.installation.projectors[job.projector].color_fields = config::parse_color_fields(preset, "test", problems);
+  ASSERT_TRUE(problems.empty());
+  const config::ProjectorJob fine = config::supersampled(job, kFine);
+  const auto& fields = fine.self().color_fields.fields;
+  ASSERT_EQ(fields.size(), 6u);
+  const int row = middle_row(fine);
+  const auto edges_at = [&](double fraction) { return square_edges(fine, fraction); };
+
+  auto pipeline = render::ProjectorPipeline::make(fine, scene_);
+  ASSERT_TRUE(pipeline) << pipeline.error();
+  ASSERT_EQ(pipeline.value()->images(), 2);
+  std::vector<image::FloatImage> images;
+  const auto drawn = pipeline.value()->draw_frame(state_at(kFrame), [&](int image) {
+    EXPECT_EQ(image, static_cast<int>(images.size()));
+    images.push_back(pipeline.value()->renderer().read_rendered());
+  });
+  ASSERT_TRUE(drawn) << drawn.error();
+  ASSERT_EQ(images.size(), 2u);
+  EXPECT_NE(pipeline.value()->image_framebuffer(0), pipeline.value()->image_framebuffer(1));
+  for (int image = 0; image < 2; ++image) {
+    std::vector<config::ColorField> own;
+    std::copy_if(fields.begin(), fields.end(), std::back_inserter(own),
+                 [&](const config::ColorField& f) { return f.image == image; });
+    ASSERT_EQ(own.size(), 3u);
+    const double error = worst_edge_error(images[static_cast<std::size_t>(image)], own, edges_at, row);
+    std::cout << "image " << image << ": worst channel edge " << error << " px from its field's moment\n";
+    EXPECT_LE(error, 0.25) << "image " << image;
+  }
+  // Negative control: the second image's fields checked against the first's
+  // image: half a frame off.
+  std::vector<config::ColorField> second(fields.begin() + 3, fields.end());
+  EXPECT_GT(worst_edge_error(images[0], second, edges_at, row), 1.0);
 }
 
 }  // namespace

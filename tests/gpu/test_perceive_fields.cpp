@@ -45,12 +45,12 @@ struct Seen {
   std::string out;
 };
 
-Seen perceive(const std::string& config, const std::string& track, const std::string& out) {
+Seen perceive(const std::string& config, const std::string& track, const std::string& out, std::uint64_t frame = 60) {
   auto loaded = master::load_run_config(config, image::decode_texture);
   EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
   if (!loaded) return {};
   tools::PerceiveOptions options;
-  options.frame = 60;
+  options.frame = frame;
   EXPECT_TRUE(tools::parse_track(track, options));
   auto logger = std::make_shared<spdlog::logger>("perceive", std::make_shared<spdlog::sinks::null_sink_mt>());
   auto seen = tools::perceive(loaded.value().config, loaded.value().scene, options, out, *logger);
@@ -134,6 +134,41 @@ TEST(PerceiveFields, TheSquareCrossesTheSeamOfTwoDlpTilesWithoutABreak) {
             << compared.value().psnr_y_weighted << " dB; fringe " << tiles.screen.fringe_px << " px\n";
   EXPECT_GE(compared.value().psnr_y_weighted, 35.0);
   EXPECT_LE(tiles.screen.fringe_px, 0.5);
+  fs::remove_all(dir);
+}
+
+// A 2×60 Hz stereo projector used as mono (configs/dlp-stereo-as-mono.json): six
+// fields per 60 Hz frame, B R G of one image and then of the other, shown half a
+// frame later. Drawn at one moment, the same frame shows twice: each channel
+// lands twice, and the channels apart.
+TEST(PerceiveFields, AStereoProjectorUsedAsMonoShowsEachOfItsSixFieldsAtItsMoment) {
+  const std::string dir = testing::make_temp_dir("optique-perceive");
+  std::ifstream in(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-stereo-as-mono.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  const auto with = [&](const std::string& method) {
+    const std::string path = dir + "/stereo-" + method + ".json";
+    std::ofstream(path) << std::regex_replace(text.str(), std::regex(R"("preset": "dlp-stereo-as-mono")"),
+                                              R"("preset": "dlp-stereo-as-mono", "method": ")" + method + '"');
+    return path;
+  };
+  // Frame 30: the square is halfway across (at 60 Hz, frame 60 is its wrap).
+  const Seen fields = perceive(with("per-field"), "square", dir + "/per-field", 30);
+  const Seen gathered = perceive(with("gather"), "square", dir + "/gather", 30);
+  const Seen twice = perceive(with("off"), "square", dir + "/off", 30);
+  const double speed = fields.screen.velocity.x / 60.0;
+  std::cout << "eye at " << speed << " px/frame; per-field: fringe " << fields.screen.fringe_px << " px, PSNR_Y "
+            << fields.screen.psnr_y_db << " dB; gather: " << gathered.screen.fringe_px << " px, "
+            << gathered.screen.psnr_y_db << " dB; the same frame twice: " << twice.screen.fringe_px << " px, "
+            << twice.screen.psnr_y_db << " dB\n";
+  EXPECT_NEAR(speed, 7.3, 0.1);
+  // The same frame twice: blue shows at −5/12 and +1/12 of the frame, green at
+  // −1/12 and +5/12; the eye sees their middles 4/12 of a frame apart.
+  EXPECT_NEAR(twice.screen.fringe_px, speed * 4.0 / 12.0, 0.25 * speed * 4.0 / 12.0);
+  EXPECT_LE(fields.screen.fringe_px, 0.5);
+  EXPECT_LE(gathered.screen.fringe_px, 1.0);
+  EXPECT_GE(fields.screen.psnr_y_db - twice.screen.psnr_y_db, 10.0);
+  EXPECT_GE(gathered.screen.psnr_y_db - twice.screen.psnr_y_db, 10.0);
   fs::remove_all(dir);
 }
 

@@ -8,6 +8,7 @@
 #include <csignal>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 
 #include "cluster_run.h"
 #include "config/load.h"
@@ -215,6 +216,39 @@ TEST(Rendering, AWindowOnAProjectorShowsWhatHeadlessRenders) {
   for (const float v : sent.pixels) brightest = std::max(brightest, v);
   EXPECT_GT(brightest, 0.5f) << "the frame should show something";
   EXPECT_EQ(largest_difference(shown.value(), sent), 0.0);
+}
+
+// A 2×60 Hz stereo projector used as mono (configs/dlp-stereo-as-mono.json): the
+// node draws, shows and captures two images per frame, each with its own three
+// fields: blue at −5/12 of the frame in the first, +1/12 in the second. On black,
+// each channel's centroid is where the square is at its field.
+TEST(Rendering, AStereoProjectorUsedAsMonoCapturesBothImagesOfAFrame) {
+  const std::string out = run_and_capture(kConfigs + "/dlp-stereo-as-mono.json", 31, 30);
+  const image::FloatImage first = capture(out, "dlp", 30);
+  auto second = image::read_image(image::frame_path(out + "/nodes/dlp/second-image", 30, "png"));
+  ASSERT_TRUE(second.ok()) << second.error();
+  ASSERT_EQ(second.value().width, first.width);
+  ASSERT_EQ(second.value().height, first.height);
+  const auto centroid_x = [](const image::FloatImage& image, int channel) {
+    double weight = 0.0;
+    double sum = 0.0;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        weight += image.at(x, y, channel);
+        sum += image.at(x, y, channel) * (x + 0.5);
+      }
+    }
+    return weight > 0.0 ? sum / weight : -1.0;
+  };
+  // 3 m/s across 160 px per metre at 60 Hz (the eye is 2 m before the wall, the
+  // square 0.2 m behind it): 8 px per frame on the square's plane, 7.27 on the wall.
+  const double per_frame = 8.0 * 2.0 / 2.2;
+  for (int channel = 0; channel < 3; ++channel) {
+    const double moved = centroid_x(second.value(), channel) - centroid_x(first, channel);
+    std::cout << "channel " << channel << ": the second image's square " << moved
+              << " px on (half a frame: " << 0.5 * per_frame << " px)\n";
+    EXPECT_NEAR(moved, 0.5 * per_frame, 0.25) << "channel " << channel;
+  }
 }
 
 // ------------------------------------------------------------- glTF scenes

@@ -233,6 +233,76 @@ TEST_F(NodeTest, AFrameIsRenderedReportedAndShownAtItsDeadline) {
   EXPECT_TRUE(node.presented(now_).empty()) << "shown once";
 }
 
+// A 2×60 Hz stereo projector used as mono shows two images per frame: the second
+// half a frame after the first, the next frame held back until it is shown, and
+// only the first reported (the master's deadline and sync are for it).
+TEST_F(NodeTest, AStereoProjectorUsedAsMonoShowsItsSecondImageHalfAFrameLater) {
+  auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-stereo-as-mono.json");
+  ASSERT_TRUE(loaded) << loaded.error();
+  wall_ = loaded.value().installation;
+  ASSERT_EQ(wall_.projectors.front().color_fields.images, 2);
+  NodeSettings s = settings();
+  s.id = "dlp";
+  NodeProtocol node(s);
+  join(node);
+  (void)begin(node, 0);
+  (void)node.rendered(0, kMs);
+  const clock::Nanos deadline = now_ + 2 * kMs;
+  Actions a = swap(node, 0, deadline);
+  const PresentAt* at = first<PresentAt>(a);
+  ASSERT_NE(at, nullptr);
+  now_ = at->deadline;
+  a = node.present_due(now_);
+  ASSERT_NE(first<Present>(a), nullptr);
+  EXPECT_EQ(first<Present>(a)->image, 0);
+  // Frame 1 comes meanwhile: it waits for both images of frame 0.
+  now_ += kMs;
+  EXPECT_EQ(first<Render>(begin(node, 1)), nullptr);
+  a = node.presented(now_);
+  ASSERT_EQ(sent(a, wire::Envelope::kPresented).size(), 1u) << "the first image is reported";
+  EXPECT_EQ(first<Render>(a), nullptr) << "the second image is not shown yet";
+  at = first<PresentAt>(a);
+  ASSERT_NE(at, nullptr);
+  EXPECT_EQ(at->deadline - (deadline), kPeriod / 2) << "half a frame after the first";
+  now_ = at->deadline;
+  a = node.present_due(now_);
+  ASSERT_NE(first<Present>(a), nullptr);
+  EXPECT_EQ(first<Present>(a)->image, 1);
+  a = node.presented(now_);
+  EXPECT_TRUE(sent(a, wire::Envelope::kPresented).empty()) << "one report per frame";
+  const Render* render = first<Render>(a);
+  ASSERT_NE(render, nullptr) << "frame 1 is drawn once frame 0's second image is shown";
+  EXPECT_EQ(render->frame.frame_id, 1u);
+  // An image is stale once the next one's time has come: a first image shown
+  // late is followed by its second only if that is not late too.
+  (void)node.rendered(1, kMs);
+  a = swap(node, 1, now_ + kMs);
+  at = first<PresentAt>(a);
+  ASSERT_NE(at, nullptr);
+  now_ = at->deadline;
+  (void)node.present_due(now_);
+  a = node.presented(now_ + kPeriod + kMs);
+  EXPECT_EQ(first<PresentAt>(a), nullptr);
+  EXPECT_TRUE(logged(a, "frame 1 image 1's present deadline passed"));
+  // And a first image woken too late gives way to the second.
+  now_ += kPeriod;
+  (void)begin(node, 2);
+  (void)node.rendered(2, kMs);
+  a = swap(node, 2, now_ + kMs);
+  at = first<PresentAt>(a);
+  ASSERT_NE(at, nullptr);
+  now_ = at->deadline + kPeriod / 2 + kMs;
+  a = node.present_due(now_);
+  EXPECT_TRUE(logged(a, "frame 2 image 0's present deadline passed"));
+  EXPECT_EQ(first<Present>(a), nullptr);
+  at = first<PresentAt>(a);
+  ASSERT_NE(at, nullptr) << "the second image's time has not passed";
+  const clock::Nanos second = at->deadline;
+  a = node.present_due(second);
+  ASSERT_NE(first<Present>(a), nullptr);
+  EXPECT_EQ(first<Present>(a)->image, 1);
+}
+
 TEST_F(NodeTest, AFrameThatComesWhileOneWaitsForItsDeadlineWaitsForIt) {
   NodeProtocol node(settings());
   join(node);
