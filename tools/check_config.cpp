@@ -43,11 +43,12 @@ std::string color_fields_summary(const config::ColorFields& c, const config::Mas
   if (c.method == config::FieldMethod::gather) text << "; " << c.gather_samples << " samples per field and pixel";
   if (c.velocity_threshold > 0.0) {
     text << "; velocity_threshold " << c.velocity_threshold << " px per frame";
-    if (c.method != config::FieldMethod::gather) {
-      text << " applies to method gather only: with " << config::to_string(c.method)
-           << " every moving object gets its field offsets";
+    if (c.method == config::FieldMethod::off) {
+      text << " has no effect with method off (no field offsets to replace)";
     } else {
-      text << ": faster pixels get motion blur over the frame instead";
+      text << ": faster pixels get motion blur over " << (c.images > 1 ? "their image's half of " : "")
+           << "the frame instead"
+           << (c.method == config::FieldMethod::per_field ? " (from one more render, with velocity)" : "");
     }
   }
   return text.str();

@@ -42,13 +42,16 @@ struct ColorFields {
   std::vector<ColorField> fields;  // in the order given; empty: all colours at once
   int images = 1;                  // images per frame: 1, or 2 for a stereo projector used as mono
   FieldMethod method = FieldMethod::per_field;
-  double velocity_threshold = 0.0;             // drawn image's pixels per frame period; 0: none (gather only)
+  double velocity_threshold = 0.0;             // drawn image's pixels per frame period; 0: none
   int gather_samples = kDefaultGatherSamples;  // per field and pixel, along the motion
 
   // Whether the projector draws its fields at their own times.
   [[nodiscard]] bool sequential() const { return !fields.empty() && method != FieldMethod::off; }
   // Whether they are gathered from one render (the velocity target and tiles).
   [[nodiscard]] bool gathers() const { return sequential() && method == FieldMethod::gather; }
+  // Whether it needs each pixel's velocity: to gather, or to blur what is
+  // faster than the threshold.
+  [[nodiscard]] bool needs_velocity() const { return gathers() || (sequential() && velocity_threshold > 0.0); }
   friend bool operator==(const ColorFields&, const ColorFields&) = default;
 };
 

@@ -138,9 +138,15 @@ void FieldGather::measure() {
   }
 }
 
+void FieldGather::keep(GLuint image) {
+  glCopyImageSubData(image, GL_TEXTURE_2D, 0, 0, 0, 0, gathered_.get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_, height_, 1);
+}
+
 GatherReport FieldGather::gather(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings) {
   assert(fields.size() <= static_cast<std::size_t>(kMaxGatherFields));
   assert(settings.samples >= 2);
+  const bool blur_only = fields.empty();
+  assert(!blur_only || settings.velocity_threshold > 0.0);
   assert(near_.size() == static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_));  // measure() first
   GatherReport report;
   report.fastest = fastest_;
@@ -153,17 +159,17 @@ GatherReport FieldGather::gather(GLuint colour, std::span<const GatherField> fie
   report.clamped = report.fastest * reach > kGatherRadius;
 
   // The render as it is; then, over it, the tiles where a field moves something
-  // (the shader's own test: a neighbour max that moves a surface 1e-3 px).
-  glCopyImageSubData(colour, GL_TEXTURE_2D, 0, 0, 0, 0, gathered_.get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_, height_, 1);
+  // (the shader's own test: a neighbour max that moves a surface 1e-3 px), or
+  // where the blur begins.
+  if (!blur_only) keep(colour);
+  const double slowest = blur_only ? kBlurBandFrom * threshold : 0.0;
   std::vector<GLfloat> quads;
   const auto ndc = [](int pixel, int size) { return static_cast<GLfloat>(2.0 * pixel / size - 1.0); };
   for (int ty = 0; ty < tiles_y_; ++ty) {
     for (int tx = 0; tx < tiles_x_; ++tx) {
-      if (near_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(tx)] *
-              reach <
-          1e-3) {
-        continue;
-      }
+      const double near =
+          near_[static_cast<std::size_t>(ty) * static_cast<std::size_t>(tiles_x_) + static_cast<std::size_t>(tx)];
+      if (near * reach < 1e-3 || near <= slowest) continue;
       const GLfloat x0 = ndc(tx * kGatherRadius, width_);
       const GLfloat x1 = ndc(std::min((tx + 1) * kGatherRadius, width_), width_);
       const GLfloat y0 = ndc(ty * kGatherRadius, height_);
@@ -200,9 +206,14 @@ GatherReport FieldGather::gather(GLuint colour, std::span<const GatherField> fie
   glBindFramebuffer(GL_FRAMEBUFFER, gathered_framebuffer_.get());
   glViewport(0, 0, width_, height_);
   glDisable(GL_DEPTH_TEST);
+  if (blur_only) {  // the shader gives the blur and its weight: over the fields, alpha kept
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ZERO, GL_ONE);
+  }
   glUseProgram(gather);
   glBindVertexArray(tile_vertex_array_.get());
   glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(quads.size() / 2));
+  glDisable(GL_BLEND);
   // With one sample per pixel the motion texture is also the scene's second
   // attachment: left bound, the next scene pass would sample what it draws into.
   glBindTextureUnit(1, 0);

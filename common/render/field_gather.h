@@ -36,7 +36,10 @@ class FieldGather {
   // each channel in one of them. Only the tiles where something moves are
   // gathered; the others are the render as it is. Again for another image's
   // fields from the same render (a stereo projector used as mono).
+  // Without fields, only the motion blur above the threshold (which must be
+  // set), laid over the image keep() put in output(): fields drawn per field.
   [[nodiscard]] GatherReport gather(GLuint colour, std::span<const GatherField> fields, const GatherSettings& settings);
+  void keep(GLuint image);  // `image` (this size, RGBA32F) into output()
   [[nodiscard]] GLuint output() const { return gathered_.get(); }
 
  private:

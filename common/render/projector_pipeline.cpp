@@ -51,7 +51,7 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
   stage.focus.inset = job.installation.depth_of_field && job.installation.depth_of_field->inset_radius > 0.0;
   stage.projector = optics::ProjectorModel(self.response);
   if (auto output = renderer.value()->set_output(stage); !output) return Error{output.error()};
-  if (self.color_fields.gathers()) {
+  if (self.color_fields.needs_velocity()) {
     if (auto gather = renderer.value()->prepare_gather(); !gather) {
       return Error{"projector '" + self.id + "': " + gather.error()};
     }
@@ -138,7 +138,20 @@ Result<void> ProjectorPipeline::draw_image(const scene::SceneState& state, int i
     pass.value().blue = field.channel == config::Channel::blue;
     passes.push_back(pass.value());
   }
-  renderer_->draw_fields(state, passes, terms_, still_once_);
+  if (!(color_fields_.velocity_threshold > 0.0)) {
+    (void)renderer_->draw_fields(state, passes, terms_, still_once_);
+    return {};
+  }
+  // What is faster than the threshold gets motion blur over the image's time on
+  // screen, from a render at its middle.
+  const double share = 1.0 / images();
+  auto blur = gather_frame(state, image, -0.5 + (image + 0.5) * share);
+  if (!blur) {
+    renderer_->draw_black();
+    return Error{blur.error()};
+  }
+  blur.value().fields.clear();
+  add(renderer_->draw_fields(state, passes, terms_, still_once_, &blur.value()));
   return {};
 }
 
@@ -157,45 +170,46 @@ double ProjectorPipeline::gather_moment() const {
   return sum / greens;
 }
 
-Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state, int image) {
-  const double rendered = gather_moment();
-  std::vector<GatherField> fields;
+Result<GatherFrame> ProjectorPipeline::gather_frame(const scene::SceneState& state, int image, double rendered) const {
+  const auto seen = moment(state, rendered);
+  const auto now = moment(state, 0.0);
+  const auto next = moment(state, 1.0);
+  for (const auto* m : {&seen, &now, &next}) {
+    if (!*m) return Error{m->error()};
+  }
+  GatherFrame frame;
+  frame.seen = seen.value();
+  frame.view_projection_now = now.value().frustum.projection * now.value().frustum.view;
+  frame.view_projection_next = next.value().frustum.projection * next.value().frustum.view;
   for (const config::ColorField& field : color_fields_.fields) {
     if (field.image != image) continue;
-    fields.push_back({field.channel == config::Channel::red, field.channel == config::Channel::green,
-                      field.channel == config::Channel::blue, field.offset - rendered});
+    frame.fields.push_back({field.channel == config::Channel::red, field.channel == config::Channel::green,
+                            field.channel == config::Channel::blue, field.offset - rendered});
   }
-  GatherSettings settings;
-  settings.samples = color_fields_.gather_samples;
-  settings.velocity_threshold = color_fields_.velocity_threshold;
+  frame.settings.samples = color_fields_.gather_samples;
+  frame.settings.velocity_threshold = color_fields_.velocity_threshold;
   // Above the threshold, motion blur over the time this image is on screen.
   const double share = 1.0 / images();
-  settings.frame_start = -0.5 + image * share - rendered;
-  settings.frame_end = -0.5 + (image + 1) * share - rendered;
-  GatherReport report;
-  if (image > 0) {
-    report = renderer_->gather_again(fields, settings);  // from the render image 0 made
-  } else {
-    const auto seen = moment(state, rendered);
-    const auto now = moment(state, 0.0);
-    const auto next = moment(state, 1.0);
-    for (const auto* m : {&seen, &now, &next}) {
-      if (!*m) {
-        renderer_->draw_black();
-        return Error{m->error()};
-      }
-    }
-    GatherFrame frame;
-    frame.seen = seen.value();
-    frame.view_projection_now = now.value().frustum.projection * now.value().frustum.view;
-    frame.view_projection_next = next.value().frustum.projection * next.value().frustum.view;
-    frame.fields = std::move(fields);
-    frame.settings = settings;
-    report = renderer_->draw_gathered(state, frame, terms_);
-  }
+  frame.settings.frame_start = -0.5 + image * share - rendered;
+  frame.settings.frame_end = -0.5 + (image + 1) * share - rendered;
+  return frame;
+}
+
+void ProjectorPipeline::add(const GatherReport& report) {
   gather_report_.fastest = std::max(gather_report_.fastest, report.fastest);
   gather_report_.clamped = gather_report_.clamped || report.clamped;
   gather_report_.gathered_tiles += report.gathered_tiles;
+}
+
+Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state, int image) {
+  auto frame = gather_frame(state, image, gather_moment());
+  if (!frame) {
+    renderer_->draw_black();
+    return Error{frame.error()};
+  }
+  // The second image's fields from the render the first made.
+  add(image == 0 ? renderer_->draw_gathered(state, frame.value(), terms_)
+                 : renderer_->gather_again(frame.value().fields, frame.value().settings));
   return {};
 }
 
@@ -203,7 +217,7 @@ void ProjectorPipeline::warm_up() {
   const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
   if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
     renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
-    if (color_fields_.gathers()) {
+    if (color_fields_.needs_velocity()) {
       // The velocity program and the tile passes too (the field pass itself
       // first runs when something moves).
       GatherFrame frame;
@@ -211,6 +225,7 @@ void ProjectorPipeline::warm_up() {
       frame.seen.frustum = frustum.value();
       frame.view_projection_now = frustum.value().projection * frustum.value().view;
       frame.view_projection_next = frame.view_projection_now;
+      frame.fields.push_back({true, true, true, 0.0});
       (void)renderer_->draw_gathered(scene::SceneState{}, frame);
     }
   }

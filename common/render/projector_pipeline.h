@@ -101,6 +101,10 @@ class ProjectorPipeline {
   [[nodiscard]] Result<void> draw_image(const scene::SceneState& state, int image);
   // When the gather's one render shows the scene, frame periods from the display time.
   [[nodiscard]] double gather_moment() const;
+  // The scene seen `rendered` frame periods after the display time, each
+  // surface's velocity over the frame, `image`'s fields as shifts from then.
+  [[nodiscard]] Result<GatherFrame> gather_frame(const scene::SceneState& state, int image, double rendered) const;
+  void add(const GatherReport& report);  // to the frame's gather_report()
   [[nodiscard]] Result<void> draw_gathered(const scene::SceneState& state, int image);
 
   ProjectorView view_;

@@ -388,8 +388,8 @@ void SceneRenderer::draw(const scene::SceneState& state, double fraction, const 
   encode();
 }
 
-void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
-                                const LightTerms& terms, bool still_once_allowed) {
+GatherReport SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
+                                        const LightTerms& terms, bool still_once_allowed, const GatherFrame* blur) {
   begin_linear();
   // Seen from one place in every field (the viewer does not move), what does not
   // move looks the same in each: it is drawn once, in every channel, and each
@@ -421,7 +421,23 @@ void SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const 
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
   }
   resolve();
-  encode();
+  if (blur == nullptr) {
+    encode();
+    return {};
+  }
+  // The fields aside; the scene once more, with its velocity, for the blur of
+  // what is too fast to follow, laid over them.
+  Gl& gl = *gl_;
+  assert(gl.gather);  // prepare_gather first
+  gl.gather->keep(gl.linear_colour.get());
+  begin_linear(true);
+  const Motion motion{blur->view_projection_now, blur->view_projection_next};
+  draw_scene(state, blur->seen.fraction, blur->seen.eye, blur->seen.frustum, terms, Objects::all, &motion);
+  resolve();
+  gl.gather->measure();
+  const GatherReport report = gl.gather->gather(gl.linear_colour.get(), {}, blur->settings);
+  encode(gl.gather->output());
+  return report;
 }
 
 Result<void> SceneRenderer::prepare_gather() {

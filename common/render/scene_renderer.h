@@ -95,9 +95,13 @@ class SceneRenderer {
   // the moment its field is on screen; then the output stage, once. When every
   // pass sees the scene from the same place, what does not move is drawn once for
   // all of them (unless `still_once` is false: to measure what that saves).
-  // Returns when the GPU is done.
-  void draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes, const LightTerms& terms = {},
-                   bool still_once = true);
+  // With `blur` (its fields empty, a velocity threshold set; prepare_gather
+  // first), the scene is drawn once more at its moment with its velocity, and
+  // pixels faster than the threshold get motion blur over its frame window
+  // instead of their fields (as draw_gathered does). Returns when the GPU is
+  // done, with what the blur found.
+  GatherReport draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
+                           const LightTerms& terms = {}, bool still_once = true, const GatherFrame* blur = nullptr);
 
   // The same by the gather method; prepare_gather first. Returns when the GPU is
   // done, with what the gather found.

@@ -4,7 +4,7 @@
 // moving square, the pinball and the scrolling stripes; per method: the frame's
 // draw time (draw and output pass, finished on the GPU) as ms and as ratios to one
 // render and to per-field, side by side in one process, alternating; and
-// tools::perceive's fringe width and PSNR_Y against the ideal at frame 60, and
+// tools::perceive's fringe width and PSNR_Y against the ideal half a second in, and
 // against per-field's perceived image. Writes fields.md, fields.csv and fields.png.
 //
 //   optique-bench-fields [--out DIR] [--frames N] [--runs R]
@@ -39,20 +39,23 @@ using namespace optique;
 struct Method {
   std::string name;
   config::FieldMethod fields;
-  int samples;             // per pixel
-  int gather_samples = 8;  // per field and pixel, along the motion
+  int samples;                      // per pixel
+  double velocity_threshold = 0.0;  // px per frame; 0: none
+  int gather_samples = 8;           // per field and pixel, along the motion
   bool still_once = true;
 };
 
+// The gather as configs/dlp-pinball.json ships it: velocity_threshold 24.
 const std::vector<Method> kMethods{
     {"one moment per frame (method off)", config::FieldMethod::off, 1},
     {"per-field, 1 sample per pixel", config::FieldMethod::per_field, 1},
     {"per-field (shipped: 4 samples per pixel, still objects once)", config::FieldMethod::per_field, 4},
-    {"per-field, still objects drawn per field too", config::FieldMethod::per_field, 4, 8, false},
-    {"gather, 4 samples along the motion", config::FieldMethod::gather, 4, 4},
-    {"gather, 8 along the motion (shipped)", config::FieldMethod::gather, 4, 8},
-    {"gather, 16 along the motion", config::FieldMethod::gather, 4, 16},
-    {"gather, 8 along the motion, 1 sample per pixel", config::FieldMethod::gather, 1, 8},
+    {"per-field, still objects drawn per field too", config::FieldMethod::per_field, 4, 0.0, 8, false},
+    {"per-field, blur above velocity_threshold 24", config::FieldMethod::per_field, 4, 24.0},
+    {"gather, 4 samples along the motion", config::FieldMethod::gather, 4, 24.0, 4},
+    {"gather, 8 along the motion (shipped)", config::FieldMethod::gather, 4, 24.0, 8},
+    {"gather, 16 along the motion", config::FieldMethod::gather, 4, 24.0, 16},
+    {"gather, 8 along the motion, 1 sample per pixel", config::FieldMethod::gather, 1, 24.0, 8},
 };
 constexpr std::size_t kPerField = 2;  // the reference for the gather's cost and image
 
@@ -60,24 +63,37 @@ struct Case {
   std::string name;
   std::string scene;    // built-in
   std::string tracked;  // the object the eye follows
+  std::string preset = "dlp-brg-120hz";
+  int frame_rate = 120;
 };
 
-// All on the wall of configs/dlp-pinball.json: 1056×594 px over 4 m, 120 Hz, B R G.
-const std::vector<Case> kCases{{"moving square (6 px/frame)", "moving-square", "square"},
-                               {"pinball (ball 6 px/frame, 8 lights)", "pinball", "ball"},
-                               {"scrolling stripes (3.3 px/frame)", "scrolling-stripes", "stripes"}};
+// All on the wall of configs/dlp-pinball.json: 1056×594 px over 4 m; 120 Hz, B R G,
+// or the stereo projector used as mono: 60 Hz, six fields in two images.
+const std::vector<Case> kCases{
+    {"moving square (6 px/frame)", "moving-square", "square"},
+    {"pinball (ball 6 px/frame, 8 lights)", "pinball", "ball"},
+    {"scrolling stripes (3.3 px/frame)", "scrolling-stripes", "stripes"},
+    {"six fields: moving square (12 px per 60 Hz frame)", "moving-square", "square", "dlp-stereo-as-mono", 60},
+    {"six fields: pinball (12 px per 60 Hz frame)", "pinball", "ball", "dlp-stereo-as-mono", 60}};
+
+// The moment perceived: half a second into the run (the square halfway across).
+std::uint64_t perceived_frame(const Case& c) { return static_cast<std::uint64_t>(c.frame_rate / 2); }
 
 master::RunConfig load(const std::string& scratch, const Case& c, const Method& method) {
   std::ifstream in(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-pinball.json");
   std::stringstream text;
   text << in.rdbuf();
   std::string json = text.str();
-  const std::string from = R"("builtin": "pinball")";
-  const std::size_t at = json.find(from);
-  if (at == std::string::npos) throw std::logic_error("configs/dlp-pinball.json no longer shows the pinball");
-  json.replace(at, from.size(), R"("builtin": ")" + c.scene + '"');
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    const std::size_t at = json.find(from);
+    if (at == std::string::npos) throw std::logic_error("configs/dlp-pinball.json no longer has " + from);
+    json.replace(at, from.size(), to);
+  };
+  replace(R"("builtin": "pinball")", R"("builtin": ")" + c.scene + '"');
+  replace(R"("preset": "dlp-brg-120hz")", R"("preset": ")" + c.preset + '"');
+  replace(R"("frame_rate": 120)", R"("frame_rate": )" + std::to_string(c.frame_rate));
   std::filesystem::create_directories(scratch);
-  const std::string path = scratch + "/" + c.scene + ".json";
+  const std::string path = scratch + "/" + c.scene + "-" + c.preset + ".json";
   std::ofstream(path) << json;
   auto loaded = master::load_run_config(path, image::decode_texture);
   if (!loaded) throw std::runtime_error(loaded.error());
@@ -85,6 +101,7 @@ master::RunConfig load(const std::string& scratch, const Case& c, const Method& 
   config::ColorFields& fields = run.config.installation.projectors.front().color_fields;
   fields.method = method.fields;
   fields.gather_samples = method.gather_samples;
+  fields.velocity_threshold = method.velocity_threshold;
   return run;
 }
 
@@ -129,7 +146,7 @@ int main(int argc, char** argv) {
       for (const Method& m : kMethods) {
         const master::RunConfig run = load(scratch, c, m);
         tools::PerceiveOptions options;
-        options.frame = 60;
+        options.frame = perceived_frame(c);
         options.object = c.tracked;
         options.samples = m.samples;
         auto logger = std::make_shared<spdlog::logger>("perceive", std::make_shared<spdlog::sinks::null_sink_mt>());
@@ -204,18 +221,23 @@ int main(int argc, char** argv) {
     md << "# Colour fields: what they cost and what the eye sees\n\n"
        << "Generated by `optique-bench-fields` on " << gl
        << ". The wall of `configs/dlp-pinball.json`: one single-chip DLP projector, 1056×594 px over 4 m at 120 Hz, "
-          "fields B R G at −0.2, 0, +0.32 of the frame (0.2 long each), showing three built-in scenes. **Draw ms**: "
+          "fields B R G at −0.2, 0, +0.32 of the frame (0.2 long each), showing three built-in scenes; then the same "
+          "wall as the stereo projector used as mono (`dlp-stereo-as-mono`: 60 Hz, six fields in two images, the "
+          "second shown half a frame after the first; one moment per frame is then the same image twice). **Draw ms**: "
           "the node's frame (every pass, then the output pass, finished on the GPU), median per run of "
        << frames << " frames, then the median (min–max) over " << runs
        << " runs; the methods alternate frame by frame in one process. **× one moment**, **× per-field**: per run, "
           "against the frame drawn at one moment (method `off`) and against the shipped per-field. **Fringe, "
-          "PSNR_Y**: `optique-master perceive --frame 60 --track OBJECT` (one 60 Hz exposure; the ideal is a display "
+          "PSNR_Y**: `optique-master perceive --frame K --track OBJECT` half a second in (one 60 Hz exposure; the "
+          "ideal is a display "
           "that shows every colour at every moment, clipped at the projector's white): the spread of the channels' "
           "edges across the motion, and PSNR_Y (0.299 R + 0.587 G + 0.114 B of the channels' PSNRs) against the "
           "ideal around the tracked object. **vs per-field**: the worst channel's PSNR of the perceived image "
           "against per-field's (the gather draws green at its own moment, as per-field does: identical green). "
           "The paper's anchor: its gather cost about 20 % of rendering all six fields of its stereo-as-mono "
-          "projector; three fields here, so one render is already a third of per-field.\n\n"
+          "projector (the six-field rows; with three fields one render is already a third of per-field). Its "
+          "gather pass ran on a GPU; here every pass runs on the CPU (llvmpipe), where the gather's many "
+          "texture reads per pixel cost far more, relative to drawing the scene, than on a GPU.\n\n"
        << table.str() << "\n![draw time against PSNR_Y per method and scene](fields.png)\n";
     md.close();
     std::cout << table.str();

@@ -149,16 +149,20 @@ TEST_F(FieldGather, ASpeedAtTheThresholdDoesNotPop) {
   const image::FloatImage fields_only = emitted(config::FieldMethod::gather, kFrame, 0.0, &report);
   const double speed = report.fastest;
   ASSERT_NEAR(speed, 3.6, 0.1);
-  const image::FloatImage blurred = emitted(config::FieldMethod::gather, kFrame, speed / 2.0);
-  const image::FloatImage just_above = emitted(config::FieldMethod::gather, kFrame, speed / 1.02);
-  const image::FloatImage just_below = emitted(config::FieldMethod::gather, kFrame, speed / 0.98);
-  const double whole_way = l1(fields_only, blurred);
-  const double step = l1(just_above, just_below) / whole_way;
-  std::cout << "threshold ±2 % around the speed: the image moves " << 100.0 * step
-            << " % of the way from fields to blur\n";
-  ASSERT_GT(whole_way, 0.0);
-  EXPECT_LE(step, 0.25);  // a hard switch: 100 %
-  EXPECT_GT(step, 0.0);
+  // Drawn per field, the blur comes from a render of its own, laid over the fields.
+  for (const config::FieldMethod method : {config::FieldMethod::gather, config::FieldMethod::per_field}) {
+    const image::FloatImage fields = method == config::FieldMethod::gather ? fields_only : emitted(method, kFrame);
+    const image::FloatImage blurred = emitted(method, kFrame, speed / 2.0);
+    const image::FloatImage just_above = emitted(method, kFrame, speed / 1.02);
+    const image::FloatImage just_below = emitted(method, kFrame, speed / 0.98);
+    const double whole_way = l1(fields, blurred);
+    const double step = l1(just_above, just_below) / whole_way;
+    std::cout << config::to_string(method) << ": threshold ±2 % around the speed: the image moves " << 100.0 * step
+              << " % of the way from fields to blur\n";
+    ASSERT_GT(whole_way, 0.0);
+    EXPECT_LE(step, 0.25) << config::to_string(method);  // a hard switch: 100 %
+    EXPECT_GT(step, 0.0) << config::to_string(method);
+  }
 }
 
 // A white wheel turning: with a threshold below its rim's speed, the rim gets
@@ -174,11 +178,14 @@ TEST_F(FieldGather, AWheelFasterThanTheThresholdIsBlurredWithoutFringes) {
   const image::FloatImage fields_only = emitted(config::FieldMethod::gather, kFrame, 0.0, &report);
   const image::FloatImage blurred = emitted(config::FieldMethod::gather, kFrame, report.fastest / 4.0);
   const image::FloatImage per_field = emitted(config::FieldMethod::per_field, kFrame);
+  const image::FloatImage per_field_blurred = emitted(config::FieldMethod::per_field, kFrame, report.fastest / 4.0);
   std::cout << "white wheel, rim " << report.fastest << " px/frame: chroma per-field " << chroma(per_field)
-            << ", gather " << chroma(fields_only) << ", gather above a threshold of " << report.fastest / 4.0
-            << " px/frame " << chroma(blurred) << "\n";
+            << ", gather " << chroma(fields_only) << "; above a threshold of " << report.fastest / 4.0
+            << " px/frame: gather " << chroma(blurred) << ", per-field " << chroma(per_field_blurred) << "\n";
   EXPECT_GT(chroma(fields_only), 0.02);
   EXPECT_LE(chroma(blurred), 0.25 * chroma(fields_only));
+  EXPECT_GT(chroma(per_field), 0.02);
+  EXPECT_LE(chroma(per_field_blurred), 0.25 * chroma(per_field));
 }
 
 // A field that would move a surface farther than the gather radius is cut short:
@@ -248,6 +255,36 @@ TEST_F(FieldGather, AnObjectCrossingOthersAtOtherDepths) {
             << "; one moment per frame worst " << worst_off.worst() << " dB\n";
   EXPECT_GE(worst.worst(), 25.0);
   EXPECT_GE(worst.worst(), worst_off.worst() + 6.0);
+}
+
+// A surface that passes right by the eye moves without bound on screen in one
+// frame: its velocity is held finite (16384 px per frame) in the half-float
+// target, the gather cuts the motion to its radius, and the frame is finite.
+TEST_F(FieldGather, ASurfacePassingByTheEyeGivesAFiniteFrame) {
+  open("dlp-120hz.json");
+  scene::SceneState state = state_at(60);
+  ASSERT_FALSE(state.objects.empty());
+  // Ten microns before the eye's plane a frame later: its clip w is 1e-5.
+  for (auto& [id, object] : state.objects) object.next.position.z = state.eye_next.z - 1e-5;
+  fields().method = config::FieldMethod::gather;
+  auto pipeline = render::ProjectorPipeline::make(config::job_for(installation(), 0), gl_.scene);
+  ASSERT_TRUE(pipeline) << pipeline.error();
+  ASSERT_TRUE(pipeline.value()->draw_frame(state));
+  const render::GatherReport& report = pipeline.value()->gather_report();
+  const image::FloatImage image = pipeline.value()->renderer().read_linear();
+  std::size_t finite = 0;
+  float brightest = 0.0f;
+  for (const float v : image.pixels) {
+    finite += std::isfinite(v) ? 1 : 0;
+    brightest = std::max(brightest, v);
+  }
+  std::cout << "a surface by the eye: fastest " << report.fastest << " px/frame, clamped " << report.clamped
+            << ", brightest " << brightest << "\n";
+  EXPECT_EQ(finite, image.pixels.size());
+  EXPECT_TRUE(report.clamped);
+  EXPECT_GT(report.fastest, 1000.0);
+  EXPECT_LE(report.fastest, 16384.0 * 1.01);
+  EXPECT_GT(brightest, 0.5f) << "the square is drawn";
 }
 
 // The viewer walks sideways past slabs at five depths that stand still: every

@@ -9,6 +9,8 @@
 // (disocclusion): the farthest candidate fills it.
 // Faster than the threshold, the eye is taken not to follow: the pixel gets the
 // average over the frame's moments (motion blur), the same in every channel.
+// Without fields (drawn per field elsewhere), only that blur and its weight, to
+// be blended over them.
 // Built with "#version 450 core" first.
 const int kMaxFields = 3;
 layout(binding = 0) uniform sampler2D colour;
@@ -103,13 +105,13 @@ void main() {
   // A band around the threshold, not a step: a speed that wavers across it does
   // not make the image jump between fields and blur from frame to frame.
   float blur = blur_band.y > 0.0 ? smoothstep(blur_band.x, blur_band.y, length(fastest)) : 0.0;
+  vec3 blurred = vec3(0.0);
   if (blur > 0.0) {
-    vec3 sum = vec3(0.0);
     for (int k = 0; k < samples; ++k) {
       float u = mix(frame_shift.x, frame_shift.y, (float(k) + 0.5) / float(samples));
-      sum += at_moment(x, fastest, u, size);
+      blurred += at_moment(x, fastest, u, size);
     }
-    shown = mix(shown, sum / float(samples), blur);
+    blurred /= float(samples);
   }
-  result = vec4(shown, 1.0);
+  result = field_count == 0 ? vec4(blurred, blur) : vec4(mix(shown, blurred, blur), 1.0);
 }

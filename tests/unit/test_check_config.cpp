@@ -1,0 +1,43 @@
+// What check-config says of a DLP projector's fields (tools/check_config.h): the
+// velocity threshold's effect told per method, as the pipeline applies it.
+
+#include "tools/check_config.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "config/load.h"
+
+namespace optique::tools {
+namespace {
+
+config::LoadedConfig pinball() {
+  auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-pinball.json");
+  EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
+  return loaded ? std::move(loaded).value() : config::LoadedConfig{};
+}
+
+TEST(CheckConfig, SaysWhatTheVelocityThresholdDoesWithEachMethod) {
+  config::LoadedConfig config = pinball();
+  ASSERT_FALSE(config.installation.projectors.empty());
+  config::ColorFields& fields = config.installation.projectors.front().color_fields;
+  ASSERT_EQ(fields.velocity_threshold, 24.0);
+  const auto said = [&](config::FieldMethod method) {
+    fields.method = method;
+    return summarize(config);
+  };
+  EXPECT_NE(said(config::FieldMethod::gather)
+                .find("velocity_threshold 24 px per frame: faster pixels get motion "
+                      "blur over the frame instead"),
+            std::string::npos)
+      << said(config::FieldMethod::gather);
+  EXPECT_NE(said(config::FieldMethod::per_field).find("instead (from one more render, with velocity)"),
+            std::string::npos)
+      << said(config::FieldMethod::per_field);
+  EXPECT_NE(said(config::FieldMethod::off).find("has no effect with method off"), std::string::npos)
+      << said(config::FieldMethod::off);
+}
+
+}  // namespace
+}  // namespace optique::tools
