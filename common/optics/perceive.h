@@ -27,9 +27,9 @@ struct Emission {
   bool blue = true;
   double start = 0.0;  // seconds, on the scene's clock
   double end = 0.0;
-  // The share of each frame those channels are on (a colour field's duration;
-  // 1 without fields): while on they emit light / on_fraction, so a still image
-  // looks the same whatever its fields.
+  // The share of each frame those channels are on (the durations of their
+  // fields in all the frame's images; 1 without fields): while on they emit
+  // light / on_fraction, so a still image looks the same whatever its fields.
   double on_fraction = 1.0;
 };
 

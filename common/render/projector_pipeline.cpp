@@ -85,7 +85,10 @@ glm::dvec3 ProjectorPipeline::eye(const glm::dvec3& centre) const {
 Result<FieldPass> ProjectorPipeline::moment(const scene::SceneState& state, double fraction) const {
   FieldPass pass;
   pass.fraction = fraction;
-  pass.eye = eye(glm::mix(state.eye_now, state.eye_next, fraction));
+  // A still viewer is exactly where it stands at every moment: mix() would
+  // round it differently per fraction, and the fields would no longer share one
+  // view (what lets still objects be drawn once).
+  pass.eye = eye(state.eye_now == state.eye_next ? state.eye_now : glm::mix(state.eye_now, state.eye_next, fraction));
   auto frustum = view_.frustum(pass.eye, viewer_.near, viewer_.far);
   if (!frustum) return Error{frustum.error()};
   pass.frustum = frustum.value();
@@ -116,6 +119,7 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state, const
 
 unsigned ProjectorPipeline::image_framebuffer(int image) const {
   assert(image >= 0 && image < images() && images() <= 2);
+  assert(images() == 1 || renderer_->held_framebuffer() != 0);  // a frame was drawn
   return image + 1 < images() ? renderer_->held_framebuffer() : renderer_->output_framebuffer();
 }
 

@@ -79,9 +79,9 @@ class ProjectorPipeline {
   [[nodiscard]] int images() const { return color_fields_.images; }
   // Where image `image` of the last frame drawn is, to show it.
   [[nodiscard]] unsigned image_framebuffer(int image) const;
-  // What the last frame's gather found (zero for other methods): how fast the
-  // scene moved, and whether the gather radius cut a motion short (over all
-  // its images).
+  // What the last frame's gather, or per-field's blur above the velocity
+  // threshold, found (zero without either): how fast the scene moved, and
+  // whether the gather radius cut a motion short (over all its images).
   [[nodiscard]] const GatherReport& gather_report() const { return gather_report_; }
   // One draw of an empty scene from a metre in front of the screen: drivers
   // compile shaders lazily, and the first frame should not pay for it.

@@ -488,7 +488,6 @@ void SceneRenderer::hold_output() {
   }
   glCopyImageSubData(gl.encoded_colour.get(), GL_TEXTURE_2D, 0, 0, 0, 0, gl.held_colour.get(), GL_TEXTURE_2D, 0, 0, 0,
                      0, gl.output_width, gl.output_height, 1);
-  glFinish();
 }
 
 unsigned SceneRenderer::held_framebuffer() const { return gl_->held_framebuffer.get(); }

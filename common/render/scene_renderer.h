@@ -134,7 +134,8 @@ class SceneRenderer {
   [[nodiscard]] image::WordImage read_signal() const;   // RGBA16: the signal at any depth, ·65535
   [[nodiscard]] unsigned output_framebuffer() const;    // the encoded image, for a window blit
   // Copies the output aside, to be shown while the next image is drawn into it
-  // (a projector that shows two images per frame); returns when it is copied.
+  // (a projector that shows two images per frame); GL orders the copy before
+  // whatever is drawn next.
   void hold_output();
   [[nodiscard]] unsigned held_framebuffer() const;  // the copy; 0 before the first hold_output
   [[nodiscard]] int width() const;                  // of the output

@@ -56,6 +56,7 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   pipeline_ = std::move(pipeline).value();
   if (node.lights) pipeline_->set_share(*node.lights);
   deep_signal_ = pipeline_->projector_model().bits() > 8;
+  gathers_ = projector.color_fields.gathers();
   pipeline_->warm_up();
   if (!captures_) captures_.emplace(capture_folder_, log_);
   configured_for_ = key;
@@ -90,15 +91,22 @@ void GlRenderer::render(const FrameInput& frame) {
   };
   if (auto drawn = pipeline_->draw_frame(*frame.state, capture); !drawn) {
     // The eye left the space in front of this screen: the projector shows black
-    // rather than a wrong picture.
+    // rather than a wrong picture (from the image where it left on).
     log_.debug("frame {}: {}", frame.frame_id, drawn.error());
   }
   if (const render::GatherReport& gather = pipeline_->gather_report(); gather.clamped && !warned_gather_radius_) {
     warned_gather_radius_ = true;  // once: it would repeat every frame of the motion
-    log_.warn(
-        "frame {}: the scene moves {:.1f} px per frame; the gather moves a surface at most {} px per colour "
-        "field, so faster motion is cut short there (its fields lag; method per-field has no such limit)",
-        frame.frame_id, gather.fastest, render::kGatherRadius);
+    if (gathers_) {
+      log_.warn(
+          "frame {}: the scene moves {:.1f} px per frame; the gather moves a surface at most {} px per colour "
+          "field, so faster motion is cut short there (its fields lag; method per-field has no such limit)",
+          frame.frame_id, gather.fastest, render::kGatherRadius);
+    } else {
+      log_.warn(
+          "frame {}: the scene moves {:.1f} px per frame; the motion blur above velocity_threshold spreads a "
+          "surface at most {} px either way, so it is shorter than the motion there (the fields are not limited)",
+          frame.frame_id, gather.fastest, render::kGatherRadius);
+    }
   }
   if (frame.capture && context_->has_window()) read_back_shown_ = frame.frame_id;
 }

@@ -37,6 +37,7 @@ class GlRenderer final : public Renderer {
   std::unique_ptr<render::ProjectorPipeline> pipeline_;
   std::optional<CaptureWriter> captures_;
   bool warned_gather_radius_ = false;
+  bool gathers_ = false;      // method gather (else the clamp can only be per-field's blur)
   bool deep_signal_ = false;  // the projector takes more than 8 bits: captures are 16-bit PNGs
   // A captured frame on a window: what the window shows is read back when it is presented.
   std::optional<std::uint64_t> read_back_shown_;

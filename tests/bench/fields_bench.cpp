@@ -65,6 +65,7 @@ struct Case {
   std::string tracked;  // the object the eye follows
   std::string preset = "dlp-brg-120hz";
   int frame_rate = 120;
+  bool viewer_walks = false;  // sideways at 3 m/s: everything moves, nothing is drawn once
 };
 
 // All on the wall of configs/dlp-pinball.json: 1056×594 px over 4 m; 120 Hz, B R G,
@@ -74,7 +75,8 @@ const std::vector<Case> kCases{
     {"pinball (ball 6 px/frame, 8 lights)", "pinball", "ball"},
     {"scrolling stripes (3.3 px/frame)", "scrolling-stripes", "stripes"},
     {"six fields: moving square (12 px per 60 Hz frame)", "moving-square", "square", "dlp-stereo-as-mono", 60},
-    {"six fields: pinball (12 px per 60 Hz frame)", "pinball", "ball", "dlp-stereo-as-mono", 60}};
+    {"six fields: pinball (12 px per 60 Hz frame)", "pinball", "ball", "dlp-stereo-as-mono", 60},
+    {"six fields: pinball, the viewer walking at 3 m/s", "pinball", "ball", "dlp-stereo-as-mono", 60, true}};
 
 // The moment perceived: half a second into the run (the square halfway across).
 std::uint64_t perceived_frame(const Case& c) { return static_cast<std::uint64_t>(c.frame_rate / 2); }
@@ -93,11 +95,14 @@ master::RunConfig load(const std::string& scratch, const Case& c, const Method& 
   replace(R"("preset": "dlp-brg-120hz")", R"("preset": ")" + c.preset + '"');
   replace(R"("frame_rate": 120)", R"("frame_rate": )" + std::to_string(c.frame_rate));
   std::filesystem::create_directories(scratch);
-  const std::string path = scratch + "/" + c.scene + "-" + c.preset + ".json";
+  const std::string path = scratch + "/" + c.scene + "-" + c.preset + (c.viewer_walks ? "-walking" : "") + ".json";
   std::ofstream(path) << json;
   auto loaded = master::load_run_config(path, image::decode_texture);
   if (!loaded) throw std::runtime_error(loaded.error());
   master::RunConfig run = std::move(loaded).value();
+  if (c.viewer_walks) {
+    run.config.installation.viewer.path = {{0.0, {-1.5, 1.2, 2.0}}, {1.0, {1.5, 1.2, 2.0}}, {2.0, {-1.5, 1.2, 2.0}}};
+  }
   config::ColorFields& fields = run.config.installation.projectors.front().color_fields;
   fields.method = method.fields;
   fields.gather_samples = method.gather_samples;
@@ -223,7 +228,11 @@ int main(int argc, char** argv) {
        << ". The wall of `configs/dlp-pinball.json`: one single-chip DLP projector, 1056×594 px over 4 m at 120 Hz, "
           "fields B R G at −0.2, 0, +0.32 of the frame (0.2 long each), showing three built-in scenes; then the same "
           "wall as the stereo projector used as mono (`dlp-stereo-as-mono`: 60 Hz, six fields in two images, the "
-          "second shown half a frame after the first; one moment per frame is then the same image twice). **Draw ms**: "
+          "second shown half a frame after the first; one moment per frame is then the same image twice), last with "
+          "the viewer walking sideways at 3 m/s (everything moves on screen: still objects cannot be drawn once). "
+          "On the six-field square the gather is per-field's image to the bit: 12 px per frame moves the square "
+          "exactly 2 px from one field to the next, so every shift lands on whole texels. "
+          "**Draw ms**: "
           "the node's frame (every pass, then the output pass, finished on the GPU), median per run of "
        << frames << " frames, then the median (min–max) over " << runs
        << " runs; the methods alternate frame by frame in one process. **× one moment**, **× per-field**: per run, "

@@ -4,6 +4,7 @@
 // `moving-square` crossing the wall at 3 m/s, B R G at −0.2, 0, +0.32 of the
 // 1/120 s frame.
 
+#include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -210,13 +211,26 @@ TEST_F(FieldRendering, EachOfTwoImagesShowsItsOwnThreeFields) {
   ASSERT_TRUE(pipeline) << pipeline.error();
   ASSERT_EQ(pipeline.value()->images(), 2);
   std::vector<image::FloatImage> images;
+  std::vector<image::ByteImage> signals;  // as sent to the projector
   const auto drawn = pipeline.value()->draw_frame(state_at(kFrame), [&](int image) {
     EXPECT_EQ(image, static_cast<int>(images.size()));
     images.push_back(pipeline.value()->renderer().read_rendered());
+    signals.push_back(pipeline.value()->renderer().read_encoded());
   });
   ASSERT_TRUE(drawn) << drawn.error();
   ASSERT_EQ(images.size(), 2u);
-  EXPECT_NE(pipeline.value()->image_framebuffer(0), pipeline.value()->image_framebuffer(1));
+  // What a window would show of each image, once both are drawn: the first one
+  // held aside, the second in the output.
+  for (int image = 0; image < 2; ++image) {
+    const image::ByteImage& want = signals[static_cast<std::size_t>(image)];
+    image::ByteImage shown(want.width, want.height, 4);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, pipeline.value()->image_framebuffer(image));
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, shown.width, shown.height, GL_RGBA, GL_UNSIGNED_BYTE, shown.pixels.data());
+    image::flip_rows(shown);
+    EXPECT_TRUE(shown.pixels == want.pixels) << "image " << image << " is not what is shown for it";
+  }
+  EXPECT_FALSE(signals[0].pixels == signals[1].pixels) << "the square moved between the images";
   for (int image = 0; image < 2; ++image) {
     std::vector<config::ColorField> own;
     std::copy_if(fields.begin(), fields.end(), std::back_inserter(own),

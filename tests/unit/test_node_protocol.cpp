@@ -303,6 +303,44 @@ TEST_F(NodeTest, AStereoProjectorUsedAsMonoShowsItsSecondImageHalfAFrameLater) {
   EXPECT_EQ(first<Present>(a)->image, 1);
 }
 
+// Between the two images: the master lost (nothing more is shown of that frame,
+// the projector goes black), or the second image's wake-up late (skipped, and the
+// frame that waited behind it goes on).
+TEST_F(NodeTest, BetweenTheTwoImagesALostMasterOrALateWakeUpEndsTheFrame) {
+  auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-stereo-as-mono.json");
+  ASSERT_TRUE(loaded) << loaded.error();
+  wall_ = loaded.value().installation;
+  NodeSettings s = settings();
+  s.id = "dlp";
+  for (const bool lose_master : {true, false}) {
+    NodeProtocol node(s);
+    join(node);
+    (void)begin(node, 0);
+    (void)node.rendered(0, kMs);
+    Actions a = swap(node, 0, now_ + kMs);
+    ASSERT_NE(first<PresentAt>(a), nullptr);
+    now_ = first<PresentAt>(a)->deadline;
+    ASSERT_NE(first<Present>(node.present_due(now_)), nullptr);
+    a = node.presented(now_);
+    ASSERT_NE(first<PresentAt>(a), nullptr);
+    const clock::Nanos second = first<PresentAt>(a)->deadline;
+    if (lose_master) {
+      a = node.closed("reset by peer", now_);
+      EXPECT_NE(first<ShowBlack>(a), nullptr);
+      EXPECT_TRUE(node.present_due(second).empty()) << "the frame's second image is not shown";
+      continue;
+    }
+    EXPECT_EQ(first<Render>(begin(node, 1)), nullptr) << "frame 1 waits for the second image";
+    now_ = second + kPeriod / 2 + kMs;
+    a = node.present_due(now_);
+    EXPECT_EQ(first<Present>(a), nullptr);
+    EXPECT_TRUE(logged(a, "frame 0 image 1's present deadline passed"));
+    const Render* render = first<Render>(a);
+    ASSERT_NE(render, nullptr) << "frame 1 goes on once frame 0 is given up";
+    EXPECT_EQ(render->frame.frame_id, 1u);
+  }
+}
+
 TEST_F(NodeTest, AFrameThatComesWhileOneWaitsForItsDeadlineWaitsForIt) {
   NodeProtocol node(settings());
   join(node);
