@@ -408,6 +408,18 @@ void NodeProtocol::wait_for_pending(clock::Nanos now, Actions& out) {
   end_round(now, out);
 }
 
+// The frame's next image, its share of the frame later, while what came
+// meanwhile waits for it; or, after the last, the frame is over and that goes on.
+void NodeProtocol::image_done(clock::Nanos now, Actions& out) {
+  if (next_image()) {
+    wait_for_pending(now, out);
+  } else {
+    pending_.reset();
+    end_round(now, out);
+  }
+  if (!pending_) release_held(now, out);
+}
+
 Actions NodeProtocol::present_due(clock::Nanos now) {
   Actions out;
   if (!pending_ || pending_->due) return out;
@@ -416,13 +428,7 @@ Actions NodeProtocol::present_due(clock::Nanos now) {
     out.push_back(Present{pending_->image});
     return out;
   }
-  if (next_image()) {
-    wait_for_pending(now, out);
-  } else {
-    pending_.reset();
-    end_round(now, out);
-  }
-  if (!pending_) release_held(now, out);  // not shown: what waited behind it goes on
+  image_done(now, out);  // not shown
   return out;
 }
 
@@ -472,14 +478,7 @@ Actions NodeProtocol::presented(clock::Nanos now) {
                     images_ > 1 ? fmt::format(" image {}", shown.image) : "", presented_at,
                     static_cast<double>(presented_at - shown.master_deadline) / 1e3));
   }
-  // The next image, its share of the frame later; what came meanwhile waits for it.
-  if (next_image()) {
-    wait_for_pending(now, out);
-  } else {
-    pending_.reset();
-    end_round(now, out);
-  }
-  if (!pending_) release_held(now, out);
+  image_done(now, out);
   return out;
 }
 

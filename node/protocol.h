@@ -175,6 +175,8 @@ class NodeProtocol {
   // Waits for the pending image's deadline; a stale one gives way to the frame's
   // next image, and a frame with none left ends its round.
   void wait_for_pending(clock::Nanos now, Actions& out);
+  // The pending image was shown or given up.
+  void image_done(clock::Nanos now, Actions& out);
   void release_held(clock::Nanos now, Actions& out);
   void stop(int exit_code, const std::string& reason, Actions& out);
   void log(Actions& out, spdlog::level::level_enum level, std::string text) const;

@@ -192,11 +192,7 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
                                field.channel == config::Channel::green, field.channel == config::Channel::blue};
             e.start = shown + field.start() * period;
             e.end = shown + field.end() * period;
-            // The share of the frame its channel is on, over all the frame's images.
-            e.on_fraction = 0.0;
-            for (const config::ColorField& other : projector->color_fields.fields) {
-              if (other.channel == field.channel) e.on_fraction += other.duration;
-            }
+            e.on_fraction = projector->color_fields.on_share(field.channel);
             emissions.push_back(e);
           }
         };

@@ -67,6 +67,12 @@ std::string_view to_string(Channel channel) {
   return "?";
 }
 
+double ColorFields::on_share(Channel channel) const {
+  double share = 0.0;
+  for (const ColorField& f : fields) share += f.channel == channel ? f.duration : 0.0;
+  return share;
+}
+
 std::string_view to_string(FieldMethod method) {
   switch (method) {
     case FieldMethod::per_field:

@@ -49,9 +49,13 @@ struct ColorFields {
   [[nodiscard]] bool sequential() const { return !fields.empty() && method != FieldMethod::off; }
   // Whether they are gathered from one render (the velocity target and tiles).
   [[nodiscard]] bool gathers() const { return sequential() && method == FieldMethod::gather; }
-  // Whether it needs each pixel's velocity: to gather, or to blur what is
-  // faster than the threshold.
-  [[nodiscard]] bool needs_velocity() const { return gathers() || (sequential() && velocity_threshold > 0.0); }
+  // Whether what is faster than the threshold gets motion blur (either method).
+  [[nodiscard]] bool blurs() const { return sequential() && velocity_threshold > 0.0; }
+  // Whether it needs each pixel's velocity: to gather, or to blur.
+  [[nodiscard]] bool needs_velocity() const { return gathers() || blurs(); }
+  // The share of a frame `channel` is on: its fields' durations, over all the
+  // frame's images.
+  [[nodiscard]] double on_share(Channel channel) const;
   friend bool operator==(const ColorFields&, const ColorFields&) = default;
 };
 

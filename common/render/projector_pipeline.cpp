@@ -142,7 +142,7 @@ Result<void> ProjectorPipeline::draw_image(const scene::SceneState& state, int i
     pass.value().blue = field.channel == config::Channel::blue;
     passes.push_back(pass.value());
   }
-  if (!(color_fields_.velocity_threshold > 0.0)) {
+  if (!color_fields_.blurs()) {
     (void)renderer_->draw_fields(state, passes, terms_, still_once_);
     return {};
   }

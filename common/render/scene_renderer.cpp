@@ -430,11 +430,7 @@ GatherReport SceneRenderer::draw_fields(const scene::SceneState& state, std::spa
   Gl& gl = *gl_;
   assert(gl.gather);  // prepare_gather first
   gl.gather->keep(gl.linear_colour.get());
-  begin_linear(true);
-  const Motion motion{blur->view_projection_now, blur->view_projection_next};
-  draw_scene(state, blur->seen.fraction, blur->seen.eye, blur->seen.frustum, terms, Objects::all, &motion);
-  resolve();
-  gl.gather->measure();
+  draw_with_motion(state, *blur, terms);
   const GatherReport report = gl.gather->gather(gl.linear_colour.get(), {}, blur->settings);
   encode(gl.gather->output());
   return report;
@@ -458,14 +454,18 @@ Result<void> SceneRenderer::prepare_gather() {
 
 GatherReport SceneRenderer::draw_gathered(const scene::SceneState& state, const GatherFrame& frame,
                                           const LightTerms& terms) {
-  Gl& gl = *gl_;
-  assert(gl.gather);  // prepare_gather first
+  assert(gl_->gather);  // prepare_gather first
+  draw_with_motion(state, frame, terms);
+  return gather_again(frame.fields, frame.settings);
+}
+
+void SceneRenderer::draw_with_motion(const scene::SceneState& state, const GatherFrame& frame,
+                                     const LightTerms& terms) {
   begin_linear(true);
   const Motion motion{frame.view_projection_now, frame.view_projection_next};
   draw_scene(state, frame.seen.fraction, frame.seen.eye, frame.seen.frustum, terms, Objects::all, &motion);
   resolve();
-  gl.gather->measure();
-  return gather_again(frame.fields, frame.settings);
+  gl_->gather->measure();
 }
 
 GatherReport SceneRenderer::gather_again(std::span<const GatherField> fields, const GatherSettings& settings) {

@@ -163,6 +163,9 @@ class SceneRenderer {
   void draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                   const geometry::Frustum& frustum, const LightTerms& terms, Objects which = Objects::all,
                   const Motion* motion = nullptr);
+  // The scene at `frame.seen`'s moment with its velocity, resolved, and the
+  // gather's tiles measured: what a gather or a blur starts from.
+  void draw_with_motion(const scene::SceneState& state, const GatherFrame& frame, const LightTerms& terms);
   void keep_still_depth();        // copies the depth drawn so far aside
   void bring_back_still_depth();  // and back
   [[nodiscard]] unsigned draw_framebuffer() const;

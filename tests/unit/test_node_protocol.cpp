@@ -109,6 +109,16 @@ class NodeTest : public ::testing::Test {
     return node.message(e, now_);
   }
 
+  // The node of configs/dlp-stereo-as-mono.json, two images per frame, in place of the wall.
+  NodeSettings stereo_as_mono() {
+    auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-stereo-as-mono.json");
+    EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
+    if (loaded) wall_ = loaded.value().installation;
+    NodeSettings s = settings();
+    s.id = "dlp";
+    return s;
+  }
+
   config::Installation wall_ = wall();
   scene::SceneState state_;
   clock::Nanos now_ = 1'000'000 * kMs;
@@ -237,12 +247,8 @@ TEST_F(NodeTest, AFrameIsRenderedReportedAndShownAtItsDeadline) {
 // half a frame after the first, the next frame held back until it is shown, and
 // only the first reported (the master's deadline and sync are for it).
 TEST_F(NodeTest, AStereoProjectorUsedAsMonoShowsItsSecondImageHalfAFrameLater) {
-  auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-stereo-as-mono.json");
-  ASSERT_TRUE(loaded) << loaded.error();
-  wall_ = loaded.value().installation;
+  const NodeSettings s = stereo_as_mono();
   ASSERT_EQ(wall_.projectors.front().color_fields.images, 2);
-  NodeSettings s = settings();
-  s.id = "dlp";
   NodeProtocol node(s);
   join(node);
   (void)begin(node, 0);
@@ -307,11 +313,7 @@ TEST_F(NodeTest, AStereoProjectorUsedAsMonoShowsItsSecondImageHalfAFrameLater) {
 // the projector goes black), or the second image's wake-up late (skipped, and the
 // frame that waited behind it goes on).
 TEST_F(NodeTest, BetweenTheTwoImagesALostMasterOrALateWakeUpEndsTheFrame) {
-  auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-stereo-as-mono.json");
-  ASSERT_TRUE(loaded) << loaded.error();
-  wall_ = loaded.value().installation;
-  NodeSettings s = settings();
-  s.id = "dlp";
+  const NodeSettings s = stereo_as_mono();
   for (const bool lose_master : {true, false}) {
     NodeProtocol node(s);
     join(node);
