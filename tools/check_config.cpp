@@ -82,6 +82,16 @@ std::string summarize(const config::LoadedConfig& config) {
     out << ", host " << p.host << ", " << config::to_string(p.output.kind) << ", eye " << config::to_string(p.eye)
         << "\n";
     if (!p.color_fields.fields.empty()) out << "      " << color_fields_summary(p.color_fields, inst.master) << "\n";
+    if (p.up_conversion.enabled()) {
+      const config::UpConversion& up = p.up_conversion;
+      out << "      up-conversion: a key frame every " << up.ratio << " frames (" << inst.master.frame_rate / up.ratio
+          << " key frames a second), the others by " << config::to_string(up.method) << ", "
+          << config::to_string(up.mode)
+          << (up.mode == config::UpMode::interpolate
+                  ? " (shown " + std::to_string(up.ratio - 1) + " frames after their time)"
+                  : " (no added latency)")
+          << "\n";
+    }
   }
   const config::Viewer& v = inst.viewer;
   out << "  viewer: ";

@@ -17,6 +17,7 @@
 #include <glm/vec3.hpp>
 
 #include "config/color_fields.h"
+#include "config/up_conversion.h"
 #include "config/defaults.h"
 #include "config/response.h"
 #include "geometry/projection.h"
@@ -111,6 +112,7 @@ struct Projector {
   ProjectorResponse response;
   Content content;
   ColorFields color_fields;  // a single-chip DLP projector's colour fields; empty: all colours at once
+  UpConversion up_conversion;  // key frames and the frames built between them; ratio 1: every frame rendered
 
   // Its geometry on the screen (checked when parsed: this cannot fail then).
   [[nodiscard]] geometry::ProjectorGeometry geometry() const;

@@ -95,6 +95,11 @@ Projector build_projector(const schema::Projector& p, const std::vector<Screen>&
     projector.color_fields = parse_color_fields(p.color_fields(), "color_fields", problems);
     assert(problems.empty());
   }
+  if (p.has_up_conversion()) {
+    std::vector<Problem> problems;
+    projector.up_conversion = parse_up_conversion(p.up_conversion(), "up_conversion", problems);
+    assert(problems.empty());
+  }
   if (p.has_camera()) projector.camera = CameraView{p.camera().camera(), matrix3(p.camera().homography())};
   return projector;
 }

@@ -88,6 +88,12 @@ schema::Projector to_schema(const Projector& p, const std::vector<Screen>& scree
     fields.set_velocity_threshold(p.color_fields.velocity_threshold);
     fields.set_gather_samples(static_cast<std::uint32_t>(p.color_fields.gather_samples));
   }
+  if (p.up_conversion.enabled()) {
+    auto& up = *out.mutable_up_conversion();
+    up.set_ratio(static_cast<std::uint32_t>(p.up_conversion.ratio));
+    up.set_method(std::string(to_string(p.up_conversion.method)));
+    up.set_mode(std::string(to_string(p.up_conversion.mode)));
+  }
   return out;
 }
 

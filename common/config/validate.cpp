@@ -11,6 +11,7 @@
 #include "config/defaults.h"
 #include "config/light_list.h"
 #include "config/response.h"
+#include "config/up_conversion.h"
 #include "scene/builtin.h"
 #include "util/number_text.h"
 
@@ -335,6 +336,9 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
     }
     check_content(check, at + ".content", p.content());
     if (p.has_color_fields()) (void)parse_color_fields(p.color_fields(), at + ".color_fields", check.problems());
+    if (p.has_up_conversion()) {
+      (void)parse_up_conversion(p.up_conversion(), at + ".up_conversion", check.problems());
+    }
   }
   if (scope == Scope::installation) check_stacked_pairs(check, inst);
 }

@@ -40,6 +40,13 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
                                                                    const scene::SceneDefinition& scene,
                                                                    const PipelineOptions& options) {
   const config::Projector& self = job.self();
+  if (self.up_conversion.enabled()) {
+    // Refused, not ignored: a node that rendered every frame anyway would hide
+    // the cost the operator asked to save.
+    return Error{"projector '" + self.id + "': up_conversion (a key frame every " +
+                 std::to_string(self.up_conversion.ratio) +
+                 " frames) is not drawn yet; remove it to render every frame"};
+  }
   auto view = ProjectorView::make(job.screen(), self.geometry(), self.rendering, options.two_pass_pixels_per_metre);
   if (!view) return Error{"projector '" + self.id + "': " + view.error()};
   const int samples = options.samples > 0 ? options.samples : self.color_fields.sequential() ? kFieldSamples : 1;

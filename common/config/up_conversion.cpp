@@ -1,0 +1,41 @@
+#include "config/up_conversion.h"
+
+namespace optique::config {
+
+std::string_view to_string(UpMethod method) { return method == UpMethod::motion ? "motion" : "average"; }
+
+std::string_view to_string(UpMode mode) { return mode == UpMode::extrapolate ? "extrapolate" : "interpolate"; }
+
+UpConversion parse_up_conversion(const schema::UpConversion& up, const std::string& path,
+                                 std::vector<Problem>& problems) {
+  UpConversion out;
+  if (up.ratio() > static_cast<std::uint32_t>(kMaxUpRatio)) {
+    problems.push_back({path + ".ratio", "must be 2…" + std::to_string(kMaxUpRatio) +
+                                             " display frames per key frame, or 0 or 1 for every frame rendered (got " +
+                                             std::to_string(up.ratio()) + ")"});
+  } else {
+    out.ratio = up.ratio() <= 1 ? 1 : static_cast<int>(up.ratio());
+  }
+  if (up.method().empty() || up.method() == "motion") {
+    out.method = UpMethod::motion;
+  } else if (up.method() == "average") {
+    out.method = UpMethod::average;
+  } else {
+    problems.push_back({path + ".method", "must be motion or average (got '" + up.method() + "')"});
+  }
+  bool mode_known = true;
+  if (up.mode().empty() || up.mode() == "extrapolate") {
+    out.mode = UpMode::extrapolate;
+  } else if (up.mode() == "interpolate") {
+    out.mode = UpMode::interpolate;
+  } else {
+    mode_known = false;
+    problems.push_back({path + ".mode", "must be extrapolate or interpolate (got '" + up.mode() + "')"});
+  }
+  if (mode_known && out.method == UpMethod::average && out.mode == UpMode::extrapolate) {
+    problems.push_back({path + ".method", "average blends the key frames before and after: it needs mode interpolate"});
+  }
+  return out;
+}
+
+}  // namespace optique::config

@@ -1,0 +1,45 @@
+#pragma once
+// A projector's frame-rate up-conversion, checked and typed: its node renders a
+// key frame every `ratio` display frames and builds the frames between from the
+// key frames and the exact screen motion of the visible surfaces (the up-
+// conversion paper's motion-compensated method), or, as the baseline, their
+// average.
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "config/problem.h"
+#include "optique/config.pb.h"
+
+namespace optique::config {
+
+// motion: each pixel taken from where its surface was in a key frame; average:
+// the key frames before and after, half each (the paper's baseline).
+enum class UpMethod { motion, average };
+// extrapolate: from the last key frame only (no latency); interpolate: between
+// the key frames before and after (ratio − 1 frames later).
+enum class UpMode { extrapolate, interpolate };
+
+[[nodiscard]] std::string_view to_string(UpMethod method);
+[[nodiscard]] std::string_view to_string(UpMode mode);
+
+inline constexpr int kMaxUpRatio = 16;
+
+struct UpConversion {
+  int ratio = 1;  // display frames per key frame; 1: every frame rendered
+  UpMethod method = UpMethod::motion;
+  UpMode mode = UpMode::extrapolate;
+
+  [[nodiscard]] bool enabled() const { return ratio > 1; }
+  friend bool operator==(const UpConversion&, const UpConversion&) = default;
+};
+
+// Checks `up` (a projector's `up_conversion`, at `path` in the file) and types
+// it. Every problem goes to `problems`, each with its own message: a ratio
+// beyond kMaxUpRatio, an unknown method or mode, the average extrapolated (it
+// needs the key frame after).
+[[nodiscard]] UpConversion parse_up_conversion(const schema::UpConversion& up, const std::string& path,
+                                               std::vector<Problem>& problems);
+
+}  // namespace optique::config

@@ -1,0 +1,75 @@
+// A projector's frame-rate up-conversion in the config (config/up_conversion.h):
+// defaults, every bad field named with its own message, all at once, and the
+// welcome's round trip.
+
+#include "config/up_conversion.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "config/load.h"
+#include "config/parse.h"
+#include "config/to_schema.h"
+
+namespace optique::config {
+namespace {
+
+// One projector with this `up_conversion` (JSON).
+Result<Installation> with(const std::string& up) {
+  const std::string json = R"({"screens": [{"id": "front", "origin": [-2, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0],
+    "width": 4, "height": 2.25, "pixels_per_metre": 160}],
+    "projectors": [{"id": "wall", "width": 640, "height": 360, "screen": "front",
+                    "up_conversion": )" +
+                           up + R"(}],
+    "viewer": {"eye": [0, 1.2, 2]}, "scene": {"builtin": "moving-square"}})";
+  return parse_installation(json, "test.json", ::testing::TempDir());
+}
+
+bool says(const Result<Installation>& parsed, const std::string& fragment) {
+  return !parsed && parsed.error().find(fragment) != std::string::npos;
+}
+
+TEST(UpConversion, DefaultsToMotionExtrapolatedAndAbsentIsOff) {
+  const auto parsed = with(R"({"ratio": 4})");
+  ASSERT_TRUE(parsed) << parsed.error();
+  const UpConversion& up = parsed.value().projectors[0].up_conversion;
+  EXPECT_EQ(up.ratio, 4);
+  EXPECT_EQ(up.method, UpMethod::motion);
+  EXPECT_EQ(up.mode, UpMode::extrapolate);
+  EXPECT_TRUE(up.enabled());
+  for (const char* off : {R"({})", R"({"ratio": 1})", R"({"ratio": 0, "method": "average", "mode": "interpolate"})"}) {
+    const auto none = with(off);
+    ASSERT_TRUE(none) << none.error();
+    EXPECT_FALSE(none.value().projectors[0].up_conversion.enabled()) << off;
+  }
+}
+
+TEST(UpConversion, EveryBadFieldIsNamedAtOnce) {
+  const auto parsed = with(R"({"ratio": 17, "method": "blend", "mode": "predict"})");
+  ASSERT_FALSE(parsed);
+  EXPECT_TRUE(says(parsed, "projectors[0].up_conversion.ratio: must be 2…16")) << parsed.error();
+  EXPECT_TRUE(says(parsed, "(got 17)")) << parsed.error();
+  EXPECT_TRUE(says(parsed, "projectors[0].up_conversion.method: must be motion or average (got 'blend')"))
+      << parsed.error();
+  EXPECT_TRUE(says(parsed, "projectors[0].up_conversion.mode: must be extrapolate or interpolate (got 'predict')"))
+      << parsed.error();
+}
+
+TEST(UpConversion, TheAverageNeedsTheKeyFrameAfter) {
+  EXPECT_TRUE(says(with(R"({"ratio": 4, "method": "average"})"), "it needs mode interpolate"));
+  EXPECT_TRUE(says(with(R"({"ratio": 4, "method": "average", "mode": "extrapolate"})"), "it needs mode interpolate"));
+  EXPECT_TRUE(with(R"({"ratio": 4, "method": "average", "mode": "interpolate"})"));
+}
+
+TEST(UpConversion, AWelcomeCarriesIt) {
+  const auto parsed = with(R"({"ratio": 3, "method": "average", "mode": "interpolate"})");
+  ASSERT_TRUE(parsed) << parsed.error();
+  const auto again = parse_installation(to_schema(parsed.value()), ::testing::TempDir(), "welcome");
+  ASSERT_TRUE(again) << again.error();
+  EXPECT_EQ(again.value().projectors[0].up_conversion, parsed.value().projectors[0].up_conversion);
+}
+
+}  // namespace
+}  // namespace optique::config
