@@ -10,6 +10,7 @@
 #include "render/field_gather.h"
 #include "render/gl_objects.h"
 #include "render/shaders.h"
+#include "render/up_converter.h"
 
 namespace optique::render {
 namespace {
@@ -40,13 +41,21 @@ struct SceneUniforms {
   GLint model_view_projection, model, normal_matrix, eye, base_colour, has_base_colour_texture, metallic, roughness,
       emissive, ambient, light_count;
   GLint model_view_projection_now, model_view_projection_next, half_size;  // velocity only
+  GLint size;                                                              // motion field only
 };
 
-// The scene program, with velocity or without: its sources come without a
-// #version line, so that the choice goes first.
-Result<glo::Program> scene_program(bool velocity, SceneUniforms& uniforms) {
-  const std::string head = std::string("#version 450 core\n") + (velocity ? "#define VELOCITY 1\n" : "");
-  auto program = glo::link_program(head + std::string(shaders::scene_vert), head + std::string(shaders::scene_frag));
+// What a scene program writes besides the geometry: shaded colour; or that
+// and each fragment's velocity (the gather); or only where each fragment was
+// in two key frames (the up-conversion's motion field).
+enum class SceneOutput { colour, velocity, key_frames };
+
+// Its sources come without a #version line, so that the choice goes first.
+Result<glo::Program> scene_program(SceneOutput output, SceneUniforms& uniforms) {
+  const std::string head =
+      std::string("#version 450 core\n") + (output != SceneOutput::colour ? "#define VELOCITY 1\n" : "");
+  const std::string_view fragment =
+      output == SceneOutput::key_frames ? shaders::motion_field_frag : shaders::scene_frag;
+  auto program = glo::link_program(head + std::string(shaders::scene_vert), head + std::string(fragment));
   if (!program) return Error{program.error()};
   const GLuint p = program.value().get();
   const auto at = [p](const char* name) { return glGetUniformLocation(p, name); };
@@ -63,7 +72,8 @@ Result<glo::Program> scene_program(bool velocity, SceneUniforms& uniforms) {
               at("light_count"),
               at("model_view_projection_0"),
               at("model_view_projection_1"),
-              at("half_size")};
+              at("half_size"),
+              at("size")};
   return program;
 }
 
@@ -127,6 +137,15 @@ struct SceneRenderer::Gl {
   glo::Program velocity_program;
   SceneUniforms velocity_uniforms{};
   std::unique_ptr<FieldGather> gather;
+  // Up-conversion's (prepare_up_conversion): the motion field's program and
+  // the key frames, targets and passes.
+  glo::Program key_frames_program;
+  SceneUniforms key_frames_uniforms{};
+  std::unique_ptr<UpConverter> up;
+  // Where the last frame's image and depth before the output stage are: the
+  // linear framebuffer, or a frame between key frames.
+  GLuint rendered_colour_framebuffer = 0;
+  GLuint rendered_depth_framebuffer = 0;
 };
 
 SceneRenderer::SceneRenderer(std::unique_ptr<Gl> gl) : gl_(std::move(gl)) {}
@@ -139,7 +158,7 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   auto gl = std::make_unique<Gl>();
   gl->width = width;
   gl->height = height;
-  auto program = scene_program(false, gl->uniforms);
+  auto program = scene_program(SceneOutput::colour, gl->uniforms);
   if (!program) return Error{program.error()};
   gl->scene_program = std::move(program).value();
 
@@ -231,6 +250,7 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   gl->linear_framebuffer = glo::make_framebuffer();
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl->linear_colour.get(), 0);
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl->depth.get(), 0);
+  gl->rendered_colour_framebuffer = gl->rendered_depth_framebuffer = gl->linear_framebuffer.get();
   if (samples > 1) {
     GLint most = 1;
     glGetIntegerv(GL_MAX_SAMPLES, &most);
@@ -439,7 +459,7 @@ GatherReport SceneRenderer::draw_fields(const scene::SceneState& state, std::spa
 Result<void> SceneRenderer::prepare_gather() {
   Gl& gl = *gl_;
   if (gl.gather) return {};
-  auto program = scene_program(true, gl.velocity_uniforms);
+  auto program = scene_program(SceneOutput::velocity, gl.velocity_uniforms);
   if (!program) return Error{program.error()};
   auto gather = FieldGather::create(gl.width, gl.height, gl.samples);
   if (!gather) return Error{gather.error()};
@@ -462,7 +482,7 @@ GatherReport SceneRenderer::draw_gathered(const scene::SceneState& state, const 
 void SceneRenderer::draw_with_motion(const scene::SceneState& state, const GatherFrame& frame,
                                      const LightTerms& terms) {
   begin_linear(true);
-  const Motion motion{frame.view_projection_now, frame.view_projection_next};
+  const Motion motion{{{&state, 0.0, frame.view_projection_now}, {&state, 1.0, frame.view_projection_next}}};
   draw_scene(state, frame.seen.fraction, frame.seen.eye, frame.seen.frustum, terms, Objects::all, &motion);
   resolve();
   gl_->gather->measure();
@@ -473,6 +493,52 @@ GatherReport SceneRenderer::gather_again(std::span<const GatherField> fields, co
   assert(gl.gather);
   const GatherReport report = gl.gather->gather(gl.linear_colour.get(), fields, settings);
   encode(gl.gather->output());
+  return report;
+}
+
+Result<void> SceneRenderer::prepare_up_conversion() {
+  Gl& gl = *gl_;
+  if (gl.up) return {};
+  auto program = scene_program(SceneOutput::key_frames, gl.key_frames_uniforms);
+  if (!program) return Error{"the up-conversion's motion field: " + program.error()};
+  auto up = UpConverter::create(gl.width, gl.height, gl.depth_format);
+  if (!up) return Error{up.error()};
+  gl.key_frames_program = std::move(program).value();
+  gl.up = std::move(up).value();
+  return {};
+}
+
+void SceneRenderer::keep_key(int slot, KeyView view) {
+  Gl& gl = *gl_;
+  assert(gl.up);  // prepare_up_conversion first
+  gl.up->keep(slot, gl.linear_colour.get(), gl.depth.get(), std::move(view));
+}
+
+BetweenReport SceneRenderer::draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                          const geometry::Frustum& frustum, const BetweenFrame& frame,
+                                          const LightTerms& terms) {
+  Gl& gl = *gl_;
+  assert(gl.up);  // prepare_up_conversion first
+  UpConverter& up = *gl.up;
+  if (frame.method == BetweenMethod::motion) {
+    up.begin_motion_field();
+    const KeyView& first = up.key(0);
+    const KeyView& second = up.key(frame.two_keys ? 1 : 0);
+    const Motion motion{{{&first.state, first.fraction, first.view_projection},
+                         {&second.state, second.fraction, second.view_projection}},
+                        true};
+    draw_scene(state, fraction, eye, frustum, terms, Objects::all, &motion);
+  }
+  const BetweenReport report = up.resolve(frame, gl.background);
+  if (frame.method == BetweenMethod::motion && frame.shade_unseen && report.unseen_pixels > 0) {
+    up.begin_shade_unseen();
+    draw_scene(state, fraction, eye, frustum, terms);
+    up.end_shade_unseen();
+  }
+  const bool motion = frame.method == BetweenMethod::motion;
+  gl.rendered_colour_framebuffer = up.output_framebuffer();
+  gl.rendered_depth_framebuffer = motion ? up.output_framebuffer() : gl.linear_framebuffer.get();
+  encode(up.output(), motion ? up.depth() : gl.depth.get());
   return report;
 }
 
@@ -526,6 +592,7 @@ void SceneRenderer::resolve() {
 
 void SceneRenderer::begin_linear(bool with_motion) {
   Gl& gl = *gl_;
+  gl.rendered_colour_framebuffer = gl.rendered_depth_framebuffer = gl.linear_framebuffer.get();
   const GLuint framebuffer = draw_framebuffer();
   if (gl.gather) {  // the velocity target is attached: drawn into only by a gather
     static constexpr GLenum kBoth[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
@@ -547,11 +614,13 @@ void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, 
                                const Motion* motion) {
   Gl& gl = *gl_;
   upload_shining_lights(state.lights_off);
-  glUseProgram(motion ? gl.velocity_program.get() : gl.scene_program.get());
+  const bool key_frames = motion && motion->key_frames;
+  glUseProgram(key_frames ? gl.key_frames_program.get() : motion ? gl.velocity_program.get() : gl.scene_program.get());
   glBindVertexArray(gl.vertex_array.get());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl.light_buffer.get());
-  const SceneUniforms& u = motion ? gl.velocity_uniforms : gl.uniforms;
+  const SceneUniforms& u = key_frames ? gl.key_frames_uniforms : motion ? gl.velocity_uniforms : gl.uniforms;
   if (motion) glUniform2f(u.half_size, 0.5f * static_cast<float>(gl.width), 0.5f * static_cast<float>(gl.height));
+  if (key_frames) glUniform2f(u.size, static_cast<float>(gl.width), static_cast<float>(gl.height));
   glUniform3f(u.eye, static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z));
   const glm::vec3 ambient = terms.ambient ? gl.ambient : glm::vec3(0.0f);
   glUniform3fv(u.ambient, 1, glm::value_ptr(ambient));
@@ -572,18 +641,22 @@ void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, 
     const glm::mat3 normal_matrix(glm::transpose(glm::inverse(glm::dmat3(model))));
     glUniformMatrix4fv(u.model_view_projection, 1, GL_FALSE, glm::value_ptr(mvp));
     if (motion) {
-      // Where this instance is at the display time and a frame later.
-      glm::dmat4 now = instance.transform;
-      glm::dmat4 next = instance.transform;
-      if (instance.object) {
-        const scene::ObjectState& object = state.objects.find(*instance.object)->second;
-        now = scene::model_matrix(scene::interpolate(object, 0.0)) * instance.transform;
-        next = scene::model_matrix(scene::interpolate(object, 1.0)) * instance.transform;
+      // Where this instance is at the motion's two ends; an object not in the
+      // scene then projects to w = 0: no place.
+      const GLint locations[2] = {u.model_view_projection_now, u.model_view_projection_next};
+      for (int e = 0; e < 2; ++e) {
+        const MotionEnd& end = motion->ends[e];
+        glm::dmat4 clip = end.view_projection * instance.transform;
+        if (instance.object) {
+          const auto there = end.state->objects.find(*instance.object);
+          clip = there == end.state->objects.end()
+                     ? glm::dmat4(0.0)
+                     : end.view_projection * scene::model_matrix(scene::interpolate(there->second, end.fraction)) *
+                           instance.transform;
+        }
+        const glm::mat4 clip_f(clip);
+        glUniformMatrix4fv(locations[e], 1, GL_FALSE, glm::value_ptr(clip_f));
       }
-      const glm::mat4 mvp_now(motion->view_projection_now * now);
-      const glm::mat4 mvp_next(motion->view_projection_next * next);
-      glUniformMatrix4fv(u.model_view_projection_now, 1, GL_FALSE, glm::value_ptr(mvp_now));
-      glUniformMatrix4fv(u.model_view_projection_next, 1, GL_FALSE, glm::value_ptr(mvp_next));
     }
     glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(model_f));
     glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
@@ -602,6 +675,7 @@ void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, 
 }
 
 void SceneRenderer::draw_black() {
+  gl_->rendered_colour_framebuffer = gl_->rendered_depth_framebuffer = gl_->linear_framebuffer.get();
   glBindFramebuffer(GL_FRAMEBUFFER, gl_->linear_framebuffer.get());
   glViewport(0, 0, gl_->width, gl_->height);
   glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
@@ -611,9 +685,10 @@ void SceneRenderer::draw_black() {
 }
 
 void SceneRenderer::encode() { encode(gl_->linear_colour.get()); }
+void SceneRenderer::encode(unsigned texture) { encode(texture, gl_->depth.get()); }
 
 // The projector's response, last: linear light → what is sent to it.
-void SceneRenderer::encode(unsigned texture) {
+void SceneRenderer::encode(unsigned texture, unsigned depth) {
   Gl& gl = *gl_;
   glBindFramebuffer(GL_FRAMEBUFFER, gl.encoded_framebuffer.get());
   glViewport(0, 0, gl.output_width, gl.output_height);
@@ -621,7 +696,7 @@ void SceneRenderer::encode(unsigned texture) {
   glUseProgram(gl.encode_program.get());
   glBindTextureUnit(0, texture);
   if (gl.weights) glBindTextureUnit(2, gl.weights.get());
-  glBindTextureUnit(3, gl.depth.get());
+  glBindTextureUnit(3, depth);
   glBindTextureUnit(4, gl.response_table.get());
   glBindVertexArray(gl.empty_vertex_array.get());
   glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -650,11 +725,11 @@ image::FloatImage SceneRenderer::read_linear() const {
 }
 
 image::FloatImage SceneRenderer::read_rendered() const {
-  return read_float(gl_->linear_framebuffer.get(), gl_->width, gl_->height, GL_RGBA, 4);
+  return read_float(gl_->rendered_colour_framebuffer, gl_->width, gl_->height, GL_RGBA, 4);
 }
 
 image::FloatImage SceneRenderer::read_depth() const {
-  return read_float(gl_->linear_framebuffer.get(), gl_->width, gl_->height, GL_DEPTH_COMPONENT, 1);
+  return read_float(gl_->rendered_depth_framebuffer, gl_->width, gl_->height, GL_DEPTH_COMPONENT, 1);
 }
 
 image::ByteImage SceneRenderer::read_encoded() const {

@@ -15,6 +15,7 @@
 #include "image/image.h"
 #include "optics/defocus.h"
 #include "optics/projector_model.h"
+#include "render/between.h"
 #include "render/fields.h"
 #include "scene/definition.h"
 #include "scene/state.h"
@@ -114,6 +115,21 @@ class SceneRenderer {
   // projectors that gather have them); fails with the driver's message.
   [[nodiscard]] Result<void> prepare_gather();
 
+  // Frame-rate up-conversion (render/up_converter.h): makes the key slots, the
+  // motion field's targets and passes (only projectors that up-convert have
+  // them); fails with the driver's message.
+  [[nodiscard]] Result<void> prepare_up_conversion();
+  // The image the last draw() made kept as key frame `slot` (0 or 1), drawn as
+  // `view` says; prepare_up_conversion first.
+  void keep_key(int slot, KeyView view);
+  // A frame between key frames, at `state`'s poses `fraction` of a frame on,
+  // seen from `eye` through `frustum`: the motion field drawn with the scene's
+  // geometry, each pixel from the kept key frames where its surface was, what
+  // none saw shaded anew (as `frame` says); or their average. Then the output
+  // stage, as draw() ends. Returns when the GPU is done.
+  BetweenReport draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                             const geometry::Frustum& frustum, const BetweenFrame& frame, const LightTerms& terms = {});
+
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);
 
@@ -154,11 +170,20 @@ class SceneRenderer {
   // velocity target, for a gather).
   void begin_linear(bool with_motion = false);
   void resolve();  // multisampled: averages the samples into the linear image
-  // With `motion`, also each fragment's screen velocity between those two views
-  // (the gather's program and target).
+  // Where each drawn surface point also is at two other moments: in `state`,
+  // objects `fraction` of the way to their next pose, seen through
+  // `view_projection`. An object missing from that state has no place then.
+  struct MotionEnd {
+    const scene::SceneState* state = nullptr;
+    double fraction = 0.0;
+    glm::dmat4 view_projection{1.0};
+  };
+  // With `motion`, also each fragment's screen velocity between the two ends
+  // (the gather's program and target), or its place in two key frames (the up-
+  // conversion's motion field).
   struct Motion {
-    glm::dmat4 view_projection_now;
-    glm::dmat4 view_projection_next;
+    MotionEnd ends[2];
+    bool key_frames = false;
   };
   void draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                   const geometry::Frustum& frustum, const LightTerms& terms, Objects which = Objects::all,
@@ -169,8 +194,9 @@ class SceneRenderer {
   void keep_still_depth();        // copies the depth drawn so far aside
   void bring_back_still_depth();  // and back
   [[nodiscard]] unsigned draw_framebuffer() const;
-  void encode();                  // the linear image
-  void encode(unsigned texture);  // or another of its size
+  void encode();                                  // the linear image
+  void encode(unsigned texture);                  // or another of its size
+  void encode(unsigned texture, unsigned depth);  // with the depth a focus share reads
   void upload_shining_lights(const std::set<std::uint32_t>& off);
   std::unique_ptr<Gl> gl_;
 };

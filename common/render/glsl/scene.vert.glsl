@@ -1,5 +1,9 @@
 // The scene: world position, normal and texture coordinates for the fragment shader.
-// Built with "#version 450 core" first, and VELOCITY for the gather (render/field_gather.h).
+// Built with "#version 450 core" first, and VELOCITY for the gather (render/field_gather.h)
+// and the motion field of up-conversion (render/up_converter.h).
+// The same depth in every program built from this: a frame between key frames
+// shades its unseen pixels on the depth its motion field left (up_converter.h).
+invariant gl_Position;
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;
 layout(location = 2) in vec2 uv;

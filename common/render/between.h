@@ -1,0 +1,47 @@
+#pragma once
+// What a frame between key frames is built from (frame-rate up-conversion,
+// config/up_conversion.h): the key frames kept, each with the scene state and
+// view it was drawn with, and how the frame between takes their pixels. Plain
+// values, no GL.
+
+#include <cstdint>
+
+#include <glm/mat4x4.hpp>
+
+#include "scene/state.h"
+
+namespace optique::render {
+
+// How a kept key frame was drawn: objects `fraction` of the way from their
+// poses in `state` to the next, seen through `view_projection`.
+struct KeyView {
+  scene::SceneState state;
+  double fraction = 0.0;
+  glm::dmat4 view_projection{1.0};
+};
+
+// motion: each pixel from where its surface was in the key frames (exact, per
+// pixel); average: the same pixel of both key frames, half each (the up-
+// conversion paper's baseline, which knows nothing of motion).
+enum class BetweenMethod { motion, average };
+
+inline constexpr int kKeySlots = 2;
+
+struct BetweenFrame {
+  BetweenMethod method = BetweenMethod::motion;
+  // Key frame 0 alone (extrapolation from the past), or keys 0 and 1 with key 1
+  // weighing `toward_second` (the frame's time between the two, 0…1).
+  bool two_keys = false;
+  double toward_second = 0.0;
+  // Pixels whose surface no key frame saw (disoccluded, or an object that was
+  // not there) shaded anew; otherwise they show key 0's pixel at that place,
+  // as a repeated frame would.
+  bool shade_unseen = true;
+};
+
+struct BetweenReport {
+  std::int64_t unseen_pixels = 0;  // not seen by any key frame used (motion only)
+  double unseen_share = 0.0;       // of the image's pixels
+};
+
+}  // namespace optique::render

@@ -1,0 +1,165 @@
+#include "render/up_converter.h"
+
+#include <cassert>
+#include <string>
+
+#include "render/shaders.h"
+
+namespace optique::render {
+namespace {
+
+constexpr std::string_view kVersion = "#version 450 core\n";
+
+// A single-sample texture read texel by texel.
+glo::Texture exact_texture(GLenum format, int width, int height) {
+  glo::Texture texture = glo::make_texture();
+  glTextureStorage2D(texture.get(), 1, format, width, height);
+  glTextureParameteri(texture.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(texture.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return texture;
+}
+
+}  // namespace
+
+UpConverter::~UpConverter() {
+  if (query_ != 0) glDeleteQueries(1, &query_);
+}
+
+Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, GLenum depth_format) {
+  assert(width > 0 && height > 0);
+  std::unique_ptr<UpConverter> u(new UpConverter());
+  u->width_ = width;
+  u->height_ = height;
+  auto resolve =
+      glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_resolve_frag));
+  if (!resolve) return Error{"the up-conversion's resolve pass: " + resolve.error()};
+  u->resolve_program_ = std::move(resolve).value();
+  auto mark =
+      glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_mark_frag));
+  if (!mark) return Error{"the up-conversion's mark pass: " + mark.error()};
+  u->mark_program_ = std::move(mark).value();
+  const GLuint r = u->resolve_program_.get();
+  u->uniforms_ = {glGetUniformLocation(r, "method"), glGetUniformLocation(r, "keys"),
+                  glGetUniformLocation(r, "toward_second"), glGetUniformLocation(r, "background")};
+
+  for (int k = 0; k < kKeySlots; ++k) {
+    u->key_colour_[k] = exact_texture(GL_RGBA32F, width, height);
+    u->key_depth_[k] = exact_texture(depth_format, width, height);
+    // Key-frame pixels in pixels, window depth at float precision: a depth
+    // tolerance of a few 1e-6 must be representable.
+    u->motion_[k] = exact_texture(GL_RGBA32F, width, height);
+  }
+  u->depth_stencil_ =
+      exact_texture(depth_format == GL_DEPTH_COMPONENT24 ? GL_DEPTH24_STENCIL8 : GL_DEPTH32F_STENCIL8, width, height);
+  u->output_ = exact_texture(GL_RGBA32F, width, height);
+  // Read by the output pass like the linear image: bilinear for a two-pass warp.
+  glTextureParameteri(u->output_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTextureParameteri(u->output_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+
+  u->motion_framebuffer_ = glo::make_framebuffer();
+  const GLuint motion = u->motion_framebuffer_.get();
+  glNamedFramebufferTexture(motion, GL_COLOR_ATTACHMENT0, u->motion_[0].get(), 0);
+  glNamedFramebufferTexture(motion, GL_COLOR_ATTACHMENT1, u->motion_[1].get(), 0);
+  static constexpr GLenum kBoth[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(motion, 2, kBoth);
+  u->output_framebuffer_ = glo::make_framebuffer();
+  glNamedFramebufferTexture(u->output_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->output_.get(), 0);
+  u->mark_framebuffer_ = glo::make_framebuffer();
+  glNamedFramebufferDrawBuffer(u->mark_framebuffer_.get(), GL_NONE);
+  for (GLuint fb : {motion, u->output_framebuffer_.get(), u->mark_framebuffer_.get()}) {
+    glNamedFramebufferTexture(fb, GL_DEPTH_STENCIL_ATTACHMENT, u->depth_stencil_.get(), 0);
+    if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+      return Error{"this GL driver cannot draw the up-conversion's targets (RGBA32F with depth and stencil)"};
+    }
+  }
+  u->empty_vertex_array_ = glo::make_vertex_array();
+  glCreateQueries(GL_SAMPLES_PASSED, 1, &u->query_);
+  return u;
+}
+
+void UpConverter::keep(int slot, GLuint colour, GLuint depth, KeyView view) {
+  assert(slot >= 0 && slot < kKeySlots);
+  glCopyImageSubData(colour, GL_TEXTURE_2D, 0, 0, 0, 0, key_colour_[slot].get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_,
+                     height_, 1);
+  glCopyImageSubData(depth, GL_TEXTURE_2D, 0, 0, 0, 0, key_depth_[slot].get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_,
+                     height_, 1);
+  key_view_[slot] = std::move(view);
+}
+
+const KeyView& UpConverter::key(int slot) const {
+  assert(slot >= 0 && slot < kKeySlots);
+  return key_view_[slot];
+}
+
+void UpConverter::begin_motion_field() {
+  const GLuint fb = motion_framebuffer_.get();
+  glBindFramebuffer(GL_FRAMEBUFFER, fb);
+  glViewport(0, 0, width_, height_);
+  const GLfloat no_surface[4] = {0.0f, 0.0f, 0.0f, -2.0f};
+  glClearNamedFramebufferfv(fb, GL_COLOR, 0, no_surface);
+  glClearNamedFramebufferfv(fb, GL_COLOR, 1, no_surface);
+  glClearNamedFramebufferfi(fb, GL_DEPTH_STENCIL, 0, 1.0f, 0);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+}
+
+BetweenReport UpConverter::resolve(const BetweenFrame& frame, const glm::vec3& background) {
+  glDisable(GL_DEPTH_TEST);
+  glBindVertexArray(empty_vertex_array_.get());
+  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
+  glViewport(0, 0, width_, height_);
+  const GLuint r = resolve_program_.get();
+  glUseProgram(r);
+  glUniform1i(uniforms_.method, frame.method == BetweenMethod::average ? 1 : 0);
+  glUniform1i(uniforms_.keys, frame.two_keys ? 2 : 1);
+  glUniform1f(uniforms_.toward_second, static_cast<float>(frame.toward_second));
+  glUniform3f(uniforms_.background, background.r, background.g, background.b);
+  for (int k = 0; k < kKeySlots; ++k) {
+    glBindTextureUnit(static_cast<GLuint>(k), key_colour_[k].get());
+    glBindTextureUnit(static_cast<GLuint>(2 + k), key_depth_[k].get());
+    glBindTextureUnit(static_cast<GLuint>(4 + k), motion_[k].get());
+  }
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  if (frame.method == BetweenMethod::average) return {};
+
+  // The unseen pixels into the stencil, counted.
+  glBindFramebuffer(GL_FRAMEBUFFER, mark_framebuffer_.get());
+  glUseProgram(mark_program_.get());
+  glBindTextureUnit(0, output_.get());
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_ALWAYS, 1, 0xFF);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  glBeginQuery(GL_SAMPLES_PASSED, query_);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glEndQuery(GL_SAMPLES_PASSED);
+  glDisable(GL_STENCIL_TEST);
+  GLint64 unseen = 0;
+  glGetQueryObjecti64v(query_, GL_QUERY_RESULT, &unseen);
+  BetweenReport report;
+  report.unseen_pixels = unseen;
+  report.unseen_share = static_cast<double>(unseen) / (static_cast<double>(width_) * static_cast<double>(height_));
+  return report;
+}
+
+void UpConverter::begin_shade_unseen() {
+  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
+  glViewport(0, 0, width_, height_);
+  glEnable(GL_STENCIL_TEST);
+  glStencilFunc(GL_EQUAL, 1, 0xFF);
+  glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LEQUAL);  // the same surface the motion field found (invariant positions)
+  glDepthMask(GL_FALSE);
+  glDisable(GL_CULL_FACE);
+}
+
+void UpConverter::end_shade_unseen() {
+  glDisable(GL_STENCIL_TEST);
+  glDepthFunc(GL_LESS);
+  glDepthMask(GL_TRUE);
+}
+
+}  // namespace optique::render

@@ -1,0 +1,72 @@
+#pragma once
+// Frame-rate up-conversion's GL side: the key frames kept (colour and depth), the
+// motion field of a frame between them (drawn by SceneRenderer with the scene's
+// geometry), and the passes that build that frame from the key frames' pixels
+// (glsl/between_resolve.frag.glsl) and mark what no key frame saw, so that only
+// those pixels are shaded anew. Needs a current OpenGL 4.5 context; made only
+// for projectors that up-convert, so the motion targets exist only there.
+
+#include <array>
+#include <cstdint>
+#include <memory>
+
+#include <epoxy/gl.h>
+
+#include "render/between.h"
+#include "render/gl_objects.h"
+#include "util/result.h"
+
+namespace optique::render {
+
+class UpConverter {
+ public:
+  // For `width` × `height` pixels whose depth is `depth_format` (the scene
+  // renderer's, GL_DEPTH_COMPONENT32F or 24).
+  [[nodiscard]] static Result<std::unique_ptr<UpConverter>> create(int width, int height, GLenum depth_format);
+  ~UpConverter();
+  UpConverter(const UpConverter&) = delete;
+  UpConverter& operator=(const UpConverter&) = delete;
+
+  // Copies a drawn image (RGBA32F) and its depth into key slot `slot`.
+  void keep(int slot, GLuint colour, GLuint depth, KeyView view);
+  [[nodiscard]] const KeyView& key(int slot) const;
+
+  // The motion field's target: where each pixel's surface was in each key frame
+  // (attachments 0 and 1) over the frame's own depth and stencil; bound,
+  // cleared (no surface anywhere, stencil 0), depth test on.
+  void begin_motion_field();
+  // Then the frame from the key frames' pixels into output(); with the motion
+  // method, the pixels no key frame saw are marked in the stencil and counted.
+  [[nodiscard]] BetweenReport resolve(const BetweenFrame& frame, const glm::vec3& background);
+  // Binds output() over the motion field's depth, drawing only where the
+  // stencil marks a pixel unseen and only the surface the field found there.
+  void begin_shade_unseen();
+  void end_shade_unseen();  // back to the GL state everything else expects
+
+  [[nodiscard]] GLuint output() const { return output_.get(); }
+  [[nodiscard]] GLuint output_framebuffer() const { return output_framebuffer_.get(); }  // with depth()
+  [[nodiscard]] GLuint depth() const { return depth_stencil_.get(); }                    // the frame's own depth
+
+ private:
+  UpConverter() = default;
+  int width_ = 0;
+  int height_ = 0;
+  std::array<glo::Texture, kKeySlots> key_colour_;
+  std::array<glo::Texture, kKeySlots> key_depth_;
+  std::array<KeyView, kKeySlots> key_view_;
+  std::array<glo::Texture, kKeySlots> motion_;
+  glo::Texture depth_stencil_;
+  glo::Framebuffer motion_framebuffer_;
+  glo::Texture output_;
+  glo::Framebuffer output_framebuffer_;
+  glo::Framebuffer mark_framebuffer_;  // the stencil alone: the mark pass reads output()
+  glo::Program resolve_program_;
+  glo::Program mark_program_;
+  glo::VertexArray empty_vertex_array_;
+  GLuint query_ = 0;
+  struct {
+    GLint method, keys, toward_second, background;
+  } uniforms_{};
+};
+
+}  // namespace optique::render
