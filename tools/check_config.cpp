@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <iomanip>
 #include <map>
 #include <sstream>
@@ -88,8 +89,12 @@ std::string summarize(const config::LoadedConfig& config) {
           << " key frames a second), the others by " << config::to_string(up.method) << ", "
           << config::to_string(up.mode)
           << (up.mode == config::UpMode::interpolate
-                  ? " (shown " + std::to_string(up.ratio - 1) + " frames after their time)"
-                  : " (no added latency)")
+                  ? " (between the key frames before and after: the master sends each key frame's scene " +
+                        std::to_string(up.ratio - 1) + " frames ahead)"
+                  : " (from the last key frame)")
+          << (up.adaptive() ? ", fewer frames between while they would fall below " +
+                                  std::to_string(static_cast<int>(std::lround(up.min_psnr))) + " dB PSNR_Y"
+                            : ", the ratio fixed")
           << "\n";
     }
   }

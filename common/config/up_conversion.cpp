@@ -32,6 +32,15 @@ UpConversion parse_up_conversion(const schema::UpConversion& up, const std::stri
     mode_known = false;
     problems.push_back({path + ".mode", "must be extrapolate or interpolate (got '" + up.mode() + "')"});
   }
+  if (up.has_min_psnr()) {
+    const double floor = up.min_psnr();
+    if (floor == 0.0 || (floor >= 10.0 && floor <= 100.0)) {
+      out.min_psnr = floor;
+    } else {
+      problems.push_back({path + ".min_psnr",
+                          "must be 10…100 dB of PSNR_Y, or 0 for a fixed ratio (got " + std::to_string(floor) + ")"});
+    }
+  }
   if (mode_known && out.method == UpMethod::average && out.mode == UpMode::extrapolate) {
     problems.push_back({path + ".method", "average blends the key frames before and after: it needs mode interpolate"});
   }

@@ -25,11 +25,17 @@ enum class UpMode { extrapolate, interpolate };
 [[nodiscard]] std::string_view to_string(UpMode mode);
 
 inline constexpr int kMaxUpRatio = 16;
+// What the frames between must keep at least, by default: the up-conversion
+// paper's "visually equal" (dB of PSNR_Y).
+inline constexpr double kDefaultMinPsnr = 30.0;
 
 struct UpConversion {
   int ratio = 1;  // display frames per key frame; 1: every frame rendered
   UpMethod method = UpMethod::motion;
   UpMode mode = UpMode::extrapolate;
+  // The adaptive ratio's floor, dB of PSNR_Y; 0: the ratio is fixed.
+  double min_psnr = kDefaultMinPsnr;
+  [[nodiscard]] bool adaptive() const { return min_psnr > 0.0; }
 
   [[nodiscard]] bool enabled() const { return ratio > 1; }
   friend bool operator==(const UpConversion&, const UpConversion&) = default;
@@ -38,7 +44,7 @@ struct UpConversion {
 // Checks `up` (a projector's `up_conversion`, at `path` in the file) and types
 // it. Every problem goes to `problems`, each with its own message: a ratio
 // beyond kMaxUpRatio, an unknown method or mode, the average extrapolated (it
-// needs the key frame after).
+// needs the key frame after), a floor that is not 0 or 10…100 dB.
 [[nodiscard]] UpConversion parse_up_conversion(const schema::UpConversion& up, const std::string& path,
                                                std::vector<Problem>& problems);
 

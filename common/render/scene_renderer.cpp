@@ -141,7 +141,7 @@ struct SceneRenderer::Gl {
   // the key frames, targets and passes.
   glo::Program key_frames_program;
   SceneUniforms key_frames_uniforms{};
-  std::unique_ptr<UpConverter> up;
+  std::unique_ptr<UpConverter> up_converter;
   // Where the last frame's image and depth before the output stage are: the
   // linear framebuffer, or a frame between key frames.
   GLuint rendered_colour_framebuffer = 0;
@@ -498,47 +498,47 @@ GatherReport SceneRenderer::gather_again(std::span<const GatherField> fields, co
 
 Result<void> SceneRenderer::prepare_up_conversion() {
   Gl& gl = *gl_;
-  if (gl.up) return {};
+  if (gl.up_converter) return {};
   auto program = scene_program(SceneOutput::key_frames, gl.key_frames_uniforms);
   if (!program) return Error{"the up-conversion's motion field: " + program.error()};
-  auto up = UpConverter::create(gl.width, gl.height, gl.depth_format);
-  if (!up) return Error{up.error()};
+  auto converter = UpConverter::create(gl.width, gl.height, gl.depth_format);
+  if (!converter) return Error{converter.error()};
   gl.key_frames_program = std::move(program).value();
-  gl.up = std::move(up).value();
+  gl.up_converter = std::move(converter).value();
   return {};
 }
 
-void SceneRenderer::keep_key(int slot, KeyView view) {
+void SceneRenderer::keep_key(int slot, up::KeyView view) {
   Gl& gl = *gl_;
-  assert(gl.up);  // prepare_up_conversion first
-  gl.up->keep(slot, gl.linear_colour.get(), gl.depth.get(), std::move(view));
+  assert(gl.up_converter);  // prepare_up_conversion first
+  gl.up_converter->keep(slot, gl.linear_colour.get(), gl.depth.get(), std::move(view));
 }
 
-BetweenReport SceneRenderer::draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
-                                          const geometry::Frustum& frustum, const BetweenFrame& frame,
-                                          const LightTerms& terms) {
+up::BetweenReport SceneRenderer::draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                              const geometry::Frustum& frustum, const up::BetweenFrame& frame,
+                                              const LightTerms& terms) {
   Gl& gl = *gl_;
-  assert(gl.up);  // prepare_up_conversion first
-  UpConverter& up = *gl.up;
-  if (frame.method == BetweenMethod::motion) {
-    up.begin_motion_field();
-    const KeyView& first = up.key(0);
-    const KeyView& second = up.key(frame.two_keys ? 1 : 0);
+  assert(gl.up_converter);  // prepare_up_conversion first
+  UpConverter& converter = *gl.up_converter;
+  if (frame.method == up::BetweenMethod::motion) {
+    converter.begin_motion_field();
+    const up::KeyView& first = converter.key(frame.first);
+    const up::KeyView& second = converter.key(frame.two_keys ? 1 - frame.first : frame.first);
     const Motion motion{{{&first.state, first.fraction, first.view_projection},
                          {&second.state, second.fraction, second.view_projection}},
                         true};
     draw_scene(state, fraction, eye, frustum, terms, Objects::all, &motion);
   }
-  const BetweenReport report = up.resolve(frame, gl.background);
-  if (frame.method == BetweenMethod::motion && frame.shade_unseen && report.unseen_pixels > 0) {
-    up.begin_shade_unseen();
+  const up::BetweenReport report = converter.resolve(frame, gl.background);
+  if (frame.method == up::BetweenMethod::motion && frame.shade_unseen && report.unseen_pixels > 0) {
+    converter.begin_shade_unseen();
     draw_scene(state, fraction, eye, frustum, terms);
-    up.end_shade_unseen();
+    converter.end_shade_unseen();
   }
-  const bool motion = frame.method == BetweenMethod::motion;
-  gl.rendered_colour_framebuffer = up.output_framebuffer();
-  gl.rendered_depth_framebuffer = motion ? up.output_framebuffer() : gl.linear_framebuffer.get();
-  encode(up.output(), motion ? up.depth() : gl.depth.get());
+  const bool motion = frame.method == up::BetweenMethod::motion;
+  gl.rendered_colour_framebuffer = converter.output_framebuffer();
+  gl.rendered_depth_framebuffer = motion ? converter.output_framebuffer() : gl.linear_framebuffer.get();
+  encode(converter.output(), motion ? converter.depth() : gl.depth.get());
   return report;
 }
 

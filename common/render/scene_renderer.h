@@ -15,10 +15,10 @@
 #include "image/image.h"
 #include "optics/defocus.h"
 #include "optics/projector_model.h"
-#include "render/between.h"
 #include "render/fields.h"
 #include "scene/definition.h"
 #include "scene/state.h"
+#include "up/between.h"
 #include "util/result.h"
 
 namespace optique::render {
@@ -121,14 +121,15 @@ class SceneRenderer {
   [[nodiscard]] Result<void> prepare_up_conversion();
   // The image the last draw() made kept as key frame `slot` (0 or 1), drawn as
   // `view` says; prepare_up_conversion first.
-  void keep_key(int slot, KeyView view);
+  void keep_key(int slot, up::KeyView view);
   // A frame between key frames, at `state`'s poses `fraction` of a frame on,
   // seen from `eye` through `frustum`: the motion field drawn with the scene's
   // geometry, each pixel from the kept key frames where its surface was, what
   // none saw shaded anew (as `frame` says); or their average. Then the output
   // stage, as draw() ends. Returns when the GPU is done.
-  BetweenReport draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
-                             const geometry::Frustum& frustum, const BetweenFrame& frame, const LightTerms& terms = {});
+  up::BetweenReport draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                 const geometry::Frustum& frustum, const up::BetweenFrame& frame,
+                                 const LightTerms& terms = {});
 
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);

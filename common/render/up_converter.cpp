@@ -44,7 +44,7 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   u->uniforms_ = {glGetUniformLocation(r, "method"), glGetUniformLocation(r, "keys"),
                   glGetUniformLocation(r, "toward_second"), glGetUniformLocation(r, "background")};
 
-  for (int k = 0; k < kKeySlots; ++k) {
+  for (int k = 0; k < up::kKeySlots; ++k) {
     u->key_colour_[k] = exact_texture(GL_RGBA32F, width, height);
     u->key_depth_[k] = exact_texture(depth_format, width, height);
     // Key-frame pixels in pixels, window depth at float precision: a depth
@@ -79,8 +79,8 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   return u;
 }
 
-void UpConverter::keep(int slot, GLuint colour, GLuint depth, KeyView view) {
-  assert(slot >= 0 && slot < kKeySlots);
+void UpConverter::keep(int slot, GLuint colour, GLuint depth, up::KeyView view) {
+  assert(slot >= 0 && slot < up::kKeySlots);
   glCopyImageSubData(colour, GL_TEXTURE_2D, 0, 0, 0, 0, key_colour_[slot].get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_,
                      height_, 1);
   glCopyImageSubData(depth, GL_TEXTURE_2D, 0, 0, 0, 0, key_depth_[slot].get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_,
@@ -88,8 +88,8 @@ void UpConverter::keep(int slot, GLuint colour, GLuint depth, KeyView view) {
   key_view_[slot] = std::move(view);
 }
 
-const KeyView& UpConverter::key(int slot) const {
-  assert(slot >= 0 && slot < kKeySlots);
+const up::KeyView& UpConverter::key(int slot) const {
+  assert(slot >= 0 && slot < up::kKeySlots);
   return key_view_[slot];
 }
 
@@ -106,24 +106,26 @@ void UpConverter::begin_motion_field() {
   glDisable(GL_CULL_FACE);
 }
 
-BetweenReport UpConverter::resolve(const BetweenFrame& frame, const glm::vec3& background) {
+up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm::vec3& background) {
   glDisable(GL_DEPTH_TEST);
   glBindVertexArray(empty_vertex_array_.get());
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
   glViewport(0, 0, width_, height_);
   const GLuint r = resolve_program_.get();
   glUseProgram(r);
-  glUniform1i(uniforms_.method, frame.method == BetweenMethod::average ? 1 : 0);
+  glUniform1i(uniforms_.method, frame.method == up::BetweenMethod::average ? 1 : 0);
   glUniform1i(uniforms_.keys, frame.two_keys ? 2 : 1);
   glUniform1f(uniforms_.toward_second, static_cast<float>(frame.toward_second));
   glUniform3f(uniforms_.background, background.r, background.g, background.b);
-  for (int k = 0; k < kKeySlots; ++k) {
-    glBindTextureUnit(static_cast<GLuint>(k), key_colour_[k].get());
-    glBindTextureUnit(static_cast<GLuint>(2 + k), key_depth_[k].get());
-    glBindTextureUnit(static_cast<GLuint>(4 + k), motion_[k].get());
+  assert(frame.first == 0 || frame.first == 1);
+  for (int k = 0; k < up::kKeySlots; ++k) {  // the first key frame as key 0
+    const int slot = k == 0 ? frame.first : 1 - frame.first;
+    glBindTextureUnit(static_cast<GLuint>(k), key_colour_[slot].get());
+    glBindTextureUnit(static_cast<GLuint>(2 + k), key_depth_[slot].get());
+    glBindTextureUnit(static_cast<GLuint>(4 + k), motion_[k].get());  // the motion field's, in that order
   }
   glDrawArrays(GL_TRIANGLES, 0, 3);
-  if (frame.method == BetweenMethod::average) return {};
+  if (frame.method == up::BetweenMethod::average) return {};
 
   // The unseen pixels into the stencil, counted.
   glBindFramebuffer(GL_FRAMEBUFFER, mark_framebuffer_.get());
@@ -138,7 +140,7 @@ BetweenReport UpConverter::resolve(const BetweenFrame& frame, const glm::vec3& b
   glDisable(GL_STENCIL_TEST);
   GLint64 unseen = 0;
   glGetQueryObjecti64v(query_, GL_QUERY_RESULT, &unseen);
-  BetweenReport report;
+  up::BetweenReport report;
   report.unseen_pixels = unseen;
   report.unseen_share = static_cast<double>(unseen) / (static_cast<double>(width_) * static_cast<double>(height_));
   return report;

@@ -12,8 +12,8 @@
 
 #include <epoxy/gl.h>
 
-#include "render/between.h"
 #include "render/gl_objects.h"
+#include "up/between.h"
 #include "util/result.h"
 
 namespace optique::render {
@@ -28,8 +28,8 @@ class UpConverter {
   UpConverter& operator=(const UpConverter&) = delete;
 
   // Copies a drawn image (RGBA32F) and its depth into key slot `slot`.
-  void keep(int slot, GLuint colour, GLuint depth, KeyView view);
-  [[nodiscard]] const KeyView& key(int slot) const;
+  void keep(int slot, GLuint colour, GLuint depth, up::KeyView view);
+  [[nodiscard]] const up::KeyView& key(int slot) const;
 
   // The motion field's target: where each pixel's surface was in each key frame
   // (attachments 0 and 1) over the frame's own depth and stencil; bound,
@@ -37,7 +37,7 @@ class UpConverter {
   void begin_motion_field();
   // Then the frame from the key frames' pixels into output(); with the motion
   // method, the pixels no key frame saw are marked in the stencil and counted.
-  [[nodiscard]] BetweenReport resolve(const BetweenFrame& frame, const glm::vec3& background);
+  [[nodiscard]] up::BetweenReport resolve(const up::BetweenFrame& frame, const glm::vec3& background);
   // Binds output() over the motion field's depth, drawing only where the
   // stencil marks a pixel unseen and only the surface the field found there.
   void begin_shade_unseen();
@@ -51,10 +51,10 @@ class UpConverter {
   UpConverter() = default;
   int width_ = 0;
   int height_ = 0;
-  std::array<glo::Texture, kKeySlots> key_colour_;
-  std::array<glo::Texture, kKeySlots> key_depth_;
-  std::array<KeyView, kKeySlots> key_view_;
-  std::array<glo::Texture, kKeySlots> motion_;
+  std::array<glo::Texture, up::kKeySlots> key_colour_;
+  std::array<glo::Texture, up::kKeySlots> key_depth_;
+  std::array<up::KeyView, up::kKeySlots> key_view_;
+  std::array<glo::Texture, up::kKeySlots> motion_;
   glo::Texture depth_stencil_;
   glo::Framebuffer motion_framebuffer_;
   glo::Texture output_;

@@ -141,9 +141,9 @@ class UpConversion : public ::testing::Test {
     renderer_->keep_key(slot, {state, 0.0, f.projection * f.view});
   }
 
-  image::FloatImage between(const scene::SceneState& state, const BetweenFrame& frame,
-                            BetweenReport* report = nullptr) {
-    const BetweenReport r = renderer_->draw_between(state, 0.0, kEye, view(), frame);
+  image::FloatImage between(const scene::SceneState& state, const up::BetweenFrame& frame,
+                            up::BetweenReport* report = nullptr) {
+    const up::BetweenReport r = renderer_->draw_between(state, 0.0, kEye, view(), frame);
     if (report) *report = r;
     return renderer_->read_rendered();
   }
@@ -188,14 +188,14 @@ TEST_F(UpConversion, WithoutMotionTheFrameBetweenIsTheKeyFrame) {
   make(squares(true));
   key(0, state_at(kStill, 0));
   const image::FloatImage key_image = renderer_->read_rendered();
-  for (BetweenMethod method : {BetweenMethod::motion, BetweenMethod::average}) {
-    if (method == BetweenMethod::average) key(1, state_at(kStill, 4));
-    BetweenReport report;
+  for (up::BetweenMethod method : {up::BetweenMethod::motion, up::BetweenMethod::average}) {
+    if (method == up::BetweenMethod::average) key(1, state_at(kStill, 4));
+    up::BetweenReport report;
     const image::FloatImage b =
-        between(state_at(kStill, 2), {method, method == BetweenMethod::average, 0.5, true}, &report);
+        between(state_at(kStill, 2), {method, 0, method == up::BetweenMethod::average, 0.5, true}, &report);
     auto c = image::compare(b, key_image);
     ASSERT_TRUE(c.ok());
-    EXPECT_LE(c.value().max_abs_error, 1e-6) << (method == BetweenMethod::motion ? "motion" : "average");
+    EXPECT_LE(c.value().max_abs_error, 1e-6) << (method == up::BetweenMethod::motion ? "motion" : "average");
     EXPECT_EQ(report.unseen_pixels, 0);
   }
 }
@@ -211,7 +211,7 @@ TEST_F(UpConversion, TranslatingAndTurningSquaresMatchTheirFullRenders) {
     key(0, state_at(c.motion, 0));
     double worst = 1e9;
     for (int n = 1; n <= 3; ++n) {  // 4:1, extrapolated from the key frame
-      const image::FloatImage b = between(state_at(c.motion, n), {BetweenMethod::motion, false, 0.0, true});
+      const image::FloatImage b = between(state_at(c.motion, n), {up::BetweenMethod::motion, 0, false, 0.0, true});
       const image::FloatImage reference = full(state_at(c.motion, n));
       const double db = psnr_y(b, reference, std::string(c.name) + "-" + std::to_string(n), 40.0);
       std::cout << c.name << " frame " << n << ": " << db << " dB\n";
@@ -235,8 +235,8 @@ TEST_F(UpConversion, UncoveredBackdropIsFoundAndShadedAnew) {
   key(0, state_at(kTranslating, 0));
   for (int n = 1; n <= 3; ++n) {
     const scene::SceneState state = state_at(kTranslating, n);
-    BetweenReport report;
-    const image::FloatImage shaded = between(state, {BetweenMethod::motion, false, 0.0, true}, &report);
+    up::BetweenReport report;
+    const image::FloatImage shaded = between(state, {up::BetweenMethod::motion, 0, false, 0.0, true}, &report);
     const image::FloatImage reference = full(state);
     const double db = psnr_y(shaded, reference, "uncovered-" + std::to_string(n), 40.0);
     // The square is 0.8 m at 128 px per metre and moves (2.5, 0.7) px per frame;
@@ -249,7 +249,7 @@ TEST_F(UpConversion, UncoveredBackdropIsFoundAndShadedAnew) {
               << uncovered << ")\n";
     EXPECT_GE(db, 40.0);
     EXPECT_NEAR(static_cast<double>(report.unseen_pixels), uncovered, 0.1 * uncovered + 2.0 * side);
-    const image::FloatImage left = between(state, {BetweenMethod::motion, false, 0.0, false});
+    const image::FloatImage left = between(state, {up::BetweenMethod::motion, 0, false, 0.0, false});
     auto c = image::compare(left, reference);
     ASSERT_TRUE(c.ok());
     EXPECT_LT(c.value().psnr_y_weighted, db - 10.0) << "unseen pixels left as the key frame had them";
@@ -263,8 +263,8 @@ TEST_F(UpConversion, AnObjectThatEntersIsShadedAnew) {
   const auto after_first = [](int n) { return n >= 2; };
   key(0, state_at(kTranslating, 0, after_first));
   const scene::SceneState state = state_at(kTranslating, 3, after_first);
-  BetweenReport report;
-  const image::FloatImage b = between(state, {BetweenMethod::motion, false, 0.0, true}, &report);
+  up::BetweenReport report;
+  const image::FloatImage b = between(state, {up::BetweenMethod::motion, 0, false, 0.0, true}, &report);
   EXPECT_GE(psnr_y(b, full(state), "entering", 40.0), 40.0);
   const double area = 0.8 * 128.0 * 0.8 * 128.0;
   EXPECT_NEAR(static_cast<double>(report.unseen_pixels), area, 0.05 * area);
@@ -280,10 +280,10 @@ TEST_F(UpConversion, BetweenTwoKeyFramesNothingIsUnseen) {
   for (int n = 1; n <= 3; ++n) {
     const scene::SceneState state = state_at(kTranslating, n);
     const image::FloatImage reference = full(state);
-    BetweenReport report;
-    const image::FloatImage b = between(state, {BetweenMethod::motion, true, n / 4.0, false}, &report);
+    up::BetweenReport report;
+    const image::FloatImage b = between(state, {up::BetweenMethod::motion, 0, true, n / 4.0, false}, &report);
     const double db = psnr_y(b, reference, "two-keys-" + std::to_string(n), 40.0);
-    const image::FloatImage average = between(state, {BetweenMethod::average, true, n / 4.0, false});
+    const image::FloatImage average = between(state, {up::BetweenMethod::average, 0, true, n / 4.0, false});
     auto c = image::compare(average, reference);
     ASSERT_TRUE(c.ok());
     std::cout << "frame " << n << ": " << db << " dB (average " << c.value().psnr_y_weighted << " dB), "

@@ -38,7 +38,12 @@ TEST(UpConversion, DefaultsToMotionExtrapolatedAndAbsentIsOff) {
   EXPECT_EQ(up.ratio, 4);
   EXPECT_EQ(up.method, UpMethod::motion);
   EXPECT_EQ(up.mode, UpMode::extrapolate);
+  EXPECT_EQ(up.min_psnr, kDefaultMinPsnr);
+  EXPECT_TRUE(up.adaptive());
   EXPECT_TRUE(up.enabled());
+  const auto fixed = with(R"({"ratio": 4, "min_psnr": 0})");
+  ASSERT_TRUE(fixed) << fixed.error();
+  EXPECT_FALSE(fixed.value().projectors[0].up_conversion.adaptive());
   for (const char* off : {R"({})", R"({"ratio": 1})", R"({"ratio": 0, "method": "average", "mode": "interpolate"})"}) {
     const auto none = with(off);
     ASSERT_TRUE(none) << none.error();
@@ -47,13 +52,15 @@ TEST(UpConversion, DefaultsToMotionExtrapolatedAndAbsentIsOff) {
 }
 
 TEST(UpConversion, EveryBadFieldIsNamedAtOnce) {
-  const auto parsed = with(R"({"ratio": 17, "method": "blend", "mode": "predict"})");
+  const auto parsed = with(R"({"ratio": 17, "method": "blend", "mode": "predict", "min_psnr": 5})");
   ASSERT_FALSE(parsed);
   EXPECT_TRUE(says(parsed, "projectors[0].up_conversion.ratio: must be 2…16")) << parsed.error();
   EXPECT_TRUE(says(parsed, "(got 17)")) << parsed.error();
   EXPECT_TRUE(says(parsed, "projectors[0].up_conversion.method: must be motion or average (got 'blend')"))
       << parsed.error();
   EXPECT_TRUE(says(parsed, "projectors[0].up_conversion.mode: must be extrapolate or interpolate (got 'predict')"))
+      << parsed.error();
+  EXPECT_TRUE(says(parsed, "projectors[0].up_conversion.min_psnr: must be 10…100 dB of PSNR_Y, or 0 for a fixed ratio"))
       << parsed.error();
 }
 
@@ -64,8 +71,9 @@ TEST(UpConversion, TheAverageNeedsTheKeyFrameAfter) {
 }
 
 TEST(UpConversion, AWelcomeCarriesIt) {
-  const auto parsed = with(R"({"ratio": 3, "method": "average", "mode": "interpolate"})");
+  const auto parsed = with(R"({"ratio": 3, "method": "average", "mode": "interpolate", "min_psnr": 42})");
   ASSERT_TRUE(parsed) << parsed.error();
+  EXPECT_EQ(parsed.value().projectors[0].up_conversion.min_psnr, 42.0);
   const auto again = parse_installation(to_schema(parsed.value()), ::testing::TempDir(), "welcome");
   ASSERT_TRUE(again) << again.error();
   EXPECT_EQ(again.value().projectors[0].up_conversion, parsed.value().projectors[0].up_conversion);

@@ -8,9 +8,10 @@
 
 #include <glm/mat4x4.hpp>
 
+#include "config/up_conversion.h"
 #include "scene/state.h"
 
-namespace optique::render {
+namespace optique::up {
 
 // How a kept key frame was drawn: objects `fraction` of the way from their
 // poses in `state` to the next, seen through `view_projection`.
@@ -23,18 +24,20 @@ struct KeyView {
 // motion: each pixel from where its surface was in the key frames (exact, per
 // pixel); average: the same pixel of both key frames, half each (the up-
 // conversion paper's baseline, which knows nothing of motion).
-enum class BetweenMethod { motion, average };
+using BetweenMethod = config::UpMethod;
 
 inline constexpr int kKeySlots = 2;
 
 struct BetweenFrame {
   BetweenMethod method = BetweenMethod::motion;
-  // Key frame 0 alone (extrapolation from the past), or keys 0 and 1 with key 1
-  // weighing `toward_second` (the frame's time between the two, 0…1).
+  // Key slot `first` alone (extrapolation from the past), or it and the other
+  // slot, the later key frame, weighing `toward_second` (the frame's time
+  // between the two, 0…1).
+  int first = 0;
   bool two_keys = false;
   double toward_second = 0.0;
   // Pixels whose surface no key frame saw (disoccluded, or an object that was
-  // not there) shaded anew; otherwise they show key 0's pixel at that place,
+  // not there) shaded anew; otherwise they show key `first`'s pixel there,
   // as a repeated frame would.
   bool shade_unseen = true;
 };
@@ -44,4 +47,4 @@ struct BetweenReport {
   double unseen_share = 0.0;       // of the image's pixels
 };
 
-}  // namespace optique::render
+}  // namespace optique::up

@@ -1,0 +1,92 @@
+#pragma once
+// Which display frames a projector that up-converts draws in full (key frames)
+// and how it builds the others (config/up_conversion.h): decisions from frame
+// numbers, scene states and what the last check measured. No GL: the pipeline
+// carries the plans out.
+//
+// extrapolate: a key frame every `ratio` frames; the frames after it are built
+// from it alone. interpolate: the key frame `ratio` frames ahead is drawn from
+// the state the master sent ahead, as soon as the last one is shown, and the
+// frames between come from both. Either way a key frame is drawn at once,
+// whatever the ratio, where a kept one would mix two sides of a cut: a light
+// switched on or off, or the viewer's eye moved farther than kCutEyeJump.
+//
+// Adaptive ratio: before each key frame is kept, the frame between the last key
+// frame would have built at its moment is checked against it (PSNR_Y): below
+// the floor, the key frames come a frame sooner; kRaiseMargin above it, a frame
+// later, up to `ratio`.
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string_view>
+
+#include "config/up_conversion.h"
+#include "scene/state.h"
+#include "up/between.h"
+
+namespace optique::up {
+
+// Farther than this (metres) between a key frame's eye and a frame's, the key
+// frame shows another view: a cut, not motion.
+inline constexpr double kCutEyeJump = 0.5;
+// dB above the floor before the key frames come further apart again.
+inline constexpr double kRaiseMargin = 3.0;
+
+// What to draw for one display frame.
+struct UpPlan {
+  // Draw a state in full and keep it as key `key_slot`: this frame's own (then
+  // it is shown), or, ahead of time, that of frame `ahead_frame` (interpolate).
+  bool draw_key = false;
+  std::optional<std::uint64_t> ahead_frame;
+  int key_slot = 0;
+  // Before keeping it: how far the frame between from key `check_slot` would
+  // have been from it, for the adaptive ratio (UpSchedule::checked).
+  std::optional<int> check_slot;
+  // Build this frame from the kept keys (frame.first is the earlier one).
+  bool between = false;
+  BetweenFrame frame;
+  // Show kept key `shown_slot` as it is: it was drawn ahead for this frame.
+  std::optional<int> shown_slot;
+  // Why a key frame is drawn now ("first frame", "ratio", "lights switched",
+  // "viewer jumped", "nothing ahead"), for the log.
+  std::string_view why;
+};
+
+class UpSchedule {
+ public:
+  explicit UpSchedule(const config::UpConversion& settings);
+
+  // States the master sent ahead of their frame, by frame; nullptr where none.
+  using Ahead = std::function<const scene::SceneState*(std::uint64_t frame)>;
+  // The plan for display frame `frame`, which shows `state`. Frames come in
+  // order; one that goes back or skips past the kept keys starts over.
+  [[nodiscard]] UpPlan plan(std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead = {});
+  // What the plan's check measured, dB of PSNR_Y (+infinity: identical).
+  void checked(double psnr_y);
+
+  // Display frames per key frame now (the adaptive ratio's; `ratio` when fixed).
+  [[nodiscard]] int ratio() const { return ratio_; }
+  [[nodiscard]] const config::UpConversion& settings() const { return settings_; }
+
+ private:
+  struct Key {
+    std::uint64_t frame = 0;
+    int slot = 0;
+    scene::SceneState state;
+  };
+  [[nodiscard]] UpPlan key_now(std::uint64_t frame, const scene::SceneState& state, std::string_view why);
+  [[nodiscard]] UpPlan interpolated(std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead);
+
+  config::UpConversion settings_;
+  int ratio_ = 1;
+  std::optional<Key> first_;   // the key frame shown last (extrapolate: the only one)
+  std::optional<Key> second_;  // interpolate: the one drawn ahead
+};
+
+// Whether a frame showing `state` may be built from a key frame of `key`: no
+// light switched, the eye not moved as far as a cut. `why` says what differs.
+[[nodiscard]] bool same_side(const scene::SceneState& key, const scene::SceneState& state,
+                             std::string_view* why = nullptr);
+
+}  // namespace optique::up

@@ -1,0 +1,173 @@
+// Which display frames an up-converting projector draws in full and how it
+// builds the others (up/schedule.h): the ratio, cuts, the adaptive ratio and
+// the key frames drawn ahead for interpolation.
+
+#include "up/schedule.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace optique::up {
+namespace {
+
+config::UpConversion settings(int ratio, config::UpMode mode = config::UpMode::extrapolate, double min_psnr = 0.0) {
+  config::UpConversion s;
+  s.ratio = ratio;
+  s.mode = mode;
+  s.min_psnr = min_psnr;
+  return s;
+}
+
+// A walking viewer: 1.2 m/s at 60 Hz.
+scene::SceneState state_at(std::uint64_t frame) {
+  scene::SceneState state;
+  state.eye_now = {0.02 * static_cast<double>(frame), 1.6, 2.0};
+  state.eye_next = {0.02 * static_cast<double>(frame + 1), 1.6, 2.0};
+  return state;
+}
+
+// The plans' kinds in a line: K (drawn now), A<frame> (drawn ahead) then B
+// (between), B1/B2 (from one or two key frames), S (shown as drawn ahead).
+std::string kinds(UpSchedule& schedule, std::uint64_t from, std::uint64_t to,
+                  const std::map<std::uint64_t, scene::SceneState>& states = {}) {
+  std::string out;
+  const auto state = [&](std::uint64_t f) {
+    const auto found = states.find(f);
+    return found == states.end() ? state_at(f) : found->second;
+  };
+  std::map<std::uint64_t, scene::SceneState> sent;
+  for (std::uint64_t f = from; f <= to; ++f) {
+    // The master sends each frame the state `ratio` − 1 frames ahead.
+    const std::uint64_t ahead = f + static_cast<std::uint64_t>(schedule.settings().ratio) - 1;
+    sent[ahead] = state(ahead);
+    const UpPlan p = schedule.plan(f, state(f), [&](std::uint64_t g) -> const scene::SceneState* {
+      const auto found = sent.find(g);
+      return found == sent.end() ? nullptr : &found->second;
+    });
+    if (!out.empty()) out += ' ';
+    if (p.draw_key && !p.ahead_frame) out += 'K';
+    if (p.ahead_frame) out += "A" + std::to_string(*p.ahead_frame);
+    if (p.between) out += p.frame.two_keys ? "B2" : "B1";
+    if (p.shown_slot) out += 'S';
+  }
+  return out;
+}
+
+TEST(UpSchedule, ExtrapolatesFromAKeyFrameEveryRatioFrames) {
+  UpSchedule schedule(settings(4));
+  EXPECT_EQ(kinds(schedule, 0, 9), "K B1 B1 B1 K B1 B1 B1 K B1");
+  UpSchedule again(settings(4));
+  const UpPlan first = again.plan(0, state_at(0));
+  EXPECT_EQ(first.why, "first frame");
+  EXPECT_FALSE(first.check_slot) << "nothing to check against: the ratio is fixed";
+  const UpPlan second = again.plan(1, state_at(1));
+  EXPECT_EQ(second.frame.first, first.key_slot);
+  EXPECT_FALSE(second.frame.two_keys);
+}
+
+TEST(UpSchedule, ALightSwitchedOrTheViewerJumpingIsACut) {
+  std::map<std::uint64_t, scene::SceneState> states;
+  for (std::uint64_t f = 2; f <= 9; ++f) states[f] = state_at(f), states[f].lights_off = {3};
+  UpSchedule schedule(settings(4));
+  EXPECT_EQ(kinds(schedule, 0, 7, states), "K B1 K B1 B1 B1 K B1");
+  UpSchedule jumps(settings(4));
+  (void)jumps.plan(0, state_at(0));
+  scene::SceneState far = state_at(1);
+  far.eye_now.z += kCutEyeJump * 1.1;
+  EXPECT_EQ(jumps.plan(1, far).why, "viewer jumped");
+  scene::SceneState near = state_at(2);
+  near.eye_now.z += kCutEyeJump * 0.9;
+  EXPECT_TRUE(jumps.plan(2, near).between);
+}
+
+TEST(UpSchedule, FramesThatGoBackOrSkipStartOver) {
+  UpSchedule schedule(settings(4));
+  (void)schedule.plan(10, state_at(10));
+  EXPECT_TRUE(schedule.plan(11, state_at(11)).between);
+  EXPECT_TRUE(schedule.plan(5, state_at(5)).draw_key);
+  EXPECT_TRUE(schedule.plan(20, state_at(20)).draw_key);
+}
+
+TEST(UpSchedule, TheAdaptiveRatioFollowsTheCheckedError) {
+  UpSchedule schedule(settings(4, config::UpMode::extrapolate, 30.0));
+  (void)schedule.plan(0, state_at(0));
+  for (std::uint64_t f = 1; f < 4; ++f) (void)schedule.plan(f, state_at(f));
+  const UpPlan key = schedule.plan(4, state_at(4));
+  ASSERT_TRUE(key.draw_key);
+  ASSERT_TRUE(key.check_slot) << "the frame between from the last key frame is checked against this one";
+  EXPECT_EQ(schedule.ratio(), 4);
+  schedule.checked(25.0);
+  EXPECT_EQ(schedule.ratio(), 3);
+  schedule.checked(29.9);
+  schedule.checked(29.9);
+  schedule.checked(29.9);
+  EXPECT_EQ(schedule.ratio(), 1) << "every frame drawn, never fewer";
+  EXPECT_EQ(kinds(schedule, 5, 7), "K K K");
+  schedule.checked(31.0);
+  EXPECT_EQ(schedule.ratio(), 1) << "within the margin: stays";
+  schedule.checked(30.0 + kRaiseMargin);
+  EXPECT_EQ(schedule.ratio(), 2);
+  for (int i = 0; i < 5; ++i) schedule.checked(1e9);
+  EXPECT_EQ(schedule.ratio(), 4) << "never beyond the configured ratio";
+  UpSchedule fixed(settings(4));
+  fixed.checked(10.0);
+  EXPECT_EQ(fixed.ratio(), 4);
+}
+
+TEST(UpSchedule, InterpolatesBetweenAKeyFrameAndOneDrawnAhead) {
+  UpSchedule schedule(settings(4, config::UpMode::interpolate));
+  EXPECT_EQ(kinds(schedule, 0, 9), "K A4B2 B2 B2 S A8B2 B2 B2 S A12B2");
+  UpSchedule again(settings(4, config::UpMode::interpolate));
+  std::map<std::uint64_t, scene::SceneState> ahead{{4, state_at(4)}};
+  const auto lookup = [&](std::uint64_t f) -> const scene::SceneState* {
+    return ahead.contains(f) ? &ahead[f] : nullptr;
+  };
+  const UpPlan a = again.plan(0, state_at(0), lookup);
+  const UpPlan b = again.plan(1, state_at(1), lookup);
+  EXPECT_NE(b.key_slot, a.key_slot);
+  EXPECT_EQ(b.frame.first, a.key_slot);
+  EXPECT_DOUBLE_EQ(b.frame.toward_second, 0.25);
+  EXPECT_DOUBLE_EQ(again.plan(3, state_at(3), lookup).frame.toward_second, 0.75);
+  EXPECT_EQ(again.plan(4, state_at(4), lookup).shown_slot, b.key_slot);
+  const UpPlan c = again.plan(5, state_at(5), lookup);
+  EXPECT_EQ(c.why, "nothing ahead");
+}
+
+TEST(UpSchedule, InterpolationTakesWhatTheMasterSentAhead) {
+  UpSchedule schedule(settings(4, config::UpMode::interpolate));
+  std::map<std::uint64_t, scene::SceneState> ahead{{2, state_at(2)}};
+  const auto lookup = [&](std::uint64_t f) -> const scene::SceneState* {
+    return ahead.contains(f) ? &ahead[f] : nullptr;
+  };
+  (void)schedule.plan(0, state_at(0), lookup);
+  const UpPlan p = schedule.plan(1, state_at(1), lookup);
+  ASSERT_TRUE(p.ahead_frame);
+  EXPECT_EQ(*p.ahead_frame, 2u) << "the farthest sent within the ratio";
+  EXPECT_DOUBLE_EQ(p.frame.toward_second, 0.5);
+}
+
+TEST(UpSchedule, NoFrameBetweenMixesTheTwoSidesOfACut) {
+  std::map<std::uint64_t, scene::SceneState> states;
+  for (std::uint64_t f = 3; f <= 12; ++f) states[f] = state_at(f), states[f].lights_off = {0};
+  UpSchedule schedule(settings(4, config::UpMode::interpolate));
+  // Frames 1 and 2 from key 0 alone, 3 from key 4 alone.
+  EXPECT_EQ(kinds(schedule, 0, 5, states), "K A4B1 B1 B1 S A8B2");
+  UpSchedule check(settings(4, config::UpMode::interpolate));
+  std::map<std::uint64_t, scene::SceneState> sent{{4, states[4]}};
+  const auto lookup = [&](std::uint64_t f) -> const scene::SceneState* {
+    return sent.contains(f) ? &sent[f] : nullptr;
+  };
+  const UpPlan a = check.plan(0, state_at(0), lookup);
+  const UpPlan one = check.plan(1, state_at(1), lookup);
+  EXPECT_EQ(one.frame.first, a.key_slot);
+  EXPECT_FALSE(one.frame.two_keys);
+  const UpPlan three = check.plan(3, states[3], lookup);
+  EXPECT_EQ(three.frame.first, one.key_slot) << "after the switch: the key frame drawn ahead";
+  EXPECT_FALSE(three.frame.two_keys);
+}
+
+}  // namespace
+}  // namespace optique::up
