@@ -33,9 +33,10 @@ struct UpConversion {
   int ratio = 1;  // display frames per key frame; 1: every frame rendered
   UpMethod method = UpMethod::motion;
   UpMode mode = UpMode::extrapolate;
-  // The adaptive ratio's floor, dB of PSNR_Y; 0: the ratio is fixed.
+  // The adaptive ratio's floor, dB of PSNR_Y; 0: the ratio is fixed. The
+  // average (a baseline to compare with) keeps its ratio.
   double min_psnr = kDefaultMinPsnr;
-  [[nodiscard]] bool adaptive() const { return min_psnr > 0.0; }
+  [[nodiscard]] bool adaptive() const { return min_psnr > 0.0 && method == UpMethod::motion; }
 
   [[nodiscard]] bool enabled() const { return ratio > 1; }
   friend bool operator==(const UpConversion&, const UpConversion&) = default;

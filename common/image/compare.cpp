@@ -16,6 +16,42 @@ double psnr(double squared_error_sum, std::size_t count, double peak) {
 
 }  // namespace
 
+Result<BlockClasses> block_classes(const FloatImage& a, const FloatImage& b, int block, double peak) {
+  if (a.width != b.width || a.height != b.height || a.channels < 3 || b.channels < 3 || a.width == 0 || a.height == 0 ||
+      block < 1) {
+    return Error{"block classes need two non-empty RGB images of one size and a block of at least 1 pixel"};
+  }
+  BlockClasses out;
+  out.worst_db = std::numeric_limits<double>::infinity();
+  std::size_t blocks = 0;
+  constexpr double kWeights[3] = {0.299, 0.587, 0.114};
+  constexpr double kIdentical = 100.0;
+  for (int by = 0; by < a.height; by += block) {
+    for (int bx = 0; bx < a.width; bx += block) {
+      double sum[3] = {0.0, 0.0, 0.0};
+      std::size_t count = 0;
+      for (int y = by; y < std::min(by + block, a.height); ++y) {
+        for (int x = bx; x < std::min(bx + block, a.width); ++x) {
+          for (int c = 0; c < 3; ++c) {
+            const double d = static_cast<double>(a.at(x, y, c)) - b.at(x, y, c);
+            sum[c] += d * d;
+          }
+          ++count;
+        }
+      }
+      double db = 0.0;
+      for (int c = 0; c < 3; ++c) db += kWeights[c] * std::min(kIdentical, psnr(sum[c], count, peak));
+      int k = 0;
+      while (k < 3 && db >= BlockClasses::kBounds[k]) ++k;
+      out.share[k] += 1.0;
+      out.worst_db = std::min(out.worst_db, db);
+      ++blocks;
+    }
+  }
+  for (double& share : out.share) share /= static_cast<double>(blocks);
+  return out;
+}
+
 Result<Comparison> compare(const FloatImage& a, const FloatImage& b, double peak) {
   if (a.width != b.width || a.height != b.height) {
     return Error{"image sizes differ: " + std::to_string(a.width) + "×" + std::to_string(a.height) + " and " +

@@ -23,6 +23,19 @@ struct Comparison {
 // RGB of both images (alpha ignored); `peak` is the largest possible value.
 [[nodiscard]] Result<Comparison> compare(const FloatImage& a, const FloatImage& b, double peak = 1.0);
 
+// The up-conversion paper's local measure: PSNR_Y of each 4×4 block, each
+// block in a quality class. The classes' bounds are ours (dB): below 20 "very
+// bad", 20–30 "bad", 30–40 "good", 40 and above "better than good". A
+// channel identical in a block counts as 100 dB there. Blocks cut by the
+// image's edge count as they are.
+struct BlockClasses {
+  static constexpr double kBounds[3] = {20.0, 30.0, 40.0};
+  double share[4] = {0.0, 0.0, 0.0, 0.0};  // very bad, bad, good, better than good; sums to 1
+  double worst_db = 0.0;                   // the worst block's PSNR_Y
+};
+[[nodiscard]] Result<BlockClasses> block_classes(const FloatImage& a, const FloatImage& b, int block = 4,
+                                                 double peak = 1.0);
+
 // Rec. 601 luma, 0.299 R + 0.587 G + 0.114 B, of one pixel.
 [[nodiscard]] double luma(const FloatImage& image, int x, int y);
 

@@ -40,12 +40,12 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
                                                                    const scene::SceneDefinition& scene,
                                                                    const PipelineOptions& options) {
   const config::Projector& self = job.self();
-  if (self.up_conversion.enabled()) {
-    // Refused, not ignored: a node that rendered every frame anyway would hide
+  if (self.up_conversion.enabled() && !self.color_fields.fields.empty()) {
+    // Refused, not ignored: a node that rendered every field anyway would hide
     // the cost the operator asked to save.
-    return Error{"projector '" + self.id + "': up_conversion (a key frame every " +
-                 std::to_string(self.up_conversion.ratio) +
-                 " frames) is not drawn yet; remove it to render every frame"};
+    return Error{"projector '" + self.id +
+                 "': up_conversion with color_fields is not drawn yet; use the colour fields' gather method, or "
+                 "up-convert a projector without colour fields"};
   }
   auto view = ProjectorView::make(job.screen(), self.geometry(), self.rendering, options.two_pass_pixels_per_metre);
   if (!view) return Error{"projector '" + self.id + "': " + view.error()};
@@ -63,8 +63,14 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
       return Error{"projector '" + self.id + "': " + gather.error()};
     }
   }
+  if (self.up_conversion.enabled()) {
+    if (auto prepared = renderer.value()->prepare_up_conversion(); !prepared) {
+      return Error{"projector '" + self.id + "': " + prepared.error()};
+    }
+  }
   std::unique_ptr<ProjectorPipeline> pipeline(
       new ProjectorPipeline(std::move(view).value(), std::move(renderer).value(), job, stage.projector));
+  if (self.up_conversion.enabled()) pipeline->schedule_.emplace(self.up_conversion);
   if (self.content.role == config::ContentRole::lights) pipeline->set_share({});
   pipeline->still_once_ = options.still_once;
   return pipeline;
@@ -112,8 +118,17 @@ Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double frac
   return {};
 }
 
-Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state, const ImageDrawn& drawn) {
+Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state, const ImageDrawn& drawn,
+                                           const DisplayFrame* display) {
   gather_report_ = {};
+  if (schedule_) {
+    const DisplayFrame next{next_frame_, {}};
+    const DisplayFrame& frame = display ? *display : next;
+    next_frame_ = frame.number + 1;
+    auto result = draw_up_converted(state, frame);
+    if (drawn) drawn(0);
+    return result;
+  }
   Result<void> result;
   for (int image = 0; image < images(); ++image) {
     if (image > 0) renderer_->hold_output();  // shown while this one is drawn
@@ -224,10 +239,52 @@ Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state, in
   return {};
 }
 
+Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state, const DisplayFrame& display) {
+  const up::UpPlan plan = schedule_->plan(display.number, state, display.ahead);
+  up_report_ = {};
+  up_report_.kind = plan.kind();
+  up_report_.why = plan.why;
+  const auto black = [&](const std::string& why) -> Result<void> {
+    renderer_->draw_black();
+    return Error{why};
+  };
+  if (plan.draw_key) {
+    // This frame's state, or the one the master sent ahead for a later frame.
+    const scene::SceneState* key = plan.ahead_frame ? display.ahead(*plan.ahead_frame) : &state;
+    assert(key != nullptr);  // the schedule plans only what was sent
+    const auto seen = moment(*key, 0.0);
+    if (!seen) return black(seen.error());
+    renderer_->draw(*key, 0.0, seen.value().eye, seen.value().frustum, terms_);
+    if (plan.check_slot) {
+      up::BetweenFrame check;
+      check.method = schedule_->settings().method;
+      check.first = *plan.check_slot;
+      up_report_.checked_psnr =
+          renderer_->check_between(*key, 0.0, seen.value().eye, seen.value().frustum, check, terms_);
+      schedule_->checked(*up_report_.checked_psnr);
+    }
+    const geometry::Frustum& f = seen.value().frustum;
+    renderer_->keep_key(plan.key_slot, {*key, 0.0, f.projection * f.view});
+  }
+  up_report_.ratio = schedule_->ratio();
+  if (plan.shown_slot) renderer_->show_key(*plan.shown_slot);
+  if (!plan.between) return {};
+  const auto seen = moment(state, 0.0);
+  if (!seen) return black(seen.error());
+  up_report_.between = renderer_->draw_between(state, 0.0, seen.value().eye, seen.value().frustum, plan.frame, terms_);
+  return {};
+}
+
 void ProjectorPipeline::warm_up() {
   const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
   if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
     renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
+    if (schedule_) {  // the motion field, the resolve, the mark and the check
+      const geometry::Frustum& f = frustum.value();
+      renderer_->keep_key(0, {scene::SceneState{}, 0.0, f.projection * f.view});
+      (void)renderer_->check_between(scene::SceneState{}, 0.0, in_front, f, {}, terms_);
+      (void)renderer_->draw_between(scene::SceneState{}, 0.0, in_front, f, {}, terms_);
+    }
     if (color_fields_.needs_velocity()) {
       // The velocity program and the tile passes too (the field pass itself
       // first runs when something moves).

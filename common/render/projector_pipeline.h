@@ -19,6 +19,7 @@
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
 #include "scene/state.h"
+#include "up/schedule.h"
 #include "util/result.h"
 
 namespace optique::render {
@@ -42,6 +43,24 @@ struct PipelineOptions {
 // it, and the other fields' edges are drawn at other moments: one sample per
 // pixel would put each channel's edge on a different pixel boundary.
 inline constexpr int kFieldSamples = 4;
+
+// Where a frame stands in the display sequence, for a projector that up-
+// converts (which frames are key frames): its number, and the states the
+// master sent ahead of their frames (interpolation).
+struct DisplayFrame {
+  std::uint64_t number = 0;
+  up::UpSchedule::Ahead ahead;
+};
+
+// What the last frame was, for a projector that up-converts.
+struct UpReport {
+  up::FrameKind kind = up::FrameKind::full;
+  up::BetweenReport between;  // a frame between: what no key frame saw
+  // A key frame checked against the frame between it replaces (dB PSNR_Y).
+  std::optional<double> checked_psnr;
+  int ratio = 1;         // display frames per key frame from now on
+  std::string_view why;  // why a key frame was drawn now
+};
 
 class ProjectorPipeline {
  public:
@@ -74,7 +93,12 @@ class ProjectorPipeline {
   // image_framebuffer() then shows either. An image that cannot be seen (the eye
   // is not in front of the screen) is black, and so is the rest of the frame.
   using ImageDrawn = std::function<void(int image)>;
-  [[nodiscard]] Result<void> draw_frame(const scene::SceneState& state, const ImageDrawn& drawn = {});
+  // A projector that up-converts (config::UpConversion) draws a key frame or
+  // builds the frame between as its schedule says, for display frame `display`
+  // (without one: the frame after the last).
+  [[nodiscard]] Result<void> draw_frame(const scene::SceneState& state, const ImageDrawn& drawn = {},
+                                        const DisplayFrame* display = nullptr);
+  [[nodiscard]] const UpReport& up_report() const { return up_report_; }
   // Images per frame: 1, or 2 (config::ColorFields::images).
   [[nodiscard]] int images() const { return color_fields_.images; }
   // Where image `image` of the last frame drawn is, to show it.
@@ -106,6 +130,7 @@ class ProjectorPipeline {
   [[nodiscard]] Result<GatherFrame> gather_frame(const scene::SceneState& state, int image, double rendered) const;
   void add(const GatherReport& report);  // to the frame's gather_report()
   [[nodiscard]] Result<void> draw_gathered(const scene::SceneState& state, int image);
+  [[nodiscard]] Result<void> draw_up_converted(const scene::SceneState& state, const DisplayFrame& display);
 
   ProjectorView view_;
   std::unique_ptr<SceneRenderer> renderer_;
@@ -118,6 +143,9 @@ class ProjectorPipeline {
   LightTerms terms_;
   GatherReport gather_report_;
   bool still_once_ = true;
+  std::optional<up::UpSchedule> schedule_;  // projectors that up-convert
+  std::uint64_t next_frame_ = 0;            // without a DisplayFrame
+  UpReport up_report_;
 };
 
 }  // namespace optique::render

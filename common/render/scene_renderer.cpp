@@ -514,32 +514,59 @@ void SceneRenderer::keep_key(int slot, up::KeyView view) {
   gl.up_converter->keep(slot, gl.linear_colour.get(), gl.depth.get(), std::move(view));
 }
 
-up::BetweenReport SceneRenderer::draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
-                                              const geometry::Frustum& frustum, const up::BetweenFrame& frame,
-                                              const LightTerms& terms) {
+up::BetweenReport SceneRenderer::build_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                               const geometry::Frustum& frustum, const up::BetweenFrame& frame,
+                                               const LightTerms& terms) {
   Gl& gl = *gl_;
   assert(gl.up_converter);  // prepare_up_conversion first
   UpConverter& converter = *gl.up_converter;
-  if (frame.method == up::BetweenMethod::motion) {
+  const bool motion = frame.method == up::BetweenMethod::motion;
+  if (motion) {
     converter.begin_motion_field();
     const up::KeyView& first = converter.key(frame.first);
     const up::KeyView& second = converter.key(frame.two_keys ? 1 - frame.first : frame.first);
-    const Motion motion{{{&first.state, first.fraction, first.view_projection},
-                         {&second.state, second.fraction, second.view_projection}},
-                        true};
-    draw_scene(state, fraction, eye, frustum, terms, Objects::all, &motion);
+    const Motion field{{{&first.state, first.fraction, first.view_projection},
+                        {&second.state, second.fraction, second.view_projection}},
+                       true};
+    draw_scene(state, fraction, eye, frustum, terms, Objects::all, &field);
   }
   const up::BetweenReport report = converter.resolve(frame, gl.background);
-  if (frame.method == up::BetweenMethod::motion && frame.shade_unseen && report.unseen_pixels > 0) {
+  if (motion && frame.shade_unseen && report.unseen_pixels > 0) {
     converter.begin_shade_unseen();
     draw_scene(state, fraction, eye, frustum, terms);
     converter.end_shade_unseen();
   }
+  return report;
+}
+
+up::BetweenReport SceneRenderer::draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                              const geometry::Frustum& frustum, const up::BetweenFrame& frame,
+                                              const LightTerms& terms) {
+  Gl& gl = *gl_;
+  const up::BetweenReport report = build_between(state, fraction, eye, frustum, frame, terms);
+  const UpConverter& converter = *gl.up_converter;
   const bool motion = frame.method == up::BetweenMethod::motion;
   gl.rendered_colour_framebuffer = converter.output_framebuffer();
   gl.rendered_depth_framebuffer = motion ? converter.output_framebuffer() : gl.linear_framebuffer.get();
   encode(converter.output(), motion ? converter.depth() : gl.depth.get());
   return report;
+}
+
+double SceneRenderer::check_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                    const geometry::Frustum& frustum, const up::BetweenFrame& frame,
+                                    const LightTerms& terms) {
+  Gl& gl = *gl_;
+  (void)build_between(state, fraction, eye, frustum, frame, terms);
+  return gl.up_converter->psnr_y_against(gl.linear_colour.get());
+}
+
+void SceneRenderer::show_key(int slot) {
+  Gl& gl = *gl_;
+  assert(gl.up_converter);
+  // Back where draw() leaves an image: read_rendered() and read_depth() find it.
+  gl.up_converter->restore(slot, gl.linear_colour.get(), gl.depth.get());
+  gl.rendered_colour_framebuffer = gl.rendered_depth_framebuffer = gl.linear_framebuffer.get();
+  encode();
 }
 
 void SceneRenderer::hold_output() {

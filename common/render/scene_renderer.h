@@ -130,6 +130,15 @@ class SceneRenderer {
   up::BetweenReport draw_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                                  const geometry::Frustum& frustum, const up::BetweenFrame& frame,
                                  const LightTerms& terms = {});
+  // The frame between that `frame` would build for the state the last draw()
+  // showed, weighed against what draw() made: PSNR_Y (dB, the up-conversion
+  // paper's; +infinity when equal). The output stays draw()'s.
+  [[nodiscard]] double check_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                     const geometry::Frustum& frustum, const up::BetweenFrame& frame,
+                                     const LightTerms& terms = {});
+  // Key `slot` as it was kept, through the output stage (a key frame drawn
+  // ahead, shown at its own moment).
+  void show_key(int slot);
 
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);
@@ -192,6 +201,11 @@ class SceneRenderer {
   // The scene at `frame.seen`'s moment with its velocity, resolved, and the
   // gather's tiles measured: what a gather or a blur starts from.
   void draw_with_motion(const scene::SceneState& state, const GatherFrame& frame, const LightTerms& terms);
+  // A frame between key frames into the up-converter's output (draw_between
+  // without the output stage).
+  up::BetweenReport build_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                  const geometry::Frustum& frustum, const up::BetweenFrame& frame,
+                                  const LightTerms& terms);
   void keep_still_depth();        // copies the depth drawn so far aside
   void bring_back_still_depth();  // and back
   [[nodiscard]] unsigned draw_framebuffer() const;

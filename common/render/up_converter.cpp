@@ -1,7 +1,10 @@
 #include "render/up_converter.h"
 
 #include <cassert>
+#include <cmath>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "render/shaders.h"
 
@@ -9,6 +12,7 @@ namespace optique::render {
 namespace {
 
 constexpr std::string_view kVersion = "#version 450 core\n";
+constexpr int kErrorBlock = 16;  // pixels per side summed by one texel of the check
 
 // A single-sample texture read texel by texel.
 glo::Texture exact_texture(GLenum format, int width, int height) {
@@ -40,6 +44,15 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
       glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_mark_frag));
   if (!mark) return Error{"the up-conversion's mark pass: " + mark.error()};
   u->mark_program_ = std::move(mark).value();
+  auto error =
+      glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_error_frag));
+  if (!error) return Error{"the up-conversion's check: " + error.error()};
+  u->error_program_ = std::move(error).value();
+  glProgramUniform1i(u->error_program_.get(), glGetUniformLocation(u->error_program_.get(), "block"), kErrorBlock);
+  u->error_sums_ =
+      exact_texture(GL_RGBA32F, (width + kErrorBlock - 1) / kErrorBlock, (height + kErrorBlock - 1) / kErrorBlock);
+  u->error_framebuffer_ = glo::make_framebuffer();
+  glNamedFramebufferTexture(u->error_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->error_sums_.get(), 0);
   const GLuint r = u->resolve_program_.get();
   u->uniforms_ = {glGetUniformLocation(r, "method"), glGetUniformLocation(r, "keys"),
                   glGetUniformLocation(r, "toward_second"), glGetUniformLocation(r, "background")};
@@ -68,6 +81,9 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   glNamedFramebufferTexture(u->output_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->output_.get(), 0);
   u->mark_framebuffer_ = glo::make_framebuffer();
   glNamedFramebufferDrawBuffer(u->mark_framebuffer_.get(), GL_NONE);
+  if (glCheckNamedFramebufferStatus(u->error_framebuffer_.get(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+    return Error{"this GL driver cannot draw the up-conversion's check (RGBA32F)"};
+  }
   for (GLuint fb : {motion, u->output_framebuffer_.get(), u->mark_framebuffer_.get()}) {
     glNamedFramebufferTexture(fb, GL_DEPTH_STENCIL_ATTACHMENT, u->depth_stencil_.get(), 0);
     if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
@@ -79,13 +95,25 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   return u;
 }
 
+namespace {
+
+void copy(GLuint from, GLuint to, int width, int height) {
+  glCopyImageSubData(from, GL_TEXTURE_2D, 0, 0, 0, 0, to, GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
+}
+
+}  // namespace
+
 void UpConverter::keep(int slot, GLuint colour, GLuint depth, up::KeyView view) {
   assert(slot >= 0 && slot < up::kKeySlots);
-  glCopyImageSubData(colour, GL_TEXTURE_2D, 0, 0, 0, 0, key_colour_[slot].get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_,
-                     height_, 1);
-  glCopyImageSubData(depth, GL_TEXTURE_2D, 0, 0, 0, 0, key_depth_[slot].get(), GL_TEXTURE_2D, 0, 0, 0, 0, width_,
-                     height_, 1);
+  copy(colour, key_colour_[slot].get(), width_, height_);
+  copy(depth, key_depth_[slot].get(), width_, height_);
   key_view_[slot] = std::move(view);
+}
+
+void UpConverter::restore(int slot, GLuint colour, GLuint depth) const {
+  assert(slot >= 0 && slot < up::kKeySlots);
+  copy(key_colour_[slot].get(), colour, width_, height_);
+  copy(key_depth_[slot].get(), depth, width_, height_);
 }
 
 const up::KeyView& UpConverter::key(int slot) const {
@@ -144,6 +172,34 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   report.unseen_pixels = unseen;
   report.unseen_share = static_cast<double>(unseen) / (static_cast<double>(width_) * static_cast<double>(height_));
   return report;
+}
+
+double UpConverter::psnr_y_against(GLuint image) {
+  const int columns = (width_ + kErrorBlock - 1) / kErrorBlock;
+  const int rows = (height_ + kErrorBlock - 1) / kErrorBlock;
+  glDisable(GL_DEPTH_TEST);
+  glBindFramebuffer(GL_FRAMEBUFFER, error_framebuffer_.get());
+  glViewport(0, 0, columns, rows);
+  glUseProgram(error_program_.get());
+  glBindTextureUnit(0, output_.get());
+  glBindTextureUnit(1, image);
+  glBindVertexArray(empty_vertex_array_.get());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  std::vector<float> sums(static_cast<std::size_t>(columns) * static_cast<std::size_t>(rows) * 4);
+  glGetTextureImage(error_sums_.get(), 0, GL_RGBA, GL_FLOAT, static_cast<GLsizei>(sums.size() * sizeof(float)),
+                    sums.data());
+  double squared[3] = {0.0, 0.0, 0.0};
+  for (std::size_t i = 0; i < sums.size(); i += 4) {
+    for (int c = 0; c < 3; ++c) squared[c] += sums[i + static_cast<std::size_t>(c)];
+  }
+  const double pixels = static_cast<double>(width_) * static_cast<double>(height_);
+  const double weights[3] = {0.299, 0.587, 0.114};
+  double psnr = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    if (squared[c] <= 0.0) return std::numeric_limits<double>::infinity();
+    psnr += weights[c] * 10.0 * std::log10(pixels / squared[c]);
+  }
+  return psnr;
 }
 
 void UpConverter::begin_shade_unseen() {

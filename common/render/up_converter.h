@@ -30,6 +30,8 @@ class UpConverter {
   // Copies a drawn image (RGBA32F) and its depth into key slot `slot`.
   void keep(int slot, GLuint colour, GLuint depth, up::KeyView view);
   [[nodiscard]] const up::KeyView& key(int slot) const;
+  // And back: key `slot`'s colour and depth into these.
+  void restore(int slot, GLuint colour, GLuint depth) const;
 
   // The motion field's target: where each pixel's surface was in each key frame
   // (attachments 0 and 1) over the frame's own depth and stencil; bound,
@@ -42,6 +44,10 @@ class UpConverter {
   // stencil marks a pixel unseen and only the surface the field found there.
   void begin_shade_unseen();
   void end_shade_unseen();  // back to the GL state everything else expects
+
+  // PSNR_Y (the up-conversion paper's weighting of each channel's PSNR, peak
+  // 1) of output() against `image` (this size, RGBA32F); +infinity when equal.
+  [[nodiscard]] double psnr_y_against(GLuint image);
 
   [[nodiscard]] GLuint output() const { return output_.get(); }
   [[nodiscard]] GLuint output_framebuffer() const { return output_framebuffer_.get(); }  // with depth()
@@ -62,6 +68,9 @@ class UpConverter {
   glo::Framebuffer mark_framebuffer_;  // the stencil alone: the mark pass reads output()
   glo::Program resolve_program_;
   glo::Program mark_program_;
+  glo::Program error_program_;
+  glo::Texture error_sums_;  // one texel per kErrorBlock² pixels
+  glo::Framebuffer error_framebuffer_;
   glo::VertexArray empty_vertex_array_;
   GLuint query_ = 0;
   struct {

@@ -6,6 +6,20 @@
 
 namespace optique::up {
 
+std::string_view to_string(FrameKind kind) {
+  switch (kind) {
+    case FrameKind::full:
+      return "full";
+    case FrameKind::key:
+      return "key";
+    case FrameKind::between:
+      return "between";
+    case FrameKind::shown:
+      return "shown";
+  }
+  return "?";
+}
+
 bool same_side(const scene::SceneState& key, const scene::SceneState& state, std::string_view* why) {
   if (key.lights_off != state.lights_off) {
     if (why) *why = "lights switched";

@@ -33,6 +33,12 @@ inline constexpr double kCutEyeJump = 0.5;
 // dB above the floor before the key frames come further apart again.
 inline constexpr double kRaiseMargin = 3.0;
 
+// What a display frame was: drawn in full (no up-conversion), a key frame
+// drawn now, one built between key frames, or a key frame drawn ahead and shown
+// now.
+enum class FrameKind { full, key, between, shown };
+[[nodiscard]] std::string_view to_string(FrameKind kind);
+
 // What to draw for one display frame.
 struct UpPlan {
   // Draw a state in full and keep it as key `key_slot`: this frame's own (then
@@ -48,6 +54,9 @@ struct UpPlan {
   BetweenFrame frame;
   // Show kept key `shown_slot` as it is: it was drawn ahead for this frame.
   std::optional<int> shown_slot;
+  [[nodiscard]] FrameKind kind() const {
+    return between ? FrameKind::between : shown_slot ? FrameKind::shown : FrameKind::key;
+  }
   // Why a key frame is drawn now ("first frame", "ratio", "lights switched",
   // "viewer jumped", "nothing ahead"), for the log.
   std::string_view why;

@@ -26,6 +26,7 @@
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
 #include "scene/state.h"
+#include "up_experiment.h"
 
 namespace optique::render {
 namespace {
@@ -296,3 +297,65 @@ TEST_F(UpConversion, BetweenTwoKeyFramesNothingIsUnseen) {
 
 }  // namespace
 }  // namespace optique::render
+
+namespace optique::bench::upconv {
+namespace {
+
+StageScene scene_named(const std::string& name) {
+  for (const StageScene& s : paper_scenes()) {
+    if (s.name == name) return s;
+  }
+  ADD_FAILURE() << "no scene " << name;
+  return {};
+}
+
+std::string kinds(const SceneResult& result) {
+  std::string out;
+  for (const FrameResult& f : result.frames) out += std::string(up::to_string(f.kind)).substr(0, 1);
+  return out;
+}
+
+class UpConvertingPipeline : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    auto context = render::make_headless_context();
+    ASSERT_TRUE(context.ok()) << "no headless OpenGL context: " << context.error();
+    context_ = std::move(context).value();
+  }
+  std::unique_ptr<render::GlContext> context_;
+};
+
+// The pipeline a node builds: every display frame drawn, a key frame every
+// four, the frames between close to the full renders of their moments; the key
+// frames drawn ahead are shown exactly as drawn.
+TEST_F(UpConvertingPipeline, DrawsEveryDisplayFrameFromKeyFramesEveryFour) {
+  StageScene scene = scene_named("cube-slow-rotation");
+  scene.frame_rate = 60.0;
+  for (config::UpMode mode : {config::UpMode::interpolate, config::UpMode::extrapolate}) {
+    auto result = measure(scene, {config::UpMethod::motion, mode, 4, 0.0}, 13, 160, 120);
+    ASSERT_TRUE(result.ok()) << result.error();
+    const SceneResult& r = result.value();
+    std::cout << config::to_string(mode) << ": " << kinds(r) << ", frames between " << r.mean_between_psnr << " dB\n";
+    EXPECT_EQ(kinds(r), mode == config::UpMode::interpolate ? "kbbbsbbbsbbbs" : "kbbbkbbbkbbbk");
+    for (const FrameResult& f : r.frames) {
+      if (f.kind != up::FrameKind::between) {
+        EXPECT_TRUE(std::isinf(f.psnr_y)) << "frame " << f.frame << " is a key frame: drawn as the full render is";
+      }
+    }
+    EXPECT_GE(r.mean_between_psnr, 45.0);  // measured 62.6 (extrapolate) and 66.7 dB
+  }
+}
+
+// A floor the frames between cannot keep: the key frames come every frame.
+TEST_F(UpConvertingPipeline, TheAdaptiveRatioDrawsMoreKeyFramesBelowTheFloor) {
+  StageScene scene = scene_named("wheel-rotation");
+  scene.frame_rate = 30.0;
+  auto result = measure(scene, {config::UpMethod::motion, config::UpMode::extrapolate, 4, 99.0}, 12, 160, 120);
+  ASSERT_TRUE(result.ok()) << result.error();
+  std::cout << kinds(result.value()) << "\n";
+  EXPECT_EQ(result.value().frames.back().ratio, 1);
+  EXPECT_EQ(kinds(result.value()).substr(9), "kkk");
+}
+
+}  // namespace
+}  // namespace optique::bench::upconv

@@ -1,0 +1,87 @@
+// Frame-rate up-conversion benchmark (docs/design.md, "Frame-rate up-conversion"):
+// the up-conversion paper's scene set, each frame built between key frames
+// against the full render of its moment, by method and mode; and speed against
+// error on many-lights: key-frame and between-frame cost by ratio.
+//
+//   optique-bench-upconversion [--out DIR] [--probe RATES]
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "image/compare.h"
+#include "image/convert.h"
+#include "image/image_io.h"
+#include "render/gl_context.h"
+#include "up_experiment.h"
+
+namespace {
+
+using namespace optique;
+using namespace optique::bench::upconv;
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"frame-rate up-conversion: accuracy on the paper's scenes, speed against error"};
+  std::string out = "docs/bench";
+  std::vector<double> probe;
+  int width = 320;
+  int height = 240;
+  int frames = 24;
+  std::vector<std::string> only;
+  double screen = 0.0;
+  std::string images;
+  app.add_option("--images", images,
+                 "probe: write each run's hardest frame, its full render and their difference here");
+  app.add_option("--screen", screen, "probe: the stage screen's width, metres (0: each scene's)");
+  app.add_option("--out", out, "where the table, CSV and plot go");
+  app.add_option("--probe", probe, "only print each scene's baseline and motion PSNR_Y at these display rates");
+  app.add_option("--frames", frames, "display frames per run");
+  app.add_option("--scene", only, "only these scenes");
+  CLI11_PARSE(app, argc, argv);
+  auto context = render::make_headless_context();
+  if (!context) {
+    std::cerr << "no GL context: " << context.error() << "\n";
+    return 1;
+  }
+  for (StageScene scene : paper_scenes()) {
+    if (!only.empty() && std::find(only.begin(), only.end(), scene.name) == only.end()) continue;
+    for (double rate : probe) {
+      scene.frame_rate = rate;
+      if (screen > 0.0) scene.screen_width = screen;
+      std::printf("%-24s %5.1f Hz (paper average %.2f, motion %.2f):", scene.name.c_str(), rate, scene.paper_average,
+                  scene.paper_motion);
+      for (const Run& run : {Run{config::UpMethod::average, config::UpMode::interpolate, 4, 0.0},
+                             Run{config::UpMethod::motion, config::UpMode::interpolate, 4, 0.0},
+                             Run{config::UpMethod::motion, config::UpMode::extrapolate, 4, 0.0}}) {
+        auto result = measure(scene, run, frames, width, height);
+        if (!result) {
+          std::printf(" error: %s\n", result.error().c_str());
+          return 1;
+        }
+        if (!images.empty()) {
+          const SceneResult& r = result.value();
+          const std::string stem = images + "/" + scene.name + "-" + std::to_string(static_cast<int>(rate)) + "-" +
+                                   std::string(config::to_string(run.method)) + "-" +
+                                   std::string(config::to_string(run.mode));
+          (void)image::write_png(stem + "-shown.png", image::encode_srgb(r.hardest_image));
+          (void)image::write_png(stem + "-full.png", image::encode_srgb(r.hardest_reference));
+          (void)image::write_png(stem + "-difference.png",
+                                 image::encode_srgb(image::difference(r.hardest_image, r.hardest_reference, 4.0f)));
+        }
+        std::printf("  %s/%s %.2f dB (key %.1f ms, between %.1f ms, full %.1f ms)",
+                    std::string(config::to_string(run.method)).c_str(),
+                    std::string(config::to_string(run.mode)).c_str(), result.value().mean_between_psnr,
+                    result.value().key_ms, result.value().between_ms, result.value().full_ms);
+      }
+      std::printf("\n");
+      std::fflush(stdout);
+    }
+  }
+  return 0;
+}
