@@ -458,17 +458,30 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     Session& session = sessions_.at(peer);
     if (session.phase == Phase::joined) session.phase = Phase::in_barrier;
     const LightShare* share = light_plan_.share(i);
-    if (share != nullptr && slots_[i].sent_share != *share) {
-      // A new share applies from this frame on, on every node of the group at once.
-      wire::Envelope with_share = envelope;
-      *with_share.mutable_frame_begin()->mutable_lights() = protocol::to_wire(*share);
-      out.push_back(Send{peer, std::move(with_share)});
-      slots_[i].sent_share = *share;
-      out.push_back(Log{spdlog::level::info, fmt::format("node '{}' draws lights [{}]{} from frame {}", slot_id(i),
-                                                         config::format_light_list(share->lights),
-                                                         share->ambient ? " and ambient" : "", frame)});
-    } else {
+    const bool new_share = share != nullptr && slots_[i].sent_share != *share;
+    const config::UpConversion& up_conversion = installation_.projectors[i].up_conversion;
+    const bool interpolates = up_conversion.enabled() && up_conversion.mode == config::UpMode::interpolate;
+    if (!new_share && !interpolates) {
       out.push_back(Send{peer, envelope});
+    } else {
+      wire::Envelope to_node = envelope;
+      if (new_share) {
+        // A new share applies from this frame on, on every node of the group at once.
+        *to_node.mutable_frame_begin()->mutable_lights() = protocol::to_wire(*share);
+        slots_[i].sent_share = *share;
+        out.push_back(Log{spdlog::level::info, fmt::format("node '{}' draws lights [{}]{} from frame {}", slot_id(i),
+                                                           config::format_light_list(share->lights),
+                                                           share->ambient ? " and ambient" : "", frame)});
+      }
+      if (interpolates) {
+        // The scene is a function of time: the frame its next key frame may be
+        // drawn for is sent now, ratio − 1 frames before its turn.
+        const std::uint64_t ahead = frame + static_cast<std::uint64_t>(up_conversion.ratio) - 1;
+        auto& begin_ahead = *to_node.mutable_frame_begin();
+        *begin_ahead.mutable_ahead() = scene::to_snapshot(authority_.state_at_frame(ahead));
+        begin_ahead.set_ahead_frame(ahead);
+      }
+      out.push_back(Send{peer, std::move(to_node)});
     }
     sent.push_back(i);
     if (session.phase == Phase::in_barrier) waited.push_back(i);
@@ -487,7 +500,7 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
 void MasterProtocol::on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now,
                               Actions& out) {
   const std::size_t slot = *session.slot;
-  recorder_.ready(ready.frame_id(), slot, received, ready.render_ns());
+  recorder_.ready(ready.frame_id(), slot, received, ready.render_ns(), ready.drawn_as());
   if (ready.frame_id() + 1 == next_frame_ && ready.state_hash() != current_hash_) {
     recorder_.hash_mismatch(slot);
     out.push_back(Log{spdlog::level::warn,

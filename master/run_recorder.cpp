@@ -30,12 +30,22 @@ void RunRecorder::frame_begun(std::uint64_t frame, clock::Nanos sent, const std:
   last_begin_ = sent;
 }
 
-void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time) {
+void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time,
+                        wire::DrawnAs drawn_as) {
   FrameRecord* record = find(frame);
   if (record == nullptr || record->nodes[node].ready != 0) return;
   record->nodes[node].ready = received;
-  totals_[node].rendered += 1;
-  totals_[node].render_us.add(static_cast<double>(render_time) / 1e3);
+  NodeTotals& t = totals_[node];
+  t.rendered += 1;
+  const double us = static_cast<double>(render_time) / 1e3;
+  t.render_us.add(us);
+  if (drawn_as == wire::DRAWN_FULL) return;
+  t.render_us_drawn_as[drawn_as].add(us);
+  if (drawn_as == wire::DRAWN_KEY || drawn_as == wire::DRAWN_KEY_SHOWN) {
+    t.key_frames.push_back(frame);
+  } else {
+    t.between += 1;
+  }
 }
 
 void RunRecorder::swapped(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes) {
@@ -133,6 +143,19 @@ report::RunReport RunRecorder::report() const {
     node.set_frames_rendered(t.rendered);
     node.set_frames_presented(t.presented);
     *node.mutable_render_us() = t.render_us.summary();
+    if (!t.render_us_drawn_as.empty()) {
+      report::UpConversionReport& up = *node.mutable_up_conversion();
+      for (std::uint64_t key : t.key_frames) up.add_key_frames(key);
+      up.set_frames_between(t.between);
+      const auto summary = [&](wire::DrawnAs drawn_as, report::Distribution* into) {
+        const auto found = t.render_us_drawn_as.find(drawn_as);
+        if (found != t.render_us_drawn_as.end()) *into = found->second.summary();
+      };
+      summary(wire::DRAWN_KEY, up.mutable_key_render_us());
+      summary(wire::DRAWN_BETWEEN, up.mutable_between_render_us());
+      summary(wire::DRAWN_BETWEEN_AND_KEY_AHEAD, up.mutable_between_and_ahead_render_us());
+      summary(wire::DRAWN_KEY_SHOWN, up.mutable_shown_render_us());
+    }
     node.set_barrier_misses(t.misses);
     node.set_hash_mismatches(t.mismatches);
     node.set_joins(t.joins);

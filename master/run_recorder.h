@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <optional>
 #include <ostream>
 #include <string>
@@ -13,6 +14,7 @@
 #include "clock/clock.h"
 #include "metrics/distribution.h"
 #include "optique/report.pb.h"
+#include "optique/wire.pb.h"
 
 namespace optique::master {
 
@@ -23,7 +25,9 @@ class RunRecorder {
   RunRecorder(std::vector<std::string> node_ids, std::ostream* csv);
 
   void frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
-  void ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time);
+  // `drawn_as`: how a node that up-converts drew it (key frame, between…).
+  void ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time,
+             wire::DrawnAs drawn_as = wire::DRAWN_FULL);
   void swapped(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
   // `content_frame`: the frame whose content the node showed (a node out of step
   // shows an older one: the frame is then incoherent).
@@ -74,6 +78,11 @@ class RunRecorder {
     std::uint64_t mismatches = 0;
     std::uint64_t joins = 0;
     metrics::Reservoir render_us;
+    // Up-conversion: frames that showed a key frame, frames between, and the
+    // render time of each way of drawing a frame (by wire::DrawnAs).
+    std::vector<std::uint64_t> key_frames;
+    std::uint64_t between = 0;
+    std::map<int, metrics::Reservoir> render_us_drawn_as;
     report::ClockReport clock;
     metrics::Reservoir clock_true_error_us;
   };

@@ -119,8 +119,8 @@ void Node::carry_out(Action& action) {
                  },
                  [&](Render& a) {
                    const clock::Nanos started = clock::monotonic_now();
-                   renderer_.render(a.frame);
-                   carry_out(protocol_.rendered(a.frame.frame_id, clock::monotonic_now() - started));
+                   const Rendered how = renderer_.render(a.frame);
+                   carry_out(protocol_.rendered(a.frame.frame_id, clock::monotonic_now() - started, how));
                  },
                  [&](PresentAt& a) { wait_for_present(a.deadline); },
                  [&](Present& a) {

@@ -6,10 +6,11 @@ namespace optique::node {
 
 Result<void> NullRenderer::configure(const protocol::NodeJob&) { return {}; }
 
-void NullRenderer::render(const FrameInput& frame) {
+Rendered NullRenderer::render(const FrameInput& frame) {
   assert(frame.state != nullptr);
   (void)frame;
   ++rendered_;
+  return {};
 }
 
 void NullRenderer::present(int image) {

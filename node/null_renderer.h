@@ -10,7 +10,7 @@ class NullRenderer final : public Renderer {
  public:
   [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
   [[nodiscard]] std::string description() const override { return "null renderer (draws nothing)"; }
-  void render(const FrameInput& frame) override;
+  Rendered render(const FrameInput& frame) override;
   void present(int image) override;
   void show_black() override {}
 

@@ -331,12 +331,48 @@ void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos no
     share_ = std::move(share).value();
     input.lights = &*share_;
   }
+  ahead_.reset();
+  if (begin.has_ahead()) {
+    const std::uint64_t on = begin.ahead_frame() - begin.frame_id();
+    if (begin.ahead_frame() <= begin.frame_id() || on > static_cast<std::uint64_t>(config::kMaxUpRatio)) {
+      out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": the scene sent ahead is for frame " +
+                          std::to_string(begin.ahead_frame()) + ", not 1…" + std::to_string(config::kMaxUpRatio) +
+                          " frames on"});
+      return;
+    }
+    auto ahead = scene::from_snapshot(begin.ahead());
+    if (!ahead) {
+      out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": the scene sent ahead: " + ahead.error()});
+      return;
+    }
+    ahead_ = std::move(ahead).value();
+    input.ahead = &*ahead_;
+    input.ahead_frame = begin.ahead_frame();
+  }
   last_content_frame_ = shown->frame_id();
   rendering_ = input;
   out.push_back(Render{input});
 }
 
-Actions NodeProtocol::rendered(std::uint64_t frame_id, clock::Nanos render_time) {
+namespace {
+
+wire::DrawnAs drawn_as(const Rendered& how) {
+  switch (how.kind) {
+    case up::FrameKind::full:
+      return wire::DRAWN_FULL;
+    case up::FrameKind::key:
+      return wire::DRAWN_KEY;
+    case up::FrameKind::between:
+      return how.key_ahead ? wire::DRAWN_BETWEEN_AND_KEY_AHEAD : wire::DRAWN_BETWEEN;
+    case up::FrameKind::shown:
+      return wire::DRAWN_KEY_SHOWN;
+  }
+  return wire::DRAWN_FULL;
+}
+
+}  // namespace
+
+Actions NodeProtocol::rendered(std::uint64_t frame_id, clock::Nanos render_time, const Rendered& how) {
   Actions out;
   if (!rendering_ || rendering_->frame_id != frame_id) return out;
   rendering_.reset();
@@ -348,6 +384,7 @@ Actions NodeProtocol::rendered(std::uint64_t frame_id, clock::Nanos render_time)
   ready.set_frame_id(frame_id);
   ready.set_render_ns(render_time);
   ready.set_state_hash(last_hash_);
+  ready.set_drawn_as(drawn_as(how));
   out.push_back(Send{std::move(envelope)});
   return out;
 }

@@ -140,7 +140,7 @@ class NodeProtocol {
   [[nodiscard]] Actions message(const wire::Envelope& message, clock::Nanos now);
   [[nodiscard]] Actions closed(const std::string& reason, clock::Nanos now);
   [[nodiscard]] Actions configured(const Result<void>& result, const std::string& renderer_description);
-  [[nodiscard]] Actions rendered(std::uint64_t frame_id, clock::Nanos render_time);
+  [[nodiscard]] Actions rendered(std::uint64_t frame_id, clock::Nanos render_time, const Rendered& how = {});
   [[nodiscard]] Actions ping_due(clock::Nanos now);
   [[nodiscard]] Actions present_due(clock::Nanos now);
   [[nodiscard]] Actions presented(clock::Nanos now);
@@ -192,6 +192,8 @@ class NodeProtocol {
     scene::SceneState state;
   };
   std::deque<PastFrame> past_frames_;
+  // The scene a later frame will show, sent ahead (a node that interpolates).
+  std::optional<scene::SceneState> ahead_;
   std::optional<protocol::LightShare> share_;  // a new share that the frame being rendered starts
   std::optional<FrameInput> rendering_;        // between Render and rendered()
   std::uint64_t last_content_frame_ = 0;

@@ -12,6 +12,7 @@
 #include "protocol/light_share.h"
 #include "protocol/welcome.h"
 #include "scene/state.h"
+#include "up/schedule.h"
 #include "util/result.h"
 
 namespace optique::node {
@@ -25,6 +26,18 @@ struct FrameInput {
   bool capture = false;                          // also write this frame to the capture folder
   std::optional<protocol::Focus> focus;          // the frame's focal depth and gaze (focus/defocus nodes)
   const protocol::LightShare* lights = nullptr;  // a new share of the lights from this frame on, if any
+  // A node that up-converts by interpolation: the scene of a later frame, sent
+  // ahead of its turn (at most config::kMaxUpRatio frames on).
+  const scene::SceneState* ahead = nullptr;
+  std::uint64_t ahead_frame = 0;
+};
+
+// How a frame was drawn: in full, or (a node that up-converts) as a key frame,
+// between key frames (and a later key frame drawn ahead with it), or as a key
+// frame drawn ahead.
+struct Rendered {
+  up::FrameKind kind = up::FrameKind::full;
+  bool key_ahead = false;
 };
 
 class Renderer {
@@ -34,8 +47,9 @@ class Renderer {
   [[nodiscard]] virtual Result<void> configure(const protocol::NodeJob& job) = 0;
   // What draws, for the master's log ("llvmpipe (...), headless").
   [[nodiscard]] virtual std::string description() const = 0;
-  // Draws the frame into the back buffer; returns when it is ready to show.
-  virtual void render(const FrameInput& frame) = 0;
+  // Draws the frame into the back buffer; returns when it is ready to show,
+  // with how it was drawn.
+  virtual Rendered render(const FrameInput& frame) = 0;
   // Shows image `image` of the last rendered frame (swap buffers): 0, or 1 for
   // a projector that shows two images per frame (a stereo one used as mono).
   virtual void present(int image) = 0;

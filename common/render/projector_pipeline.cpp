@@ -244,6 +244,7 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
   up_report_ = {};
   up_report_.kind = plan.kind();
   up_report_.why = plan.why;
+  up_report_.drew_key_ahead = plan.ahead_frame.has_value();
   const auto black = [&](const std::string& why) -> Result<void> {
     renderer_->draw_black();
     return Error{why};
@@ -279,11 +280,18 @@ void ProjectorPipeline::warm_up() {
   const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
   if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
     renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
-    if (schedule_) {  // the motion field, the resolve, the mark and the check
+    if (schedule_) {  // the motion field, each resolve, the mark and the check
       const geometry::Frustum& f = frustum.value();
-      renderer_->keep_key(0, {scene::SceneState{}, 0.0, f.projection * f.view});
+      for (int slot = 0; slot < up::kKeySlots; ++slot) {
+        renderer_->keep_key(slot, {scene::SceneState{}, 0.0, f.projection * f.view});
+      }
       (void)renderer_->check_between(scene::SceneState{}, 0.0, in_front, f, {}, terms_);
-      (void)renderer_->draw_between(scene::SceneState{}, 0.0, in_front, f, {}, terms_);
+      up::BetweenFrame frame;
+      frame.method = schedule_->settings().method;
+      for (bool two : {false, true}) {
+        frame.two_keys = two;
+        (void)renderer_->draw_between(scene::SceneState{}, 0.0, in_front, f, frame, terms_);
+      }
     }
     if (color_fields_.needs_velocity()) {
       // The velocity program and the tile passes too (the field pass itself

@@ -58,8 +58,9 @@ struct UpReport {
   up::BetweenReport between;  // a frame between: what no key frame saw
   // A key frame checked against the frame between it replaces (dB PSNR_Y).
   std::optional<double> checked_psnr;
-  int ratio = 1;         // display frames per key frame from now on
-  std::string_view why;  // why a key frame was drawn now
+  bool drew_key_ahead = false;  // a later key frame was drawn with it (interpolation)
+  int ratio = 1;                // display frames per key frame from now on
+  std::string_view why;         // why a key frame was drawn now
 };
 
 class ProjectorPipeline {

@@ -36,10 +36,15 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   std::unique_ptr<UpConverter> u(new UpConverter());
   u->width_ = width;
   u->height_ = height;
-  auto resolve =
-      glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_resolve_frag));
-  if (!resolve) return Error{"the up-conversion's resolve pass: " + resolve.error()};
-  u->resolve_program_ = std::move(resolve).value();
+  for (int r = 0; r < resolves; ++r) {
+    const std::string head = std::string(kVersion) + "#define AVERAGE " + (r == average ? "1" : "0") +
+                             "\n#define KEYS " + (r == one_key ? "1" : "2") + "\n";
+    auto resolve = glo::link_program(shaders::fullscreen_vert, head + std::string(shaders::between_resolve_frag));
+    if (!resolve) return Error{"the up-conversion's resolve pass: " + resolve.error()};
+    u->resolve_programs_[r] = std::move(resolve).value();
+    const GLuint p = u->resolve_programs_[r].get();
+    u->uniforms_[r] = {glGetUniformLocation(p, "toward_second"), glGetUniformLocation(p, "background")};
+  }
   auto mark =
       glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_mark_frag));
   if (!mark) return Error{"the up-conversion's mark pass: " + mark.error()};
@@ -53,12 +58,13 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
       exact_texture(GL_RGBA32F, (width + kErrorBlock - 1) / kErrorBlock, (height + kErrorBlock - 1) / kErrorBlock);
   u->error_framebuffer_ = glo::make_framebuffer();
   glNamedFramebufferTexture(u->error_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->error_sums_.get(), 0);
-  const GLuint r = u->resolve_program_.get();
-  u->uniforms_ = {glGetUniformLocation(r, "method"), glGetUniformLocation(r, "keys"),
-                  glGetUniformLocation(r, "toward_second"), glGetUniformLocation(r, "background")};
 
   for (int k = 0; k < up::kKeySlots; ++k) {
     u->key_colour_[k] = exact_texture(GL_RGBA32F, width, height);
+    // Bilinear where all four pixels around a point saw its surface (the
+    // resolve's one fetch); texel by texel elsewhere.
+    glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     u->key_depth_[k] = exact_texture(depth_format, width, height);
     // Key-frame pixels in pixels, window depth at float precision: a depth
     // tolerance of a few 1e-6 must be representable.
@@ -139,12 +145,10 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   glBindVertexArray(empty_vertex_array_.get());
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
   glViewport(0, 0, width_, height_);
-  const GLuint r = resolve_program_.get();
-  glUseProgram(r);
-  glUniform1i(uniforms_.method, frame.method == up::BetweenMethod::average ? 1 : 0);
-  glUniform1i(uniforms_.keys, frame.two_keys ? 2 : 1);
-  glUniform1f(uniforms_.toward_second, static_cast<float>(frame.toward_second));
-  glUniform3f(uniforms_.background, background.r, background.g, background.b);
+  const Resolve r = frame.method == up::BetweenMethod::average ? average : frame.two_keys ? two_keys : one_key;
+  glUseProgram(resolve_programs_[r].get());
+  glUniform1f(uniforms_[r].toward_second, static_cast<float>(frame.toward_second));
+  glUniform3f(uniforms_[r].background, background.r, background.g, background.b);
   assert(frame.first == 0 || frame.first == 1);
   for (int k = 0; k < up::kKeySlots; ++k) {  // the first key frame as key 0
     const int slot = k == 0 ? frame.first : 1 - frame.first;

@@ -66,16 +66,19 @@ class UpConverter {
   glo::Texture output_;
   glo::Framebuffer output_framebuffer_;
   glo::Framebuffer mark_framebuffer_;  // the stencil alone: the mark pass reads output()
-  glo::Program resolve_program_;
+  // The resolve for each way: average, motion from one key frame, from two.
+  enum Resolve { average, one_key, two_keys, resolves };
+  std::array<glo::Program, resolves> resolve_programs_;
+  struct ResolveUniforms {
+    GLint toward_second, background;
+  };
+  std::array<ResolveUniforms, resolves> uniforms_{};
   glo::Program mark_program_;
   glo::Program error_program_;
   glo::Texture error_sums_;  // one texel per kErrorBlock² pixels
   glo::Framebuffer error_framebuffer_;
   glo::VertexArray empty_vertex_array_;
   GLuint query_ = 0;
-  struct {
-    GLint method, keys, toward_second, background;
-  } uniforms_{};
 };
 
 }  // namespace optique::render

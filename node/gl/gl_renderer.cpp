@@ -75,7 +75,7 @@ std::string GlRenderer::description() const {
   return context_->renderer_name() + (context_->has_window() ? ", window" : ", headless");
 }
 
-void GlRenderer::render(const FrameInput& frame) {
+Rendered GlRenderer::render(const FrameInput& frame) {
   read_back_shown_.reset();  // a captured frame that was never presented (stale) has no read-back
   // A new share comes once, with the frame it starts at: taken even when this
   // frame shows nothing, so it is not lost.
@@ -89,7 +89,13 @@ void GlRenderer::render(const FrameInput& frame) {
                       deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
                       deep_signal_ ? renderer.read_signal() : image::WordImage{});
   };
-  if (auto drawn = pipeline_->draw_frame(*frame.state, capture); !drawn) {
+  if (frame.ahead != nullptr) ahead_[frame.ahead_frame] = *frame.ahead;
+  while (!ahead_.empty() && ahead_.begin()->first < frame.frame_id) ahead_.erase(ahead_.begin());
+  const render::DisplayFrame display{frame.frame_id, [this](std::uint64_t f) -> const scene::SceneState* {
+                                       const auto found = ahead_.find(f);
+                                       return found == ahead_.end() ? nullptr : &found->second;
+                                     }};
+  if (auto drawn = pipeline_->draw_frame(*frame.state, capture, &display); !drawn) {
     // The eye left the space in front of this screen: the projector shows black
     // rather than a wrong picture (from the image where it left on).
     log_.debug("frame {}: {}", frame.frame_id, drawn.error());
@@ -109,6 +115,19 @@ void GlRenderer::render(const FrameInput& frame) {
     }
   }
   if (frame.capture && context_->has_window()) read_back_shown_ = frame.frame_id;
+  const render::UpReport& up = pipeline_->up_report();
+  if (up.kind == up::FrameKind::full) return {};
+  if (up.kind == up::FrameKind::key && up.why != "ratio" && up.why != "first frame") {
+    log_.debug("frame {}: a key frame now ({})", frame.frame_id, up.why);
+  }
+  if (up.ratio != logged_ratio_) {
+    if (logged_ratio_ != 0) {
+      log_.info("frame {}: a key frame every {} frames from now (the frames between checked at {:.1f} dB PSNR_Y)",
+                frame.frame_id, up.ratio, up.checked_psnr.value_or(0.0));
+    }
+    logged_ratio_ = up.ratio;
+  }
+  return {up.kind, up.kind == up::FrameKind::between && up.drew_key_ahead};
 }
 
 void GlRenderer::present(int image) {

@@ -3,6 +3,8 @@
 // projector's output says), the projector's pipeline (render/projector_pipeline.h),
 // shown on present(), and captured on request.
 
+#include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,7 +27,7 @@ class GlRenderer final : public Renderer {
 
   [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
   [[nodiscard]] std::string description() const override;
-  void render(const FrameInput& frame) override;
+  Rendered render(const FrameInput& frame) override;
   void present(int image) override;
   void show_black() override;
 
@@ -39,6 +41,10 @@ class GlRenderer final : public Renderer {
   bool warned_gather_radius_ = false;
   bool gathers_ = false;      // method gather (else the clamp can only be per-field's blur)
   bool deep_signal_ = false;  // the projector takes more than 8 bits: captures are 16-bit PNGs
+  // Up-conversion: the scenes the master sent ahead, by frame, until their
+  // frame has passed; the ratio last logged.
+  std::map<std::uint64_t, scene::SceneState> ahead_;
+  int logged_ratio_ = 0;
   // A captured frame on a window: what the window shows is read back when it is presented.
   std::optional<std::uint64_t> read_back_shown_;
 };

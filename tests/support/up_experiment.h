@@ -58,12 +58,13 @@ struct FrameResult {
 
 struct SceneResult {
   std::vector<FrameResult> frames;
-  double mean_between_psnr = 0.0;  // over the frames built between key frames
-  double block_share[4] = {};      // their 4×4 block classes, averaged
-  std::size_t hardest = 0;         // the index of the worst frame between
-  double full_ms = 0.0;            // the median full render of the same frames
-  double key_ms = 0.0;             // medians per kind (0 where none)
-  double between_ms = 0.0;
+  double mean_between_psnr = 0.0;     // over the frames built between key frames
+  double block_share[4] = {};         // their 4×4 block classes, averaged
+  std::size_t hardest = 0;            // the index of the worst frame between
+  double full_ms = 0.0;               // the median full render of the same frames
+  double key_ms = 0.0;                // medians per kind (0 where none)
+  double between_ms = 0.0;            // a frame between alone
+  double between_and_ahead_ms = 0.0;  // one that also drew the next key frame ahead
   double per_display_frame_ms = 0.0;  // the mean over all display frames
   image::FloatImage hardest_image;    // the hardest frame, its full render and their difference
   image::FloatImage hardest_reference;

@@ -3,6 +3,7 @@
 // as events in and actions out.
 
 #include "master/protocol.h"
+#include "master/scene_authority.h"
 
 #include <gtest/gtest.h>
 
@@ -236,6 +237,49 @@ TEST_F(MasterTest, FramesStartWhenAllAreUpAndSwapWhenAllAreReady) {
   }
   ASSERT_NE(armed(a, Timer::next_frame), nullptr);
   EXPECT_EQ(*armed(a, Timer::next_frame), now_ - 3 * kMs + 16'666'666) << "on schedule from the first frame";
+}
+
+// A node that interpolates gets, with each frame, the scene ratio − 1 frames
+// on (the scene is a function of time); the others get the frame alone. What
+// the nodes say of how they drew each frame ends in the run report.
+TEST_F(MasterTest, ANodeThatInterpolatesGetsTheSceneAheadAndItsKeyFramesAreReported) {
+  load("powerwall-2x2.json", [](config::Installation& inst) {
+    inst.projectors[1].up_conversion = {4, config::UpMethod::motion, config::UpMode::interpolate};
+    inst.projectors[2].up_conversion = {3, config::UpMethod::motion, config::UpMode::extrapolate};
+  });
+  Actions a = join_all();
+  ASSERT_TRUE(master_->running());
+  const auto begin_of = [&](PeerId p) { return sent_to(a, p, wire::Envelope::kFrameBegin).front().frame_begin(); };
+  EXPECT_FALSE(begin_of(1).has_ahead());
+  EXPECT_FALSE(begin_of(3).has_ahead()) << "extrapolation needs nothing ahead";
+  ASSERT_TRUE(begin_of(2).has_ahead());
+  EXPECT_EQ(begin_of(2).ahead_frame(), 3u);
+  auto ahead = scene::from_snapshot(begin_of(2).ahead());
+  ASSERT_TRUE(ahead) << ahead.error();
+  const master::SceneAuthority authority(run_.scene.definition.objects, run_.config.installation.viewer,
+                                         run_.config.installation.master.frame_rate);
+  EXPECT_EQ(ahead.value(), authority.state_at_frame(3));
+
+  const std::uint64_t hash = hash_of(a, 1);
+  const auto drawn = [&](PeerId p, wire::DrawnAs as) {
+    wire::Envelope e = envelope();
+    e.mutable_frame_ready()->set_frame_id(0);
+    e.mutable_frame_ready()->set_state_hash(hash);
+    e.mutable_frame_ready()->set_render_ns(2 * kMs);
+    e.mutable_frame_ready()->set_drawn_as(as);
+    return master_->message(p, e, now_);
+  };
+  (void)drawn(1, wire::DRAWN_FULL);
+  (void)drawn(2, wire::DRAWN_KEY);
+  (void)drawn(3, wire::DRAWN_KEY);
+  (void)drawn(4, wire::DRAWN_FULL);
+  recorder_->finalize_all();
+  const report::RunReport report = recorder_->report();
+  EXPECT_FALSE(report.nodes(0).has_up_conversion());
+  ASSERT_TRUE(report.nodes(1).has_up_conversion());
+  ASSERT_EQ(report.nodes(1).up_conversion().key_frames_size(), 1);
+  EXPECT_EQ(report.nodes(1).up_conversion().key_frames(0), 0u);
+  EXPECT_EQ(report.nodes(1).up_conversion().key_render_us().count(), 1u);
 }
 
 TEST_F(MasterTest, AStragglerIsLeftOutAndComesBack) {

@@ -449,6 +449,52 @@ TEST_F(NodeTest, BadFrameInputClosesTheConnection) {
   EXPECT_NE(first<Close>(a)->reason.find("focus depth"), std::string::npos);
 }
 
+// A node that interpolates gets a later frame's scene with a frame: checked and
+// handed to the renderer beside the frame's own; how the frame was drawn goes
+// back in FrameReady. A scene for a frame not ahead, or beyond the largest
+// ratio, or not a valid snapshot, closes the connection by name.
+TEST_F(NodeTest, TheSceneSentAheadReachesTheRendererAndHowTheFrameWasDrawnGoesBack) {
+  NodeProtocol node(settings());
+  join(node);
+  scene::SceneState later = state_;
+  later.eye_now.x += 0.25;
+  wire::Envelope e = envelope();
+  auto& b = *e.mutable_frame_begin();
+  b.set_frame_id(0);
+  b.set_state_hash(scene::state_hash(state_));
+  *b.mutable_ahead() = scene::to_snapshot(later);
+  b.set_ahead_frame(3);
+  Actions a = node.message(e, now_);
+  const Render* render = first<Render>(a);
+  ASSERT_NE(render, nullptr);
+  ASSERT_NE(render->frame.ahead, nullptr);
+  EXPECT_EQ(*render->frame.ahead, later);
+  EXPECT_EQ(render->frame.ahead_frame, 3u);
+  a = node.rendered(0, kMs, {up::FrameKind::between, true});
+  const auto ready = sent(a, wire::Envelope::kFrameReady);
+  ASSERT_EQ(ready.size(), 1u);
+  EXPECT_EQ(ready.front().frame_ready().drawn_as(), wire::DRAWN_BETWEEN_AND_KEY_AHEAD);
+
+  const auto refused = [&](std::uint64_t frame, std::uint64_t ahead, double x, const std::string& says) {
+    NodeProtocol other(settings());
+    join(other);
+    wire::Envelope bad = envelope();
+    auto& begin = *bad.mutable_frame_begin();
+    begin.set_frame_id(frame);
+    scene::SceneState odd = state_;
+    odd.eye_now.x = x;
+    *begin.mutable_ahead() = scene::to_snapshot(odd);
+    begin.set_ahead_frame(ahead);
+    Actions closed = other.message(bad, now_);
+    ASSERT_NE(first<Close>(closed), nullptr) << says;
+    EXPECT_NE(first<Close>(closed)->reason.find(says), std::string::npos) << first<Close>(closed)->reason;
+    EXPECT_EQ(first<Render>(closed), nullptr);
+  };
+  refused(0, 0, 0.0, "the scene sent ahead is for frame 0, not 1…16 frames on");
+  refused(0, 17, 0.0, "not 1…16 frames on");
+  refused(0, 2, std::numeric_limits<double>::quiet_NaN(), "the scene sent ahead:");
+}
+
 // --give-up-after-ms 10000 once gave up after 11.1 s: the backoff ran past it.
 TEST_F(NodeTest, GivingUpKeepsToTheLimitWhateverTheBackoff) {
   for (const long limit : {10000L, 150L, 2500L, 7777L}) {
