@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <string>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -41,7 +42,7 @@ struct SceneUniforms {
   GLint model_view_projection, model, normal_matrix, eye, base_colour, has_base_colour_texture, metallic, roughness,
       emissive, ambient, light_count;
   GLint model_view_projection_now, model_view_projection_next, half_size;  // velocity only
-  GLint size;                                                              // motion field only
+  GLint size, normal_matrix_now, normal_matrix_next, most_turn_cosine;     // motion field only
 };
 
 // What a scene program writes besides the geometry: shaded colour; or that
@@ -73,7 +74,10 @@ Result<glo::Program> scene_program(SceneOutput output, SceneUniforms& uniforms) 
               at("model_view_projection_0"),
               at("model_view_projection_1"),
               at("half_size"),
-              at("size")};
+              at("size"),
+              at("normal_matrix_0"),
+              at("normal_matrix_1"),
+              at("most_turn_cosine")};
   return program;
 }
 
@@ -647,7 +651,10 @@ void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, 
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, gl.light_buffer.get());
   const SceneUniforms& u = key_frames ? gl.key_frames_uniforms : motion ? gl.velocity_uniforms : gl.uniforms;
   if (motion) glUniform2f(u.half_size, 0.5f * static_cast<float>(gl.width), 0.5f * static_cast<float>(gl.height));
-  if (key_frames) glUniform2f(u.size, static_cast<float>(gl.width), static_cast<float>(gl.height));
+  if (key_frames) {
+    glUniform2f(u.size, static_cast<float>(gl.width), static_cast<float>(gl.height));
+    glUniform1f(u.most_turn_cosine, static_cast<float>(std::cos(up::kMostTurn)));
+  }
   glUniform3f(u.eye, static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z));
   const glm::vec3 ambient = terms.ambient ? gl.ambient : glm::vec3(0.0f);
   glUniform3fv(u.ambient, 1, glm::value_ptr(ambient));
@@ -671,18 +678,22 @@ void SceneRenderer::draw_scene(const scene::SceneState& state, double fraction, 
       // Where this instance is at the motion's two ends; an object not in the
       // scene then projects to w = 0: no place.
       const GLint locations[2] = {u.model_view_projection_now, u.model_view_projection_next};
+      const GLint normal_locations[2] = {u.normal_matrix_now, u.normal_matrix_next};
       for (int e = 0; e < 2; ++e) {
         const MotionEnd& end = motion->ends[e];
-        glm::dmat4 clip = end.view_projection * instance.transform;
+        glm::dmat4 then = instance.transform;
+        bool there = true;
         if (instance.object) {
-          const auto there = end.state->objects.find(*instance.object);
-          clip = there == end.state->objects.end()
-                     ? glm::dmat4(0.0)
-                     : end.view_projection * scene::model_matrix(scene::interpolate(there->second, end.fraction)) *
-                           instance.transform;
+          const auto found = end.state->objects.find(*instance.object);
+          there = found != end.state->objects.end();
+          if (there) then = scene::model_matrix(scene::interpolate(found->second, end.fraction)) * instance.transform;
         }
-        const glm::mat4 clip_f(clip);
-        glUniformMatrix4fv(locations[e], 1, GL_FALSE, glm::value_ptr(clip_f));
+        const glm::mat4 clip(there ? end.view_projection * then : glm::dmat4(0.0));
+        glUniformMatrix4fv(locations[e], 1, GL_FALSE, glm::value_ptr(clip));
+        if (key_frames) {
+          const glm::mat3 normals(glm::transpose(glm::inverse(glm::dmat3(then))));
+          glUniformMatrix3fv(normal_locations[e], 1, GL_FALSE, glm::value_ptr(normals));
+        }
       }
     }
     glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(model_f));

@@ -28,6 +28,11 @@ using BetweenMethod = config::UpMethod;
 
 inline constexpr int kKeySlots = 2;
 
+// A surface turned further than this (radians) since a key frame faces the
+// lights and the eye otherwise than the key frame shaded it: its pixels there
+// are not taken; where no key frame has it turned less, it is shaded anew.
+inline constexpr double kMostTurn = 0.35;  // 20°
+
 struct BetweenFrame {
   BetweenMethod method = BetweenMethod::motion;
   // Key slot `first` alone (extrapolation from the past), or it and the other

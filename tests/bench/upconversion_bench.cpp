@@ -7,7 +7,9 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -43,6 +45,10 @@ int main(int argc, char** argv) {
   app.add_option("--probe", probe, "only print each scene's baseline and motion PSNR_Y at these display rates");
   app.add_option("--frames", frames, "display frames per run");
   app.add_option("--scene", only, "only these scenes");
+  bool find_rates = false;
+  app.add_flag("--find-rates", find_rates,
+               "choose each scene's framing: the screen width and display rate whose average baseline lands "
+               "nearest the paper's");
   std::string timing;
   app.add_option("--timing", timing, "only time this built-in scene at 640×360, 4:1 interpolated");
   CLI11_PARSE(app, argc, argv);
@@ -71,10 +77,41 @@ int main(int argc, char** argv) {
     }
     return 0;
   }
+  if (find_rates) {
+    for (StageScene scene : paper_scenes()) {
+      if (!only.empty() && std::find(only.begin(), only.end(), scene.name) == only.end()) continue;
+      double best_gap = 1e9;
+      StageScene best = scene;
+      double best_db = 0.0;
+      for (double screen_width : {0.15, 0.25, 0.4, 0.6, 1.0, 1.6, 2.4, 3.2}) {
+        for (double rate : {12.0, 15.0, 20.0, 24.0, 30.0, 40.0, 50.0, 60.0, 90.0, 120.0}) {
+          scene.screen_width = screen_width;
+          scene.frame_rate = rate;
+          auto result =
+              measure(scene, {config::UpMethod::average, config::UpMode::interpolate, 4, 0.0}, frames, width, height);
+          if (!result) {
+            std::cerr << scene.name << ": " << result.error() << "\n";
+            return 1;
+          }
+          const double gap = std::abs(result.value().mean_between_psnr - scene.paper_average);
+          if (gap < best_gap) {
+            best_gap = gap;
+            best = scene;
+            best_db = result.value().mean_between_psnr;
+          }
+        }
+      }
+      std::printf("%-24s screen %.1f m, %5.1f Hz: average %.2f dB (paper %.2f)\n", best.name.c_str(), best.screen_width,
+                  best.frame_rate, best_db, best.paper_average);
+      std::fflush(stdout);
+    }
+    return 0;
+  }
   for (StageScene scene : paper_scenes()) {
     if (!only.empty() && std::find(only.begin(), only.end(), scene.name) == only.end()) continue;
+    if (probe.empty()) probe.push_back(0.0);
     for (double rate : probe) {
-      scene.frame_rate = rate;
+      if (rate > 0.0) scene.frame_rate = rate;
       if (screen > 0.0) scene.screen_width = screen;
       std::printf("%-24s %5.1f Hz (paper average %.2f, motion %.2f):", scene.name.c_str(), rate, scene.paper_average,
                   scene.paper_motion);
@@ -95,6 +132,13 @@ int main(int argc, char** argv) {
           (void)image::write_png(stem + "-full.png", image::encode_srgb(r.hardest_reference));
           (void)image::write_png(stem + "-difference.png",
                                  image::encode_srgb(image::difference(r.hardest_image, r.hardest_reference, 4.0f)));
+        }
+        if (std::getenv("OPTIQUE_UP_FRAMES")) {
+          for (const FrameResult& f : result.value().frames) {
+            std::printf("\n    frame %llu %s %.2f dB unseen %.4f", static_cast<unsigned long long>(f.frame),
+                        std::string(up::to_string(f.kind)).c_str(), f.psnr_y, f.unseen_share);
+          }
+          std::printf("\n");
         }
         std::printf("  %s/%s %.2f dB (key %.1f ms, between %.1f ms, full %.1f ms)",
                     std::string(config::to_string(run.method)).c_str(),

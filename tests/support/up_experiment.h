@@ -3,8 +3,9 @@
 // a scene of the up-conversion paper's set on a stage, seen through one
 // projector, drawn by the pipeline a node builds (ProjectorPipeline with the
 // projector's up_conversion) frame after frame as a node draws them, each
-// display frame compared with the full render of the same moment: PSNR_Y (the
-// paper's), its 4×4 block classes, and what each kind of frame cost. Shared by
+// display frame compared with the full render of the same moment as displayed
+// (the projector's 8-bit sRGB signal, as the paper compared frame buffers):
+// PSNR_Y (the paper's), its 4×4 block classes, and what each kind of frame cost. Shared by
 // the benchmark (optique-bench-upconversion) and the gpu test.
 
 #include <cstdint>

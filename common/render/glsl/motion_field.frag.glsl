@@ -7,14 +7,21 @@
 // and VELOCITY (for clip_0 and clip_1 from scene.vert.glsl) first.
 in vec4 clip_0;
 in vec4 clip_1;
+in vec3 world_normal;  // now
+in vec3 normal_0;      // in each key frame
+in vec3 normal_1;
 uniform vec2 size;  // the image's pixels
+// A surface turned further than this since a key frame (cosine of the angle
+// between its normals) is shaded there for another orientation to the lights
+// and the eye: its pixels there are not taken, it is shaded anew.
+uniform float most_turn_cosine;
 // x, y: pixels; z: window depth; w: the depth tolerance, or −1 where the key
 // frame has no place for the point (it was behind its eye, or its object was
-// not in the scene then). A pixel no surface covers keeps the clear's −2.
+// not in the scene then) or shows it turned too far. A pixel no surface covers keeps the clear's −2.
 layout(location = 0) out vec4 key_0;
 layout(location = 1) out vec4 key_1;
 
-vec4 seen_at(vec4 clip) {
+vec4 seen_at(vec4 clip, vec3 normal_then) {
   // Derivatives first, outside any branch: each is taken over the pixel quad.
   float w = max(clip.w, 1e-6);
   vec3 ndc = clip.xyz / w;
@@ -24,6 +31,7 @@ vec4 seen_at(vec4 clip) {
   vec2 pixel_y = dFdy(pixel);
   vec2 depth_xy = vec2(dFdx(depth), dFdy(depth));
   if (clip.w <= 1e-6) return vec4(0.0, 0.0, 0.0, -1.0);
+  if (dot(normalize(world_normal), normalize(normal_then)) < most_turn_cosine) return vec4(0.0, 0.0, 0.0, -1.0);
   // Depth per key-frame pixel: its change per pixel here through the inverse of
   // how far the key-frame position moves per pixel here.
   mat2 key_per_pixel = mat2(pixel_x, pixel_y);
@@ -35,6 +43,6 @@ vec4 seen_at(vec4 clip) {
 }
 
 void main() {
-  key_0 = seen_at(clip_0);
-  key_1 = seen_at(clip_1);
+  key_0 = seen_at(clip_0, normal_0);
+  key_1 = seen_at(clip_1, normal_1);
 }

@@ -20,6 +20,11 @@ uniform mat4 model_view_projection_0;
 uniform mat4 model_view_projection_1;
 out vec4 clip_0;
 out vec4 clip_1;
+// And its normal then (world space; the motion field's, up_converter.h).
+uniform mat3 normal_matrix_0;
+uniform mat3 normal_matrix_1;
+out vec3 normal_0;
+out vec3 normal_1;
 #endif
 void main() {
   world_position = (model * vec4(position, 1.0)).xyz;
@@ -29,5 +34,7 @@ void main() {
 #ifdef VELOCITY
   clip_0 = model_view_projection_0 * vec4(position, 1.0);
   clip_1 = model_view_projection_1 * vec4(position, 1.0);
+  normal_0 = normal_matrix_0 * normal;
+  normal_1 = normal_matrix_1 * normal;
 #endif
 }
