@@ -34,6 +34,11 @@ struct StageScene {
   double start = 0.0;          // seconds: where the sequence starts
   double paper_average = 0.0;  // dB PSNR_Y: the paper's temporal average for it
   double paper_motion = 0.0;   // and its motion-compensated result (0: not in the paper)
+  // Config JSON in place of the defaults, for the hard cases: the viewer
+  // (default: an eye 2 m before the screen's centre), and more of the scene
+  // (e.g. `"light_switches": […]`, after the scene's name).
+  std::string viewer_json;
+  std::string scene_json;
 };
 
 // The paper's set: the built-in cubes, pyramids, wheels and falling ring, and
@@ -60,6 +65,7 @@ struct FrameResult {
 struct SceneResult {
   std::vector<FrameResult> frames;
   double mean_between_psnr = 0.0;     // over the frames built between key frames
+  double mean_shaded_anew = 0.0;      // the share of their pixels shaded anew, averaged
   double block_share[4] = {};         // their 4×4 block classes, averaged
   std::size_t hardest = 0;            // the index of the worst frame between
   double full_ms = 0.0;               // the median full render of the same frames

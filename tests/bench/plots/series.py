@@ -5,7 +5,7 @@ error. Writes gnuplot data: one block per series group, blocks apart by two blan
 lines (gnuplot's `index`), one number per column, NaN where there is none.
 
 usage: series.py NAME CSV OUT.dat   (NAME: barrier, calibration, dof, fields,
-                                     lighting, oblique, oblique-depth)
+                                     lighting, oblique, oblique-depth, upconversion)
 
 The drawing is tests/bench/plots/NAME.gp; scripts/plot-bench.sh runs both."""
 
@@ -234,8 +234,35 @@ def fields(rows):
     return blocks
 
 
+def upconversion(rows):
+    """One block per way in the bench's order (average at 4:1, then motion
+    interpolated and extrapolated at each ratio), one line per scene in order:
+    scene index, cost per display frame ÷ every frame drawn (median, min, max
+    over runs), PSNR_Y of the frames between (the first run; it does not vary)."""
+    ways, scenes = [], []
+    for r in rows:
+        way = (r["method"], r["mode"], r["ratio"])
+        if way not in ways:
+            ways.append(way)
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
+    blocks = []
+    for way in ways:
+        block = []
+        for i, scene in enumerate(scenes):
+            mine = [r for r in rows if r["scene"] == scene and (r["method"], r["mode"], r["ratio"]) == way]
+            if not mine:
+                continue
+            psnr = float(mine[0]["psnr_y_db"])
+            block.append([i, *spread([float(r["cost_ratio"]) for r in mine]), min(psnr, 100.0)])
+        if not block:
+            fail(f"upconversion: no rows for {way}")
+        blocks.append(block)
+    return blocks
+
+
 SERIES = {"barrier": barrier, "calibration": calibration, "dof": dof, "fields": fields, "lighting": lighting,
-          "oblique": oblique, "oblique-depth": oblique_depth}
+          "oblique": oblique, "oblique-depth": oblique_depth, "upconversion": upconversion}
 
 
 def main():
