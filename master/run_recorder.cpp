@@ -39,10 +39,12 @@ void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos rece
   t.rendered += 1;
   const double us = static_cast<double>(render_time) / 1e3;
   t.render_us.add(us);
-  if (drawn_as == wire::DRAWN_FULL) return;
+  // A value this master does not know (a newer node) counts as a full frame.
+  if (drawn_as == wire::DRAWN_FULL || !wire::DrawnAs_IsValid(drawn_as)) return;
   t.render_us_drawn_as[drawn_as].add(us);
   if (drawn_as == wire::DRAWN_KEY || drawn_as == wire::DRAWN_KEY_SHOWN) {
-    t.key_frames.push_back(frame);
+    t.key_frames_total += 1;
+    if (t.key_frames.size() < kMostKeyFramesListed) t.key_frames.push_back(frame);
   } else {
     t.between += 1;
   }
@@ -146,6 +148,7 @@ report::RunReport RunRecorder::report() const {
     if (!t.render_us_drawn_as.empty()) {
       report::UpConversionReport& up = *node.mutable_up_conversion();
       for (std::uint64_t key : t.key_frames) up.add_key_frames(key);
+      up.set_key_frames_total(t.key_frames_total);
       up.set_frames_between(t.between);
       const auto summary = [&](wire::DrawnAs drawn_as, report::Distribution* into) {
         const auto found = t.render_us_drawn_as.find(drawn_as);

@@ -44,8 +44,7 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
     // Refused, not ignored: a node that rendered every field anyway would hide
     // the cost the operator asked to save.
     return Error{"projector '" + self.id +
-                 "': up_conversion with color_fields is not drawn yet; use the colour fields' gather method, or "
-                 "up-convert a projector without colour fields"};
+                 "': up_conversion with color_fields is not drawn yet; remove one of the two for this projector"};
   }
   auto view = ProjectorView::make(job.screen(), self.geometry(), self.rendering, options.two_pass_pixels_per_metre);
   if (!view) return Error{"projector '" + self.id + "': " + view.error()};
@@ -79,6 +78,9 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
 void ProjectorPipeline::set_share(const protocol::LightShare& share) {
   renderer_->set_lights(share.lights);
   terms_ = {share.ambient, share.ambient};
+  // Kept key frames show the old share: the next frame is a key frame, so the
+  // group's light changes on every node at once.
+  if (schedule_) schedule_->forget();
 }
 
 void ProjectorPipeline::set_focus(const protocol::Focus& focus) {
@@ -240,19 +242,28 @@ Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state, in
 }
 
 Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state, const DisplayFrame& display) {
-  const up::UpPlan plan = schedule_->plan(display.number, state, display.ahead);
+  up::UpPlan plan = schedule_->plan(display.number, state, display.ahead);
   up_report_ = {};
-  up_report_.kind = plan.kind();
-  up_report_.why = plan.why;
-  up_report_.drew_key_ahead = plan.ahead_frame.has_value();
+  up_report_.ratio = schedule_->ratio();
   const auto black = [&](const std::string& why) -> Result<void> {
+    // Nothing kept shows what the next frames need: they start over.
+    schedule_->forget();
+    up_report_ = {up::FrameKind::key, {}, std::nullopt, false, schedule_->ratio(), "not in front of the screen"};
     renderer_->draw_black();
     return Error{why};
   };
+  if (plan.draw_key && plan.ahead_frame && !moment(*plan.key_state, 0.0)) {
+    // The key frame ahead cannot be seen (the eye will have left the space in
+    // front of this screen): this frame is drawn on its own, and so on.
+    schedule_->forget();
+    plan = schedule_->plan(display.number, state, display.ahead);
+  }
+  up_report_.kind = plan.kind();
+  up_report_.why = plan.why;
+  up_report_.drew_key_ahead = plan.ahead_frame.has_value();
   if (plan.draw_key) {
     // This frame's state, or the one the master sent ahead for a later frame.
-    const scene::SceneState* key = plan.ahead_frame ? display.ahead(*plan.ahead_frame) : &state;
-    assert(key != nullptr);  // the schedule plans only what was sent
+    const scene::SceneState* key = plan.key_state;
     const auto seen = moment(*key, 0.0);
     if (!seen) return black(seen.error());
     renderer_->draw(*key, 0.0, seen.value().eye, seen.value().frustum, terms_);

@@ -1,5 +1,6 @@
 #include "render/up_converter.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <limits>
@@ -37,8 +38,10 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   u->width_ = width;
   u->height_ = height;
   for (int r = 0; r < resolves; ++r) {
-    const std::string head = std::string(kVersion) + "#define AVERAGE " + (r == average ? "1" : "0") +
-                             "\n#define KEYS " + (r == one_key ? "1" : "2") + "\n";
+    const bool averages = r == average || r == average_one_key;
+    const bool one = r == one_key || r == average_one_key;
+    const std::string head = std::string(kVersion) + "#define AVERAGE " + (averages ? "1" : "0") + "\n#define KEYS " +
+                             (one ? "1" : "2") + "\n";
     auto resolve = glo::link_program(shaders::fullscreen_vert, head + std::string(shaders::between_resolve_frag));
     if (!resolve) return Error{"the up-conversion's resolve pass: " + resolve.error()};
     u->resolve_programs_[r] = std::move(resolve).value();
@@ -145,7 +148,8 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   glBindVertexArray(empty_vertex_array_.get());
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
   glViewport(0, 0, width_, height_);
-  const Resolve r = frame.method == up::BetweenMethod::average ? average : frame.two_keys ? two_keys : one_key;
+  const bool averages = frame.method == up::BetweenMethod::average;
+  const Resolve r = averages ? (frame.two_keys ? average : average_one_key) : frame.two_keys ? two_keys : one_key;
   glUseProgram(resolve_programs_[r].get());
   glUniform1f(uniforms_[r].toward_second, static_cast<float>(frame.toward_second));
   glUniform3f(uniforms_[r].background, background.r, background.g, background.b);
@@ -198,12 +202,17 @@ double UpConverter::psnr_y_against(GLuint image) {
   }
   const double pixels = static_cast<double>(width_) * static_cast<double>(height_);
   const double weights[3] = {0.299, 0.587, 0.114};
+  // A channel identical everywhere (a share without blue) counts as 100 dB,
+  // as a 4×4 block's does (image/compare.h): the others still weigh.
+  constexpr double kIdentical = 100.0;
   double psnr = 0.0;
+  bool all_identical = true;
   for (int c = 0; c < 3; ++c) {
-    if (squared[c] <= 0.0) return std::numeric_limits<double>::infinity();
-    psnr += weights[c] * 10.0 * std::log10(pixels / squared[c]);
+    all_identical = all_identical && squared[c] <= 0.0;
+    psnr +=
+        weights[c] * (squared[c] <= 0.0 ? kIdentical : std::min(kIdentical, 10.0 * std::log10(pixels / squared[c])));
   }
-  return psnr;
+  return all_identical ? std::numeric_limits<double>::infinity() : psnr;
 }
 
 void UpConverter::begin_shade_unseen() {

@@ -45,8 +45,9 @@ class UpConverter {
   void begin_shade_unseen();
   void end_shade_unseen();  // back to the GL state everything else expects
 
-  // PSNR_Y (the up-conversion paper's weighting of each channel's PSNR, peak
-  // 1) of output() against `image` (this size, RGBA32F); +infinity when equal.
+  // PSNR_Y (the up-conversion paper's weighting of each channel's PSNR) of
+  // output() against `image` (this size, RGBA32F, linear), both as displayed
+  // (sRGB, 8-bit range); +infinity when equal, a channel equal alone 100 dB.
   [[nodiscard]] double psnr_y_against(GLuint image);
 
   [[nodiscard]] GLuint output() const { return output_.get(); }
@@ -66,8 +67,9 @@ class UpConverter {
   glo::Texture output_;
   glo::Framebuffer output_framebuffer_;
   glo::Framebuffer mark_framebuffer_;  // the stencil alone: the mark pass reads output()
-  // The resolve for each way: average, motion from one key frame, from two.
-  enum Resolve { average, one_key, two_keys, resolves };
+  // The resolve for each way: the average of two key frames (or one key frame
+  // as it is, across a cut), motion from one key frame, from two.
+  enum Resolve { average, average_one_key, one_key, two_keys, resolves };
   std::array<glo::Program, resolves> resolve_programs_;
   struct ResolveUniforms {
     GLint toward_second, background;

@@ -34,6 +34,11 @@ bool same_side(const scene::SceneState& key, const scene::SceneState& state, std
 
 UpSchedule::UpSchedule(const config::UpConversion& settings) : settings_(settings), ratio_(settings.ratio) {}
 
+void UpSchedule::forget() {
+  first_.reset();
+  second_.reset();
+}
+
 void UpSchedule::checked(double psnr_y) {
   if (!settings_.adaptive()) return;
   if (psnr_y < settings_.min_psnr) {
@@ -50,15 +55,22 @@ UpPlan UpSchedule::key_now(std::uint64_t frame, const scene::SceneState& state, 
   // A key drawn ahead for a later frame stays; this one takes the other slot.
   if (second_ && second_->frame <= frame) second_.reset();
   plan.key_slot = second_ ? 1 - second_->slot : 0;
-  if (settings_.adaptive() && first_ && first_->frame < frame && same_side(first_->state, state)) {
+  // Checked only a whole interval on: frames skipped or a cut say nothing of
+  // how well the frames between follow the scene.
+  if (settings_.adaptive() && first_ && first_->frame + static_cast<std::uint64_t>(ratio_) == frame &&
+      same_side(first_->state, state)) {
     plan.check_slot = first_->slot;
   }
   first_ = Key{frame, plan.key_slot, state};
+  plan.key_state = &first_->state;
   return plan;
 }
 
 UpPlan UpSchedule::plan(std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead) {
-  if (!first_ || frame <= first_->frame) return key_now(frame, state, "first frame");
+  if (!first_ || frame <= first_->frame) {
+    second_.reset();  // frames that go back start over: a key drawn ahead belongs to another run
+    return key_now(frame, state, "first frame");
+  }
   std::string_view why;
   if (settings_.mode == config::UpMode::interpolate) return interpolated(frame, state, ahead);
   if (!same_side(first_->state, state, &why)) return key_now(frame, state, why);
@@ -94,8 +106,9 @@ UpPlan UpSchedule::interpolated(std::uint64_t frame, const scene::SceneState& st
     plan.draw_key = true;
     plan.ahead_frame = b;
     plan.key_slot = 1 - first_->slot;
-    if (settings_.adaptive() && same_side(first_->state, *later)) plan.check_slot = first_->slot;
+    if (settings_.adaptive() && b == last && same_side(first_->state, *later)) plan.check_slot = first_->slot;
     second_ = Key{b, plan.key_slot, *later};
+    plan.key_state = &second_->state;
   }
   // From the key frames on this frame's side of any cut; none: drawn now.
   const bool from_first = same_side(first_->state, state);

@@ -11,10 +11,12 @@
 // whatever the ratio, where a kept one would mix two sides of a cut: a light
 // switched on or off, or the viewer's eye moved farther than kCutEyeJump.
 //
-// Adaptive ratio: before each key frame is kept, the frame between the last key
-// frame would have built at its moment is checked against it (PSNR_Y): below
-// the floor, the key frames come a frame sooner; kRaiseMargin above it, a frame
-// later, up to `ratio`.
+// Adaptive ratio: before each key frame that comes `ratio` frames after the
+// last is kept, the frame that key frame would have built at its moment is
+// checked against it (PSNR_Y as displayed): below the floor, the key frames
+// come a frame sooner; kRaiseMargin above it, a frame later, up to `ratio`. The
+// check extrapolates over the whole interval, so with interpolation (whose
+// frames are at most half an interval from a key frame) it is cautious.
 
 #include <cstdint>
 #include <functional>
@@ -46,6 +48,9 @@ struct UpPlan {
   bool draw_key = false;
   std::optional<std::uint64_t> ahead_frame;
   int key_slot = 0;
+  // The state to draw it from (this frame's, or the one sent ahead), as the
+  // schedule keeps it: valid until the next plan() or forget().
+  const scene::SceneState* key_state = nullptr;
   // Before keeping it: how far the frame between from key `check_slot` would
   // have been from it, for the adaptive ratio (UpSchedule::checked).
   std::optional<int> check_slot;
@@ -73,6 +78,9 @@ class UpSchedule {
   [[nodiscard]] UpPlan plan(std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead = {});
   // What the plan's check measured, dB of PSNR_Y (+infinity: identical).
   void checked(double psnr_y);
+  // The kept key frames no longer show what is drawn (a key frame that could
+  // not be drawn, another share of the lights): the next frame is a key frame.
+  void forget();
 
   // Display frames per key frame now (the adaptive ratio's; `ratio` when fixed).
   [[nodiscard]] int ratio() const { return ratio_; }

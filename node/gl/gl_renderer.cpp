@@ -19,6 +19,8 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   const config::ProjectorJob& job = node.job;
   const config::Projector& projector = job.self();
   const std::string key = config::to_schema(job.installation).SerializeAsString() + node.scene_sha256;
+  ahead_.clear();  // sent ahead by the master before: a (re)join starts over
+  last_frame_.reset();
   if (key == configured_for_ && pipeline_) {  // a rejoin: the same job, keep everything
     if (node.lights) pipeline_->set_share(*node.lights);
     return {};
@@ -89,6 +91,8 @@ Rendered GlRenderer::render(const FrameInput& frame) {
                       deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
                       deep_signal_ ? renderer.read_signal() : image::WordImage{});
   };
+  if (last_frame_ && frame.frame_id <= *last_frame_) ahead_.clear();
+  last_frame_ = frame.frame_id;
   if (frame.ahead != nullptr) ahead_[frame.ahead_frame] = *frame.ahead;
   while (!ahead_.empty() && ahead_.begin()->first < frame.frame_id) ahead_.erase(ahead_.begin());
   const render::DisplayFrame display{frame.frame_id, [this](std::uint64_t f) -> const scene::SceneState* {

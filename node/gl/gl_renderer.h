@@ -44,6 +44,7 @@ class GlRenderer final : public Renderer {
   // Up-conversion: the scenes the master sent ahead, by frame, until their
   // frame has passed; the ratio last logged.
   std::map<std::uint64_t, scene::SceneState> ahead_;
+  std::optional<std::uint64_t> last_frame_;  // frames that go back (a new run) drop what was sent ahead
   int logged_ratio_ = 0;
   // A captured frame on a window: what the window shows is read back when it is presented.
   std::optional<std::uint64_t> read_back_shown_;

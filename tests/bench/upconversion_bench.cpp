@@ -127,6 +127,10 @@ int main(int argc, char** argv) {
   app.add_option("--frames", frames, "display frames per run (from each scene's start)");
   app.add_flag("--find-rates", rates, "only choose each scene's framing and print it");
   CLI11_PARSE(app, argc, argv);
+  if (runs < 1 || frames < 4) {
+    std::cerr << "--runs must be at least 1 and --frames at least 4 (a key frame and frames between)\n";
+    return 2;
+  }
   auto context = render::make_headless_context();
   if (!context) {
     std::cerr << "no GL context: " << context.error() << "\n";

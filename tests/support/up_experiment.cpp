@@ -103,6 +103,7 @@ std::vector<StageScene> paper_scenes() {
 }
 
 Result<SceneResult> measure(const StageScene& stage, const Run& run, int frames, int width, int height) {
+  if (frames < 1) return Error{"at least one display frame to measure"};
   const auto parse = [&](bool up_converts) {
     return config::parse_installation(installation_json(stage, run, width, height, up_converts), stage.name + ".json",
                                       OPTIQUE_SOURCE_DIR);
@@ -176,7 +177,8 @@ Result<SceneResult> measure(const StageScene& stage, const Run& run, int frames,
       psnr_sum += std::min(100.0, frame.psnr_y);
       result.mean_shaded_anew += frame.unseen_share;
       for (int k = 0; k < 4; ++k) result.block_share[k] += frame.blocks.share[k];
-      if (frame.psnr_y < worst) {
+      // The worst frame between (the first, where all are identical).
+      if (frame.psnr_y < worst || result.hardest_image.empty()) {
         worst = frame.psnr_y;
         result.hardest = result.frames.size();
         result.hardest_image = shown;

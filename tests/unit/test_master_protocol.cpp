@@ -279,6 +279,7 @@ TEST_F(MasterTest, ANodeThatInterpolatesGetsTheSceneAheadAndItsKeyFramesAreRepor
   ASSERT_TRUE(report.nodes(1).has_up_conversion());
   ASSERT_EQ(report.nodes(1).up_conversion().key_frames_size(), 1);
   EXPECT_EQ(report.nodes(1).up_conversion().key_frames(0), 0u);
+  EXPECT_EQ(report.nodes(1).up_conversion().key_frames_total(), 1u);
   EXPECT_EQ(report.nodes(1).up_conversion().key_render_us().count(), 1u);
 }
 

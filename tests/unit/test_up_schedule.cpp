@@ -91,6 +91,33 @@ TEST(UpSchedule, FramesThatGoBackOrSkipStartOver) {
   EXPECT_TRUE(schedule.plan(20, state_at(20)).draw_key);
 }
 
+TEST(UpSchedule, ForgettingOrGoingBackStartsOver) {
+  UpSchedule schedule(settings(4, config::UpMode::interpolate));
+  EXPECT_EQ(kinds(schedule, 0, 2), "K A4B2 B2");
+  schedule.forget();  // another share of the lights: the kept key frames show the old one
+  const UpPlan now = schedule.plan(3, state_at(3));
+  EXPECT_TRUE(now.draw_key);
+  EXPECT_FALSE(now.ahead_frame);
+  EXPECT_EQ(now.why, "first frame");
+  // A new run from frame 0: the key drawn ahead for frame 4 of the old run is gone.
+  UpSchedule again(settings(4, config::UpMode::interpolate));
+  EXPECT_EQ(kinds(again, 0, 2), "K A4B2 B2");
+  EXPECT_EQ(kinds(again, 0, 2), "K A4B2 B2") << "frames that go back start over";
+  const UpPlan key = again.plan(0, state_at(0));
+  ASSERT_NE(key.key_state, nullptr);
+  EXPECT_EQ(*key.key_state, state_at(0));
+}
+
+TEST(UpSchedule, TheCheckWeighsOnlyAWholeInterval) {
+  UpSchedule schedule(settings(4, config::UpMode::extrapolate, 30.0));
+  (void)schedule.plan(0, state_at(0));
+  const UpPlan skipped = schedule.plan(6, state_at(6));  // frames 1–5 never came
+  EXPECT_TRUE(skipped.draw_key);
+  EXPECT_FALSE(skipped.check_slot) << "six frames on says nothing of a four-frame interval";
+  for (std::uint64_t f = 7; f < 10; ++f) (void)schedule.plan(f, state_at(f));
+  EXPECT_TRUE(schedule.plan(10, state_at(10)).check_slot);
+}
+
 TEST(UpSchedule, TheAdaptiveRatioFollowsTheCheckedError) {
   UpSchedule schedule(settings(4, config::UpMode::extrapolate, 30.0));
   (void)schedule.plan(0, state_at(0));

@@ -6,7 +6,8 @@
 // surface there (or beyond the image's edge, where the key frame's edge pixel
 // stands in) left out. Two key frames mix by the frame's time between them.
 // A pixel no key frame saw shows key 0's pixel at its place, alpha 0 (marked,
-// to be shaded anew). average: the same pixel of both, half each.
+// to be shaded anew). average: the same pixel of both, half each (of one
+// across a cut).
 // Built with "#version 450 core", AVERAGE 0 or 1 and KEYS 1 or 2 first (one
 // program each: a branch on a uniform still costs llvmpipe both sides).
 layout(binding = 0) uniform sampler2D key_colour_0;
@@ -45,8 +46,10 @@ vec4 taken(sampler2D key_colour, sampler2D key_depth, vec4 seen) {
 
 void main() {
   ivec2 p = ivec2(gl_FragCoord.xy);
-#if AVERAGE
+#if AVERAGE && KEYS == 2
   colour = vec4(0.5 * (texelFetch(key_colour_0, p, 0).rgb + texelFetch(key_colour_1, p, 0).rgb), 1.0);
+#elif AVERAGE  // across a cut: the key frame on this frame's side, as it is
+  colour = vec4(texelFetch(key_colour_0, p, 0).rgb, 1.0);
 #else
   vec4 seen_0 = texelFetch(motion_0, p, 0);
   if (seen_0.w < -1.5) {  // no surface: the background, as every key frame shows it
