@@ -244,7 +244,6 @@ Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state, in
 Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state, const DisplayFrame& display) {
   up::UpPlan plan = schedule_->plan(display.number, state, display.ahead);
   up_report_ = {};
-  up_report_.ratio = schedule_->ratio();
   const auto black = [&](const std::string& why) -> Result<void> {
     // Nothing kept shows what the next frames need: they start over.
     schedule_->forget();
@@ -262,8 +261,7 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
   up_report_.why = plan.why;
   up_report_.drew_key_ahead = plan.ahead_frame.has_value();
   if (plan.draw_key) {
-    // This frame's state, or the one the master sent ahead for a later frame.
-    const scene::SceneState* key = plan.key_state;
+    const scene::SceneState* key = plan.key_state;  // this frame's, or one sent ahead
     const auto seen = moment(*key, 0.0);
     if (!seen) return black(seen.error());
     renderer_->draw(*key, 0.0, seen.value().eye, seen.value().frustum, terms_);

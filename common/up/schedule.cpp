@@ -71,8 +71,8 @@ UpPlan UpSchedule::plan(std::uint64_t frame, const scene::SceneState& state, con
     second_.reset();  // frames that go back start over: a key drawn ahead belongs to another run
     return key_now(frame, state, "first frame");
   }
-  std::string_view why;
   if (settings_.mode == config::UpMode::interpolate) return interpolated(frame, state, ahead);
+  std::string_view why;
   if (!same_side(first_->state, state, &why)) return key_now(frame, state, why);
   if (frame - first_->frame >= static_cast<std::uint64_t>(ratio_)) return key_now(frame, state, "ratio");
   UpPlan plan;
