@@ -189,11 +189,12 @@ class SceneRenderer {
     glm::dmat4 view_projection{1.0};
   };
   // With `motion`, also each fragment's screen velocity between the two ends
-  // (the gather's program and target), or its place in two key frames (the up-
-  // conversion's motion field).
+  // (the gather's program and target, key_frames 0), or its place in the
+  // key_frames (1 or 2) key frames at the first ends (the up-conversion's motion
+  // field).
   struct Motion {
     MotionEnd ends[2];
-    bool key_frames = false;
+    int key_frames = 0;
   };
   void draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                   const geometry::Frustum& frustum, const LightTerms& terms, Objects which = Objects::all,

@@ -48,10 +48,6 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
     const GLuint p = u->resolve_programs_[r].get();
     u->uniforms_[r] = {glGetUniformLocation(p, "toward_second"), glGetUniformLocation(p, "background")};
   }
-  auto mark =
-      glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_mark_frag));
-  if (!mark) return Error{"the up-conversion's mark pass: " + mark.error()};
-  u->mark_program_ = std::move(mark).value();
   auto error =
       glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_error_frag));
   if (!error) return Error{"the up-conversion's check: " + error.error()};
@@ -84,16 +80,14 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   const GLuint motion = u->motion_framebuffer_.get();
   glNamedFramebufferTexture(motion, GL_COLOR_ATTACHMENT0, u->motion_[0].get(), 0);
   glNamedFramebufferTexture(motion, GL_COLOR_ATTACHMENT1, u->motion_[1].get(), 0);
-  static constexpr GLenum kBoth[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glNamedFramebufferDrawBuffers(motion, 2, kBoth);
   u->output_framebuffer_ = glo::make_framebuffer();
   glNamedFramebufferTexture(u->output_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->output_.get(), 0);
-  u->mark_framebuffer_ = glo::make_framebuffer();
-  glNamedFramebufferDrawBuffer(u->mark_framebuffer_.get(), GL_NONE);
   if (glCheckNamedFramebufferStatus(u->error_framebuffer_.get(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
     return Error{"this GL driver cannot draw the up-conversion's check (RGBA32F)"};
   }
-  for (GLuint fb : {motion, u->output_framebuffer_.get(), u->mark_framebuffer_.get()}) {
+  static constexpr GLenum kBoth[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(motion, 2, kBoth);
+  for (GLuint fb : {motion, u->output_framebuffer_.get()}) {
     glNamedFramebufferTexture(fb, GL_DEPTH_STENCIL_ATTACHMENT, u->depth_stencil_.get(), 0);
     if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
       return Error{"this GL driver cannot draw the up-conversion's targets (RGBA32F with depth and stencil)"};
@@ -130,13 +124,15 @@ const up::KeyView& UpConverter::key(int slot) const {
   return key_view_[slot];
 }
 
-void UpConverter::begin_motion_field() {
+void UpConverter::begin_motion_field(bool from_two) {
   const GLuint fb = motion_framebuffer_.get();
+  static constexpr GLenum kBoth[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+  glNamedFramebufferDrawBuffers(fb, from_two ? 2 : 1, kBoth);
   glBindFramebuffer(GL_FRAMEBUFFER, fb);
   glViewport(0, 0, width_, height_);
   const GLfloat no_surface[4] = {0.0f, 0.0f, 0.0f, -2.0f};
   glClearNamedFramebufferfv(fb, GL_COLOR, 0, no_surface);
-  glClearNamedFramebufferfv(fb, GL_COLOR, 1, no_surface);
+  if (from_two) glClearNamedFramebufferfv(fb, GL_COLOR, 1, no_surface);
   glClearNamedFramebufferfi(fb, GL_DEPTH_STENCIL, 0, 1.0f, 0);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
@@ -150,6 +146,11 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   glViewport(0, 0, width_, height_);
   const bool averages = frame.method == up::BetweenMethod::average;
   const Resolve r = averages ? (frame.two_keys ? average : average_one_key) : frame.two_keys ? two_keys : one_key;
+  if (!averages && !frame.shade_unseen) {
+    // What no key frame saw keeps the first key frame's pixel (the resolve
+    // leaves it): a test's view of the frame without shading anew.
+    copy(key_colour_[frame.first].get(), output_.get(), width_, height_);
+  }
   glUseProgram(resolve_programs_[r].get());
   glUniform1f(uniforms_[r].toward_second, static_cast<float>(frame.toward_second));
   glUniform3f(uniforms_[r].background, background.r, background.g, background.b);
@@ -160,13 +161,13 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
     glBindTextureUnit(static_cast<GLuint>(2 + k), key_depth_[slot].get());
     glBindTextureUnit(static_cast<GLuint>(4 + k), motion_[k].get());  // the motion field's, in that order
   }
-  glDrawArrays(GL_TRIANGLES, 0, 3);
-  if (frame.method == up::BetweenMethod::average) return {};
-
-  // The unseen pixels into the stencil, counted.
-  glBindFramebuffer(GL_FRAMEBUFFER, mark_framebuffer_.get());
-  glUseProgram(mark_program_.get());
-  glBindTextureUnit(0, output_.get());
+  if (averages) {
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    return {};
+  }
+  // Every pixel the resolve wrote is marked in the stencil and counted; it
+  // discards those no key frame saw (one pass: a second that read the output
+  // back to mark them cost llvmpipe 2 ms at 1280×720).
   glEnable(GL_STENCIL_TEST);
   glStencilFunc(GL_ALWAYS, 1, 0xFF);
   glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
@@ -174,8 +175,9 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glEndQuery(GL_SAMPLES_PASSED);
   glDisable(GL_STENCIL_TEST);
-  GLint64 unseen = 0;
-  glGetQueryObjecti64v(query_, GL_QUERY_RESULT, &unseen);
+  GLint64 resolved = 0;
+  glGetQueryObjecti64v(query_, GL_QUERY_RESULT, &resolved);
+  const GLint64 unseen = std::max<GLint64>(0, static_cast<GLint64>(width_) * height_ - resolved);
   up::BetweenReport report;
   report.unseen_pixels = unseen;
   report.unseen_share = static_cast<double>(unseen) / (static_cast<double>(width_) * static_cast<double>(height_));
@@ -219,7 +221,7 @@ void UpConverter::begin_shade_unseen() {
   glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
   glViewport(0, 0, width_, height_);
   glEnable(GL_STENCIL_TEST);
-  glStencilFunc(GL_EQUAL, 1, 0xFF);
+  glStencilFunc(GL_EQUAL, 0, 0xFF);  // what the resolve left
   glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);  // the same surface the motion field found (invariant positions)

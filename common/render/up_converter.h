@@ -34,14 +34,16 @@ class UpConverter {
   void restore(int slot, GLuint colour, GLuint depth) const;
 
   // The motion field's target: where each pixel's surface was in each key frame
-  // (attachments 0 and 1) over the frame's own depth and stencil; bound,
-  // cleared (no surface anywhere, stencil 0), depth test on.
-  void begin_motion_field();
+  // (attachment 0, and 1 `from_two` key frames) over the frame's own depth and
+  // stencil; bound, cleared (no surface anywhere, stencil 0), depth test on.
+  void begin_motion_field(bool from_two);
   // Then the frame from the key frames' pixels into output(); with the motion
-  // method, the pixels no key frame saw are marked in the stencil and counted.
+  // method, the pixels some key frame saw are marked in the stencil, and those
+  // none saw are left for begin_shade_unseen() (frame.shade_unseen; otherwise
+  // they show the first key frame's pixel) and counted.
   [[nodiscard]] up::BetweenReport resolve(const up::BetweenFrame& frame, const glm::vec3& background);
   // Binds output() over the motion field's depth, drawing only where the
-  // stencil marks a pixel unseen and only the surface the field found there.
+  // stencil leaves a pixel unseen and only the surface the field found there.
   void begin_shade_unseen();
   void end_shade_unseen();  // back to the GL state everything else expects
 
@@ -66,7 +68,6 @@ class UpConverter {
   glo::Framebuffer motion_framebuffer_;
   glo::Texture output_;
   glo::Framebuffer output_framebuffer_;
-  glo::Framebuffer mark_framebuffer_;  // the stencil alone: the mark pass reads output()
   // The resolve for each way: the average of two key frames (or one key frame
   // as it is, across a cut), motion from one key frame, from two.
   enum Resolve { average, average_one_key, one_key, two_keys, resolves };
@@ -75,7 +76,6 @@ class UpConverter {
     GLint toward_second, background;
   };
   std::array<ResolveUniforms, resolves> uniforms_{};
-  glo::Program mark_program_;
   glo::Program error_program_;
   glo::Texture error_sums_;  // one texel per kErrorBlock² pixels
   glo::Framebuffer error_framebuffer_;

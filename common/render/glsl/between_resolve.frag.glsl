@@ -5,9 +5,9 @@
 // distance, as the up-conversion paper weighs them), those that saw another
 // surface there (or beyond the image's edge, where the key frame's edge pixel
 // stands in) left out. Two key frames mix by the frame's time between them.
-// A pixel no key frame saw shows key 0's pixel at its place, alpha 0 (marked,
-// to be shaded anew). average: the same pixel of both, half each (of one
-// across a cut).
+// A pixel no key frame saw is discarded: left unmarked in the stencil, to be
+// shaded anew (up_converter.h). average: the same pixel of both, half each (of
+// one across a cut).
 // Built with "#version 450 core", AVERAGE 0 or 1 and KEYS 1 or 2 first (one
 // program each: a branch on a uniform still costs llvmpipe both sides).
 layout(binding = 0) uniform sampler2D key_colour_0;
@@ -72,7 +72,7 @@ void main() {
   } else if (b.w > kSeen) {
     colour = vec4(b.rgb / b.w, 1.0);
   } else {
-    colour = vec4(texelFetch(key_colour_0, p, 0).rgb, 0.0);
+    discard;
   }
 #endif
 }

@@ -4,12 +4,15 @@
 // frame's pixels around it and still be the same surface. Clip positions are
 // linear in the surface point, so interpolated they are the fragment's own: the
 // field is exact per pixel, not a vertex average. Built with "#version 450 core"
-// and VELOCITY (for clip_0 and clip_1 from scene.vert.glsl) first.
+// and VELOCITY (for clip_0 and clip_1 from scene.vert.glsl) first; ONE_END for
+// one key frame only (key_0 alone).
 in vec4 clip_0;
-in vec4 clip_1;
 in vec3 world_normal;  // now
 in vec3 normal_0;      // in each key frame
+#ifndef ONE_END
+in vec4 clip_1;
 in vec3 normal_1;
+#endif
 uniform vec2 size;  // the image's pixels
 // A surface turned further than this since a key frame (cosine of the angle
 // between its normals) is shaded there for another orientation to the lights
@@ -19,7 +22,9 @@ uniform float most_turn_cosine;
 // frame has no place for the point (it was behind its eye, or its object was
 // not in the scene then) or shows it turned too far. A pixel no surface covers keeps the clear's −2.
 layout(location = 0) out vec4 key_0;
+#ifndef ONE_END
 layout(location = 1) out vec4 key_1;
+#endif
 
 vec4 seen_at(vec4 clip, vec3 normal_then) {
   // Derivatives first, outside any branch: each is taken over the pixel quad.
@@ -44,5 +49,7 @@ vec4 seen_at(vec4 clip, vec3 normal_then) {
 
 void main() {
   key_0 = seen_at(clip_0, normal_0);
+#ifndef ONE_END
   key_1 = seen_at(clip_1, normal_1);
+#endif
 }

@@ -1,6 +1,7 @@
 // The scene: world position, normal and texture coordinates for the fragment shader.
 // Built with "#version 450 core" first, and VELOCITY for the gather (render/field_gather.h)
-// and the motion field of up-conversion (render/up_converter.h).
+// and the motion field of up-conversion (render/up_converter.h), with ONE_END
+// where that field is from one key frame alone.
 // The same depth in every program built from this: a frame between key frames
 // shades its unseen pixels on the depth its motion field left (up_converter.h).
 invariant gl_Position;
@@ -17,14 +18,16 @@ out vec2 texture_uv;
 // The vertex seen at the frame's display time and a frame later (each moment
 // with its own eye): the fragment's screen velocity comes from these.
 uniform mat4 model_view_projection_0;
-uniform mat4 model_view_projection_1;
 out vec4 clip_0;
-out vec4 clip_1;
 // And its normal then (world space; the motion field's, up_converter.h).
 uniform mat3 normal_matrix_0;
-uniform mat3 normal_matrix_1;
 out vec3 normal_0;
+#ifndef ONE_END
+uniform mat4 model_view_projection_1;
+out vec4 clip_1;
+uniform mat3 normal_matrix_1;
 out vec3 normal_1;
+#endif
 #endif
 void main() {
   world_position = (model * vec4(position, 1.0)).xyz;
@@ -33,8 +36,10 @@ void main() {
   gl_Position = model_view_projection * vec4(position, 1.0);
 #ifdef VELOCITY
   clip_0 = model_view_projection_0 * vec4(position, 1.0);
-  clip_1 = model_view_projection_1 * vec4(position, 1.0);
   normal_0 = normal_matrix_0 * normal;
+#ifndef ONE_END
+  clip_1 = model_view_projection_1 * vec4(position, 1.0);
   normal_1 = normal_matrix_1 * normal;
+#endif
 #endif
 }
