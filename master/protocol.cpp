@@ -460,7 +460,7 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     const LightShare* share = light_plan_.share(i);
     const bool new_share = share != nullptr && slots_[i].sent_share != *share;
     const config::UpConversion& up_conversion = installation_.projectors[i].up_conversion;
-    const bool interpolates = up_conversion.enabled() && up_conversion.mode == config::UpMode::interpolate;
+    const bool interpolates = up_conversion.frames_ahead() > 0;
     if (!new_share && !interpolates) {
       out.push_back(Send{peer, envelope});
     } else {
@@ -475,8 +475,9 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
       }
       if (interpolates) {
         // The scene is a function of time: the frame its next key frame may be
-        // drawn for is sent now, ratio − 1 frames before its turn.
-        const std::uint64_t ahead = frame + static_cast<std::uint64_t>(up_conversion.ratio) - 1;
+        // drawn for is sent now, ratio − 1 frames before its turn (2·ratio − 1
+        // where the key frames are drawn a band a frame).
+        const std::uint64_t ahead = frame + static_cast<std::uint64_t>(up_conversion.frames_ahead());
         auto& begin_ahead = *to_node.mutable_frame_begin();
         *begin_ahead.mutable_ahead() = scene::to_snapshot(authority_.state_at_frame(ahead));
         begin_ahead.set_ahead_frame(ahead);

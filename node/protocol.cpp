@@ -334,9 +334,9 @@ void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos no
   ahead_.reset();
   if (begin.has_ahead()) {
     const std::uint64_t on = begin.ahead_frame() - begin.frame_id();
-    if (begin.ahead_frame() <= begin.frame_id() || on > static_cast<std::uint64_t>(config::kMaxUpRatio)) {
+    if (begin.ahead_frame() <= begin.frame_id() || on > static_cast<std::uint64_t>(config::kMostFramesAhead)) {
       out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": the scene sent ahead is for frame " +
-                          std::to_string(begin.ahead_frame()) + ", not 1…" + std::to_string(config::kMaxUpRatio) +
+                          std::to_string(begin.ahead_frame()) + ", not 1…" + std::to_string(config::kMostFramesAhead) +
                           " frames on"});
       return;
     }

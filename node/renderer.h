@@ -27,7 +27,7 @@ struct FrameInput {
   std::optional<protocol::Focus> focus;          // the frame's focal depth and gaze (focus/defocus nodes)
   const protocol::LightShare* lights = nullptr;  // a new share of the lights from this frame on, if any
   // A node that up-converts by interpolation: the scene of a later frame, sent
-  // ahead of its turn (at most config::kMaxUpRatio frames on).
+  // ahead of its turn (at most config::kMostFramesAhead frames on).
   const scene::SceneState* ahead = nullptr;
   std::uint64_t ahead_frame = 0;
 };

@@ -90,8 +90,11 @@ std::string summarize(const config::LoadedConfig& config) {
           << config::to_string(up.mode)
           << (up.mode == config::UpMode::interpolate
                   ? " (between the key frames before and after: the master sends each key frame's scene " +
-                        std::to_string(up.ratio - 1) + " frames ahead)"
-                  : " (from the last key frame)")
+                        std::to_string(up.frames_ahead()) + " frames ahead)"
+              : up.spread ? " (from the last key frame drawn; each is used " + std::to_string(up.ratio) +
+                                " frames after its moment)"
+                          : " (from the last key frame)")
+          << (up.spread ? ", each key frame drawn a band a frame" : "")
           << (up.adaptive() ? ", fewer frames between while they would fall below " +
                                   std::to_string(static_cast<int>(std::lround(up.min_psnr))) + " dB PSNR_Y"
                             : ", the ratio fixed")

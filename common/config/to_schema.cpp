@@ -94,6 +94,7 @@ schema::Projector to_schema(const Projector& p, const std::vector<Screen>& scree
     up.set_method(std::string(to_string(p.up_conversion.method)));
     up.set_mode(std::string(to_string(p.up_conversion.mode)));
     up.set_min_psnr(p.up_conversion.min_psnr);
+    up.set_spread(p.up_conversion.spread);
   }
   return out;
 }

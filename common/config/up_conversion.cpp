@@ -41,6 +41,7 @@ UpConversion parse_up_conversion(const schema::UpConversion& up, const std::stri
                           "must be 10…100 dB of PSNR_Y, or 0 for a fixed ratio (got " + std::to_string(floor) + ")"});
     }
   }
+  out.spread = up.spread();
   if (mode_known && out.method == UpMethod::average && out.mode == UpMode::extrapolate) {
     problems.push_back({path + ".method", "average blends the key frames before and after: it needs mode interpolate"});
   }

@@ -25,6 +25,9 @@ enum class UpMode { extrapolate, interpolate };
 [[nodiscard]] std::string_view to_string(UpMode mode);
 
 inline constexpr int kMaxUpRatio = 16;
+// The farthest ahead of its frame the master sends a scene: interpolation with
+// the key frames spread (UpConversion::frames_ahead).
+inline constexpr int kMostFramesAhead = 2 * kMaxUpRatio - 1;
 // What the frames between must keep at least, by default: the up-conversion
 // paper's "visually equal" (dB of PSNR_Y).
 inline constexpr double kDefaultMinPsnr = 30.0;
@@ -37,6 +40,15 @@ struct UpConversion {
   // average (a baseline to compare with) keeps its ratio.
   double min_psnr = kDefaultMinPsnr;
   [[nodiscard]] bool adaptive() const { return min_psnr > 0.0 && method == UpMethod::motion; }
+  // Each key frame drawn in bands over the frames before it is used, not at once.
+  bool spread = false;
+  // How many frames ahead of its frame the master sends the scene of a later
+  // key frame: interpolation needs the next key frame before the frames before
+  // it, and with spread key frames the one after (0: nothing sent ahead).
+  [[nodiscard]] int frames_ahead() const {
+    if (!enabled() || mode != UpMode::interpolate) return 0;
+    return spread ? 2 * ratio - 1 : ratio - 1;
+  }
 
   [[nodiscard]] bool enabled() const { return ratio > 1; }
   friend bool operator==(const UpConversion&, const UpConversion&) = default;

@@ -63,7 +63,8 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
     }
   }
   if (self.up_conversion.enabled()) {
-    if (auto prepared = renderer.value()->prepare_up_conversion(); !prepared) {
+    if (auto prepared = renderer.value()->prepare_up_conversion(up::UpSchedule::slots_for(self.up_conversion));
+        !prepared) {
       return Error{"projector '" + self.id + "': " + prepared.error()};
     }
   }
@@ -247,7 +248,7 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
   const auto black = [&](const std::string& why) -> Result<void> {
     // Nothing kept shows what the next frames need: they start over.
     schedule_->forget();
-    up_report_ = {up::FrameKind::key, {}, std::nullopt, false, schedule_->ratio(), "not in front of the screen"};
+    up_report_ = {up::FrameKind::key, {}, std::nullopt, false, false, schedule_->ratio(), "not in front of the screen"};
     renderer_->draw_black();
     return Error{why};
   };
@@ -260,6 +261,25 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
   up_report_.kind = plan.kind();
   up_report_.why = plan.why;
   up_report_.drew_key_ahead = plan.ahead_frame.has_value();
+  if (plan.band) {  // first: it draws through the image the frame's own then replaces
+    const up::UpPlan::Band& band = *plan.band;
+    const auto seen = moment(*band.state, 0.0);
+    if (!seen) {
+      schedule_->drop_band();  // its moment cannot be seen from here: another is begun later
+    } else {
+      const geometry::Frustum& f = seen.value().frustum;
+      renderer_->draw_key_band(*band.state, 0.0, seen.value().eye, f, terms_, band.slot, band.index, band.count);
+      up_report_.drew_band = true;
+      if (band.last() && plan.check_slot) {
+        up::BetweenFrame check;
+        check.method = schedule_->settings().method;
+        check.first = *plan.check_slot;
+        up_report_.checked_psnr =
+            renderer_->check_between(*band.state, 0.0, seen.value().eye, f, check, terms_, band.slot);
+        schedule_->checked(*up_report_.checked_psnr);
+      }
+    }
+  }
   if (plan.draw_key) {
     const scene::SceneState* key = plan.key_state;  // this frame's, or one sent ahead
     const auto seen = moment(*key, 0.0);
@@ -291,7 +311,7 @@ void ProjectorPipeline::warm_up() {
     renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
     if (schedule_) {  // the motion field, each resolve, the mark and the check
       const geometry::Frustum& f = frustum.value();
-      for (int slot = 0; slot < up::kKeySlots; ++slot) {
+      for (int slot = 0; slot < schedule_->slots(); ++slot) {
         renderer_->keep_key(slot, {scene::SceneState{}, 0.0, f.projection * f.view});
       }
       (void)renderer_->check_between(scene::SceneState{}, 0.0, in_front, f, {}, terms_);

@@ -59,6 +59,7 @@ struct UpReport {
   // A key frame checked against the frame between it replaces (dB PSNR_Y).
   std::optional<double> checked_psnr;
   bool drew_key_ahead = false;  // a later key frame was drawn with it (interpolation)
+  bool drew_band = false;       // and a band of a key frame drawn a band a frame (spread)
   int ratio = 1;                // display frames per key frame from now on
   std::string_view why;         // why a key frame was drawn now
 };

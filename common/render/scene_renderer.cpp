@@ -504,7 +504,7 @@ GatherReport SceneRenderer::gather_again(std::span<const GatherField> fields, co
   return report;
 }
 
-Result<void> SceneRenderer::prepare_up_conversion() {
+Result<void> SceneRenderer::prepare_up_conversion(int slots) {
   Gl& gl = *gl_;
   if (gl.up_converter) return {};
   std::array<glo::Program, 2> programs;
@@ -514,7 +514,7 @@ Result<void> SceneRenderer::prepare_up_conversion() {
     if (!program) return Error{"the up-conversion's motion field: " + program.error()};
     programs[keys - 1] = std::move(program).value();
   }
-  auto converter = UpConverter::create(gl.width, gl.height, gl.depth_format);
+  auto converter = UpConverter::create(gl.width, gl.height, gl.depth_format, slots);
   if (!converter) return Error{converter.error()};
   gl.key_frames_program = std::move(programs);
   gl.key_frames_uniforms = uniforms;
@@ -538,7 +538,7 @@ up::BetweenReport SceneRenderer::build_between(const scene::SceneState& state, d
   if (motion) {
     converter.begin_motion_field(frame.two_keys);
     const up::KeyView& first = converter.key(frame.first);
-    const up::KeyView& second = converter.key(frame.two_keys ? 1 - frame.first : frame.first);
+    const up::KeyView& second = converter.key(frame.two_keys ? frame.second : frame.first);
     const Motion field{{{&first.state, first.fraction, first.view_projection},
                         {&second.state, second.fraction, second.view_projection}},
                        frame.two_keys ? 2 : 1};
@@ -568,10 +568,31 @@ up::BetweenReport SceneRenderer::draw_between(const scene::SceneState& state, do
 
 double SceneRenderer::check_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                                     const geometry::Frustum& frustum, const up::BetweenFrame& frame,
-                                    const LightTerms& terms) {
+                                    const LightTerms& terms, std::optional<int> against_slot) {
   Gl& gl = *gl_;
   (void)build_between(state, fraction, eye, frustum, frame, terms);
-  return gl.up_converter->psnr_y_against(gl.linear_colour.get());
+  UpConverter& converter = *gl.up_converter;
+  return converter.psnr_y_against(against_slot ? converter.key_colour(*against_slot) : gl.linear_colour.get());
+}
+
+void SceneRenderer::draw_key_band(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                  const geometry::Frustum& frustum, const LightTerms& terms, int slot, int index,
+                                  int count) {
+  Gl& gl = *gl_;
+  assert(gl.up_converter);  // prepare_up_conversion first
+  assert(count >= 1 && index >= 0 && index < count);
+  const int first_row = gl.height * index / count;
+  const int rows = gl.height * (index + 1) / count - first_row;
+  // The scissor bounds the clear, the fragments and the multisample resolve;
+  // the geometry is processed whole each band.
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(0, first_row, gl.width, rows);
+  begin_linear();
+  draw_scene(state, fraction, eye, frustum, terms);
+  resolve();
+  glDisable(GL_SCISSOR_TEST);
+  gl.up_converter->keep_rows(slot, gl.linear_colour.get(), gl.depth.get(),
+                             {state, fraction, frustum.projection * frustum.view}, first_row, rows);
 }
 
 void SceneRenderer::show_key(int slot) {

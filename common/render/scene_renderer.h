@@ -117,11 +117,19 @@ class SceneRenderer {
 
   // Frame-rate up-conversion (render/up_converter.h): makes the key slots, the
   // motion field's targets and passes (only projectors that up-convert have
-  // them); fails with the driver's message.
-  [[nodiscard]] Result<void> prepare_up_conversion();
-  // The image the last draw() made kept as key frame `slot` (0 or 1), drawn as
-  // `view` says; prepare_up_conversion first.
+  // them), `slots` key frames (2, or up::kKeySlots where they are drawn in
+  // bands); fails with the driver's message.
+  [[nodiscard]] Result<void> prepare_up_conversion(int slots = 2);
+  // The image the last draw() made kept as key frame `slot`, drawn as `view`
+  // says; prepare_up_conversion first.
   void keep_key(int slot, up::KeyView view);
+  // Band `index` of `count` (rows, from the bottom) of a key frame drawn as
+  // draw() would, at `state`'s poses `fraction` of a frame on, seen from `eye`
+  // through `frustum` (= view), into key slot `slot`: the rest of the slot
+  // stays. Drawn through the linear image: before the frame's own (draw_between,
+  // show_key); nothing is shown.
+  void draw_key_band(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                     const geometry::Frustum& frustum, const LightTerms& terms, int slot, int index, int count);
   // A frame between key frames, at `state`'s poses `fraction` of a frame on,
   // seen from `eye` through `frustum`: the motion field drawn with the scene's
   // geometry, each pixel from the kept key frames where its surface was, what
@@ -131,11 +139,12 @@ class SceneRenderer {
                                  const geometry::Frustum& frustum, const up::BetweenFrame& frame,
                                  const LightTerms& terms = {});
   // The frame between that `frame` would build for the state the last draw()
-  // showed, weighed against what draw() made: PSNR_Y (dB, the up-conversion
-  // paper's; +infinity when equal). The output stays draw()'s.
+  // showed, weighed against what draw() made (or against kept key
+  // `against_slot`, drawn for `state`): PSNR_Y (dB, the up-conversion paper's;
+  // +infinity when equal). The output stays the last frame's.
   [[nodiscard]] double check_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                                      const geometry::Frustum& frustum, const up::BetweenFrame& frame,
-                                     const LightTerms& terms = {});
+                                     const LightTerms& terms = {}, std::optional<int> against_slot = {});
   // Key `slot` as it was kept, through the output stage (a key frame drawn
   // ahead, shown at its own moment).
   void show_key(int slot);

@@ -32,11 +32,13 @@ UpConverter::~UpConverter() {
   if (query_ != 0) glDeleteQueries(1, &query_);
 }
 
-Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, GLenum depth_format) {
+Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, GLenum depth_format, int slots) {
   assert(width > 0 && height > 0);
+  assert(slots >= 2 && slots <= up::kKeySlots);
   std::unique_ptr<UpConverter> u(new UpConverter());
   u->width_ = width;
   u->height_ = height;
+  u->slots_ = slots;
   for (int r = 0; r < resolves; ++r) {
     const bool averages = r == average || r == average_one_key;
     const bool one = r == one_key || r == average_one_key;
@@ -58,16 +60,18 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   u->error_framebuffer_ = glo::make_framebuffer();
   glNamedFramebufferTexture(u->error_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->error_sums_.get(), 0);
 
-  for (int k = 0; k < up::kKeySlots; ++k) {
+  for (std::size_t k = 0; k < u->motion_.size(); ++k) {
+    // Key-frame pixels in pixels, window depth at float precision: a depth
+    // tolerance of a few 1e-6 must be representable.
+    u->motion_[k] = exact_texture(GL_RGBA32F, width, height);
+  }
+  for (int k = 0; k < slots; ++k) {  // a key frame drawn in bands needs a third
     u->key_colour_[k] = exact_texture(GL_RGBA32F, width, height);
     // Bilinear where all four pixels around a point saw its surface (the
     // resolve's one fetch); texel by texel elsewhere.
     glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     u->key_depth_[k] = exact_texture(depth_format, width, height);
-    // Key-frame pixels in pixels, window depth at float precision: a depth
-    // tolerance of a few 1e-6 must be representable.
-    u->motion_[k] = exact_texture(GL_RGBA32F, width, height);
   }
   u->depth_stencil_ =
       exact_texture(depth_format == GL_DEPTH_COMPONENT24 ? GL_DEPTH24_STENCIL8 : GL_DEPTH32F_STENCIL8, width, height);
@@ -100,27 +104,39 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
 
 namespace {
 
-void copy(GLuint from, GLuint to, int width, int height) {
-  glCopyImageSubData(from, GL_TEXTURE_2D, 0, 0, 0, 0, to, GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
+void copy(GLuint from, GLuint to, int width, int height, int first_row = 0) {
+  glCopyImageSubData(from, GL_TEXTURE_2D, 0, 0, first_row, 0, to, GL_TEXTURE_2D, 0, 0, first_row, 0, width, height, 1);
 }
 
 }  // namespace
 
 void UpConverter::keep(int slot, GLuint colour, GLuint depth, up::KeyView view) {
-  assert(slot >= 0 && slot < up::kKeySlots);
-  copy(colour, key_colour_[slot].get(), width_, height_);
-  copy(depth, key_depth_[slot].get(), width_, height_);
+  keep_rows(slot, colour, depth, std::move(view), 0, height_);
+}
+
+void UpConverter::keep_rows(int slot, GLuint colour, GLuint depth, up::KeyView view, int first_row, int rows) {
+  assert(slot >= 0 && slot < slots_);
+  assert(first_row >= 0 && rows >= 0 && first_row + rows <= height_);
+  if (rows > 0) {
+    copy(colour, key_colour_[slot].get(), width_, rows, first_row);
+    copy(depth, key_depth_[slot].get(), width_, rows, first_row);
+  }
   key_view_[slot] = std::move(view);
 }
 
+GLuint UpConverter::key_colour(int slot) const {
+  assert(slot >= 0 && slot < slots_);
+  return key_colour_[slot].get();
+}
+
 void UpConverter::restore(int slot, GLuint colour, GLuint depth) const {
-  assert(slot >= 0 && slot < up::kKeySlots);
+  assert(slot >= 0 && slot < slots_);
   copy(key_colour_[slot].get(), colour, width_, height_);
   copy(key_depth_[slot].get(), depth, width_, height_);
 }
 
 const up::KeyView& UpConverter::key(int slot) const {
-  assert(slot >= 0 && slot < up::kKeySlots);
+  assert(slot >= 0 && slot < slots_);
   return key_view_[slot];
 }
 
@@ -154,9 +170,10 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   glUseProgram(resolve_programs_[r].get());
   glUniform1f(uniforms_[r].toward_second, static_cast<float>(frame.toward_second));
   glUniform3f(uniforms_[r].background, background.r, background.g, background.b);
-  assert(frame.first == 0 || frame.first == 1);
-  for (int k = 0; k < up::kKeySlots; ++k) {  // the first key frame as key 0
-    const int slot = k == 0 ? frame.first : 1 - frame.first;
+  assert(frame.first >= 0 && frame.first < slots_);
+  assert(!frame.two_keys || (frame.second >= 0 && frame.second < slots_ && frame.second != frame.first));
+  for (int k = 0; k < 2; ++k) {  // the first key frame as key 0
+    const int slot = k == 0 || !frame.two_keys ? frame.first : frame.second;
     glBindTextureUnit(static_cast<GLuint>(k), key_colour_[slot].get());
     glBindTextureUnit(static_cast<GLuint>(2 + k), key_depth_[slot].get());
     glBindTextureUnit(static_cast<GLuint>(4 + k), motion_[k].get());  // the motion field's, in that order

@@ -21,15 +21,20 @@ namespace optique::render {
 class UpConverter {
  public:
   // For `width` × `height` pixels whose depth is `depth_format` (the scene
-  // renderer's, GL_DEPTH_COMPONENT32F or 24).
-  [[nodiscard]] static Result<std::unique_ptr<UpConverter>> create(int width, int height, GLenum depth_format);
+  // renderer's, GL_DEPTH_COMPONENT32F or 24), with `slots` key frames (2…
+  // up::kKeySlots).
+  [[nodiscard]] static Result<std::unique_ptr<UpConverter>> create(int width, int height, GLenum depth_format,
+                                                                   int slots = 2);
   ~UpConverter();
   UpConverter(const UpConverter&) = delete;
   UpConverter& operator=(const UpConverter&) = delete;
 
   // Copies a drawn image (RGBA32F) and its depth into key slot `slot`.
   void keep(int slot, GLuint colour, GLuint depth, up::KeyView view);
+  // Only `rows` rows from `first_row` (a band of a key frame drawn in bands).
+  void keep_rows(int slot, GLuint colour, GLuint depth, up::KeyView view, int first_row, int rows);
   [[nodiscard]] const up::KeyView& key(int slot) const;
+  [[nodiscard]] GLuint key_colour(int slot) const;
   // And back: key `slot`'s colour and depth into these.
   void restore(int slot, GLuint colour, GLuint depth) const;
 
@@ -60,10 +65,11 @@ class UpConverter {
   UpConverter() = default;
   int width_ = 0;
   int height_ = 0;
+  int slots_ = 2;
   std::array<glo::Texture, up::kKeySlots> key_colour_;
   std::array<glo::Texture, up::kKeySlots> key_depth_;
   std::array<up::KeyView, up::kKeySlots> key_view_;
-  std::array<glo::Texture, up::kKeySlots> motion_;
+  std::array<glo::Texture, 2> motion_;  // where each pixel was in the first and the second key frame
   glo::Texture depth_stencil_;
   glo::Framebuffer motion_framebuffer_;
   glo::Texture output_;

@@ -26,7 +26,9 @@ struct KeyView {
 // conversion paper's baseline, which knows nothing of motion).
 using BetweenMethod = config::UpMethod;
 
-inline constexpr int kKeySlots = 2;
+// Key frames kept at most: the two a frame between is built from, and one being
+// drawn a band a frame (config::UpConversion::spread).
+inline constexpr int kKeySlots = 3;
 
 // A surface turned further than this (radians) since a key frame faces the
 // lights and the eye otherwise than the key frame shaded it: its pixels there
@@ -35,8 +37,8 @@ inline constexpr double kMostTurn = 0.35;  // 20°
 
 struct BetweenFrame {
   BetweenMethod method = BetweenMethod::motion;
-  // Key slot `first` alone (extrapolation from the past), or it and the other
-  // slot, the later key frame, weighing `toward_second` (the frame's time
+  // Key slot `first` alone (extrapolation from the past), or it and slot
+  // `second`, the later key frame, weighing `toward_second` (the frame's time
   // between the two, 0…1).
   int first = 0;
   bool two_keys = false;
@@ -45,6 +47,7 @@ struct BetweenFrame {
   // not there) shaded anew; otherwise they show key `first`'s pixel there,
   // as a repeated frame would.
   bool shade_unseen = true;
+  int second = 1;  // with two_keys
 };
 
 struct BetweenReport {

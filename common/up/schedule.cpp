@@ -1,6 +1,7 @@
 #include "up/schedule.h"
 
 #include <algorithm>
+#include <cassert>
 
 #include <glm/geometric.hpp>
 
@@ -37,7 +38,10 @@ UpSchedule::UpSchedule(const config::UpConversion& settings) : settings_(setting
 void UpSchedule::forget() {
   first_.reset();
   second_.reset();
+  building_.reset();
 }
+
+void UpSchedule::drop_band() { building_.reset(); }
 
 void UpSchedule::checked(double psnr_y) {
   if (!settings_.adaptive()) return;
@@ -48,13 +52,27 @@ void UpSchedule::checked(double psnr_y) {
   }
 }
 
+int UpSchedule::free_slot() const {
+  for (int slot = 0; slot < slots(); ++slot) {
+    const bool used = (first_ && first_->slot == slot) || (second_ && second_->slot == slot) ||
+                      (building_ && building_->key.slot == slot);
+    if (!used) return slot;
+  }
+  assert(false && "more key frames than slots");
+  return 0;
+}
+
 UpPlan UpSchedule::key_now(std::uint64_t frame, const scene::SceneState& state, std::string_view why) {
   UpPlan plan;
   plan.draw_key = true;
   plan.why = why;
-  // A key drawn ahead for a later frame stays; this one takes the other slot.
+  // A key frame drawn in bands is begun again after this one (it may be of the
+  // other side of a cut, or late).
+  building_.reset();
+  // A key drawn ahead for a later frame stays; this one takes another slot.
   if (second_ && second_->frame <= frame) second_.reset();
-  plan.key_slot = second_ ? 1 - second_->slot : 0;
+  plan.key_slot = 0;
+  while (second_ && plan.key_slot == second_->slot) ++plan.key_slot;
   // Checked only a whole interval on: frames skipped or a cut say nothing of
   // how well the frames between follow the scene.
   if (settings_.adaptive() && first_ && first_->frame + static_cast<std::uint64_t>(ratio_) == frame &&
@@ -67,19 +85,68 @@ UpPlan UpSchedule::key_now(std::uint64_t frame, const scene::SceneState& state, 
 }
 
 UpPlan UpSchedule::plan(std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead) {
+  // A key frame whose last band was drawn is kept from this frame on.
+  if (building_ && building_->next == building_->count) {
+    if (settings_.mode == config::UpMode::extrapolate) {
+      first_ = std::move(building_->key);
+      building_.reset();
+    } else if (!second_) {
+      second_ = std::move(building_->key);
+      building_.reset();
+    }
+  }
   if (!first_ || frame <= first_->frame) {
     second_.reset();  // frames that go back start over: a key drawn ahead belongs to another run
     return key_now(frame, state, "first frame");
   }
-  if (settings_.mode == config::UpMode::interpolate) return interpolated(frame, state, ahead);
+  UpPlan plan =
+      settings_.mode == config::UpMode::interpolate ? interpolated(frame, state, ahead) : extrapolated(frame, state);
+  if (settings_.spread && !plan.draw_key) add_band(plan, frame, state, ahead);
+  return plan;
+}
+
+UpPlan UpSchedule::extrapolated(std::uint64_t frame, const scene::SceneState& state) {
   std::string_view why;
   if (!same_side(first_->state, state, &why)) return key_now(frame, state, why);
-  if (frame - first_->frame >= static_cast<std::uint64_t>(ratio_)) return key_now(frame, state, "ratio");
+  // Spread, a key frame is used from ratio to 2·ratio − 1 frames after its
+  // moment; older (frames were skipped), one is drawn now.
+  const int oldest = settings_.spread ? 2 * settings_.ratio : ratio_;
+  if (frame - first_->frame >= static_cast<std::uint64_t>(oldest)) return key_now(frame, state, "ratio");
   UpPlan plan;
   plan.between = true;
   plan.frame.method = settings_.method;
   plan.frame.first = first_->slot;
   return plan;
+}
+
+void UpSchedule::add_band(UpPlan& plan, std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead) {
+  // A key frame begun before a cut shows the other side: begun again.
+  if (building_ && !same_side(building_->key.state, state)) building_.reset();
+  if (!building_) {
+    if (settings_.mode == config::UpMode::extrapolate) {
+      // This frame's key frame, in the next ratio frames.
+      building_ = Building{Key{frame, free_slot(), state}, 0, ratio_};
+    } else {
+      // The key frame after the next, in the frames up to the one that shows
+      // the next: from the scene sent ahead for it.
+      if (!second_) return;
+      const std::uint64_t target = second_->frame + static_cast<std::uint64_t>(ratio_);
+      const scene::SceneState* later = ahead ? ahead(target) : nullptr;
+      if (later == nullptr || !same_side(second_->state, *later)) return;  // drawn at once when its turn comes
+      building_ = Building{Key{target, free_slot(), *later}, 0, static_cast<int>(second_->frame - frame) + 1};
+    }
+  }
+  Building& b = *building_;
+  plan.band = UpPlan::Band{b.key.slot, b.next, b.count, b.key.frame, &b.key.state};
+  ++b.next;
+  if (plan.band->last() && settings_.adaptive()) {
+    // How the frames between would have followed the scene to this key frame:
+    // from the key frame before it, a whole interval on.
+    const Key& before = settings_.mode == config::UpMode::extrapolate || !second_ ? *first_ : *second_;
+    if (before.frame + static_cast<std::uint64_t>(ratio_) == b.key.frame && same_side(before.state, b.key.state)) {
+      plan.check_slot = before.slot;
+    }
+  }
 }
 
 UpPlan UpSchedule::interpolated(std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead) {
@@ -103,9 +170,10 @@ UpPlan UpSchedule::interpolated(std::uint64_t frame, const scene::SceneState& st
     if (later == nullptr) return key_now(frame, state, "nothing ahead");
     std::string_view why;
     if (!same_side(first_->state, state, &why) && !same_side(*later, state)) return key_now(frame, state, why);
+    building_.reset();  // begun for another key frame after the next
     plan.draw_key = true;
     plan.ahead_frame = b;
-    plan.key_slot = 1 - first_->slot;
+    plan.key_slot = free_slot();
     if (settings_.adaptive() && b == last && same_side(first_->state, *later)) plan.check_slot = first_->slot;
     second_ = Key{b, plan.key_slot, *later};
     plan.key_state = &second_->state;
@@ -124,6 +192,7 @@ UpPlan UpSchedule::interpolated(std::uint64_t frame, const scene::SceneState& st
   const double t = static_cast<double>(frame - first_->frame) / span;
   if (from_first && from_second) {
     plan.frame.first = first_->slot;
+    plan.frame.second = second_->slot;
     plan.frame.two_keys = true;
     plan.frame.toward_second = t;
   } else {

@@ -11,6 +11,15 @@
 // whatever the ratio, where a kept one would mix two sides of a cut: a light
 // switched on or off, or the viewer's eye moved farther than kCutEyeJump.
 //
+// spread: each key frame is drawn a band of rows a frame over the frames before
+// it is needed, so that no frame pays for a whole key frame. extrapolate: the
+// key frame of a frame is drawn over that frame and the next ratio − 1, and
+// used from then on (the frames between come from a key frame ratio … 2·ratio
+// − 1 frames old); interpolate: the key frame after the next, from the scene
+// sent 2·ratio − 1 frames ahead, is drawn over the frames up to the one that
+// shows the next. A cut, or too little sent ahead, still draws a key frame at
+// once.
+//
 // Adaptive ratio: before each key frame that comes `ratio` frames after the
 // last is kept, the frame that key frame would have built at its moment is
 // checked against it (PSNR_Y as displayed): below the floor, the key frames
@@ -52,8 +61,21 @@ struct UpPlan {
   // schedule keeps it: valid until the next plan() or forget().
   const scene::SceneState* key_state = nullptr;
   // Before keeping it: how far the frame between from key `check_slot` would
-  // have been from it, for the adaptive ratio (UpSchedule::checked).
+  // have been from it, for the adaptive ratio (UpSchedule::checked). With
+  // spread key frames, when the band that completes one is drawn.
   std::optional<int> check_slot;
+  // Spread key frames: band `index` of `count` (rows of the image, from the
+  // bottom) of the key frame of frame `frame`, drawn from `state` into key slot
+  // `slot`. After the last band it is kept: frames from the next on use it.
+  struct Band {
+    int slot = 0;
+    int index = 0;
+    int count = 1;
+    std::uint64_t frame = 0;
+    const scene::SceneState* state = nullptr;  // valid until the next plan() or forget()
+    [[nodiscard]] bool last() const { return index + 1 == count; }
+  };
+  std::optional<Band> band;
   // Build this frame from the kept keys (frame.first is the earlier one).
   bool between = false;
   BetweenFrame frame;
@@ -82,8 +104,15 @@ class UpSchedule {
   // not be drawn, another share of the lights): the next frame is a key frame.
   void forget();
 
+  // The band of the plan could not be drawn (its key frame's moment cannot be
+  // seen): that key frame is dropped, the next is begun on a later frame.
+  void drop_band();
+
   // Display frames per key frame now (the adaptive ratio's; `ratio` when fixed).
   [[nodiscard]] int ratio() const { return ratio_; }
+  // Key slots the plans use: three with spread key frames, otherwise two.
+  [[nodiscard]] int slots() const { return slots_for(settings_); }
+  [[nodiscard]] static int slots_for(const config::UpConversion& settings) { return settings.spread ? kKeySlots : 2; }
   [[nodiscard]] const config::UpConversion& settings() const { return settings_; }
 
  private:
@@ -92,13 +121,23 @@ class UpSchedule {
     int slot = 0;
     scene::SceneState state;
   };
+  struct Building {
+    Key key;
+    int next = 0;  // the band drawn next
+    int count = 1;
+  };
   [[nodiscard]] UpPlan key_now(std::uint64_t frame, const scene::SceneState& state, std::string_view why);
+  [[nodiscard]] UpPlan extrapolated(std::uint64_t frame, const scene::SceneState& state);
   [[nodiscard]] UpPlan interpolated(std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead);
+  // Spread: the next band of the key frame being drawn, begun here if none is.
+  void add_band(UpPlan& plan, std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead);
+  [[nodiscard]] int free_slot() const;
 
   config::UpConversion settings_;
   int ratio_ = 1;
-  std::optional<Key> first_;   // the key frame shown last (extrapolate: the only one)
-  std::optional<Key> second_;  // interpolate: the one drawn ahead
+  std::optional<Key> first_;          // the key frame shown last (extrapolate: the only one)
+  std::optional<Key> second_;         // interpolate: the one drawn ahead
+  std::optional<Building> building_;  // spread: the key frame drawn a band a frame
 };
 
 // Whether a frame showing `state` may be built from a key frame of `key`: no

@@ -38,23 +38,27 @@ struct StackedRun {
 
 // A shipped config at `rate` Hz: at 3 Hz the statue turns 0.1 rad between
 // frames, about eight screen pixels at its corners, so a frame's lag shows
-// plainly.
-std::string slow_config(const std::string& dir, const std::string& shipped, int rate) {
+// plainly. With `spread`, its interpolating node draws key frames a band a frame.
+std::string slow_config(const std::string& dir, const std::string& shipped, int rate, bool spread) {
   std::string json = read_file(shipped);
-  const std::string at_60 = "\"frame_rate\": 60";
-  const auto at = json.find(at_60);
-  EXPECT_NE(at, std::string::npos);
-  json.replace(at, at_60.size(), "\"frame_rate\": " + std::to_string(rate));
+  const auto replace = [&](const std::string& what, const std::string& with) {
+    const auto at = json.find(what);
+    EXPECT_NE(at, std::string::npos) << what;
+    if (at != std::string::npos) json.replace(at, what.size(), with);
+  };
+  replace("\"frame_rate\": 60", "\"frame_rate\": " + std::to_string(rate));
+  if (spread) replace("\"mode\": \"interpolate\"}", "\"mode\": \"interpolate\", \"spread\": true}");
   const std::string path = dir + "/stacked.json";
   std::ofstream(path) << json;
   return path;
 }
 
 StackedRun run_cluster(const std::string& lagging_node, const std::string& shipped = kConfig, int rate = 3,
-                       std::uint64_t frames = kFrames, std::uint64_t capture_every = kCaptureEvery) {
+                       std::uint64_t frames = kFrames, std::uint64_t capture_every = kCaptureEvery,
+                       bool spread = false) {
   StackedRun run;
   const std::string dir = make_temp_dir("optique-coherence");
-  const std::string config = slow_config(dir, shipped, rate);
+  const std::string config = slow_config(dir, shipped, rate, spread);
   run.out = dir + "/out";
   Process master(
       {kMaster, "--config", config, "--listen", "127.0.0.1", "--port", "0", "--port-file", dir + "/port", "--out",
@@ -144,6 +148,25 @@ TEST(StackedCoherence, ANodeThatUpConvertsStillAddsUpWithItsPartners) {
             << " µs, between with a key frame ahead " << up.between_and_ahead_render_us().median() << " µs\n";
   EXPECT_EQ(static_cast<std::uint64_t>(up.key_frames_size()) + up.frames_between(), kUpFrames);
   EXPECT_GE(up.frames_between(), kUpFrames / 2) << "most frames built between key frames";
+
+  // The same node drawing its key frames a band a frame: the master sends the
+  // scene 7 frames ahead; key frames are drawn at once until those reach far
+  // enough (frames 0-3), then only shown (7, 11).
+  const StackedRun spread =
+      run_cluster("", std::string(OPTIQUE_SOURCE_DIR) + "/configs/stacked-upconversion.json", 15, kUpFrames, 3, true);
+  ASSERT_TRUE(spread.summary.error.empty()) << spread.summary.error;
+  ASSERT_EQ(spread.psnr_db.size(), every.psnr_db.size());
+  for (std::size_t i = 0; i < spread.psnr_db.size(); ++i) {
+    std::cout << "spread, frame " << (i + 1) * 3 << ": composite vs reference " << spread.psnr_db[i] << " dB\n";
+    EXPECT_GE(spread.psnr_db[i], 40.0);
+    EXPECT_GE(spread.psnr_db[i], every.psnr_db[i] - 8.0);
+  }
+  EXPECT_EQ(spread.summary.report.sync().frames_incoherent(), 0u);
+  for (const auto& node : spread.summary.report.nodes()) EXPECT_EQ(node.frames_presented(), kUpFrames) << node.id();
+  const report::UpConversionReport& banded = spread.summary.report.nodes(0).up_conversion();
+  const std::vector<std::uint64_t> keys(banded.key_frames().begin(), banded.key_frames().end());
+  EXPECT_EQ(keys, (std::vector<std::uint64_t>{0, 1, 2, 3, 7, 11}));
+  EXPECT_EQ(banded.frames_between(), kUpFrames - 6);
 }
 
 }  // namespace

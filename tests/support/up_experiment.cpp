@@ -34,7 +34,8 @@ std::string installation_json(const StageScene& scene, const Run& run, int width
        << width << R"(, "height": )" << height << R"(, "screen": "stage")";
   if (up_converts) {
     json << R"(, "up_conversion": {"ratio": )" << run.ratio << R"(, "method": ")" << config::to_string(run.method)
-         << R"(", "mode": ")" << config::to_string(run.mode) << R"(", "min_psnr": )" << run.min_psnr << "}";
+         << R"(", "mode": ")" << config::to_string(run.mode) << R"(", "min_psnr": )" << run.min_psnr
+         << R"(, "spread": )" << (run.spread ? "true" : "false") << "}";
   }
   json << R"(}],
     "viewer": )";
@@ -127,7 +128,8 @@ Result<SceneResult> measure(const StageScene& stage, const Run& run, int frames,
                                          master::LightSwitches::from_config(inst.scene));
   const auto first = static_cast<std::uint64_t>(std::llround(stage.start * inst.master.frame_rate));
 
-  // What the master sends ahead: each frame, the state ratio − 1 frames on.
+  // What the master sends ahead: each frame, the state frames_ahead() frames on.
+  const int frames_ahead = inst.projectors.front().up_conversion.frames_ahead();
   std::map<std::uint64_t, scene::SceneState> sent;
   SceneResult result;
   std::vector<double> full_ms, key_ms, between_ms, ahead_ms, all_ms;
@@ -138,8 +140,8 @@ Result<SceneResult> measure(const StageScene& stage, const Run& run, int frames,
   for (int i = 0; i < frames; ++i) {
     const std::uint64_t n = first + static_cast<std::uint64_t>(i);
     const scene::SceneState state = authority.state_at_frame(n);
-    if (run.mode == config::UpMode::interpolate) {
-      const std::uint64_t ahead = n + static_cast<std::uint64_t>(run.ratio) - 1;
+    if (frames_ahead > 0) {
+      const std::uint64_t ahead = n + static_cast<std::uint64_t>(frames_ahead);
       sent[ahead] = authority.state_at_frame(ahead);
       while (!sent.empty() && sent.begin()->first < n) sent.erase(sent.begin());
     }
@@ -170,6 +172,7 @@ Result<SceneResult> measure(const StageScene& stage, const Run& run, int frames,
                       report.ratio};
     full_ms.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
     all_ms.push_back(frame.ms);
+    if (i >= 2 * run.ratio) result.steady_max_ms = std::max(result.steady_max_ms, frame.ms);
     if (frame.kind == up::FrameKind::between) {
       (report.drew_key_ahead ? ahead_ms : between_ms).push_back(frame.ms);
       ++betweens;

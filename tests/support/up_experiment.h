@@ -50,6 +50,7 @@ struct Run {
   config::UpMode mode = config::UpMode::interpolate;
   int ratio = 4;
   double min_psnr = 0.0;  // 0: the ratio fixed
+  bool spread = false;    // key frames drawn a band a frame
 };
 
 struct FrameResult {
@@ -73,7 +74,11 @@ struct SceneResult {
   double between_ms = 0.0;            // a frame between alone
   double between_and_ahead_ms = 0.0;  // one that also drew the next key frame ahead
   double per_display_frame_ms = 0.0;  // the mean over all display frames
-  image::FloatImage hardest_image;    // the hardest frame, its full render and their difference
+  // The costliest display frame once started (after the first 2·ratio frames,
+  // where interpolation draws key frames at once until the scenes sent ahead
+  // reach far enough): what a frame rate must allow.
+  double steady_max_ms = 0.0;
+  image::FloatImage hardest_image;  // the hardest frame, its full render and their difference
   image::FloatImage hardest_reference;
 };
 

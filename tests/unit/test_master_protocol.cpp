@@ -240,12 +240,15 @@ TEST_F(MasterTest, FramesStartWhenAllAreUpAndSwapWhenAllAreReady) {
 }
 
 // A node that interpolates gets, with each frame, the scene ratio − 1 frames
-// on (the scene is a function of time); the others get the frame alone. What
+// on (the scene is a function of time; 2·ratio − 1 where it draws its key
+// frames a band a frame); the others get the frame alone. What
 // the nodes say of how they drew each frame ends in the run report.
 TEST_F(MasterTest, ANodeThatInterpolatesGetsTheSceneAheadAndItsKeyFramesAreReported) {
   load("powerwall-2x2.json", [](config::Installation& inst) {
     inst.projectors[1].up_conversion = {4, config::UpMethod::motion, config::UpMode::interpolate};
     inst.projectors[2].up_conversion = {3, config::UpMethod::motion, config::UpMode::extrapolate};
+    inst.projectors[3].up_conversion = {4, config::UpMethod::motion, config::UpMode::interpolate,
+                                        config::kDefaultMinPsnr, true};
   });
   Actions a = join_all();
   ASSERT_TRUE(master_->running());
@@ -254,6 +257,8 @@ TEST_F(MasterTest, ANodeThatInterpolatesGetsTheSceneAheadAndItsKeyFramesAreRepor
   EXPECT_FALSE(begin_of(3).has_ahead()) << "extrapolation needs nothing ahead";
   ASSERT_TRUE(begin_of(2).has_ahead());
   EXPECT_EQ(begin_of(2).ahead_frame(), 3u);
+  ASSERT_TRUE(begin_of(4).has_ahead());
+  EXPECT_EQ(begin_of(4).ahead_frame(), 7u) << "key frames drawn a band a frame: the one after the next";
   auto ahead = scene::from_snapshot(begin_of(2).ahead());
   ASSERT_TRUE(ahead) << ahead.error();
   const master::SceneAuthority authority(run_.scene.definition.objects, run_.config.installation.viewer,

@@ -451,8 +451,8 @@ TEST_F(NodeTest, BadFrameInputClosesTheConnection) {
 
 // A node that interpolates gets a later frame's scene with a frame: checked and
 // handed to the renderer beside the frame's own; how the frame was drawn goes
-// back in FrameReady. A scene for a frame not ahead, or beyond the largest
-// ratio, or not a valid snapshot, closes the connection by name.
+// back in FrameReady. A scene for a frame not ahead, or beyond what the largest
+// ratio with spread key frames needs, or not a valid snapshot, closes the connection by name.
 TEST_F(NodeTest, TheSceneSentAheadReachesTheRendererAndHowTheFrameWasDrawnGoesBack) {
   NodeProtocol node(settings());
   join(node);
@@ -490,8 +490,8 @@ TEST_F(NodeTest, TheSceneSentAheadReachesTheRendererAndHowTheFrameWasDrawnGoesBa
     EXPECT_NE(first<Close>(closed)->reason.find(says), std::string::npos) << first<Close>(closed)->reason;
     EXPECT_EQ(first<Render>(closed), nullptr);
   };
-  refused(0, 0, 0.0, "the scene sent ahead is for frame 0, not 1…16 frames on");
-  refused(0, 17, 0.0, "not 1…16 frames on");
+  refused(0, 0, 0.0, "the scene sent ahead is for frame 0, not 1…31 frames on");
+  refused(0, 32, 0.0, "not 1…31 frames on");
   refused(0, 2, std::numeric_limits<double>::quiet_NaN(), "the scene sent ahead:");
 }
 

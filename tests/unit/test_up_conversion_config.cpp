@@ -41,6 +41,8 @@ TEST(UpConversion, DefaultsToMotionExtrapolatedAndAbsentIsOff) {
   EXPECT_EQ(up.min_psnr, kDefaultMinPsnr);
   EXPECT_TRUE(up.adaptive());
   EXPECT_TRUE(up.enabled());
+  EXPECT_FALSE(up.spread) << "a key frame drawn at once unless asked";
+  EXPECT_EQ(up.frames_ahead(), 0) << "extrapolation needs nothing sent ahead";
   const auto fixed = with(R"({"ratio": 4, "min_psnr": 0})");
   ASSERT_TRUE(fixed) << fixed.error();
   EXPECT_FALSE(fixed.value().projectors[0].up_conversion.adaptive());
@@ -70,10 +72,27 @@ TEST(UpConversion, TheAverageNeedsTheKeyFrameAfter) {
   EXPECT_TRUE(with(R"({"ratio": 4, "method": "average", "mode": "interpolate"})"));
 }
 
+// Interpolation needs the next key frame's scene ratio − 1 frames ahead; drawn
+// a band a frame, the one after it, 2·ratio − 1 ahead.
+TEST(UpConversion, HowFarAheadTheSceneIsSent) {
+  const auto at_once = with(R"({"ratio": 4, "mode": "interpolate"})");
+  ASSERT_TRUE(at_once) << at_once.error();
+  EXPECT_EQ(at_once.value().projectors[0].up_conversion.frames_ahead(), 3);
+  const auto spread = with(R"({"ratio": 16, "mode": "interpolate", "spread": true})");
+  ASSERT_TRUE(spread) << spread.error();
+  EXPECT_TRUE(spread.value().projectors[0].up_conversion.spread);
+  EXPECT_EQ(spread.value().projectors[0].up_conversion.frames_ahead(), kMostFramesAhead);
+  const auto extrapolated = with(R"({"ratio": 4, "spread": true})");
+  ASSERT_TRUE(extrapolated) << extrapolated.error();
+  EXPECT_EQ(extrapolated.value().projectors[0].up_conversion.frames_ahead(), 0);
+}
+
 TEST(UpConversion, AWelcomeCarriesIt) {
-  const auto parsed = with(R"({"ratio": 3, "method": "average", "mode": "interpolate", "min_psnr": 42})");
+  const auto parsed =
+      with(R"({"ratio": 3, "method": "average", "mode": "interpolate", "min_psnr": 42, "spread": true})");
   ASSERT_TRUE(parsed) << parsed.error();
   EXPECT_EQ(parsed.value().projectors[0].up_conversion.min_psnr, 42.0);
+  EXPECT_TRUE(parsed.value().projectors[0].up_conversion.spread);
   const auto again = parse_installation(to_schema(parsed.value()), ::testing::TempDir(), "welcome");
   ASSERT_TRUE(again) << again.error();
   EXPECT_EQ(again.value().projectors[0].up_conversion, parsed.value().projectors[0].up_conversion);

@@ -13,11 +13,13 @@
 namespace optique::up {
 namespace {
 
-config::UpConversion settings(int ratio, config::UpMode mode = config::UpMode::extrapolate, double min_psnr = 0.0) {
+config::UpConversion settings(int ratio, config::UpMode mode = config::UpMode::extrapolate, double min_psnr = 0.0,
+                              bool spread = false) {
   config::UpConversion s;
   s.ratio = ratio;
   s.mode = mode;
   s.min_psnr = min_psnr;
+  s.spread = spread;
   return s;
 }
 
@@ -30,7 +32,8 @@ scene::SceneState state_at(std::uint64_t frame) {
 }
 
 // The plans' kinds in a line: K (drawn now), A<frame> (drawn ahead) then B
-// (between), B1/B2 (from one or two key frames), S (shown as drawn ahead).
+// (between), B1/B2 (from one or two key frames), S (shown as drawn ahead);
+// |<index> a band of a spread key frame, ! its last.
 std::string kinds(UpSchedule& schedule, std::uint64_t from, std::uint64_t to,
                   const std::map<std::uint64_t, scene::SceneState>& states = {}) {
   std::string out;
@@ -40,8 +43,8 @@ std::string kinds(UpSchedule& schedule, std::uint64_t from, std::uint64_t to,
   };
   std::map<std::uint64_t, scene::SceneState> sent;
   for (std::uint64_t f = from; f <= to; ++f) {
-    // The master sends each frame the state `ratio` − 1 frames ahead.
-    const std::uint64_t ahead = f + static_cast<std::uint64_t>(schedule.settings().ratio) - 1;
+    // The master sends each frame the state frames_ahead() frames ahead.
+    const std::uint64_t ahead = f + static_cast<std::uint64_t>(std::max(1, schedule.settings().frames_ahead()));
     sent[ahead] = state(ahead);
     const UpPlan p = schedule.plan(f, state(f), [&](std::uint64_t g) -> const scene::SceneState* {
       const auto found = sent.find(g);
@@ -52,6 +55,7 @@ std::string kinds(UpSchedule& schedule, std::uint64_t from, std::uint64_t to,
     if (p.ahead_frame) out += "A" + std::to_string(*p.ahead_frame);
     if (p.between) out += p.frame.two_keys ? "B2" : "B1";
     if (p.shown_slot) out += 'S';
+    if (p.band) out += "|" + std::to_string(p.band->index) + (p.band->last() ? "!" : "");
   }
   return out;
 }
@@ -194,6 +198,92 @@ TEST(UpSchedule, NoFrameBetweenMixesTheTwoSidesOfACut) {
   const UpPlan three = check.plan(3, states[3], lookup);
   EXPECT_EQ(three.frame.first, one.key_slot) << "after the switch: the key frame drawn ahead";
   EXPECT_FALSE(three.frame.two_keys);
+}
+
+// Spread, extrapolated: the key frame of a frame is drawn a band a frame over it
+// and the next ratio − 1 frames, then used; every frame between draws a band,
+// into a slot no frame between reads.
+TEST(UpSchedule, SpreadKeyFramesAreDrawnABandAFrame) {
+  UpSchedule schedule(settings(4, config::UpMode::extrapolate, 0.0, true));
+  EXPECT_EQ(schedule.slots(), 3);
+  EXPECT_EQ(kinds(schedule, 0, 10), "K B1|0 B1|1 B1|2 B1|3! B1|0 B1|1 B1|2 B1|3! B1|0 B1|1");
+  UpSchedule again(settings(4, config::UpMode::extrapolate, 0.0, true));
+  const UpPlan key = again.plan(0, state_at(0));
+  std::vector<UpPlan> plans;
+  for (std::uint64_t f = 1; f <= 9; ++f) plans.push_back(again.plan(f, state_at(f)));
+  for (const UpPlan& p : plans) {
+    ASSERT_TRUE(p.band);
+    EXPECT_NE(p.band->slot, p.frame.first) << "a band never lands in the key frame a frame between reads";
+  }
+  EXPECT_EQ(plans[0].frame.first, key.key_slot);
+  EXPECT_EQ(plans[0].band->frame, 1u) << "the key frame of the frame its first band is drawn with";
+  EXPECT_EQ(plans[3].frame.first, key.key_slot) << "frame 4 still from frame 0's key frame";
+  EXPECT_EQ(plans[4].frame.first, plans[0].band->slot) << "frame 5 from frame 1's, drawn over frames 1-4";
+  EXPECT_EQ(plans[8].frame.first, plans[4].band->slot) << "frame 9 from frame 5's";
+  // Without spread, two slots.
+  EXPECT_EQ(UpSchedule(settings(4)).slots(), 2);
+}
+
+// A cut while a key frame is drawn in bands: the key frame is drawn at once and
+// the bands begin again from the new side. Frames skipped past twice the ratio
+// draw one at once too.
+TEST(UpSchedule, ACutOrSkippedFramesBeginTheBandsAgain) {
+  std::map<std::uint64_t, scene::SceneState> states;
+  for (std::uint64_t f = 3; f <= 12; ++f) states[f] = state_at(f), states[f].lights_off = {1};
+  UpSchedule schedule(settings(4, config::UpMode::extrapolate, 0.0, true));
+  EXPECT_EQ(kinds(schedule, 0, 9, states), "K B1|0 B1|1 K B1|0 B1|1 B1|2 B1|3! B1|0 B1|1");
+  EXPECT_EQ(schedule.plan(18, states[12]).why, "ratio") << "frame 8's key frame is ten frames old";
+}
+
+// Spread, interpolated: the key frame after the next is drawn, from the scene
+// sent 2·ratio − 1 frames ahead, over the frames up to the one that shows the
+// next. Until the scenes sent ahead reach that far (the first frames), key
+// frames are drawn at once.
+TEST(UpSchedule, SpreadInterpolationDrawsTheKeyFrameAfterTheNext) {
+  UpSchedule schedule(settings(4, config::UpMode::interpolate, 0.0, true));
+  EXPECT_EQ(schedule.settings().frames_ahead(), 7);
+  EXPECT_EQ(kinds(schedule, 0, 16), "K K K K A7B2 B2|0 B2|1 S|2! B2|0 B2|1 B2|2 S|3! B2|0 B2|1 B2|2 S|3! B2|0");
+  UpSchedule again(settings(4, config::UpMode::interpolate, 0.0, true));
+  std::map<std::uint64_t, scene::SceneState> sent;
+  const auto lookup = [&](std::uint64_t f) -> const scene::SceneState* {
+    return sent.contains(f) ? &sent[f] : nullptr;
+  };
+  std::vector<UpPlan> plans;
+  for (std::uint64_t f = 0; f <= 12; ++f) {
+    sent[f + 7] = state_at(f + 7);
+    plans.push_back(again.plan(f, state_at(f), lookup));
+    if (f == 5) {  // the state is the schedule's until the next plan
+      ASSERT_TRUE(plans[5].band);
+      EXPECT_EQ(plans[5].band->frame, 11u);
+      ASSERT_NE(plans[5].band->state, nullptr);
+      EXPECT_EQ(plans[5].band->state->eye_now, state_at(11).eye_now);
+    }
+  }
+  for (int f = 8; f <= 10; ++f) {
+    ASSERT_TRUE(plans[f].between);
+    EXPECT_TRUE(plans[f].frame.two_keys);
+    EXPECT_EQ(plans[f].frame.first, plans[4].key_slot) << "frame " << f << " from the key frame shown at 7";
+    EXPECT_EQ(plans[f].frame.second, plans[5].band->slot) << "and frame 11's, drawn over frames 5-7";
+    EXPECT_NE(plans[f].band->slot, plans[f].frame.first);
+    EXPECT_NE(plans[f].band->slot, plans[f].frame.second);
+  }
+  EXPECT_DOUBLE_EQ(plans[9].frame.toward_second, 0.5);
+  EXPECT_EQ(plans[11].shown_slot, plans[5].band->slot);
+}
+
+// The adaptive check with spread key frames: with the band that completes one,
+// from the key frame a whole interval before it.
+TEST(UpSchedule, SpreadKeyFramesAreCheckedWhenComplete) {
+  UpSchedule schedule(settings(4, config::UpMode::extrapolate, 30.0, true));
+  std::vector<UpPlan> plans;
+  for (std::uint64_t f = 0; f <= 8; ++f) plans.push_back(schedule.plan(f, state_at(f)));
+  EXPECT_FALSE(plans[4].check_slot) << "frame 1's key frame is one frame after frame 0's";
+  ASSERT_TRUE(plans[8].band && plans[8].band->last());
+  ASSERT_TRUE(plans[8].check_slot);
+  EXPECT_EQ(*plans[8].check_slot, plans[4].band->slot) << "frame 5's key frame against frame 1's";
+  schedule.checked(20.0);
+  EXPECT_EQ(schedule.ratio(), 3);
+  EXPECT_EQ(kinds(schedule, 9, 12), "B1|0 B1|1 B1|2! B1|0") << "the next key frame in three bands";
 }
 
 }  // namespace

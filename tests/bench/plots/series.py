@@ -236,12 +236,13 @@ def fields(rows):
 
 def upconversion(rows):
     """One block per way in the bench's order (average at 4:1, then motion
-    interpolated and extrapolated at each ratio), one line per scene in order:
+    interpolated and extrapolated at each ratio, then both at 4:1 with the key
+    frames spread), one line per scene in order:
     scene index, cost per display frame ÷ every frame drawn (median, min, max
     over runs), PSNR_Y of the frames between (the first run; it does not vary)."""
     ways, scenes = [], []
     for r in rows:
-        way = (r["method"], r["mode"], r["ratio"])
+        way = (r["method"], r["mode"], r["ratio"], r["spread"])
         if way not in ways:
             ways.append(way)
         if r["scene"] not in scenes:
@@ -250,7 +251,7 @@ def upconversion(rows):
     for way in ways:
         block = []
         for i, scene in enumerate(scenes):
-            mine = [r for r in rows if r["scene"] == scene and (r["method"], r["mode"], r["ratio"]) == way]
+            mine = [r for r in rows if r["scene"] == scene and (r["method"], r["mode"], r["ratio"], r["spread"]) == way]
             if not mine:
                 continue
             psnr = float(mine[0]["psnr_y_db"])
