@@ -79,6 +79,8 @@ std::string_view to_string(FieldMethod method) {
       return "per-field";
     case FieldMethod::gather:
       return "gather";
+    case FieldMethod::up_conversion:
+      return "up-conversion";
     case FieldMethod::off:
       return "off";
   }
@@ -100,8 +102,11 @@ ColorFields parse_color_fields(const schema::ColorFields& c, const std::string& 
     out.method = FieldMethod::off;
   } else if (c.method() == "gather") {
     out.method = FieldMethod::gather;
+  } else if (c.method() == "up-conversion") {
+    out.method = FieldMethod::up_conversion;
   } else if (!c.method().empty() && c.method() != "per-field") {
-    problems.push_back({path + ".method", "must be per-field, gather or off (got '" + c.method() + "')"});
+    problems.push_back(
+        {path + ".method", "must be per-field, gather, up-conversion or off (got '" + c.method() + "')"});
   }
   if (c.gather_samples() != 0) {
     if (c.gather_samples() < kMinGatherSamples || c.gather_samples() > kMaxGatherSamples) {
@@ -116,6 +121,11 @@ ColorFields parse_color_fields(const schema::ColorFields& c, const std::string& 
   if (!std::isfinite(c.velocity_threshold()) || c.velocity_threshold() < 0.0) {
     problems.push_back({path + ".velocity_threshold", "must be 0 (none) or more, screen pixels per frame period (got " +
                                                           number_text(c.velocity_threshold()) + ")"});
+  } else if (out.method == FieldMethod::up_conversion && c.velocity_threshold() > 0.0) {
+    problems.push_back({path + ".velocity_threshold",
+                        "blurs what is too fast to follow with per-field or gather; up-conversion builds every "
+                        "field at its moment: leave it 0 (got " +
+                            number_text(c.velocity_threshold()) + ")"});
   } else {
     out.velocity_threshold = c.velocity_threshold();
   }

@@ -16,9 +16,12 @@ namespace optique::config {
 
 enum class Channel { red, green, blue };
 // per_field: one render per field; gather: one render with screen-space
-// velocity and depth, each field gathered from it along the motion; off: every
+// velocity and depth, each field gathered from it along the motion;
+// up_conversion: one render, each other field built from it at its moment as
+// frame-rate up-conversion builds a frame between key frames (an exact per-
+// pixel motion field; what the render did not see shaded anew); off: every
 // colour at the display time.
-enum class FieldMethod { per_field, gather, off };
+enum class FieldMethod { per_field, gather, up_conversion, off };
 
 [[nodiscard]] std::string_view to_string(Channel channel);
 [[nodiscard]] std::string_view to_string(FieldMethod method);
@@ -49,6 +52,8 @@ struct ColorFields {
   [[nodiscard]] bool sequential() const { return !fields.empty() && method != FieldMethod::off; }
   // Whether they are gathered from one render (the velocity target and tiles).
   [[nodiscard]] bool gathers() const { return sequential() && method == FieldMethod::gather; }
+  // Whether they are built from one render by up-conversion (its key slots and passes).
+  [[nodiscard]] bool up_converts() const { return sequential() && method == FieldMethod::up_conversion; }
   // Whether what is faster than the threshold gets motion blur (either method).
   [[nodiscard]] bool blurs() const { return sequential() && velocity_threshold > 0.0; }
   // Whether it needs each pixel's velocity: to gather, or to blur.

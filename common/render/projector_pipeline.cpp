@@ -62,9 +62,9 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
       return Error{"projector '" + self.id + "': " + gather.error()};
     }
   }
-  if (self.up_conversion.enabled()) {
-    if (auto prepared = renderer.value()->prepare_up_conversion(up::UpSchedule::slots_for(self.up_conversion));
-        !prepared) {
+  if (self.up_conversion.enabled() || self.color_fields.up_converts()) {
+    const int slots = self.up_conversion.enabled() ? up::UpSchedule::slots_for(self.up_conversion) : 2;
+    if (auto prepared = renderer.value()->prepare_up_conversion(slots); !prepared) {
       return Error{"projector '" + self.id + "': " + prepared.error()};
     }
   }
@@ -154,6 +154,27 @@ Result<void> ProjectorPipeline::draw_image(const scene::SceneState& state, int i
     return image == 0 ? draw(state, 0.0) : Result<void>{};
   }
   if (color_fields_.gathers()) return draw_gathered(state, image);
+  if (color_fields_.up_converts()) return draw_fields_up_converted(state, image);
+  auto passes = field_passes(state, image);
+  if (!passes) return Error{passes.error()};
+  if (!color_fields_.blurs()) {
+    (void)renderer_->draw_fields(state, passes.value(), terms_, still_once_);
+    return {};
+  }
+  // What is faster than the threshold gets motion blur over the image's time on
+  // screen, from a render at its middle.
+  const double share = 1.0 / images();
+  auto blur = gather_frame(state, image, -0.5 + (image + 0.5) * share);
+  if (!blur) {
+    renderer_->draw_black();
+    return Error{blur.error()};
+  }
+  blur.value().fields.clear();
+  add(renderer_->draw_fields(state, passes.value(), terms_, still_once_, &blur.value()));
+  return {};
+}
+
+Result<std::vector<FieldPass>> ProjectorPipeline::field_passes(const scene::SceneState& state, int image) {
   std::vector<FieldPass> passes;
   for (const config::ColorField& field : color_fields_.fields) {
     if (field.image != image) continue;
@@ -167,20 +188,24 @@ Result<void> ProjectorPipeline::draw_image(const scene::SceneState& state, int i
     pass.value().blue = field.channel == config::Channel::blue;
     passes.push_back(pass.value());
   }
-  if (!color_fields_.blurs()) {
-    (void)renderer_->draw_fields(state, passes, terms_, still_once_);
-    return {};
+  return passes;
+}
+
+Result<void> ProjectorPipeline::draw_fields_up_converted(const scene::SceneState& state, int image) {
+  // One render per frame, at the green fields' moment (as the gather): green is
+  // shown as drawn; every other field, the second image's all, built from it.
+  std::optional<FieldPass> key;
+  if (image == 0) {
+    auto pass = moment(state, gather_moment());
+    if (!pass) {
+      renderer_->draw_black();
+      return Error{pass.error()};
+    }
+    key = pass.value();
   }
-  // What is faster than the threshold gets motion blur over the image's time on
-  // screen, from a render at its middle.
-  const double share = 1.0 / images();
-  auto blur = gather_frame(state, image, -0.5 + (image + 0.5) * share);
-  if (!blur) {
-    renderer_->draw_black();
-    return Error{blur.error()};
-  }
-  blur.value().fields.clear();
-  add(renderer_->draw_fields(state, passes, terms_, still_once_, &blur.value()));
+  auto passes = field_passes(state, image);
+  if (!passes) return Error{passes.error()};
+  fields_shaded_anew_ = renderer_->draw_fields_up_converted(state, key ? &*key : nullptr, passes.value(), terms_);
   return {};
 }
 
@@ -321,6 +346,13 @@ void ProjectorPipeline::warm_up() {
         frame.two_keys = two;
         (void)renderer_->draw_between(scene::SceneState{}, 0.0, in_front, f, frame, terms_);
       }
+    }
+    if (color_fields_.up_converts()) {  // one field at the render's moment, one built from it
+      FieldPass key{true, true, true, 0.0, in_front, frustum.value()};
+      FieldPass other = key;
+      other.fraction = 0.5;
+      other.green = other.blue = false;
+      (void)renderer_->draw_fields_up_converted(scene::SceneState{}, &key, {&other, 1});
     }
     if (color_fields_.needs_velocity()) {
       // The velocity program and the tile passes too (the field pass itself

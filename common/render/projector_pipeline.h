@@ -101,6 +101,9 @@ class ProjectorPipeline {
   [[nodiscard]] Result<void> draw_frame(const scene::SceneState& state, const ImageDrawn& drawn = {},
                                         const DisplayFrame* display = nullptr);
   [[nodiscard]] const UpReport& up_report() const { return up_report_; }
+  // Colour fields by up-conversion: the share of pixels the last image's fields
+  // shaded anew (what the one render did not see), summed over its fields.
+  [[nodiscard]] double fields_shaded_anew() const { return fields_shaded_anew_; }
   // Images per frame: 1, or 2 (config::ColorFields::images).
   [[nodiscard]] int images() const { return color_fields_.images; }
   // Where image `image` of the last frame drawn is, to show it.
@@ -133,6 +136,10 @@ class ProjectorPipeline {
   void add(const GatherReport& report);  // to the frame's gather_report()
   [[nodiscard]] Result<void> draw_gathered(const scene::SceneState& state, int image);
   [[nodiscard]] Result<void> draw_up_converted(const scene::SceneState& state, const DisplayFrame& display);
+  [[nodiscard]] Result<void> draw_fields_up_converted(const scene::SceneState& state, int image);
+  // Image `image`'s fields, each at its moment with its channels; a moment that
+  // cannot be seen draws black and fails.
+  [[nodiscard]] Result<std::vector<FieldPass>> field_passes(const scene::SceneState& state, int image);
 
   ProjectorView view_;
   std::unique_ptr<SceneRenderer> renderer_;
@@ -148,6 +155,7 @@ class ProjectorPipeline {
   std::optional<up::UpSchedule> schedule_;  // projectors that up-convert
   std::uint64_t next_frame_ = 0;            // without a DisplayFrame
   UpReport up_report_;
+  double fields_shaded_anew_ = 0.0;
 };
 
 }  // namespace optique::render

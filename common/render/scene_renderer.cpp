@@ -595,6 +595,35 @@ void SceneRenderer::draw_key_band(const scene::SceneState& state, double fractio
                              {state, fraction, frustum.projection * frustum.view}, first_row, rows);
 }
 
+double SceneRenderer::draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key,
+                                               std::span<const FieldPass> passes, const LightTerms& terms) {
+  Gl& gl = *gl_;
+  assert(gl.up_converter);  // prepare_up_conversion first
+  UpConverter& converter = *gl.up_converter;
+  if (key != nullptr) {
+    begin_linear();
+    draw_scene(state, key->fraction, key->eye, key->frustum, terms);
+    resolve();
+    converter.keep(0, gl.linear_colour.get(), gl.depth.get(),
+                   {state, key->fraction, key->frustum.projection * key->frustum.view});
+  }
+  const auto at_key = [&](const FieldPass& pass) {
+    return key != nullptr && pass.fraction == key->fraction && pass.eye == key->eye &&
+           pass.frustum.view == key->frustum.view && pass.frustum.projection == key->frustum.projection;
+  };
+  double unseen = 0.0;
+  for (const FieldPass& pass : passes) {
+    if (at_key(pass)) continue;  // shown as drawn
+    up::BetweenFrame frame;
+    frame.first = 0;
+    unseen += build_between(state, pass.fraction, pass.eye, pass.frustum, frame, terms).unseen_share;
+    converter.write_channels(gl.linear_framebuffer.get(), pass.red, pass.green, pass.blue);
+  }
+  gl.rendered_colour_framebuffer = gl.rendered_depth_framebuffer = gl.linear_framebuffer.get();
+  encode();
+  return unseen;
+}
+
 void SceneRenderer::show_key(int slot) {
   Gl& gl = *gl_;
   assert(gl.up_converter);

@@ -148,6 +148,14 @@ class SceneRenderer {
   // Key `slot` as it was kept, through the output stage (a key frame drawn
   // ahead, shown at its own moment).
   void show_key(int slot);
+  // Colour fields by up-conversion: with `key`, the scene drawn at its moment
+  // and kept as key frame 0; then each of `passes` (a field at its own moment)
+  // built from key frame 0 as a frame between (what it did not see shaded
+  // anew) into its channels of the image, except those at the key's own moment,
+  // which show it as drawn. Then the output stage. prepare_up_conversion first.
+  // Returns the share of pixels shaded anew, summed over the fields built.
+  double draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key,
+                                  std::span<const FieldPass> passes, const LightTerms& terms = {});
 
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);

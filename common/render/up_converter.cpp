@@ -54,6 +54,10 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
       glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_error_frag));
   if (!error) return Error{"the up-conversion's check: " + error.error()};
   u->error_program_ = std::move(error).value();
+  auto channels =
+      glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::between_channels_frag));
+  if (!channels) return Error{"the up-conversion's colour fields: " + channels.error()};
+  u->channels_program_ = std::move(channels).value();
   glProgramUniform1i(u->error_program_.get(), glGetUniformLocation(u->error_program_.get(), "block"), kErrorBlock);
   u->error_sums_ =
       exact_texture(GL_RGBA32F, (width + kErrorBlock - 1) / kErrorBlock, (height + kErrorBlock - 1) / kErrorBlock);
@@ -232,6 +236,18 @@ double UpConverter::psnr_y_against(GLuint image) {
         weights[c] * (squared[c] <= 0.0 ? kIdentical : std::min(kIdentical, 10.0 * std::log10(pixels / squared[c])));
   }
   return all_identical ? std::numeric_limits<double>::infinity() : psnr;
+}
+
+void UpConverter::write_channels(GLuint framebuffer, bool red, bool green, bool blue) {
+  glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+  glViewport(0, 0, width_, height_);
+  glDisable(GL_DEPTH_TEST);
+  glColorMask(red, green, blue, GL_FALSE);
+  glUseProgram(channels_program_.get());
+  glBindTextureUnit(0, output_.get());
+  glBindVertexArray(empty_vertex_array_.get());
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
 void UpConverter::begin_shade_unseen() {

@@ -57,6 +57,10 @@ class UpConverter {
   // (sRGB, 8-bit range); +infinity when equal, a channel equal alone 100 dB.
   [[nodiscard]] double psnr_y_against(GLuint image);
 
+  // output()'s red, green and/or blue into `framebuffer` (this size), the other
+  // channels left as they are.
+  void write_channels(GLuint framebuffer, bool red, bool green, bool blue);
+
   [[nodiscard]] GLuint output() const { return output_.get(); }
   [[nodiscard]] GLuint output_framebuffer() const { return output_framebuffer_.get(); }  // with depth()
   [[nodiscard]] GLuint depth() const { return depth_stencil_.get(); }                    // the frame's own depth
@@ -83,6 +87,7 @@ class UpConverter {
   };
   std::array<ResolveUniforms, resolves> uniforms_{};
   glo::Program error_program_;
+  glo::Program channels_program_;
   glo::Texture error_sums_;  // one texel per kErrorBlock² pixels
   glo::Framebuffer error_framebuffer_;
   glo::VertexArray empty_vertex_array_;

@@ -56,6 +56,8 @@ const std::vector<Method> kMethods{
     {"gather, 8 along the motion (shipped)", config::FieldMethod::gather, 4, 24.0, 8},
     {"gather, 16 along the motion", config::FieldMethod::gather, 4, 24.0, 16},
     {"gather, 8 along the motion, 1 sample per pixel", config::FieldMethod::gather, 1, 24.0, 8},
+    {"up-conversion: each other field from one render by its motion field", config::FieldMethod::up_conversion, 4},
+    {"up-conversion, 1 sample per pixel", config::FieldMethod::up_conversion, 1},
 };
 constexpr std::size_t kPerField = 2;  // the reference for the gather's cost and image
 

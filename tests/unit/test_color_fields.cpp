@@ -183,6 +183,20 @@ TEST(ColorFields, GatherAndItsSamples) {
   }
 }
 
+// Each other field built from one render by up-conversion; it builds every
+// field at its moment, so a blur threshold is refused by name.
+TEST(ColorFields, UpConversionBuildsTheFieldsAndTakesNoThreshold) {
+  const auto parsed = parse(R"({"preset": "dlp-brg-120hz", "method": "up-conversion"})");
+  ASSERT_TRUE(parsed) << parsed.error();
+  const ColorFields& c = parsed.value().projectors[0].color_fields;
+  EXPECT_EQ(c.method, FieldMethod::up_conversion);
+  EXPECT_TRUE(c.up_converts());
+  EXPECT_FALSE(c.needs_velocity()) << "no velocity target or tiles";
+  EXPECT_EQ(to_string(c.method), "up-conversion");
+  expect_one(parse(R"({"preset": "dlp-brg-120hz", "method": "up-conversion", "velocity_threshold": 24})"),
+             ".velocity_threshold", "up-conversion builds every field at its moment: leave it 0 (got 24)");
+}
+
 TEST(ColorFields, UnknownPresetListsThePresets) {
   const auto parsed = parse(R"({"preset": "dlp"})");
   expect_one(parsed, ".preset", "(presets are: dlp-brg-120hz, dlp-stereo-as-mono)");
