@@ -91,8 +91,8 @@ std::string summarize(const config::LoadedConfig& config) {
           << (up.mode == config::UpMode::interpolate
                   ? " (between the key frames before and after: the master sends each key frame's scene " +
                         std::to_string(up.frames_ahead()) + " frames ahead)"
-              : up.spread ? " (from the last key frame drawn; each is used " + std::to_string(up.ratio) +
-                                " frames after its moment)"
+              : up.spread ? " (from the last key frame drawn; each is used " + std::to_string(up.ratio) + "…" +
+                                std::to_string(2 * up.ratio - 1) + " frames after its moment)"
                           : " (from the last key frame)")
           << (up.spread ? ", each key frame drawn a band a frame" : "")
           << (up.adaptive() ? ", fewer frames between while they would fall below " +

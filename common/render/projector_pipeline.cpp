@@ -194,6 +194,8 @@ Result<std::vector<FieldPass>> ProjectorPipeline::field_passes(const scene::Scen
 Result<void> ProjectorPipeline::draw_fields_up_converted(const scene::SceneState& state, int image) {
   // One render per frame, at the green fields' moment (as the gather): green is
   // shown as drawn; every other field, the second image's all, built from it.
+  // With two images the render is halfway between their greens: every field is
+  // built.
   std::optional<FieldPass> key;
   if (image == 0) {
     auto pass = moment(state, gather_moment());
@@ -293,7 +295,8 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
       schedule_->drop_band();  // its moment cannot be seen from here: another is begun later
     } else {
       const geometry::Frustum& f = seen.value().frustum;
-      renderer_->draw_key_band(*band.state, 0.0, seen.value().eye, f, terms_, band.slot, band.index, band.count);
+      renderer_->draw_key_band(*band.state, 0.0, seen.value().eye, f, terms_, band.slot, band.index, band.count,
+                               band.bands);
       up_report_.drew_band = true;
       if (band.last() && plan.check_slot) {
         up::BetweenFrame check;

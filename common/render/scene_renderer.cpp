@@ -560,6 +560,9 @@ up::BetweenReport SceneRenderer::draw_between(const scene::SceneState& state, do
   const up::BetweenReport report = build_between(state, fraction, eye, frustum, frame, terms);
   const UpConverter& converter = *gl.up_converter;
   const bool motion = frame.method == up::BetweenMethod::motion;
+  // The average has no depth of its own: the first key frame's (the linear
+  // depth may hold bands of a key frame being drawn).
+  if (!motion) converter.restore_depth(frame.first, gl.depth.get());
   gl.rendered_colour_framebuffer = converter.output_framebuffer();
   gl.rendered_depth_framebuffer = motion ? converter.output_framebuffer() : gl.linear_framebuffer.get();
   encode(converter.output(), motion ? converter.depth() : gl.depth.get());
@@ -577,12 +580,12 @@ double SceneRenderer::check_between(const scene::SceneState& state, double fract
 
 void SceneRenderer::draw_key_band(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                                   const geometry::Frustum& frustum, const LightTerms& terms, int slot, int index,
-                                  int count) {
+                                  int count, int bands) {
   Gl& gl = *gl_;
   assert(gl.up_converter);  // prepare_up_conversion first
-  assert(count >= 1 && index >= 0 && index < count);
+  assert(count >= 1 && index >= 0 && bands >= 1 && index + bands <= count);
   const int first_row = gl.height * index / count;
-  const int rows = gl.height * (index + 1) / count - first_row;
+  const int rows = gl.height * (index + bands) / count - first_row;
   // The scissor bounds the clear, the fragments and the multisample resolve;
   // the geometry is processed whole each band.
   glEnable(GL_SCISSOR_TEST);

@@ -123,13 +123,15 @@ class SceneRenderer {
   // The image the last draw() made kept as key frame `slot`, drawn as `view`
   // says; prepare_up_conversion first.
   void keep_key(int slot, up::KeyView view);
-  // Band `index` of `count` (rows, from the bottom) of a key frame drawn as
+  // Bands `index` … `index + bands − 1` of `count` (rows, from the bottom) of a
+  // key frame drawn as
   // draw() would, at `state`'s poses `fraction` of a frame on, seen from `eye`
   // through `frustum` (= view), into key slot `slot`: the rest of the slot
   // stays. Drawn through the linear image: before the frame's own (draw_between,
   // show_key); nothing is shown.
   void draw_key_band(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
-                     const geometry::Frustum& frustum, const LightTerms& terms, int slot, int index, int count);
+                     const geometry::Frustum& frustum, const LightTerms& terms, int slot, int index, int count,
+                     int bands = 1);
   // A frame between key frames, at `state`'s poses `fraction` of a frame on,
   // seen from `eye` through `frustum`: the motion field drawn with the scene's
   // geometry, each pixel from the kept key frames where its surface was, what

@@ -139,6 +139,11 @@ void UpConverter::restore(int slot, GLuint colour, GLuint depth) const {
   copy(key_depth_[slot].get(), depth, width_, height_);
 }
 
+void UpConverter::restore_depth(int slot, GLuint depth) const {
+  assert(slot >= 0 && slot < slots_);
+  copy(key_depth_[slot].get(), depth, width_, height_);
+}
+
 const up::KeyView& UpConverter::key(int slot) const {
   assert(slot >= 0 && slot < slots_);
   return key_view_[slot];

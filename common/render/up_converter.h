@@ -37,6 +37,7 @@ class UpConverter {
   [[nodiscard]] GLuint key_colour(int slot) const;
   // And back: key `slot`'s colour and depth into these.
   void restore(int slot, GLuint colour, GLuint depth) const;
+  void restore_depth(int slot, GLuint depth) const;  // the depth alone
 
   // The motion field's target: where each pixel's surface was in each key frame
   // (attachment 0, and 1 `from_two` key frames) over the frame's own depth and

@@ -109,8 +109,9 @@ UpPlan UpSchedule::extrapolated(std::uint64_t frame, const scene::SceneState& st
   std::string_view why;
   if (!same_side(first_->state, state, &why)) return key_now(frame, state, why);
   // Spread, a key frame is used from ratio to 2·ratio − 1 frames after its
-  // moment; older (frames were skipped), one is drawn now.
-  const int oldest = settings_.spread ? 2 * settings_.ratio : ratio_;
+  // moment (a frame or two more where frames were skipped); much older, or
+  // with every frame a key frame (the adaptive ratio at 1), one is drawn now.
+  const int oldest = settings_.spread && ratio_ > 1 ? 3 * ratio_ : ratio_;
   if (frame - first_->frame >= static_cast<std::uint64_t>(oldest)) return key_now(frame, state, "ratio");
   UpPlan plan;
   plan.between = true;
@@ -120,12 +121,15 @@ UpPlan UpSchedule::extrapolated(std::uint64_t frame, const scene::SceneState& st
 }
 
 void UpSchedule::add_band(UpPlan& plan, std::uint64_t frame, const scene::SceneState& state, const Ahead& ahead) {
-  // A key frame begun before a cut shows the other side: begun again.
-  if (building_ && !same_side(building_->key.state, state)) building_.reset();
+  // Extrapolated, a key frame begun before a cut shows the other side to the
+  // frames that will use it: begun again. (Interpolated, it is a later frame's,
+  // and the frames between weigh each key frame's side themselves.)
+  const bool extrapolates = settings_.mode == config::UpMode::extrapolate;
+  if (extrapolates && building_ && !same_side(building_->key.state, state)) building_.reset();
   if (!building_) {
-    if (settings_.mode == config::UpMode::extrapolate) {
+    if (extrapolates) {
       // This frame's key frame, in the next ratio frames.
-      building_ = Building{Key{frame, free_slot(), state}, 0, ratio_};
+      building_ = Building{Key{frame, free_slot(), state}, 0, ratio_, frame + static_cast<std::uint64_t>(ratio_) - 1};
     } else {
       // The key frame after the next, in the frames up to the one that shows
       // the next: from the scene sent ahead for it.
@@ -133,12 +137,15 @@ void UpSchedule::add_band(UpPlan& plan, std::uint64_t frame, const scene::SceneS
       const std::uint64_t target = second_->frame + static_cast<std::uint64_t>(ratio_);
       const scene::SceneState* later = ahead ? ahead(target) : nullptr;
       if (later == nullptr || !same_side(second_->state, *later)) return;  // drawn at once when its turn comes
-      building_ = Building{Key{target, free_slot(), *later}, 0, static_cast<int>(second_->frame - frame) + 1};
+      building_ =
+          Building{Key{target, free_slot(), *later}, 0, static_cast<int>(second_->frame - frame) + 1, second_->frame};
     }
   }
   Building& b = *building_;
-  plan.band = UpPlan::Band{b.key.slot, b.next, b.count, b.key.frame, &b.key.state};
-  ++b.next;
+  // A band a frame; on the frame it is due (frames were skipped), all it lacks.
+  const int bands = frame >= b.due ? b.count - b.next : 1;
+  plan.band = UpPlan::Band{b.key.slot, b.next, b.count, bands, b.key.frame, &b.key.state};
+  b.next += bands;
   if (plan.band->last() && settings_.adaptive()) {
     // How the frames between would have followed the scene to this key frame:
     // from the key frame before it, a whole interval on.

@@ -17,15 +17,18 @@
 // used from then on (the frames between come from a key frame ratio … 2·ratio
 // − 1 frames old); interpolate: the key frame after the next, from the scene
 // sent 2·ratio − 1 frames ahead, is drawn over the frames up to the one that
-// shows the next. A cut, or too little sent ahead, still draws a key frame at
-// once.
+// shows the next. Where frames were skipped, the frame a key frame is due with
+// draws all the bands it lacks. A cut, too little sent ahead, or the adaptive
+// ratio at 1 still draws a key frame at once.
 //
 // Adaptive ratio: before each key frame that comes `ratio` frames after the
 // last is kept, the frame that key frame would have built at its moment is
 // checked against it (PSNR_Y as displayed): below the floor, the key frames
 // come a frame sooner; kRaiseMargin above it, a frame later, up to `ratio`. The
 // check extrapolates over the whole interval, so with interpolation (whose
-// frames are at most half an interval from a key frame) it is cautious.
+// frames are at most half an interval from a key frame) it is cautious; with
+// spread extrapolation (whose frames are one to two intervals from theirs) it
+// weighs the youngest frames, and is optimistic.
 
 #include <cstdint>
 #include <functional>
@@ -64,16 +67,18 @@ struct UpPlan {
   // have been from it, for the adaptive ratio (UpSchedule::checked). With
   // spread key frames, when the band that completes one is drawn.
   std::optional<int> check_slot;
-  // Spread key frames: band `index` of `count` (rows of the image, from the
-  // bottom) of the key frame of frame `frame`, drawn from `state` into key slot
-  // `slot`. After the last band it is kept: frames from the next on use it.
+  // Spread key frames: bands `index` … `index + bands − 1` of `count` (rows of
+  // the image, from the bottom; one band, or all that are left where frames
+  // were skipped) of the key frame of frame `frame`, drawn from `state` into key
+  // slot `slot`. After the last band it is kept: frames from the next on use it.
   struct Band {
     int slot = 0;
     int index = 0;
     int count = 1;
+    int bands = 1;
     std::uint64_t frame = 0;
     const scene::SceneState* state = nullptr;  // valid until the next plan() or forget()
-    [[nodiscard]] bool last() const { return index + 1 == count; }
+    [[nodiscard]] bool last() const { return index + bands == count; }
   };
   std::optional<Band> band;
   // Build this frame from the kept keys (frame.first is the earlier one).
@@ -125,6 +130,7 @@ class UpSchedule {
     Key key;
     int next = 0;  // the band drawn next
     int count = 1;
+    std::uint64_t due = 0;  // the frame its last band is drawn with at the latest
   };
   [[nodiscard]] UpPlan key_now(std::uint64_t frame, const scene::SceneState& state, std::string_view why);
   [[nodiscard]] UpPlan extrapolated(std::uint64_t frame, const scene::SceneState& state);

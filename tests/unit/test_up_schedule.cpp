@@ -232,7 +232,44 @@ TEST(UpSchedule, ACutOrSkippedFramesBeginTheBandsAgain) {
   for (std::uint64_t f = 3; f <= 12; ++f) states[f] = state_at(f), states[f].lights_off = {1};
   UpSchedule schedule(settings(4, config::UpMode::extrapolate, 0.0, true));
   EXPECT_EQ(kinds(schedule, 0, 9, states), "K B1|0 B1|1 K B1|0 B1|1 B1|2 B1|3! B1|0 B1|1");
-  EXPECT_EQ(schedule.plan(18, states[12]).why, "ratio") << "frame 8's key frame is ten frames old";
+  EXPECT_EQ(schedule.plan(18, states[12]).why, "ratio") << "frame 4's key frame is 14 frames old";
+}
+
+// A frame skipped while a key frame is drawn in bands: the frame it is due with
+// draws all the bands it lacks, and the next frame uses it (no key frame at
+// once). With the adaptive ratio at 1, every frame is a key frame drawn at once.
+TEST(UpSchedule, ASkippedFrameLeavesTheRestOfTheBandsToTheDueFrame) {
+  UpSchedule schedule(settings(4, config::UpMode::extrapolate, 0.0, true));
+  EXPECT_EQ(kinds(schedule, 0, 6), "K B1|0 B1|1 B1|2 B1|3! B1|0 B1|1");
+  const UpPlan due = schedule.plan(8, state_at(8));  // frame 7 never came
+  ASSERT_TRUE(due.between);
+  ASSERT_TRUE(due.band);
+  EXPECT_EQ(due.band->index, 2);
+  EXPECT_EQ(due.band->bands, 2);
+  EXPECT_TRUE(due.band->last());
+  const UpPlan next = schedule.plan(9, state_at(9));
+  EXPECT_TRUE(next.between) << next.why;
+  EXPECT_EQ(next.frame.first, due.band->slot) << "frame 5's key frame, complete";
+
+  UpSchedule interpolating(settings(4, config::UpMode::interpolate, 0.0, true));
+  EXPECT_EQ(kinds(interpolating, 0, 9), "K K K K A7B2 B2|0 B2|1 S|2! B2|0 B2|1");
+  std::map<std::uint64_t, scene::SceneState> sent;
+  for (std::uint64_t f = 10; f <= 18; ++f) sent[f] = state_at(f);
+  const auto lookup = [&](std::uint64_t f) -> const scene::SceneState* {
+    return sent.contains(f) ? &sent[f] : nullptr;
+  };
+  const UpPlan shown = interpolating.plan(11, state_at(11), lookup);  // frame 10 never came
+  ASSERT_TRUE(shown.shown_slot);
+  ASSERT_TRUE(shown.band);
+  EXPECT_EQ(shown.band->bands, 2) << "the two bands frame 15's key frame lacks";
+  EXPECT_TRUE(shown.band->last());
+  EXPECT_TRUE(interpolating.plan(12, state_at(12), lookup).frame.two_keys);
+
+  UpSchedule lowered(settings(4, config::UpMode::extrapolate, 30.0, true));
+  (void)lowered.plan(0, state_at(0));
+  for (int i = 0; i < 3; ++i) lowered.checked(10.0);
+  ASSERT_EQ(lowered.ratio(), 1);
+  EXPECT_EQ(kinds(lowered, 1, 3), "K K K") << "every frame drawn at once, not a band of one and a frame between";
 }
 
 // Spread, interpolated: the key frame after the next is drawn, from the scene
