@@ -207,7 +207,7 @@ Result<void> ProjectorPipeline::draw_fields_up_converted(const scene::SceneState
   }
   auto passes = field_passes(state, image);
   if (!passes) return Error{passes.error()};
-  fields_shaded_anew_ = renderer_->draw_fields_up_converted(state, key ? &*key : nullptr, passes.value(), terms_);
+  renderer_->draw_fields_up_converted(state, key ? &*key : nullptr, passes.value(), terms_);
   return {};
 }
 
@@ -275,7 +275,7 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
   const auto black = [&](const std::string& why) -> Result<void> {
     // Nothing kept shows what the next frames need: they start over.
     schedule_->forget();
-    up_report_ = {up::FrameKind::key, {}, std::nullopt, false, false, schedule_->ratio(), "not in front of the screen"};
+    up_report_ = {up::FrameKind::key, {}, std::nullopt, false, schedule_->ratio(), "not in front of the screen"};
     renderer_->draw_black();
     return Error{why};
   };
@@ -288,6 +288,17 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
   up_report_.kind = plan.kind();
   up_report_.why = plan.why;
   up_report_.drew_key_ahead = plan.ahead_frame.has_value();
+  // The adaptive ratio's check: the frame between from kept key
+  // plan.check_slot at `key`'s moment, against what was just drawn for it (or
+  // kept key `against`).
+  const auto check = [&](const scene::SceneState& key, const auto& seen, std::optional<int> against) {
+    if (!plan.check_slot) return;
+    up::BetweenFrame from;
+    from.method = schedule_->settings().method;
+    from.first = *plan.check_slot;
+    up_report_.checked_psnr = renderer_->check_between(key, 0.0, seen.eye, seen.frustum, from, terms_, against);
+    schedule_->checked(*up_report_.checked_psnr);
+  };
   if (plan.band) {  // first: it draws through the image the frame's own then replaces
     const up::UpPlan::Band& band = *plan.band;
     const auto seen = moment(*band.state, 0.0);
@@ -297,15 +308,7 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
       const geometry::Frustum& f = seen.value().frustum;
       renderer_->draw_key_band(*band.state, 0.0, seen.value().eye, f, terms_, band.slot, band.index, band.count,
                                band.bands);
-      up_report_.drew_band = true;
-      if (band.last() && plan.check_slot) {
-        up::BetweenFrame check;
-        check.method = schedule_->settings().method;
-        check.first = *plan.check_slot;
-        up_report_.checked_psnr =
-            renderer_->check_between(*band.state, 0.0, seen.value().eye, f, check, terms_, band.slot);
-        schedule_->checked(*up_report_.checked_psnr);
-      }
+      if (band.last()) check(*band.state, seen.value(), band.slot);
     }
   }
   if (plan.draw_key) {
@@ -313,14 +316,7 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
     const auto seen = moment(*key, 0.0);
     if (!seen) return black(seen.error());
     renderer_->draw(*key, 0.0, seen.value().eye, seen.value().frustum, terms_);
-    if (plan.check_slot) {
-      up::BetweenFrame check;
-      check.method = schedule_->settings().method;
-      check.first = *plan.check_slot;
-      up_report_.checked_psnr =
-          renderer_->check_between(*key, 0.0, seen.value().eye, seen.value().frustum, check, terms_);
-      schedule_->checked(*up_report_.checked_psnr);
-    }
+    check(*key, seen.value(), std::nullopt);
     const geometry::Frustum& f = seen.value().frustum;
     renderer_->keep_key(plan.key_slot, {*key, 0.0, f.projection * f.view});
   }
@@ -337,7 +333,7 @@ void ProjectorPipeline::warm_up() {
   const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
   if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
     renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
-    if (schedule_) {  // the motion field, each resolve, the mark and the check
+    if (schedule_) {  // the motion fields, each resolve and the check
       const geometry::Frustum& f = frustum.value();
       for (int slot = 0; slot < schedule_->slots(); ++slot) {
         renderer_->keep_key(slot, {scene::SceneState{}, 0.0, f.projection * f.view});

@@ -59,7 +59,6 @@ struct UpReport {
   // A key frame checked against the frame between it replaces (dB PSNR_Y).
   std::optional<double> checked_psnr;
   bool drew_key_ahead = false;  // a later key frame was drawn with it (interpolation)
-  bool drew_band = false;       // and a band of a key frame drawn a band a frame (spread)
   int ratio = 1;                // display frames per key frame from now on
   std::string_view why;         // why a key frame was drawn now
 };
@@ -101,9 +100,6 @@ class ProjectorPipeline {
   [[nodiscard]] Result<void> draw_frame(const scene::SceneState& state, const ImageDrawn& drawn = {},
                                         const DisplayFrame* display = nullptr);
   [[nodiscard]] const UpReport& up_report() const { return up_report_; }
-  // Colour fields by up-conversion: the share of pixels the last image's fields
-  // shaded anew (what the one render did not see), summed over its fields.
-  [[nodiscard]] double fields_shaded_anew() const { return fields_shaded_anew_; }
   // Images per frame: 1, or 2 (config::ColorFields::images).
   [[nodiscard]] int images() const { return color_fields_.images; }
   // Where image `image` of the last frame drawn is, to show it.
@@ -155,7 +151,6 @@ class ProjectorPipeline {
   std::optional<up::UpSchedule> schedule_;  // projectors that up-convert
   std::uint64_t next_frame_ = 0;            // without a DisplayFrame
   UpReport up_report_;
-  double fields_shaded_anew_ = 0.0;
 };
 
 }  // namespace optique::render

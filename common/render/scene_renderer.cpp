@@ -410,10 +410,15 @@ void SceneRenderer::set_focus(const FocusFrame& frame) {
 
 void SceneRenderer::draw(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                          const geometry::Frustum& frustum, const LightTerms& terms) {
+  draw_linear(state, fraction, eye, frustum, terms);
+  encode();
+}
+
+void SceneRenderer::draw_linear(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                const geometry::Frustum& frustum, const LightTerms& terms) {
   begin_linear();
   draw_scene(state, fraction, eye, frustum, terms);
   resolve();
-  encode();
 }
 
 GatherReport SceneRenderer::draw_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
@@ -590,41 +595,34 @@ void SceneRenderer::draw_key_band(const scene::SceneState& state, double fractio
   // the geometry is processed whole each band.
   glEnable(GL_SCISSOR_TEST);
   glScissor(0, first_row, gl.width, rows);
-  begin_linear();
-  draw_scene(state, fraction, eye, frustum, terms);
-  resolve();
+  draw_linear(state, fraction, eye, frustum, terms);
   glDisable(GL_SCISSOR_TEST);
   gl.up_converter->keep_rows(slot, gl.linear_colour.get(), gl.depth.get(),
                              {state, fraction, frustum.projection * frustum.view}, first_row, rows);
 }
 
-double SceneRenderer::draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key,
-                                               std::span<const FieldPass> passes, const LightTerms& terms) {
+void SceneRenderer::draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key,
+                                             std::span<const FieldPass> passes, const LightTerms& terms) {
   Gl& gl = *gl_;
   assert(gl.up_converter);  // prepare_up_conversion first
   UpConverter& converter = *gl.up_converter;
   if (key != nullptr) {
-    begin_linear();
-    draw_scene(state, key->fraction, key->eye, key->frustum, terms);
-    resolve();
-    converter.keep(0, gl.linear_colour.get(), gl.depth.get(),
-                   {state, key->fraction, key->frustum.projection * key->frustum.view});
+    draw_linear(state, key->fraction, key->eye, key->frustum, terms);
+    keep_key(0, {state, key->fraction, key->frustum.projection * key->frustum.view});
   }
   const auto at_key = [&](const FieldPass& pass) {
     return key != nullptr && pass.fraction == key->fraction && pass.eye == key->eye &&
            pass.frustum.view == key->frustum.view && pass.frustum.projection == key->frustum.projection;
   };
-  double unseen = 0.0;
   for (const FieldPass& pass : passes) {
     if (at_key(pass)) continue;  // shown as drawn
     up::BetweenFrame frame;
     frame.first = 0;
-    unseen += build_between(state, pass.fraction, pass.eye, pass.frustum, frame, terms).unseen_share;
+    (void)build_between(state, pass.fraction, pass.eye, pass.frustum, frame, terms);
     converter.write_channels(gl.linear_framebuffer.get(), pass.red, pass.green, pass.blue);
   }
   gl.rendered_colour_framebuffer = gl.rendered_depth_framebuffer = gl.linear_framebuffer.get();
   encode();
-  return unseen;
 }
 
 void SceneRenderer::show_key(int slot) {

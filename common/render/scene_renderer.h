@@ -124,11 +124,10 @@ class SceneRenderer {
   // says; prepare_up_conversion first.
   void keep_key(int slot, up::KeyView view);
   // Bands `index` … `index + bands − 1` of `count` (rows, from the bottom) of a
-  // key frame drawn as
-  // draw() would, at `state`'s poses `fraction` of a frame on, seen from `eye`
-  // through `frustum` (= view), into key slot `slot`: the rest of the slot
-  // stays. Drawn through the linear image: before the frame's own (draw_between,
-  // show_key); nothing is shown.
+  // key frame drawn as draw() would, at `state`'s poses `fraction` of a frame
+  // on, seen from `eye` through `frustum`, into key slot `slot`: the rest of
+  // the slot stays. Drawn through the linear image: before the frame's own
+  // (draw_between, show_key); nothing is shown.
   void draw_key_band(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                      const geometry::Frustum& frustum, const LightTerms& terms, int slot, int index, int count,
                      int bands = 1);
@@ -155,9 +154,8 @@ class SceneRenderer {
   // built from key frame 0 as a frame between (what it did not see shaded
   // anew) into its channels of the image, except those at the key's own moment,
   // which show it as drawn. Then the output stage. prepare_up_conversion first.
-  // Returns the share of pixels shaded anew, summed over the fields built.
-  double draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key,
-                                  std::span<const FieldPass> passes, const LightTerms& terms = {});
+  void draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key, std::span<const FieldPass> passes,
+                                const LightTerms& terms = {});
 
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);
@@ -218,6 +216,10 @@ class SceneRenderer {
   void draw_scene(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                   const geometry::Frustum& frustum, const LightTerms& terms, Objects which = Objects::all,
                   const Motion* motion = nullptr);
+  // The whole scene into the linear image (begin_linear, draw_scene, resolve):
+  // draw() without the output stage.
+  void draw_linear(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                   const geometry::Frustum& frustum, const LightTerms& terms);
   // The scene at `frame.seen`'s moment with its velocity, resolved, and the
   // gather's tiles measured: what a gather or a blur starts from.
   void draw_with_motion(const scene::SceneState& state, const GatherFrame& frame, const LightTerms& terms);

@@ -14,6 +14,7 @@ namespace {
 
 constexpr std::string_view kVersion = "#version 450 core\n";
 constexpr int kErrorBlock = 16;  // pixels per side summed by one texel of the check
+constexpr GLenum kBothKeys[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};  // the motion field's targets
 
 // A single-sample texture read texel by texel.
 glo::Texture exact_texture(GLenum format, int width, int height) {
@@ -93,8 +94,6 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   if (glCheckNamedFramebufferStatus(u->error_framebuffer_.get(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
     return Error{"this GL driver cannot draw the up-conversion's check (RGBA32F)"};
   }
-  static constexpr GLenum kBoth[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glNamedFramebufferDrawBuffers(motion, 2, kBoth);
   for (GLuint fb : {motion, u->output_framebuffer_.get()}) {
     glNamedFramebufferTexture(fb, GL_DEPTH_STENCIL_ATTACHMENT, u->depth_stencil_.get(), 0);
     if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
@@ -136,7 +135,7 @@ GLuint UpConverter::key_colour(int slot) const {
 void UpConverter::restore(int slot, GLuint colour, GLuint depth) const {
   assert(slot >= 0 && slot < slots_);
   copy(key_colour_[slot].get(), colour, width_, height_);
-  copy(key_depth_[slot].get(), depth, width_, height_);
+  restore_depth(slot, depth);
 }
 
 void UpConverter::restore_depth(int slot, GLuint depth) const {
@@ -151,8 +150,7 @@ const up::KeyView& UpConverter::key(int slot) const {
 
 void UpConverter::begin_motion_field(bool from_two) {
   const GLuint fb = motion_framebuffer_.get();
-  static constexpr GLenum kBoth[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-  glNamedFramebufferDrawBuffers(fb, from_two ? 2 : 1, kBoth);
+  glNamedFramebufferDrawBuffers(fb, from_two ? 2 : 1, kBothKeys);
   glBindFramebuffer(GL_FRAMEBUFFER, fb);
   glViewport(0, 0, width_, height_);
   const GLfloat no_surface[4] = {0.0f, 0.0f, 0.0f, -2.0f};

@@ -148,8 +148,9 @@ void UpSchedule::add_band(UpPlan& plan, std::uint64_t frame, const scene::SceneS
   b.next += bands;
   if (plan.band->last() && settings_.adaptive()) {
     // How the frames between would have followed the scene to this key frame:
-    // from the key frame before it, a whole interval on.
-    const Key& before = settings_.mode == config::UpMode::extrapolate || !second_ ? *first_ : *second_;
+    // from the key frame before it, a whole interval on (interpolated, the last
+    // band is drawn with the frame that shows that one: first_ by now).
+    const Key& before = *first_;
     if (before.frame + static_cast<std::uint64_t>(ratio_) == b.key.frame && same_side(before.state, b.key.state)) {
       plan.check_slot = before.slot;
     }

@@ -7,8 +7,8 @@
 // stands in) left out. Two key frames mix by the frame's time between them.
 // A pixel no key frame saw is discarded: left unmarked in the stencil, to be
 // shaded anew (up_converter.h); until then it holds the last frame's output.
-// Every such pixel is drawn again, as the scene's program discards nothing. average: the same pixel of both, half each (of
-// one across a cut).
+// Every such pixel is drawn again, as the scene's program discards nothing.
+// average: the same pixel of both, half each (of one across a cut).
 // Built with "#version 450 core", AVERAGE 0 or 1 and KEYS 1 or 2 first (one
 // program each: a branch on a uniform still costs llvmpipe both sides).
 layout(binding = 0) uniform sampler2D key_colour_0;
