@@ -62,8 +62,7 @@ Result<std::unique_ptr<FieldGather>> FieldGather::create(int width, int height, 
   // frame, about 4 mm at 5 m (surfaces closer than that in depth are one layer).
   make_target(GL_RGBA16F, width, height, g->motion_, g->motion_framebuffer_);
   if (samples > 1) {
-    g->motion_samples_ = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
-    glTextureStorage2DMultisample(g->motion_samples_.get(), samples, GL_RGBA16F, width, height, GL_TRUE);
+    g->motion_samples_ = glo::make_storage(GL_RGBA16F, width, height, samples);
   }
   make_target(GL_RGBA32F, width, height, g->gathered_, g->gathered_framebuffer_);
   // Read by the output pass like the linear image: bilinear for a two-pass warp.

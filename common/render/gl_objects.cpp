@@ -19,6 +19,17 @@ Texture make_texture(GLenum target) {
   return Texture(name);
 }
 
+Texture make_storage(GLenum format, int width, int height, int samples) {
+  if (samples <= 1) {
+    Texture texture = make_texture();
+    glTextureStorage2D(texture.get(), 1, format, width, height);
+    return texture;
+  }
+  Texture texture = make_texture(GL_TEXTURE_2D_MULTISAMPLE);
+  glTextureStorage2DMultisample(texture.get(), samples, format, width, height, GL_TRUE);
+  return texture;
+}
+
 Buffer make_buffer() {
   GLuint name = 0;
   glCreateBuffers(1, &name);

@@ -58,6 +58,10 @@ using Shader = Object<detail::delete_shader>;
 using Program = Object<detail::delete_program>;
 
 [[nodiscard]] Texture make_texture(GLenum target = GL_TEXTURE_2D);
+// Storage of `format` for an attachment, multisampled (fixed sample
+// locations, as every multisampled target here: they share framebuffers) when
+// `samples` > 1.
+[[nodiscard]] Texture make_storage(GLenum format, int width, int height, int samples = 1);
 [[nodiscard]] Buffer make_buffer();
 [[nodiscard]] Framebuffer make_framebuffer();
 [[nodiscard]] VertexArray make_vertex_array();

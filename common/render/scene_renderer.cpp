@@ -17,18 +17,6 @@
 namespace optique::render {
 namespace {
 
-// A depth attachment of `format`, multisampled when `samples` > 1.
-glo::Texture depth_texture(GLenum format, int samples, int width, int height) {
-  if (samples == 1) {
-    glo::Texture texture = glo::make_texture();
-    glTextureStorage2D(texture.get(), 1, format, width, height);
-    return texture;
-  }
-  glo::Texture texture = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
-  glTextureStorage2DMultisample(texture.get(), samples, format, width, height, GL_TRUE);
-  return texture;
-}
-
 // The output pass's choices for a stage, as the preprocessor constants it is
 // built with (the enums' values are the shader's numbers).
 std::string output_stage_defines(const OutputStage& stage) {
@@ -254,7 +242,7 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
   glTextureParameteri(gl->linear_colour.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
   glTextureParameteri(gl->linear_colour.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
   gl->depth_format = depth == DepthFormat::fixed24 ? GL_DEPTH_COMPONENT24 : GL_DEPTH_COMPONENT32F;
-  gl->depth = depth_texture(gl->depth_format, 1, width, height);
+  gl->depth = glo::make_storage(gl->depth_format, width, height);
   gl->linear_framebuffer = glo::make_framebuffer();
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl->linear_colour.get(), 0);
   glNamedFramebufferTexture(gl->linear_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl->depth.get(), 0);
@@ -267,9 +255,8 @@ Result<std::unique_ptr<SceneRenderer>> SceneRenderer::create(const scene::SceneD
                    std::to_string(most)};
     }
     gl->samples = samples;
-    gl->multisample_colour = glo::make_texture(GL_TEXTURE_2D_MULTISAMPLE);
-    glTextureStorage2DMultisample(gl->multisample_colour.get(), samples, GL_RGBA32F, width, height, GL_TRUE);
-    gl->multisample_depth = depth_texture(gl->depth_format, samples, width, height);
+    gl->multisample_colour = glo::make_storage(GL_RGBA32F, width, height, samples);
+    gl->multisample_depth = glo::make_storage(gl->depth_format, width, height, samples);
     gl->multisample_framebuffer = glo::make_framebuffer();
     glNamedFramebufferTexture(gl->multisample_framebuffer.get(), GL_COLOR_ATTACHMENT0, gl->multisample_colour.get(), 0);
     glNamedFramebufferTexture(gl->multisample_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl->multisample_depth.get(), 0);
@@ -519,7 +506,7 @@ Result<void> SceneRenderer::prepare_up_conversion(int slots) {
     if (!program) return Error{"the up-conversion's motion field: " + program.error()};
     programs[keys - 1] = std::move(program).value();
   }
-  auto converter = UpConverter::create(gl.width, gl.height, gl.depth_format, slots);
+  auto converter = UpConverter::create(gl.width, gl.height, gl.depth_format, slots, gl.samples);
   if (!converter) return Error{converter.error()};
   gl.key_frames_program = std::move(programs);
   gl.key_frames_uniforms = uniforms;
@@ -530,7 +517,7 @@ Result<void> SceneRenderer::prepare_up_conversion(int slots) {
 void SceneRenderer::keep_key(int slot, up::KeyView view) {
   Gl& gl = *gl_;
   assert(gl.up_converter);  // prepare_up_conversion first
-  gl.up_converter->keep(slot, gl.linear_colour.get(), gl.depth.get(), std::move(view));
+  gl.up_converter->keep(slot, gl.linear_colour.get(), gl.depth.get(), gl.multisample_depth.get(), std::move(view));
 }
 
 up::BetweenReport SceneRenderer::build_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
@@ -555,6 +542,7 @@ up::BetweenReport SceneRenderer::build_between(const scene::SceneState& state, d
     draw_scene(state, fraction, eye, frustum, terms);
     converter.end_shade_unseen();
   }
+  converter.finish();
   return report;
 }
 
@@ -597,7 +585,7 @@ void SceneRenderer::draw_key_band(const scene::SceneState& state, double fractio
   glScissor(0, first_row, gl.width, rows);
   draw_linear(state, fraction, eye, frustum, terms);
   glDisable(GL_SCISSOR_TEST);
-  gl.up_converter->keep_rows(slot, gl.linear_colour.get(), gl.depth.get(),
+  gl.up_converter->keep_rows(slot, gl.linear_colour.get(), gl.depth.get(), gl.multisample_depth.get(),
                              {state, fraction, frustum.projection * frustum.view}, first_row, rows);
 }
 
@@ -653,7 +641,7 @@ unsigned SceneRenderer::held_framebuffer() const { return gl_->held_framebuffer.
 void SceneRenderer::keep_still_depth() {
   Gl& gl = *gl_;
   if (gl.still_depth_framebuffer.get() == 0) {
-    gl.still_depth = depth_texture(gl.depth_format, gl.samples, gl.width, gl.height);
+    gl.still_depth = glo::make_storage(gl.depth_format, gl.width, gl.height, gl.samples);
     gl.still_depth_framebuffer = glo::make_framebuffer();
     glNamedFramebufferTexture(gl.still_depth_framebuffer.get(), GL_DEPTH_ATTACHMENT, gl.still_depth.get(), 0);
   }

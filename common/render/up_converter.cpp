@@ -18,8 +18,7 @@ constexpr GLenum kBothKeys[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};  //
 
 // A single-sample texture read texel by texel.
 glo::Texture exact_texture(GLenum format, int width, int height) {
-  glo::Texture texture = glo::make_texture();
-  glTextureStorage2D(texture.get(), 1, format, width, height);
+  glo::Texture texture = glo::make_storage(format, width, height);
   glTextureParameteri(texture.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
   glTextureParameteri(texture.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
   glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -33,18 +32,21 @@ UpConverter::~UpConverter() {
   if (query_ != 0) glDeleteQueries(1, &query_);
 }
 
-Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, GLenum depth_format, int slots) {
+Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, GLenum depth_format, int slots,
+                                                         int samples) {
   assert(width > 0 && height > 0);
   assert(slots >= 2 && slots <= up::kKeySlots);
+  assert(samples >= 1 && samples <= 32);  // the resolve's sample mask is one int
   std::unique_ptr<UpConverter> u(new UpConverter());
   u->width_ = width;
   u->height_ = height;
   u->slots_ = slots;
+  u->samples_ = samples;
   for (int r = 0; r < resolves; ++r) {
     const bool averages = r == average || r == average_one_key;
     const bool one = r == one_key || r == average_one_key;
     const std::string head = std::string(kVersion) + "#define AVERAGE " + (averages ? "1" : "0") + "\n#define KEYS " +
-                             (one ? "1" : "2") + "\n";
+                             (one ? "1" : "2") + "\n#define SAMPLES " + std::to_string(samples) + "\n";
     auto resolve = glo::link_program(shaders::fullscreen_vert, head + std::string(shaders::between_resolve_frag));
     if (!resolve) return Error{"the up-conversion's resolve pass: " + resolve.error()};
     u->resolve_programs_[r] = std::move(resolve).value();
@@ -67,8 +69,9 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
 
   for (std::size_t k = 0; k < u->motion_.size(); ++k) {
     // Key-frame pixels in pixels, window depth at float precision: a depth
-    // tolerance of a few 1e-6 must be representable.
-    u->motion_[k] = exact_texture(GL_RGBA32F, width, height);
+    // tolerance of a few 1e-6 must be representable. Read texel by texel.
+    u->motion_[k] =
+        samples > 1 ? glo::make_storage(GL_RGBA32F, width, height, samples) : exact_texture(GL_RGBA32F, width, height);
   }
   for (int k = 0; k < slots; ++k) {  // a key frame drawn in bands needs a third
     u->key_colour_[k] = exact_texture(GL_RGBA32F, width, height);
@@ -77,9 +80,25 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
     glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     u->key_depth_[k] = exact_texture(depth_format, width, height);
+    if (samples > 1) {
+      u->key_range_[k] = exact_texture(GL_RG32F, width, height);
+      u->key_range_framebuffer_[k] = glo::make_framebuffer();
+      glNamedFramebufferTexture(u->key_range_framebuffer_[k].get(), GL_COLOR_ATTACHMENT0, u->key_range_[k].get(), 0);
+      if (glCheckNamedFramebufferStatus(u->key_range_framebuffer_[k].get(), GL_FRAMEBUFFER) !=
+          GL_FRAMEBUFFER_COMPLETE) {
+        return Error{"this GL driver cannot draw the up-conversion's key depth range (RG32F)"};
+      }
+    }
   }
-  u->depth_stencil_ =
-      exact_texture(depth_format == GL_DEPTH_COMPONENT24 ? GL_DEPTH24_STENCIL8 : GL_DEPTH32F_STENCIL8, width, height);
+  if (samples > 1) {
+    auto range =
+        glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::key_depth_range_frag));
+    if (!range) return Error{"the up-conversion's key depth range: " + range.error()};
+    u->range_program_ = std::move(range).value();
+    glProgramUniform1i(u->range_program_.get(), glGetUniformLocation(u->range_program_.get(), "samples"), samples);
+  }
+  const GLenum depth_stencil = depth_format == GL_DEPTH_COMPONENT24 ? GL_DEPTH24_STENCIL8 : GL_DEPTH32F_STENCIL8;
+  u->depth_stencil_ = exact_texture(depth_stencil, width, height);
   u->output_ = exact_texture(GL_RGBA32F, width, height);
   // Read by the output pass like the linear image: bilinear for a two-pass warp.
   glTextureParameteri(u->output_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -91,17 +110,33 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   glNamedFramebufferTexture(motion, GL_COLOR_ATTACHMENT1, u->motion_[1].get(), 0);
   u->output_framebuffer_ = glo::make_framebuffer();
   glNamedFramebufferTexture(u->output_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->output_.get(), 0);
+  glNamedFramebufferTexture(u->output_framebuffer_.get(), GL_DEPTH_STENCIL_ATTACHMENT, u->depth_stencil_.get(), 0);
   if (glCheckNamedFramebufferStatus(u->error_framebuffer_.get(), GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
     return Error{"this GL driver cannot draw the up-conversion's check (RGBA32F)"};
   }
-  for (GLuint fb : {motion, u->output_framebuffer_.get()}) {
-    glNamedFramebufferTexture(fb, GL_DEPTH_STENCIL_ATTACHMENT, u->depth_stencil_.get(), 0);
+  // The motion field and the frame share their depth and stencil: the resolve
+  // marks, the shading anew tests; multisampled, both have their own.
+  GLuint frame_depth_stencil = u->depth_stencil_.get();
+  if (samples > 1) {
+    u->multisample_depth_stencil_ = glo::make_storage(depth_stencil, width, height, samples);
+    u->multisample_frame_ = glo::make_storage(GL_RGBA32F, width, height, samples);
+    u->multisample_framebuffer_ = glo::make_framebuffer();
+    glNamedFramebufferTexture(u->multisample_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->multisample_frame_.get(), 0);
+    glNamedFramebufferTexture(u->multisample_framebuffer_.get(), GL_DEPTH_STENCIL_ATTACHMENT,
+                              u->multisample_depth_stencil_.get(), 0);
+    frame_depth_stencil = u->multisample_depth_stencil_.get();
+  }
+  glNamedFramebufferTexture(motion, GL_DEPTH_STENCIL_ATTACHMENT, frame_depth_stencil, 0);
+  for (GLuint fb : {motion, u->output_framebuffer_.get(), u->frame_framebuffer()}) {
     if (glCheckNamedFramebufferStatus(fb, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-      return Error{"this GL driver cannot draw the up-conversion's targets (RGBA32F with depth and stencil)"};
+      return Error{"this GL driver cannot draw the up-conversion's targets (RGBA32F with depth and stencil, " +
+                   std::to_string(samples) + " sample(s) per pixel)"};
     }
   }
   u->empty_vertex_array_ = glo::make_vertex_array();
   glCreateQueries(GL_SAMPLES_PASSED, 1, &u->query_);
+  u->unseen_box_ = glo::make_buffer();
+  glNamedBufferStorage(u->unseen_box_.get(), sizeof(GLint) * 4, nullptr, GL_DYNAMIC_STORAGE_BIT | GL_MAP_READ_BIT);
   return u;
 }
 
@@ -113,16 +148,30 @@ void copy(GLuint from, GLuint to, int width, int height, int first_row = 0) {
 
 }  // namespace
 
-void UpConverter::keep(int slot, GLuint colour, GLuint depth, up::KeyView view) {
-  keep_rows(slot, colour, depth, std::move(view), 0, height_);
+void UpConverter::keep(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view) {
+  keep_rows(slot, colour, depth, sample_depth, std::move(view), 0, height_);
 }
 
-void UpConverter::keep_rows(int slot, GLuint colour, GLuint depth, up::KeyView view, int first_row, int rows) {
+void UpConverter::keep_rows(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view, int first_row,
+                            int rows) {
   assert(slot >= 0 && slot < slots_);
   assert(first_row >= 0 && rows >= 0 && first_row + rows <= height_);
+  assert((samples_ > 1) == (sample_depth != 0));
   if (rows > 0) {
     copy(colour, key_colour_[slot].get(), width_, rows, first_row);
     copy(depth, key_depth_[slot].get(), width_, rows, first_row);
+    if (samples_ > 1) {
+      glBindFramebuffer(GL_FRAMEBUFFER, key_range_framebuffer_[slot].get());
+      glViewport(0, 0, width_, height_);
+      glEnable(GL_SCISSOR_TEST);
+      glScissor(0, first_row, width_, rows);
+      glDisable(GL_DEPTH_TEST);
+      glUseProgram(range_program_.get());
+      glBindTextureUnit(0, sample_depth);
+      glBindVertexArray(empty_vertex_array_.get());
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+      glDisable(GL_SCISSOR_TEST);
+    }
   }
   key_view_[slot] = std::move(view);
 }
@@ -162,17 +211,27 @@ void UpConverter::begin_motion_field(bool from_two) {
   glDisable(GL_CULL_FACE);
 }
 
+GLuint UpConverter::frame_framebuffer() const {
+  return samples_ > 1 ? multisample_framebuffer_.get() : output_framebuffer_.get();
+}
+
 up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm::vec3& background) {
   glDisable(GL_DEPTH_TEST);
   glBindVertexArray(empty_vertex_array_.get());
-  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
+  glBindFramebuffer(GL_FRAMEBUFFER, frame_framebuffer());
   glViewport(0, 0, width_, height_);
   const bool averages = frame.method == up::BetweenMethod::average;
   const Resolve r = averages ? (frame.two_keys ? average : average_one_key) : frame.two_keys ? two_keys : one_key;
   if (!averages && !frame.shade_unseen) {
     // What no key frame saw keeps the first key frame's pixel (the resolve
-    // leaves it): a test's view of the frame without shading anew.
-    copy(key_colour_[frame.first].get(), output_.get(), width_, height_);
+    // leaves it).
+    if (samples_ == 1) {
+      copy(key_colour_[frame.first].get(), output_.get(), width_, height_);
+    } else {
+      glUseProgram(channels_program_.get());
+      glBindTextureUnit(0, key_colour_[frame.first].get());
+      glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
   }
   glUseProgram(resolve_programs_[r].get());
   glUniform1f(uniforms_[r].toward_second, static_cast<float>(frame.toward_second));
@@ -182,29 +241,36 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   for (int k = 0; k < 2; ++k) {  // the first key frame as key 0
     const int slot = k == 0 || !frame.two_keys ? frame.first : frame.second;
     glBindTextureUnit(static_cast<GLuint>(k), key_colour_[slot].get());
-    glBindTextureUnit(static_cast<GLuint>(2 + k), key_depth_[slot].get());
+    // Multisampled, the depth range (glsl/key_depth_range.frag.glsl).
+    glBindTextureUnit(static_cast<GLuint>(2 + k), (samples_ > 1 ? key_range_ : key_depth_)[slot].get());
     glBindTextureUnit(static_cast<GLuint>(4 + k), motion_[k].get());  // the motion field's, in that order
   }
   if (averages) {
     glDrawArrays(GL_TRIANGLES, 0, 3);
     return {};
   }
-  // Every pixel the resolve wrote is marked in the stencil and counted; it
-  // discards those no key frame saw (one pass: a second that read the output
-  // back to mark them cost llvmpipe 2 ms at 1280×720).
+  // Every pixel (sample) the resolve wrote is marked in the stencil and
+  // counted; it discards those no key frame saw (one pass: a second that read
+  // the output back to mark them cost llvmpipe 2 ms at 1280×720).
   glEnable(GL_STENCIL_TEST);
   glStencilFunc(GL_ALWAYS, 1, 0xFF);
   glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+  const GLint empty[4] = {width_, height_, -1, -1};
+  glNamedBufferSubData(unseen_box_.get(), 0, sizeof(empty), empty);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, unseen_box_.get());
   glBeginQuery(GL_SAMPLES_PASSED, query_);
   glDrawArrays(GL_TRIANGLES, 0, 3);
   glEndQuery(GL_SAMPLES_PASSED);
   glDisable(GL_STENCIL_TEST);
   GLint64 resolved = 0;
   glGetQueryObjecti64v(query_, GL_QUERY_RESULT, &resolved);
-  const GLint64 unseen = std::max<GLint64>(0, static_cast<GLint64>(width_) * height_ - resolved);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glGetNamedBufferSubData(unseen_box_.get(), 0, sizeof(GLint) * 4, box_.data());
+  const GLint64 all = static_cast<GLint64>(width_) * height_ * samples_;
+  const GLint64 unseen = std::max<GLint64>(0, all - resolved);  // samples
   up::BetweenReport report;
-  report.unseen_pixels = unseen;
-  report.unseen_share = static_cast<double>(unseen) / (static_cast<double>(width_) * static_cast<double>(height_));
+  report.unseen_pixels = (unseen + samples_ - 1) / samples_;  // in pixels' worth, none only if none
+  report.unseen_share = static_cast<double>(unseen) / static_cast<double>(all);
   return report;
 }
 
@@ -254,10 +320,12 @@ void UpConverter::write_channels(GLuint framebuffer, bool red, bool green, bool 
 }
 
 void UpConverter::begin_shade_unseen() {
-  glBindFramebuffer(GL_FRAMEBUFFER, output_framebuffer_.get());
+  glBindFramebuffer(GL_FRAMEBUFFER, frame_framebuffer());
   glViewport(0, 0, width_, height_);
   glEnable(GL_STENCIL_TEST);
   glStencilFunc(GL_EQUAL, 0, 0xFF);  // what the resolve left
+  glEnable(GL_SCISSOR_TEST);         // within the box around it
+  glScissor(box_[0], box_[1], std::max(0, box_[2] - box_[0] + 1), std::max(0, box_[3] - box_[1] + 1));
   glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);  // the same surface the motion field found (invariant positions)
@@ -267,8 +335,19 @@ void UpConverter::begin_shade_unseen() {
 
 void UpConverter::end_shade_unseen() {
   glDisable(GL_STENCIL_TEST);
+  glDisable(GL_SCISSOR_TEST);
   glDepthFunc(GL_LESS);
   glDepthMask(GL_TRUE);
+}
+
+void UpConverter::finish() {
+  if (samples_ == 1) return;
+  // The samples averaged (linear light), as the scene renderer resolves its
+  // own; depth from one sample, for the passes that read it.
+  glBlitNamedFramebuffer(multisample_framebuffer_.get(), output_framebuffer_.get(), 0, 0, width_, height_, 0, 0, width_,
+                         height_, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBlitNamedFramebuffer(multisample_framebuffer_.get(), output_framebuffer_.get(), 0, 0, width_, height_, 0, 0, width_,
+                         height_, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
 }
 
 }  // namespace optique::render

@@ -3,8 +3,11 @@
 // motion field of a frame between them (drawn by SceneRenderer with the scene's
 // geometry), and the passes that build that frame from the key frames' pixels
 // (glsl/between_resolve.frag.glsl) and mark what no key frame saw, so that only
-// those pixels are shaded anew. Needs a current OpenGL 4.5 context; made only
-// for projectors that up-convert, so the motion targets exist only there.
+// those pixels are shaded anew. On a multisampled projector the motion field,
+// the frame and the shading anew are multisampled too (each sample of an edge
+// pixel built from its own surface), then averaged into output(). Needs a
+// current OpenGL 4.5 context; made only for projectors that up-convert, so the
+// motion targets exist only there.
 
 #include <array>
 #include <cstdint>
@@ -22,17 +25,19 @@ class UpConverter {
  public:
   // For `width` × `height` pixels whose depth is `depth_format` (the scene
   // renderer's, GL_DEPTH_COMPONENT32F or 24), with `slots` key frames (2…
-  // up::kKeySlots).
+  // up::kKeySlots), `samples` per pixel (the scene renderer's).
   [[nodiscard]] static Result<std::unique_ptr<UpConverter>> create(int width, int height, GLenum depth_format,
-                                                                   int slots = 2);
+                                                                   int slots = 2, int samples = 1);
   ~UpConverter();
   UpConverter(const UpConverter&) = delete;
   UpConverter& operator=(const UpConverter&) = delete;
 
-  // Copies a drawn image (RGBA32F) and its depth into key slot `slot`.
-  void keep(int slot, GLuint colour, GLuint depth, up::KeyView view);
+  // Copies a drawn image (RGBA32F) and its depth into key slot `slot`;
+  // multisampled, `sample_depth` is its depth per sample (before the resolve:
+  // which pixels hold more than one surface).
+  void keep(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view);
   // Only `rows` rows from `first_row` (a band of a key frame drawn in bands).
-  void keep_rows(int slot, GLuint colour, GLuint depth, up::KeyView view, int first_row, int rows);
+  void keep_rows(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view, int first_row, int rows);
   [[nodiscard]] const up::KeyView& key(int slot) const;
   [[nodiscard]] GLuint key_colour(int slot) const;
   // And back: key `slot`'s colour and depth into these.
@@ -43,15 +48,18 @@ class UpConverter {
   // (attachment 0, and 1 `from_two` key frames) over the frame's own depth and
   // stencil; bound, cleared (no surface anywhere, stencil 0), depth test on.
   void begin_motion_field(bool from_two);
-  // Then the frame from the key frames' pixels into output(); with the motion
-  // method, the pixels some key frame saw are marked in the stencil, and those
+  // Then the frame from the key frames' pixels; with the motion method, the
+  // pixels (samples) some key frame saw are marked in the stencil, and those
   // none saw are left for begin_shade_unseen() (frame.shade_unseen; otherwise
   // they show the first key frame's pixel) and counted.
   [[nodiscard]] up::BetweenReport resolve(const up::BetweenFrame& frame, const glm::vec3& background);
-  // Binds output() over the motion field's depth, drawing only where the
+  // Binds the frame over the motion field's depth, drawing only where the
   // stencil leaves a pixel unseen and only the surface the field found there.
   void begin_shade_unseen();
   void end_shade_unseen();  // back to the GL state everything else expects
+  // The frame done: multisampled, its samples averaged into output() and one
+  // sample's depth into depth(); nothing to do otherwise.
+  void finish();
 
   // PSNR_Y (the up-conversion paper's weighting of each channel's PSNR) of
   // output() against `image` (this size, RGBA32F, linear), both as displayed
@@ -71,14 +79,26 @@ class UpConverter {
   int width_ = 0;
   int height_ = 0;
   int slots_ = 2;
+  int samples_ = 1;
   std::array<glo::Texture, up::kKeySlots> key_colour_;
   std::array<glo::Texture, up::kKeySlots> key_depth_;
   std::array<up::KeyView, up::kKeySlots> key_view_;
-  std::array<glo::Texture, 2> motion_;  // where each pixel was in the first and the second key frame
-  glo::Texture depth_stencil_;
+  // Multisampled: each key frame's nearest and farthest sample depth per pixel.
+  std::array<glo::Texture, up::kKeySlots> key_range_;
+  std::array<glo::Framebuffer, up::kKeySlots> key_range_framebuffer_;
+  glo::Program range_program_;
+  // Where each pixel (sample) was in the first and the second key frame.
+  std::array<glo::Texture, 2> motion_;
+  glo::Texture depth_stencil_;  // output()'s; the motion field's too with one sample
   glo::Framebuffer motion_framebuffer_;
   glo::Texture output_;
   glo::Framebuffer output_framebuffer_;
+  // Multisampled: the motion field's depth and stencil, and the frame before
+  // its samples are averaged (drawn into by resolve() and the shading anew).
+  glo::Texture multisample_depth_stencil_;
+  glo::Texture multisample_frame_;
+  glo::Framebuffer multisample_framebuffer_;
+  [[nodiscard]] GLuint frame_framebuffer() const;  // where the frame is drawn
   // The resolve for each way: the average of two key frames (or one key frame
   // as it is, across a cut), motion from one key frame, from two.
   enum Resolve { average, average_one_key, one_key, two_keys, resolves };
@@ -93,6 +113,8 @@ class UpConverter {
   glo::Framebuffer error_framebuffer_;
   glo::VertexArray empty_vertex_array_;
   GLuint query_ = 0;
+  glo::Buffer unseen_box_;      // glsl/between_resolve.frag.glsl: x0, y0, x1, y1
+  std::array<GLint, 4> box_{};  // the last resolve's
 };
 
 }  // namespace optique::render

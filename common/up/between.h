@@ -45,14 +45,16 @@ struct BetweenFrame {
   double toward_second = 0.0;
   // Pixels whose surface no key frame saw (disoccluded, or an object that was
   // not there) shaded anew; otherwise they show key `first`'s pixel there,
-  // as a repeated frame would.
+  // as a repeated frame would (what shading anew is worth, in tests).
   bool shade_unseen = true;
   int second = 1;  // with two_keys
 };
 
 struct BetweenReport {
-  std::int64_t unseen_pixels = 0;  // not seen by any key frame used (motion only)
-  double unseen_share = 0.0;       // of the image's pixels
+  // Not seen by any key frame used (motion only); multisampled, the unseen
+  // samples in pixels' worth, rounded up.
+  std::int64_t unseen_pixels = 0;
+  double unseen_share = 0.0;  // of the image's pixels (samples)
 };
 
 }  // namespace optique::up

@@ -117,9 +117,11 @@ Result<SceneResult> measure(const StageScene& stage, const Run& run, int frames,
   auto loaded = scene::load_scene(source.builtin, source.gltf, image::decode_texture);
   if (!loaded) return Error{loaded.error()};
   const scene::SceneDefinition& scene = loaded.value().definition;
-  auto up_pipeline = render::ProjectorPipeline::make(config::job_for(up_installation.value(), 0), scene);
+  render::PipelineOptions options;
+  options.samples = run.samples;
+  auto up_pipeline = render::ProjectorPipeline::make(config::job_for(up_installation.value(), 0), scene, options);
   if (!up_pipeline) return Error{up_pipeline.error()};
-  auto full_pipeline = render::ProjectorPipeline::make(config::job_for(full_installation.value(), 0), scene);
+  auto full_pipeline = render::ProjectorPipeline::make(config::job_for(full_installation.value(), 0), scene, options);
   if (!full_pipeline) return Error{full_pipeline.error()};
   up_pipeline.value()->warm_up();
   full_pipeline.value()->warm_up();

@@ -51,6 +51,7 @@ struct Run {
   int ratio = 4;
   double min_psnr = 0.0;  // 0: the ratio fixed
   bool spread = false;    // key frames drawn a band a frame
+  int samples = 1;        // per pixel, both pipelines (multisampling)
 };
 
 struct FrameResult {
