@@ -98,6 +98,7 @@ std::string summarize(const config::LoadedConfig& config) {
           << (up.adaptive() ? ", fewer frames between while they would fall below " +
                                   std::to_string(static_cast<int>(std::lround(up.min_psnr))) + " dB PSNR_Y"
                             : ", the ratio fixed")
+          << (p.color_fields.sequential() ? "; every colour field built from the key frames at its own moment" : "")
           << "\n";
     }
   }

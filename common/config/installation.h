@@ -17,9 +17,9 @@
 #include <glm/vec3.hpp>
 
 #include "config/color_fields.h"
-#include "config/up_conversion.h"
 #include "config/defaults.h"
 #include "config/response.h"
+#include "config/up_conversion.h"
 #include "geometry/projection.h"
 #include "geometry/projector_geometry.h"
 
@@ -111,7 +111,7 @@ struct Projector {
   double blend_ramp = 0.0;  // metres of roll-off inside its edges; 0: across the whole overlap
   ProjectorResponse response;
   Content content;
-  ColorFields color_fields;  // a single-chip DLP projector's colour fields; empty: all colours at once
+  ColorFields color_fields;    // a single-chip DLP projector's colour fields; empty: all colours at once
   UpConversion up_conversion;  // key frames and the frames built between them; ratio 1: every frame rendered
 
   // Its geometry on the screen (checked when parsed: this cannot fail then).

@@ -48,4 +48,21 @@ UpConversion parse_up_conversion(const schema::UpConversion& up, const std::stri
   return out;
 }
 
+std::optional<Problem> up_conversion_with_fields(const UpConversion& up, const ColorFields& fields) {
+  if (!up.enabled() || !fields.sequential()) return std::nullopt;
+  if (fields.method != FieldMethod::up_conversion) {
+    return Problem{"color_fields.method",
+                   "must be \"up-conversion\" with up_conversion (got \"" + std::string(to_string(fields.method)) +
+                       "\"): the fields of a frame built between key frames are built from them too, at their own "
+                       "moments; \"" +
+                       std::string(to_string(fields.method)) + "\" would render every frame anyway"};
+  }
+  if (fields.images != 1) {
+    return Problem{"color_fields",
+                   "two images a frame (a stereo projector used as mono) cannot be built between key "
+                   "frames yet: remove up_conversion from this projector, or show one image a frame"};
+  }
+  return std::nullopt;
+}
+
 }  // namespace optique::config

@@ -5,10 +5,12 @@
 // conversion paper's motion-compensated method), or, as the baseline, their
 // average.
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "config/color_fields.h"
 #include "config/problem.h"
 #include "optique/config.pb.h"
 
@@ -60,5 +62,12 @@ struct UpConversion {
 // needs the key frame after), a floor that is not 0 or 10…100 dB.
 [[nodiscard]] UpConversion parse_up_conversion(const schema::UpConversion& up, const std::string& path,
                                                std::vector<Problem>& problems);
+
+// What keeps one projector from both up-converting its frames and showing
+// these colour fields (the path from the projector), or nothing. Each field of
+// a frame built between key frames is built from them at its own moment, so the
+// fields' method must be up-conversion (per-field or a gather would render
+// every frame anyway); one image a frame.
+[[nodiscard]] std::optional<Problem> up_conversion_with_fields(const UpConversion& up, const ColorFields& fields);
 
 }  // namespace optique::config

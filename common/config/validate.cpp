@@ -335,9 +335,13 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
       check.fail(at + "." + e.substr(0, colon), colon == std::string::npos ? e : e.substr(colon + 2));
     }
     check_content(check, at + ".content", p.content());
-    if (p.has_color_fields()) (void)parse_color_fields(p.color_fields(), at + ".color_fields", check.problems());
-    if (p.has_up_conversion()) {
-      (void)parse_up_conversion(p.up_conversion(), at + ".up_conversion", check.problems());
+    const std::size_t problems_before = check.problems().size();
+    ColorFields fields;
+    UpConversion up;
+    if (p.has_color_fields()) fields = parse_color_fields(p.color_fields(), at + ".color_fields", check.problems());
+    if (p.has_up_conversion()) up = parse_up_conversion(p.up_conversion(), at + ".up_conversion", check.problems());
+    if (check.problems().size() == problems_before) {  // each well formed: together?
+      if (auto problem = up_conversion_with_fields(up, fields)) check.fail(at + "." + problem->path, problem->message);
     }
   }
   if (scope == Scope::installation) check_stacked_pairs(check, inst);

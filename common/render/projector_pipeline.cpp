@@ -40,11 +40,9 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
                                                                    const scene::SceneDefinition& scene,
                                                                    const PipelineOptions& options) {
   const config::Projector& self = job.self();
-  if (self.up_conversion.enabled() && !self.color_fields.fields.empty()) {
-    // Refused, not ignored: a node that rendered every field anyway would hide
-    // the cost the operator asked to save.
-    return Error{"projector '" + self.id +
-                 "': up_conversion with color_fields is not drawn yet; remove one of the two for this projector"};
+  // The config refuses these (config/validate.cpp); a job built otherwise too.
+  if (auto problem = config::up_conversion_with_fields(self.up_conversion, self.color_fields)) {
+    return Error{"projector '" + self.id + "': " + problem->path + ": " + problem->message};
   }
   auto view = ProjectorView::make(job.screen(), self.geometry(), self.rendering, options.two_pass_pixels_per_metre);
   if (!view) return Error{"projector '" + self.id + "': " + view.error()};
@@ -321,11 +319,26 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
     renderer_->keep_key(plan.key_slot, {*key, 0.0, f.projection * f.view});
   }
   up_report_.ratio = schedule_->ratio();
+  if (color_fields_.sequential()) return draw_fields_between(state, plan);
   if (plan.shown_slot) renderer_->show_key(*plan.shown_slot);
   if (!plan.between) return {};
   const auto seen = moment(state, 0.0);
   if (!seen) return black(seen.error());
   up_report_.between = renderer_->draw_between(state, 0.0, seen.value().eye, seen.value().frustum, plan.frame, terms_);
+  return {};
+}
+
+Result<void> ProjectorPipeline::draw_fields_between(const scene::SceneState& state, const up::UpPlan& plan) {
+  up::BetweenFrame from = plan.frame;
+  if (!plan.between) {  // a key frame: its own fields from it alone
+    from = {};
+    from.method = schedule_->settings().method;
+    from.first = plan.shown_slot ? *plan.shown_slot : plan.key_slot;
+  }
+  auto passes = field_passes(state, 0);
+  if (!passes) return Error{passes.error()};  // drawn black
+  const up::BetweenReport report = renderer_->draw_fields_between(state, passes.value(), from, terms_);
+  if (plan.between) up_report_.between = report;
   return {};
 }
 

@@ -591,26 +591,43 @@ void SceneRenderer::draw_key_band(const scene::SceneState& state, double fractio
 
 void SceneRenderer::draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key,
                                              std::span<const FieldPass> passes, const LightTerms& terms) {
-  Gl& gl = *gl_;
-  assert(gl.up_converter);  // prepare_up_conversion first
-  UpConverter& converter = *gl.up_converter;
+  assert(gl_->up_converter);  // prepare_up_conversion first
   if (key != nullptr) {
     draw_linear(state, key->fraction, key->eye, key->frustum, terms);
     keep_key(0, {state, key->fraction, key->frustum.projection * key->frustum.view});
   }
-  const auto at_key = [&](const FieldPass& pass) {
-    return key != nullptr && pass.fraction == key->fraction && pass.eye == key->eye &&
-           pass.frustum.view == key->frustum.view && pass.frustum.projection == key->frustum.projection;
+  up::BetweenFrame from;
+  from.first = 0;
+  (void)build_fields(state, passes, from, terms, key);
+}
+
+up::BetweenReport SceneRenderer::draw_fields_between(const scene::SceneState& state, std::span<const FieldPass> passes,
+                                                     const up::BetweenFrame& from, const LightTerms& terms) {
+  assert(gl_->up_converter);  // prepare_up_conversion first
+  return build_fields(state, passes, from, terms, nullptr);
+}
+
+up::BetweenReport SceneRenderer::build_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
+                                              const up::BetweenFrame& from, const LightTerms& terms,
+                                              const FieldPass* shown) {
+  Gl& gl = *gl_;
+  UpConverter& converter = *gl.up_converter;
+  const auto at_shown = [&](const FieldPass& pass) {
+    return shown != nullptr && pass.fraction == shown->fraction && pass.eye == shown->eye &&
+           pass.frustum.view == shown->frustum.view && pass.frustum.projection == shown->frustum.projection;
   };
+  up::BetweenReport most;
   for (const FieldPass& pass : passes) {
-    if (at_key(pass)) continue;  // shown as drawn
-    up::BetweenFrame frame;
-    frame.first = 0;
-    (void)build_between(state, pass.fraction, pass.eye, pass.frustum, frame, terms);
+    if (at_shown(pass)) continue;  // shown as drawn
+    up::BetweenFrame frame = from;
+    if (frame.two_keys) frame.toward_second = std::clamp(from.toward_second + pass.fraction * from.per_frame, 0.0, 1.0);
+    const up::BetweenReport report = build_between(state, pass.fraction, pass.eye, pass.frustum, frame, terms);
+    if (report.unseen_share >= most.unseen_share) most = report;
     converter.write_channels(gl.linear_framebuffer.get(), pass.red, pass.green, pass.blue);
   }
   gl.rendered_colour_framebuffer = gl.rendered_depth_framebuffer = gl.linear_framebuffer.get();
   encode();
+  return most;
 }
 
 void SceneRenderer::show_key(int slot) {

@@ -156,6 +156,12 @@ class SceneRenderer {
   // which show it as drawn. Then the output stage. prepare_up_conversion first.
   void draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key, std::span<const FieldPass> passes,
                                 const LightTerms& terms = {});
+  // Colour fields of a frame that frame-rate up-conversion builds: each of
+  // `passes` built from the kept key frames as `from` says (two weighed by the
+  // pass's own moment), into its channels of the image. Then the output stage.
+  // The largest share of a field's pixels that no key frame saw.
+  up::BetweenReport draw_fields_between(const scene::SceneState& state, std::span<const FieldPass> passes,
+                                        const up::BetweenFrame& from, const LightTerms& terms = {});
 
   // Fails when the weights do not match the output size.
   [[nodiscard]] Result<void> set_output(const OutputStage& stage);
@@ -228,6 +234,10 @@ class SceneRenderer {
   up::BetweenReport build_between(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
                                   const geometry::Frustum& frustum, const up::BetweenFrame& frame,
                                   const LightTerms& terms);
+  // Each of `passes` but `shown` (at the image's own moment: left as drawn)
+  // built as `from` says into its channels of the linear image; then encoded.
+  up::BetweenReport build_fields(const scene::SceneState& state, std::span<const FieldPass> passes,
+                                 const up::BetweenFrame& from, const LightTerms& terms, const FieldPass* shown);
   void keep_still_depth();        // copies the depth drawn so far aside
   void bring_back_still_depth();  // and back
   [[nodiscard]] unsigned draw_framebuffer() const;

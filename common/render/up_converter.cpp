@@ -36,7 +36,7 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
                                                          int samples) {
   assert(width > 0 && height > 0);
   assert(slots >= 2 && slots <= up::kKeySlots);
-  assert(samples >= 1 && samples <= 32);  // the resolve's sample mask is one int
+  assert(samples >= 1 && samples <= 16);  // the resolve's sample mask: (1 << SAMPLES) - 1
   std::unique_ptr<UpConverter> u(new UpConverter());
   u->width_ = width;
   u->height_ = height;
@@ -115,7 +115,8 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
     return Error{"this GL driver cannot draw the up-conversion's check (RGBA32F)"};
   }
   // The motion field and the frame share their depth and stencil: the resolve
-  // marks, the shading anew tests; multisampled, both have their own.
+  // marks, the shading anew tests. Multisampled, they share multisampled ones,
+  // and output() has its own single-sample depth (finish()).
   GLuint frame_depth_stencil = u->depth_stencil_.get();
   if (samples > 1) {
     u->multisample_depth_stencil_ = glo::make_storage(depth_stencil, width, height, samples);

@@ -48,6 +48,9 @@ struct BetweenFrame {
   // as a repeated frame would (what shading anew is worth, in tests).
   bool shade_unseen = true;
   int second = 1;  // with two_keys
+  // How far toward_second moves in one display frame period (1 / the key
+  // frames' span): a moment within the frame (a colour field) weighs by its own.
+  double per_frame = 0.0;
 };
 
 struct BetweenReport {

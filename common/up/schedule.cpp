@@ -203,6 +203,7 @@ UpPlan UpSchedule::interpolated(std::uint64_t frame, const scene::SceneState& st
     plan.frame.second = second_->slot;
     plan.frame.two_keys = true;
     plan.frame.toward_second = t;
+    plan.frame.per_frame = 1.0 / span;
   } else {
     plan.frame.first = from_first ? first_->slot : second_->slot;
   }

@@ -185,8 +185,8 @@ const Motion kTurningAway = [](double t) {
                      glm::angleAxis(glm::radians(10.0 + 2.0 * 60.0 * t), glm::dvec3(0, 1, 0))};
 };
 
-// Multisampled, the pixels at the square's edges hold two surfaces in the key
-// frame: no sample takes them, and they are shaded anew (as they were drawn).
+// Multisampled, the pixels at the squares' edges hold two surfaces each; they
+// moved alike (not at all), so each is the key frame's pixel as it is.
 TEST_F(UpConversion, WithoutMotionTheFrameBetweenIsTheKeyFrame) {
   for (const int samples : {1, 4}) {
     make(squares(true), samples);
@@ -203,7 +203,7 @@ TEST_F(UpConversion, WithoutMotionTheFrameBetweenIsTheKeyFrame) {
                                std::to_string(samples) + " sample(s)";
       EXPECT_LE(c.value().max_abs_error, 1e-6) << name;
       // Multisampled, the squares' outlines (measured: 595 px, 1.2 %).
-      EXPECT_LE(report.unseen_share, samples == 1 ? 0.0 : 0.02) << name;
+      EXPECT_EQ(report.unseen_pixels, 0) << name;
     }
   }
 }
@@ -213,19 +213,23 @@ TEST_F(UpConversion, TranslatingAndTurningSquaresMatchTheirFullRenders) {
     const char* name;
     Motion motion;
     int samples = 1;  // multisampled: each sample of an edge from its own surface
+    // The bar at one sample; multisampled, measured 61-66 dB (55-62
+    // turning away), the bar below that.
+    double bar = 40.0;
   };
   for (const Case& c :
        {Case{"translating", kTranslating}, Case{"turning", kTurning}, Case{"turning-away", kTurningAway},
-        Case{"translating, 4 samples", kTranslating, 4}, Case{"turning, 4 samples", kTurning, 4}}) {
+        Case{"translating, 4 samples", kTranslating, 4, 55.0}, Case{"turning, 4 samples", kTurning, 4, 55.0},
+        Case{"turning-away, 4 samples", kTurningAway, 4, 50.0}}) {
     make(squares(false), c.samples);
     key(0, state_at(c.motion, 0));
     double worst = 1e9;
     for (int n = 1; n <= 3; ++n) {  // 4:1, extrapolated from the key frame
       const image::FloatImage b = between(state_at(c.motion, n), {up::BetweenMethod::motion, 0, false, 0.0});
       const image::FloatImage reference = full(state_at(c.motion, n));
-      const double db = psnr_y(b, reference, std::string(c.name) + "-" + std::to_string(n), 40.0);
+      const double db = psnr_y(b, reference, std::string(c.name) + "-" + std::to_string(n), c.bar);
       std::cout << c.name << " frame " << n << ": " << db << " dB\n";
-      EXPECT_GE(db, 40.0) << c.name << " frame " << n;
+      EXPECT_GE(db, c.bar) << c.name << " frame " << n;
       worst = std::min(worst, db);
     }
     // What the motion field is worth: the key frame shown again is far off.

@@ -39,5 +39,17 @@ TEST(CheckConfig, SaysWhatTheVelocityThresholdDoesWithEachMethod) {
       << said(config::FieldMethod::off);
 }
 
+TEST(CheckConfig, SaysThatAnUpConvertingDlpProjectorBuildsEveryField) {
+  config::LoadedConfig config = pinball();
+  ASSERT_FALSE(config.installation.projectors.empty());
+  config::Projector& p = config.installation.projectors.front();
+  p.color_fields.method = config::FieldMethod::up_conversion;
+  p.color_fields.velocity_threshold = 0.0;
+  p.up_conversion.ratio = 4;
+  const std::string said = summarize(config);
+  EXPECT_NE(said.find("up-conversion: a key frame every 4 frames"), std::string::npos) << said;
+  EXPECT_NE(said.find("; every colour field built from the key frames at its own moment"), std::string::npos) << said;
+}
+
 }  // namespace
 }  // namespace optique::tools

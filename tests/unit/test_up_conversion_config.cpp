@@ -66,6 +66,28 @@ TEST(UpConversion, EveryBadFieldIsNamedAtOnce) {
       << parsed.error();
 }
 
+// A DLP projector that up-converts its frames builds every field between key
+// frames: its fields' method must say so, and one image a frame.
+TEST(UpConversion, WithColourFieldsTheFieldsAreBuiltBetweenKeyFrames) {
+  const auto fields = [](const std::string& colour_fields) {
+    return with(R"({"ratio": 4}, "color_fields": )" + colour_fields);
+  };
+  const auto built = fields(R"({"preset": "dlp-brg-120hz", "method": "up-conversion"})");
+  ASSERT_TRUE(built) << built.error();
+  EXPECT_TRUE(built.value().projectors[0].up_conversion.enabled());
+  EXPECT_TRUE(built.value().projectors[0].color_fields.up_converts());
+  for (const char* method : {"per-field", "gather"}) {
+    const auto refused = fields(std::string(R"({"preset": "dlp-brg-120hz", "method": ")") + method + R"("})");
+    EXPECT_TRUE(says(refused, std::string("projectors[0].color_fields.method: must be \"up-conversion\" with "
+                                          "up_conversion (got \"") +
+                                  method + "\")"))
+        << refused.error();
+  }
+  EXPECT_TRUE(fields(R"({"preset": "dlp-brg-120hz", "method": "off"})")) << "every colour at once: nothing to build";
+  EXPECT_TRUE(says(fields(R"({"preset": "dlp-stereo-as-mono", "method": "up-conversion"})"),
+                   "projectors[0].color_fields: two images a frame"));
+}
+
 TEST(UpConversion, TheAverageNeedsTheKeyFrameAfter) {
   EXPECT_TRUE(says(with(R"({"ratio": 4, "method": "average"})"), "it needs mode interpolate"));
   EXPECT_TRUE(says(with(R"({"ratio": 4, "method": "average", "mode": "extrapolate"})"), "it needs mode interpolate"));

@@ -161,6 +161,7 @@ TEST(UpSchedule, InterpolatesBetweenAKeyFrameAndOneDrawnAhead) {
   EXPECT_NE(b.key_slot, a.key_slot);
   EXPECT_EQ(b.frame.first, a.key_slot);
   EXPECT_DOUBLE_EQ(b.frame.toward_second, 0.25);
+  EXPECT_DOUBLE_EQ(b.frame.per_frame, 0.25) << "a colour field a frame later would weigh 0.5";
   EXPECT_DOUBLE_EQ(again.plan(3, state_at(3), lookup).frame.toward_second, 0.75);
   EXPECT_EQ(again.plan(4, state_at(4), lookup).shown_slot, b.key_slot);
   const UpPlan c = again.plan(5, state_at(5), lookup);

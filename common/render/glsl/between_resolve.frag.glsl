@@ -9,15 +9,18 @@
 // shaded anew (up_converter.h); until then it holds the last frame's output.
 // Every such pixel is drawn again, as the scene's program discards nothing.
 // average: the same pixel of both, half each (of one across a cut).
-// Multisampled (SAMPLES > 1), the motion field holds each sample's surface: a
-// pixel whose samples all hold the same (one surface covers it) is built once;
-// at an edge each sample is built from its own surface, the samples some key
-// frame saw get their mean and the sample mask keeps the others for shading
-// anew, so that the average of the pixel's samples is that of each sample's own.
-// Multisampled, a key frame's pixel is taken for a surface only if all its
-// samples saw that surface: key_depth is then the nearest and the farthest sample's depth
-// (glsl/key_depth_range.frag.glsl); a pixel at the key frame's edge mixes two
-// surfaces' colours, and where no pure pixel is near, the sample is shaded anew.
+// Multisampled (SAMPLES > 1), the motion field holds each sample's surface and
+// key_depth is each key-frame pixel's nearest and farthest sample depth
+// (glsl/key_depth_range.frag.glsl). A pixel whose samples hold one surface, or
+// surfaces that all moved alike (an edge of what stands still), is built once,
+// from the key frames' pixels whose nearest and farthest samples saw its nearest
+// and farthest surface (a still edge's mixed pixel, as it was). At a moving edge
+// each sample is built from its own surface, only from key-frame pixels all of
+// whose samples saw it (a pixel at a key frame's edge mixes two surfaces'
+// colours; with less than half a pixel's weight of pure ones near, the sample
+// is shaded anew); the samples some key frame saw get their mean and the sample
+// mask keeps the others for shading anew, so that the pixel's average is that
+// of each sample's own.
 // Built with "#version 450 core", AVERAGE 0 or 1, KEYS 1 or 2 and SAMPLES first
 // (one program each: a branch on a uniform still costs llvmpipe both sides).
 layout(binding = 0) uniform sampler2D key_colour_0;
@@ -55,17 +58,20 @@ vec4 taken(sampler2D key_colour, sampler2D key_depth, vec4 seen, vec2 far) {
   vec2 size = vec2(textureSize(key_colour, 0));
   if (seen.w < 0.0 || any(lessThan(seen.xy, vec2(0.0))) || any(greaterThan(seen.xy, size))) return vec4(0.0);
   vec2 uv = seen.xy / size;
-  // Gathered in the order (0, 1), (1, 1), (1, 0), (0, 0) from the lower-left texel.
-#if SAMPLES > 1
-  bvec4 same = bvec4(step(abs(textureGather(key_depth, uv, 0) - seen.z), vec4(seen.w)) *
-                     step(abs(textureGather(key_depth, uv, 1) - far.x), vec4(far.y)));
-#else
-  bvec4 same = lessThanEqual(abs(textureGather(key_depth, uv, 0) - seen.z), vec4(seen.w));
-#endif
-  if (all(same)) return vec4(textureLod(key_colour, uv, 0.0).rgb, 1.0);
   vec2 p = seen.xy - 0.5;  // texel centres at integers
   vec2 corner = floor(p);
   vec2 f = p - corner;
+  // The four texels from `corner` (the weights' own: gathered at their shared
+  // corner, never where rounding could pick the next four), in the order
+  // (0, 1), (1, 1), (1, 0), (0, 0).
+  vec2 four = (corner + 1.0) / size;
+#if SAMPLES > 1
+  bvec4 same = bvec4(step(abs(textureGather(key_depth, four, 0) - seen.z), vec4(seen.w)) *
+                     step(abs(textureGather(key_depth, four, 1) - far.x), vec4(far.y)));
+#else
+  bvec4 same = lessThanEqual(abs(textureGather(key_depth, four, 0) - seen.z), vec4(seen.w));
+#endif
+  if (all(same)) return vec4(textureLod(key_colour, uv, 0.0).rgb, 1.0);
   vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y)) * vec4(same);
   float weight = w.x + w.y + w.z + w.w;
   if (weight <= 0.0) return vec4(0.0);
