@@ -225,14 +225,10 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   const Resolve r = averages ? (frame.two_keys ? average : average_one_key) : frame.two_keys ? two_keys : one_key;
   if (!averages && !frame.shade_unseen) {
     // What no key frame saw keeps the first key frame's pixel (the resolve
-    // leaves it).
-    if (samples_ == 1) {
-      copy(key_colour_[frame.first].get(), output_.get(), width_, height_);
-    } else {
-      glUseProgram(channels_program_.get());
-      glBindTextureUnit(0, key_colour_[frame.first].get());
-      glDrawArrays(GL_TRIANGLES, 0, 3);
-    }
+    // leaves it): drawn into every sample.
+    glUseProgram(channels_program_.get());
+    glBindTextureUnit(0, key_colour_[frame.first].get());
+    glDrawArrays(GL_TRIANGLES, 0, 3);
   }
   glUseProgram(resolve_programs_[r].get());
   glUniform1f(uniforms_[r].toward_second, static_cast<float>(frame.toward_second));

@@ -114,6 +114,17 @@ vec4 built(vec4 seen_0, vec4 seen_1, vec2 far_0, vec2 far_1) {
 // A sample's place in a key frame; where no surface was drawn, the background
 // there (still, at the clear's depth 1).
 vec4 placed(vec4 m) { return m.w < -1.5 ? vec4(gl_FragCoord.xy, 1.0, 0.0) : m; }
+
+// Sample `m` of one key frame's motion field against the pixel's first: still
+// one surface, still moved alike, and the nearest and farthest so far.
+void take(vec4 m, vec4 first, inout bool one_surface, inout bool alike, inout vec4 near, inout vec4 far) {
+  const float kAlike = 1e-3;  // pixels
+  one_surface = one_surface && m == first;
+  m = placed(m);
+  alike = alike && m.w >= 0.0 && all(lessThanEqual(abs(m.xy - near.xy), vec2(kAlike)));
+  near = m.z < near.z ? m : near;
+  far = m.z > far.z ? m : far;
+}
 #endif
 
 void main() {
@@ -135,7 +146,6 @@ void main() {
   // the key frames' pixel there as it is, their mix included, where their
   // nearest and farthest samples saw the nearest and the farthest of these
   // surfaces. Otherwise sample by sample.
-  const float kAlike = 1e-3;  // pixels
   bool one_surface = true;
   vec4 near_0 = placed(first_0);
   vec4 far_0 = near_0;
@@ -148,19 +158,9 @@ void main() {
   vec4 far_1 = vec4(0.0);
 #endif
   for (int s = 1; s < SAMPLES; ++s) {
-    vec4 m = texelFetch(motion_0, p, s);
-    one_surface = one_surface && m == first_0;
-    m = placed(m);
-    alike = alike && m.w >= 0.0 && all(lessThanEqual(abs(m.xy - near_0.xy), vec2(kAlike)));
-    near_0 = m.z < near_0.z ? m : near_0;
-    far_0 = m.z > far_0.z ? m : far_0;
+    take(texelFetch(motion_0, p, s), first_0, one_surface, alike, near_0, far_0);
 #if KEYS == 2
-    m = texelFetch(motion_1, p, s);
-    one_surface = one_surface && m == first_1;
-    m = placed(m);
-    alike = alike && m.w >= 0.0 && all(lessThanEqual(abs(m.xy - near_1.xy), vec2(kAlike)));
-    near_1 = m.z < near_1.z ? m : near_1;
-    far_1 = m.z > far_1.z ? m : far_1;
+    take(texelFetch(motion_1, p, s), first_1, one_surface, alike, near_1, far_1);
 #endif
   }
   if (alike && !one_surface) {  // near_k: a surface (not every sample is the background)
@@ -179,14 +179,13 @@ void main() {
   float seen = 0.0;
   int mask = 0;
   for (int s = 0; s < count; ++s) {
+    vec4 m_0 = s == 0 ? first_0 : texelFetch(motion_0, p, s);
 #if KEYS == 2
-    vec4 m_0 = s == 0 ? first_0 : texelFetch(motion_0, p, s);
     vec4 m_1 = s == 0 ? first_1 : texelFetch(motion_1, p, s);
-    vec4 here = built(m_0, m_1, s == 0 ? far_0.zw : m_0.zw, s == 0 ? far_1.zw : m_1.zw);
 #else
-    vec4 m_0 = s == 0 ? first_0 : texelFetch(motion_0, p, s);
-    vec4 here = built(m_0, vec4(0.0), s == 0 ? far_0.zw : m_0.zw, vec2(0.0));
+    vec4 m_1 = vec4(0.0);  // unread
 #endif
+    vec4 here = built(m_0, m_1, s == 0 ? far_0.zw : m_0.zw, s == 0 ? far_1.zw : m_1.zw);
     if (here.w > 0.0) {
       sum += here.rgb;
       seen += 1.0;
