@@ -834,7 +834,9 @@ image::FloatImage SceneRenderer::read_linear() const {
 }
 
 image::FloatImage SceneRenderer::read_rendered() const {
-  return read_float(gl_->rendered_colour_framebuffer, gl_->width, gl_->height, GL_RGBA, 4);
+  image::FloatImage image = read_float(gl_->rendered_colour_framebuffer, gl_->width, gl_->height, GL_RGBA, 4);
+  for (std::size_t i = 3; i < image.pixels.size(); i += 4) image.pixels[i] = 1.0f;
+  return image;
 }
 
 image::FloatImage SceneRenderer::read_depth() const {

@@ -189,7 +189,8 @@ class SceneRenderer {
   [[nodiscard]] unsigned held_framebuffer() const;  // the copy; 0 before the first hold_output
   [[nodiscard]] int width() const;                  // of the output
   [[nodiscard]] int height() const;
-  // The rendered image before the output stage, and its depth (window z in [0, 1]).
+  // The rendered image before the output stage (opaque: the alpha that carries
+  // depth inside is read as 1), and its depth (window z in [0, 1]).
   [[nodiscard]] image::FloatImage read_rendered() const;
   [[nodiscard]] image::FloatImage read_depth() const;
 

@@ -75,8 +75,8 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   }
   for (int k = 0; k < slots; ++k) {  // a key frame drawn in bands needs a third
     u->key_colour_[k] = exact_texture(GL_RGBA32F, width, height);
-    // Bilinear where all four pixels around a point saw its surface (the
-    // resolve's one fetch); texel by texel elsewhere.
+    // Multisampled, bilinear where all four pixels around a point saw its
+    // surface (the resolve's one fetch); texel by texel elsewhere.
     glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     u->key_depth_[k] = exact_texture(depth_format, width, height);
@@ -238,8 +238,9 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   for (int k = 0; k < 2; ++k) {  // the first key frame as key 0
     const int slot = k == 0 || !frame.two_keys ? frame.first : frame.second;
     glBindTextureUnit(static_cast<GLuint>(k), key_colour_[slot].get());
-    // Multisampled, the depth range (glsl/key_depth_range.frag.glsl).
-    glBindTextureUnit(static_cast<GLuint>(2 + k), (samples_ > 1 ? key_range_ : key_depth_)[slot].get());
+    // Multisampled, the depth range (glsl/key_depth_range.frag.glsl); with one
+    // sample the key colour's alpha is its depth.
+    if (samples_ > 1) glBindTextureUnit(static_cast<GLuint>(2 + k), key_range_[slot].get());
     glBindTextureUnit(static_cast<GLuint>(4 + k), motion_[k].get());  // the motion field's, in that order
   }
   if (averages) {

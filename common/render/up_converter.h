@@ -32,7 +32,8 @@ class UpConverter {
   UpConverter(const UpConverter&) = delete;
   UpConverter& operator=(const UpConverter&) = delete;
 
-  // Copies a drawn image (RGBA32F) and its depth into key slot `slot`;
+  // Copies a drawn image (RGBA32F, its alpha the window depth as the scene's
+  // program writes it) and its depth into key slot `slot`;
   // multisampled, `sample_depth` is its depth per sample (before the resolve:
   // which pixels hold more than one surface).
   void keep(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view);

@@ -50,38 +50,40 @@ void left_unseen(ivec2 p) {
 }
 
 // The key frame's colour there times the weight that saw the same surface, and
-// that weight. Where all four saw it (most pixels), one bilinear fetch.
-// Multisampled, `far` is the depth (and its tolerance) that the key frame's
-// farthest sample must match, seen.zw its nearest's: one surface, or a still
-// edge's two (see main).
+// that weight. One sample per pixel, the key frame's alpha is its depth (the
+// scene's program writes it): four fetches give colour and depth. Multisampled,
+// `far` is the depth (and its tolerance) that the key frame's farthest sample
+// must match, seen.zw its nearest's (key_depth: the range), one surface or a
+// still edge's two (see main); where all four saw it (most pixels), one
+// bilinear fetch.
 vec4 taken(sampler2D key_colour, sampler2D key_depth, vec4 seen, vec2 far) {
   vec2 size = vec2(textureSize(key_colour, 0));
   if (seen.w < 0.0 || any(lessThan(seen.xy, vec2(0.0))) || any(greaterThan(seen.xy, size))) return vec4(0.0);
-  vec2 uv = seen.xy / size;
   vec2 p = seen.xy - 0.5;  // texel centres at integers
   vec2 corner = floor(p);
   vec2 f = p - corner;
-  // The four texels from `corner` (the weights' own: gathered at their shared
-  // corner, never where rounding could pick the next four), in the order
-  // (0, 1), (1, 1), (1, 0), (0, 0).
-  vec2 four = (corner + 1.0) / size;
-#if SAMPLES > 1
-  bvec4 same = bvec4(step(abs(textureGather(key_depth, four, 0) - seen.z), vec4(seen.w)) *
-                     step(abs(textureGather(key_depth, four, 1) - far.x), vec4(far.y)));
-#else
-  bvec4 same = lessThanEqual(abs(textureGather(key_depth, four, 0) - seen.z), vec4(seen.w));
-#endif
-  if (all(same)) return vec4(textureLod(key_colour, uv, 0.0).rgb, 1.0);
-  vec4 w = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y)) * vec4(same);
-  float weight = w.x + w.y + w.z + w.w;
-  if (weight <= 0.0) return vec4(0.0);
+  // The four texels from `corner` (the weights' own), in the order (0, 1),
+  // (1, 1), (1, 0), (0, 0); beyond the image's edge its edge pixel stands in.
   ivec2 base = ivec2(corner);
   ivec2 last = ivec2(size) - 1;
-  vec3 sum = w.x * texelFetch(key_colour, clamp(base + ivec2(0, 1), ivec2(0), last), 0).rgb +
-             w.y * texelFetch(key_colour, clamp(base + ivec2(1, 1), ivec2(0), last), 0).rgb +
-             w.z * texelFetch(key_colour, clamp(base + ivec2(1, 0), ivec2(0), last), 0).rgb +
-             w.w * texelFetch(key_colour, clamp(base, ivec2(0), last), 0).rgb;
-  return vec4(sum, weight);
+  vec4 bilinear = vec4((1.0 - f.x) * f.y, f.x * f.y, f.x * (1.0 - f.y), (1.0 - f.x) * (1.0 - f.y));
+#if SAMPLES > 1
+  vec2 four = (corner + 1.0) / size;  // gathered at their shared corner
+  bvec4 same = bvec4(step(abs(textureGather(key_depth, four, 0) - seen.z), vec4(seen.w)) *
+                     step(abs(textureGather(key_depth, four, 1) - far.x), vec4(far.y)));
+  if (all(same)) return vec4(textureLod(key_colour, seen.xy / size, 0.0).rgb, 1.0);
+#endif
+  // llvmpipe runs both sides of an if: one sample per pixel, this is the only
+  // way (a bilinear fetch where all four saw the surface cost more than it saved).
+  vec4 t01 = texelFetch(key_colour, clamp(base + ivec2(0, 1), ivec2(0), last), 0);
+  vec4 t11 = texelFetch(key_colour, clamp(base + ivec2(1, 1), ivec2(0), last), 0);
+  vec4 t10 = texelFetch(key_colour, clamp(base + ivec2(1, 0), ivec2(0), last), 0);
+  vec4 t00 = texelFetch(key_colour, clamp(base, ivec2(0), last), 0);
+#if SAMPLES == 1
+  bvec4 same = lessThanEqual(abs(vec4(t01.a, t11.a, t10.a, t00.a) - seen.z), vec4(seen.w));
+#endif
+  vec4 w = bilinear * vec4(same);
+  return vec4(w.x * t01.rgb + w.y * t11.rgb + w.z * t10.rgb + w.w * t00.rgb, w.x + w.y + w.z + w.w);
 }
 
 // The colour of a surface seen at seen_0 in the first key frame and at seen_1

@@ -50,7 +50,10 @@ void main() {
     vec3 specular = f0 * normalization * pow(max(dot(n, h), 0.0), shininess);
     result += (diffuse + specular) * lights[2 * i + 1].rgb * (n_dot_l / r2);
   }
-  colour = vec4(result, 1.0);
+  // Alpha: the window depth (the clear's 1 where nothing was drawn), so that
+  // the up-converter reads a key frame's colour and depth in one fetch
+  // (glsl/between_resolve.frag.glsl). Nothing else reads the linear alpha.
+  colour = vec4(result, gl_FragCoord.z);
 #ifdef VELOCITY
   vec2 velocity = vec2(0.0);
   if (clip_0.w > 1e-6 && clip_1.w > 1e-6) velocity = (clip_1.xy / clip_1.w - clip_0.xy / clip_0.w) * half_size;
