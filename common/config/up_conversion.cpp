@@ -57,11 +57,6 @@ std::optional<Problem> up_conversion_with_fields(const UpConversion& up, const C
                        "moments; \"" +
                        std::string(to_string(fields.method)) + "\" would render every frame anyway"};
   }
-  if (fields.images != 1) {
-    return Problem{"color_fields",
-                   "two images a frame (a stereo projector used as mono) cannot be built between key "
-                   "frames yet: remove up_conversion from this projector, or show one image a frame"};
-  }
   return std::nullopt;
 }
 

@@ -67,7 +67,7 @@ struct UpConversion {
 // these colour fields (the path from the projector), or nothing. Each field of
 // a frame built between key frames is built from them at its own moment, so the
 // fields' method must be up-conversion (per-field or a gather would render
-// every frame anyway); one image a frame.
+// every frame anyway), in one image a frame or two.
 [[nodiscard]] std::optional<Problem> up_conversion_with_fields(const UpConversion& up, const ColorFields& fields);
 
 }  // namespace optique::config

@@ -128,6 +128,13 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state, const
     next_frame_ = frame.number + 1;
     auto result = draw_up_converted(state, frame);
     if (drawn) drawn(0);
+    // The second image's fields are built from what the first's were, at their
+    // own moments; black after a first that could not be seen.
+    for (int image = 1; image < images(); ++image) {
+      renderer_->hold_output();
+      if (result) result = draw_fields_between(state, image);
+      if (drawn) drawn(image);
+    }
     return result;
   }
   Result<void> result;
@@ -319,7 +326,16 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
     renderer_->keep_key(plan.key_slot, {*key, 0.0, f.projection * f.view});
   }
   up_report_.ratio = schedule_->ratio();
-  if (color_fields_.sequential()) return draw_fields_between(state, plan);
+  if (color_fields_.sequential()) {
+    fields_from_ = plan.frame;
+    if (!plan.between) {  // a key frame: its own fields from it alone
+      fields_from_ = {};
+      fields_from_.method = schedule_->settings().method;
+      fields_from_.first = plan.shown_slot ? *plan.shown_slot : plan.key_slot;
+    }
+    fields_between_ = plan.between;
+    return draw_fields_between(state, 0);
+  }
   if (plan.shown_slot) renderer_->show_key(*plan.shown_slot);
   if (!plan.between) return {};
   const auto seen = moment(state, 0.0);
@@ -328,17 +344,14 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
   return {};
 }
 
-Result<void> ProjectorPipeline::draw_fields_between(const scene::SceneState& state, const up::UpPlan& plan) {
-  up::BetweenFrame from = plan.frame;
-  if (!plan.between) {  // a key frame: its own fields from it alone
-    from = {};
-    from.method = schedule_->settings().method;
-    from.first = plan.shown_slot ? *plan.shown_slot : plan.key_slot;
-  }
-  auto passes = field_passes(state, 0);
+Result<void> ProjectorPipeline::draw_fields_between(const scene::SceneState& state, int image) {
+  auto passes = field_passes(state, image);
   if (!passes) return Error{passes.error()};  // drawn black
-  const up::BetweenReport report = renderer_->draw_fields_between(state, passes.value(), from, terms_);
-  if (plan.between) up_report_.between = report;
+  const up::BetweenReport report = renderer_->draw_fields_between(state, passes.value(), fields_from_, terms_);
+  // The frame's report: the image that left the most unseen.
+  if (fields_between_ && (image == 0 || report.unseen_share > up_report_.between.unseen_share)) {
+    up_report_.between = report;
+  }
   return {};
 }
 

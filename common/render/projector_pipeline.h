@@ -132,10 +132,10 @@ class ProjectorPipeline {
   void add(const GatherReport& report);  // to the frame's gather_report()
   [[nodiscard]] Result<void> draw_gathered(const scene::SceneState& state, int image);
   [[nodiscard]] Result<void> draw_up_converted(const scene::SceneState& state, const DisplayFrame& display);
-  // Frame up-conversion with colour fields: every field of the frame built from
-  // the kept key frames at its own moment (from the key frame this frame draws
-  // or shows, or from the frame's two around it).
-  [[nodiscard]] Result<void> draw_fields_between(const scene::SceneState& state, const up::UpPlan& plan);
+  // Frame up-conversion with colour fields: every field of image `image` built
+  // from the kept key frames at its own moment (from the key frame this frame
+  // draws or shows, or from the frame's two around it: fields_from_).
+  [[nodiscard]] Result<void> draw_fields_between(const scene::SceneState& state, int image);
   [[nodiscard]] Result<void> draw_fields_up_converted(const scene::SceneState& state, int image);
   // Image `image`'s fields, each at its moment with its channels; a moment that
   // cannot be seen draws black and fails.
@@ -155,6 +155,10 @@ class ProjectorPipeline {
   std::optional<up::UpSchedule> schedule_;  // projectors that up-convert
   std::uint64_t next_frame_ = 0;            // without a DisplayFrame
   UpReport up_report_;
+  // This frame's, for every image's fields (draw_fields_between); whether the
+  // frame is one between key frames.
+  up::BetweenFrame fields_from_;
+  bool fields_between_ = false;
 };
 
 }  // namespace optique::render

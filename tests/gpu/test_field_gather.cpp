@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -28,8 +29,9 @@ const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs/";
 
 class FieldGather : public ::testing::Test {
  protected:
-  void open(const std::string& config) {
-    auto opened = testing::open_gl_installation(kConfigs + config);
+  void open(const std::string& config) { open_path(kConfigs + config); }
+  void open_path(const std::string& path) {
+    auto opened = testing::open_gl_installation(path);
     ASSERT_TRUE(opened) << opened.error();
     gl_ = std::move(opened).value();
   }
@@ -373,61 +375,92 @@ TEST_F(FieldGather, FieldsByUpConversionAgainstTheGather) {
 // per-field (every field of every frame rendered) where motion shows, beside
 // one moment per frame; every display frame is drawn, the key frames where the
 // schedule says.
-TEST_F(FieldGather, FramesUpConvertedBuildEveryFieldBetweenKeyFrames) {
-  open("dlp-pinball.json");
-  const auto draw_all = [&](config::FieldMethod method, const config::UpConversion& up, std::uint64_t first, int frames,
-                            std::string* kinds) {
-    fields().method = method;
-    installation().projectors.front().up_conversion = up;
-    std::vector<image::FloatImage> images;
-    auto pipeline = render::ProjectorPipeline::make(config::job_for(installation(), 0), gl_.scene);
-    EXPECT_TRUE(pipeline) << (pipeline ? "" : pipeline.error());
-    if (!pipeline) return images;
-    std::map<std::uint64_t, scene::SceneState> sent;
-    for (int i = 0; i < frames; ++i) {
-      const std::uint64_t n = first + static_cast<std::uint64_t>(i);
-      sent[n + static_cast<std::uint64_t>(up.frames_ahead())] =
-          state_at(n + static_cast<std::uint64_t>(up.frames_ahead()));
-      const render::DisplayFrame display{n, [&](std::uint64_t f) -> const scene::SceneState* {
-                                           const auto found = sent.find(f);
-                                           return found == sent.end() ? nullptr : &found->second;
-                                         }};
-      const auto drawn = pipeline.value()->draw_frame(state_at(n), {}, &display);
-      EXPECT_TRUE(drawn) << (drawn ? "" : drawn.error());
-      if (kinds) *kinds += std::string(up::to_string(pipeline.value()->up_report().kind)).substr(0, 1);
-      images.push_back(pipeline.value()->renderer().read_linear());
+// A projector that up-converts its frames builds every field of every image
+// between key frames (the DLP pinball, one image a frame; the stereo projector
+// used as mono, two), against per-field's render of every field.
+class FieldsBetweenKeyFrames : public FieldGather {
+ protected:
+  void expect_built(const std::string& config) {
+    open_path(config);
+    // Every image of every frame, in the order shown.
+    const auto draw_all = [&](config::FieldMethod method, const config::UpConversion& up, std::uint64_t first,
+                              int frames, std::string* kinds) {
+      fields().method = method;
+      installation().projectors.front().up_conversion = up;
+      std::vector<image::FloatImage> images;
+      auto pipeline = render::ProjectorPipeline::make(config::job_for(installation(), 0), gl_.scene);
+      EXPECT_TRUE(pipeline) << (pipeline ? "" : pipeline.error());
+      if (!pipeline) return images;
+      std::map<std::uint64_t, scene::SceneState> sent;
+      for (int i = 0; i < frames; ++i) {
+        const std::uint64_t n = first + static_cast<std::uint64_t>(i);
+        sent[n + static_cast<std::uint64_t>(up.frames_ahead())] =
+            state_at(n + static_cast<std::uint64_t>(up.frames_ahead()));
+        const render::DisplayFrame display{n, [&](std::uint64_t f) -> const scene::SceneState* {
+                                             const auto found = sent.find(f);
+                                             return found == sent.end() ? nullptr : &found->second;
+                                           }};
+        const auto drawn = pipeline.value()->draw_frame(
+            state_at(n), [&](int) { images.push_back(pipeline.value()->renderer().read_linear()); }, &display);
+        EXPECT_TRUE(drawn) << (drawn ? "" : drawn.error());
+        if (kinds) *kinds += std::string(up::to_string(pipeline.value()->up_report().kind)).substr(0, 1);
+      }
+      return images;
+    };
+    constexpr std::uint64_t kFirst = 72;
+    constexpr int kFrames = 9;
+    const auto shown = static_cast<std::size_t>(kFrames * fields().images);
+    const std::vector<image::FloatImage> per_field =
+        draw_all(config::FieldMethod::per_field, {}, kFirst, kFrames, nullptr);
+    const std::vector<image::FloatImage> one_moment = draw_all(config::FieldMethod::off, {}, kFirst, kFrames, nullptr);
+    ASSERT_EQ(per_field.size(), shown) << config;
+    ASSERT_EQ(one_moment.size(), shown) << config;
+    for (const config::UpMode mode : {config::UpMode::extrapolate, config::UpMode::interpolate}) {
+      config::UpConversion up;
+      up.ratio = 4;
+      up.mode = mode;
+      up.min_psnr = 0.0;
+      std::string kinds;
+      const std::vector<image::FloatImage> built =
+          draw_all(config::FieldMethod::up_conversion, up, kFirst, kFrames, &kinds);
+      ASSERT_EQ(built.size(), shown) << config;
+      EXPECT_EQ(kinds, mode == config::UpMode::interpolate ? "kbbbsbbbs" : "kbbbkbbbk") << config;
+      double worst = INFINITY;
+      double worst_off = INFINITY;
+      for (std::size_t i = 0; i < shown; ++i) {
+        const std::vector<bool> band = motion_band(per_field[i], one_moment[i]);
+        worst = std::min(worst, band_psnr(built[i], per_field[i], band).worst_of_all());
+        worst_off = std::min(worst_off, band_psnr(one_moment[i], per_field[i], band).worst_of_all());
+      }
+      std::cout << config << ", " << config::to_string(mode) << " 4:1, " << kinds
+                << ": worst channel against per-field where motion shows " << worst << " dB; one moment per frame "
+                << worst_off << " dB\n";
+      // Measured: pinball 50.3 (extrapolated) and 49.1 dB, one moment 20.9;
+      // in two images a frame 48.2 and 48.0, one moment 18.9.
+      EXPECT_GE(worst, 40.0) << config << " " << config::to_string(mode);
+      EXPECT_GE(worst, worst_off + 6.0) << config << " " << config::to_string(mode);
     }
-    return images;
-  };
-  constexpr std::uint64_t kFirst = 72;
-  constexpr int kFrames = 9;
-  const std::vector<image::FloatImage> per_field =
-      draw_all(config::FieldMethod::per_field, {}, kFirst, kFrames, nullptr);
-  const std::vector<image::FloatImage> one_moment = draw_all(config::FieldMethod::off, {}, kFirst, kFrames, nullptr);
-  ASSERT_EQ(per_field.size(), static_cast<std::size_t>(kFrames));
-  for (const config::UpMode mode : {config::UpMode::extrapolate, config::UpMode::interpolate}) {
-    config::UpConversion up;
-    up.ratio = 4;
-    up.mode = mode;
-    up.min_psnr = 0.0;
-    std::string kinds;
-    const std::vector<image::FloatImage> built =
-        draw_all(config::FieldMethod::up_conversion, up, kFirst, kFrames, &kinds);
-    ASSERT_EQ(built.size(), static_cast<std::size_t>(kFrames));
-    EXPECT_EQ(kinds, mode == config::UpMode::interpolate ? "kbbbsbbbs" : "kbbbkbbbk");
-    double worst = INFINITY;
-    double worst_off = INFINITY;
-    for (int i = 0; i < kFrames; ++i) {
-      const std::vector<bool> band = motion_band(per_field[i], one_moment[i]);
-      worst = std::min(worst, band_psnr(built[i], per_field[i], band).worst_of_all());
-      worst_off = std::min(worst_off, band_psnr(one_moment[i], per_field[i], band).worst_of_all());
-    }
-    std::cout << config::to_string(mode) << " 4:1, " << kinds << ": worst channel against per-field where motion shows "
-              << worst << " dB; one moment per frame " << worst_off << " dB\n";
-    // Measured 50.3 (extrapolated) and 49.1 dB; one moment 20.9.
-    EXPECT_GE(worst, 40.0) << config::to_string(mode);
-    EXPECT_GE(worst, worst_off + 6.0) << config::to_string(mode);
   }
+};
+
+TEST_F(FieldsBetweenKeyFrames, OneImageAFrame) { expect_built(kConfigs + "dlp-pinball.json"); }
+// The pinball on the stereo projector used as mono: six fields per 60 Hz frame
+// in two images.
+TEST_F(FieldsBetweenKeyFrames, TwoImagesAFrame) {
+  std::ifstream in(kConfigs + "dlp-pinball.json");
+  std::stringstream text;
+  text << in.rdbuf();
+  std::string json = text.str();
+  for (const auto& [from, to] :
+       {std::pair<std::string, std::string>{R"("preset": "dlp-brg-120hz")", R"("preset": "dlp-stereo-as-mono")"},
+        {R"("frame_rate": 120)", R"("frame_rate": 60)"}}) {
+    const std::size_t at = json.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    json.replace(at, from.size(), to);
+  }
+  const std::string path = ::testing::TempDir() + "dlp-pinball-stereo-as-mono.json";
+  std::ofstream(path) << json;
+  expect_built(path);
 }
 
 }  // namespace
