@@ -315,9 +315,11 @@ int main(int argc, char** argv) {
         "45 % of drawing every frame. A key frame costs what a full render does; interpolation draws the next\n"
         "key frame with the first frame after a key frame (*with a key ahead*), and the key frame's own\n"
         "frame then only shows it. *Spread*: each key frame drawn a band of rows a frame over the frames\n"
-        "before it is needed, so that no frame pays for a whole one (its frames between include a band). The\n"
-        "*costliest frame* (after the first 2·ratio frames) is what the display rate must allow: drawing\n"
-        "every frame, that is the full render.\n\n";
+        "before it is needed, so that no frame pays for a whole one (its frames between include a band).\n"
+        "*Per display frame* and the *costliest frame* are taken once started, after the first 2·ratio\n"
+        "frames (where key frames are drawn at once until the scenes sent ahead reach far enough): the mean\n"
+        "is what a wall pays hour after hour, the costliest what the display rate must allow (drawing every\n"
+        "frame, that is the full render).\n\n";
   cost_table(md, {heavy}, heavy_ways);
   md << "## Speed against error: the scene set (" << kWidth << "×" << kHeight << ")\n\n"
      << "These scenes are light: a full render costs little more than the full-screen passes of a frame\n"

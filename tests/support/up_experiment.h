@@ -74,10 +74,10 @@ struct SceneResult {
   double key_ms = 0.0;                // medians per kind (0 where none)
   double between_ms = 0.0;            // a frame between alone
   double between_and_ahead_ms = 0.0;  // one that also drew the next key frame ahead
-  double per_display_frame_ms = 0.0;  // the mean over all display frames
-  // The costliest display frame once started (after the first 2·ratio frames,
-  // where interpolation draws key frames at once until the scenes sent ahead
-  // reach far enough): what a frame rate must allow.
+  // Once started (after the first 2·ratio frames, where interpolation draws key
+  // frames at once until the scenes sent ahead reach far enough): the mean
+  // display frame, and the costliest, which a frame rate must allow.
+  double per_display_frame_ms = 0.0;
   double steady_max_ms = 0.0;
   image::FloatImage hardest_image;  // the hardest frame, its full render and their difference
   image::FloatImage hardest_reference;
