@@ -13,6 +13,15 @@
 namespace optique::master {
 namespace {
 
+// A Refuse: its reason, and whether trying again later may get in.
+wire::Envelope refusal(const std::string& reason, bool retriable) {
+  wire::Envelope envelope;
+  envelope.set_protocol_version(net::kProtocolVersion);
+  envelope.mutable_refuse()->set_reason(reason);
+  envelope.mutable_refuse()->set_retriable(retriable);
+  return envelope;
+}
+
 using std::chrono::milliseconds;
 
 clock::Nanos nanos(std::chrono::nanoseconds d) { return d.count(); }
@@ -83,27 +92,32 @@ Actions MasterProtocol::accepted(PeerId peer, const std::string& peer_text, bool
                                  const std::vector<std::uint8_t>& nonce, clock::Nanos now) {
   (void)now;
   Actions out;
+  // Refused at the door, before any session: the peer is told why (a node stops
+  // on a refusal it cannot cure by retrying), and the master logs it.
+  const auto refuse_at_door = [&](const std::string& reason, bool retriable) {
+    out.push_back(Log{spdlog::level::warn, "refused connection from " + peer_text + ": " + reason});
+    ++refused_connections_;
+    out.push_back(Send{peer, refusal(reason, retriable)});
+    out.push_back(Close{peer, "refused: " + reason, true});
+  };
   if (state_ != RunState::starting && state_ != RunState::running) {
-    out.push_back(Close{peer, "the master is shutting down"});
+    out.push_back(Send{peer, refusal("the master is shutting down", true)});
+    out.push_back(Close{peer, "the master is shutting down", true});
     return out;
   }
   if (!settings_.secret && !loopback) {
-    out.push_back(Log{spdlog::level::warn, "refused connection from " + peer_text +
-                                               ": no shared secret is configured (master.secret_file), so only "
-                                               "nodes on this machine are accepted"});
-    ++refused_connections_;
-    out.push_back(Close{peer, "no shared secret and not on this machine"});
+    refuse_at_door(
+        "no shared secret is configured (master.secret_file), so only nodes on this machine are accepted; for nodes "
+        "on other hosts, give the master master.secret_file and each node --secret-file",
+        false);
     return out;
   }
   const auto pending = static_cast<std::size_t>(std::count_if(
       sessions_.begin(), sessions_.end(), [](const auto& s) { return s.second.phase == Phase::handshake; }));
   if (pending >= config_.max_pending_connections) {
-    out.push_back(Log{spdlog::level::warn,
-                      fmt::format("refused connection from {}: {} connections are already waiting to authenticate "
-                                  "(master.max_pending_connections)",
-                                  peer_text, pending)});
-    ++refused_connections_;
-    out.push_back(Close{peer, "too many connections waiting to authenticate"});
+    refuse_at_door(
+        fmt::format("{} connections are already waiting to authenticate (master.max_pending_connections)", pending),
+        true);
     return out;
   }
   Session& session = sessions_[peer];
@@ -177,11 +191,7 @@ void MasterProtocol::refuse(PeerId peer, Session& session, const std::string& no
   out.push_back(Log{spdlog::level::warn, "refused node '" + node_id + "' from " + session.peer_text + ": " + reason});
   session.refused = true;
   ++refused_connections_;
-  wire::Envelope envelope;
-  envelope.set_protocol_version(net::kProtocolVersion);
-  envelope.mutable_refuse()->set_reason(reason);
-  envelope.mutable_refuse()->set_retriable(retriable);
-  out.push_back(Send{peer, std::move(envelope)});
+  out.push_back(Send{peer, refusal(reason, retriable)});
   out.push_back(Close{peer, "refused: " + reason, true});
 }
 

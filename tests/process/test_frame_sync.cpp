@@ -546,6 +546,13 @@ TEST(Security, WithoutASecretOnlyLoopbackPeersAreAccepted) {
   EXPECT_TRUE(outsider.closed_within(scaled(3s)));
   EXPECT_TRUE(master.wait_for_output("refused connection from " + address, 5s)) << master.output();
   EXPECT_NE(master.output().find("only nodes on this machine are accepted"), std::string::npos);
+  // A node from "another host" is told why and stops (exit 2), as a wrong
+  // secret does, instead of retrying a handshake that can never pass.
+  Process node({node_binary(), "--master", address + ":" + port, "--id", "wall", "--renderer", "null"},
+               dir + "/node.log");
+  EXPECT_EQ(node.wait(20s).value_or(-1), 2) << node.output();
+  EXPECT_NE(node.output().find("the master refused this node: no shared secret is configured"), std::string::npos)
+      << node.output();
   master.signal(SIGINT);
   EXPECT_TRUE(master.wait(20s).has_value());
 }

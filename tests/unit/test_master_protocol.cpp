@@ -126,7 +126,14 @@ TEST_F(MasterTest, WithoutASecretOnlyThisMachineIsLetIn) {
   load("powerwall-2x2.json");
   const Actions a = master_->accepted(1, "10.0.0.7:5000", false, nonce_, now_);
   ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_TRUE(first<Close>(a)->after_sending) << "the refusal goes first";
   EXPECT_TRUE(sent_to(a, 1, wire::Envelope::kChallenge).empty());
+  // The node is told why, and that trying again will not help.
+  const auto refused = sent_to(a, 1, wire::Envelope::kRefuse);
+  ASSERT_EQ(refused.size(), 1u);
+  EXPECT_FALSE(refused.front().refuse().retriable());
+  EXPECT_NE(refused.front().refuse().reason().find("no shared secret is configured (master.secret_file)"),
+            std::string::npos);
   EXPECT_TRUE(logged(a, "refused connection from 10.0.0.7:5000: no shared secret"));
   EXPECT_TRUE(master_->closed(1, "closed", now_).empty()) << "refused once, logged once";
   EXPECT_EQ(master_->report().connections_refused(), 1u);
@@ -139,6 +146,9 @@ TEST_F(MasterTest, TooManyWaitingToAuthenticateAreRefused) {
   const Actions a = master_->accepted(3, "127.0.0.1:3", true, nonce_, now_);
   ASSERT_NE(first<Close>(a), nullptr);
   EXPECT_TRUE(logged(a, "2 connections are already waiting to authenticate"));
+  const auto refused = sent_to(a, 3, wire::Envelope::kRefuse);
+  ASSERT_EQ(refused.size(), 1u);
+  EXPECT_TRUE(refused.front().refuse().retriable()) << "a later try may get in";
 }
 
 TEST_F(MasterTest, EachWrongHelloIsRefusedWithItsReason) {
