@@ -104,6 +104,7 @@ int run_cli(int argc, char** argv) {
   }
   options.config = std::move(loaded.value().config);
   options.scene = std::move(loaded.value().scene);
+  options.run.replay = std::move(loaded.value().replay);
   auto secret = load_installation_secret(options.config);
   if (!secret) {
     std::cerr << config::describe_problems({{"master.secret_file", secret.error()}}, config_path) << "\n";

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "master/report_json.h"
+#include "tracking/dtrack.h"
 #include "util/overloaded.h"
 
 namespace optique::master {
@@ -27,6 +28,7 @@ Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
       options_(std::move(options)),
       log_(log),
       acceptor_(io),
+      tracker_socket_(io),
       accept_retry_timer_(io),
       signals_(io, SIGINT, SIGTERM),
       housekeeping_timer_(io),
@@ -35,6 +37,39 @@ Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
 }
 
 Master::~Master() = default;
+
+Result<void> Master::listen_to_tracker(const config::Tracking& tracking) {
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(tracking.listen, ec);
+  if (ec) return Error{"viewer.tracking.listen: '" + tracking.listen + "' is not an address"};
+  const asio::ip::udp::endpoint endpoint(address, tracking.port);
+  tracker_socket_.open(endpoint.protocol(), ec);
+  if (!ec) tracker_socket_.set_option(asio::socket_base::reuse_address(true), ec);
+  if (!ec) tracker_socket_.bind(endpoint, ec);
+  if (ec) {
+    return Error{"viewer.tracking: cannot receive on " + tracking.listen + ":" + std::to_string(tracking.port) +
+                 " (UDP): " + ec.message()};
+  }
+  log_.info("tracking: DTrack's ASCII output on {}:{} (UDP), body {}, predicted {}", tracking.listen,
+            tracker_socket_.local_endpoint().port(), tracking.body, config::to_string(tracking.prediction));
+  tracker_buffer_.resize(tracking::kMaxDTrackDatagram + 1);
+  receive_tracker();
+  return {};
+}
+
+void Master::receive_tracker() {
+  tracker_socket_.async_receive(asio::buffer(tracker_buffer_), [this](const boost::system::error_code& error,
+                                                                      std::size_t bytes) {
+    if (error == asio::error::operation_aborted || finished_) return;
+    if (error) {
+      if (!tracker_error_said_) log_.warn("tracking: receiving failed: {} (going on)", error.message());
+      tracker_error_said_ = true;
+    } else {
+      carry_out(protocol_->tracker_datagram(std::string_view(tracker_buffer_.data(), bytes), clock::monotonic_now()));
+    }
+    receive_tracker();
+  });
+}
 
 Result<void> Master::start() {
   const config::Installation& installation = options_.config.installation;
@@ -52,6 +87,13 @@ Result<void> Master::start() {
   recorder_.emplace(ids, csv_.is_open() ? &csv_ : nullptr);
   RunSettings run = options_.run;
   run.send_clock = clock::monotonic_now;
+  const std::optional<config::Tracking>& tracking = installation.viewer.tracking;
+  if (tracking && !options_.out_dir.empty()) {
+    const auto head_path = std::filesystem::path(options_.out_dir) / "head.csv";
+    head_csv_.open(head_path);
+    if (!head_csv_) return Error{"cannot write " + head_path.string()};
+    run.head_csv = &head_csv_;
+  }
   protocol_.emplace(installation, options_.scene, std::move(run), *recorder_);
 
   // Listen.
@@ -77,6 +119,12 @@ Result<void> Master::start() {
   std::string id_list;
   for (const auto& id : ids) id_list += (id_list.empty() ? "" : ", ") + id;
   log_.info("listening on {}:{}; waiting for {} node(s): {}", settings.listen, port_, ids.size(), id_list);
+  if (tracking && tracking->source == config::TrackingSource::dtrack) {
+    if (auto listening = listen_to_tracker(*tracking); !listening) return listening;
+  } else if (tracking) {
+    log_.info("tracking: replaying {} ({} samples), predicted {}", tracking->file, options_.run.replay.size(),
+              config::to_string(tracking->prediction));
+  }
   if (options_.run.secret) {
     log_.info("nodes must prove they hold the shared secret in {}", options_.secret_path);
   } else {
@@ -284,6 +332,7 @@ void Master::finish(int exit_code) {
   signals_.cancel();
   boost::system::error_code ignored;
   acceptor_.close(ignored);
+  tracker_socket_.close(ignored);
   if (launcher_) {
     for (const ChildExit& exit : launcher_->reap()) {
       log_.debug("node '{}' (pid {}) {}", exit.id, exit.pid, exit.describe());
@@ -295,6 +344,7 @@ void Master::finish(int exit_code) {
 
 void Master::write_outputs() {
   if (options_.out_dir.empty()) return;
+  if (head_csv_.is_open()) head_csv_.flush();
   report::RunReport report = protocol_->report();
   report.set_config_file(options_.config.path);
   report.set_config_sha256(options_.config.sha256);

@@ -8,6 +8,7 @@
 #include <spdlog/logger.h>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/ip/udp.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
 
@@ -61,6 +62,9 @@ class Master {
 
  private:
   void accept_next();
+  // The head tracker's datagrams (viewer.tracking, source dtrack).
+  [[nodiscard]] Result<void> listen_to_tracker(const config::Tracking& tracking);
+  void receive_tracker();
   void on_accepted(asio::ip::tcp::socket socket);
   void carry_out(Actions actions);
   void carry_out(Action& action);
@@ -79,10 +83,14 @@ class Master {
   spdlog::logger& log_;
 
   std::ofstream csv_;
+  std::ofstream head_csv_;  // the head shown each frame, with tracking
   std::optional<RunRecorder> recorder_;
   std::optional<MasterProtocol> protocol_;
 
   asio::ip::tcp::acceptor acceptor_;
+  asio::ip::udp::socket tracker_socket_;
+  std::vector<char> tracker_buffer_;
+  bool tracker_error_said_ = false;
   asio::steady_timer accept_retry_timer_;
   bool accept_failing_ = false;
   asio::signal_set signals_;

@@ -48,6 +48,12 @@ MasterProtocol::MasterProtocol(const config::Installation& installation, const s
       light_plan_(installation, scene.definition),
       focus_(FocusSchedule::make(installation)) {
   frame_period_ = authority_.frame_period();
+  if (installation.viewer.tracking) {
+    head_tracker_.emplace(*installation.viewer.tracking);
+    if (settings_.head_csv != nullptr) {
+      *settings_.head_csv << "frame_id,display_ns,tracker,eye_x,eye_y,eye_z,right_x,right_y,right_z\n";
+    }
+  }
   current_state_ = authority_.state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
   // Until nodes come, plan as if all were up: each node's welcome then carries a
@@ -81,6 +87,7 @@ MasterProtocol::Session* MasterProtocol::session_of(std::size_t slot) {
 
 Actions MasterProtocol::start(clock::Nanos now) {
   Actions out;
+  if (head_tracker_ && !settings_.replay.empty()) replay_.emplace(std::move(settings_.replay), now);
   out.push_back(Arm{Timer::startup, now + nanos(config_.startup_timeout)});
   out.push_back(Arm{Timer::heartbeat, now + nanos(config_.heartbeat)});
   return out;
@@ -430,6 +437,9 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     return;
   }
   scene::SceneState state = authority_.state_at_frame(frame);
+  const clock::Nanos display =
+      schedule_origin_ + static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_;
+  if (head_tracker_) track_head(state, frame, display, now, out);
   wire::Envelope envelope;
   auto& begin = *envelope.mutable_frame_begin();
   begin.set_frame_id(frame);
@@ -441,8 +451,7 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   if (lights_switched) log_light_switches(frame, begin.delta(), out);
   begin.set_state_hash(current_hash_);
   begin.set_capture(settings_.capture_every != 0 && frame % settings_.capture_every == 0);
-  begin.set_present_time_ns(schedule_origin_ +
-                            static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_);
+  begin.set_present_time_ns(display);
   if (focus_) {
     *begin.mutable_focus() = protocol::to_wire(focus_->at(static_cast<double>(begin.simulation_time_ns()) / 1e9,
                                                           scene_.definition, current_state_, current_state_.eye_now));
@@ -489,7 +498,11 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
         // where the key frames are drawn a band a frame).
         const std::uint64_t ahead = frame + static_cast<std::uint64_t>(up_conversion.frames_ahead());
         auto& begin_ahead = *to_node.mutable_frame_begin();
-        *begin_ahead.mutable_ahead() = scene::to_snapshot(authority_.state_at_frame(ahead));
+        scene::SceneState ahead_state = authority_.state_at_frame(ahead);
+        // A tracked head that far ahead is a prediction that far ahead.
+        if (head_tracker_)
+          (void)head_into(ahead_state, display + static_cast<clock::Nanos>(ahead - frame) * frame_period_);
+        *begin_ahead.mutable_ahead() = scene::to_snapshot(ahead_state);
         begin_ahead.set_ahead_frame(ahead);
       }
       out.push_back(Send{peer, std::move(to_node)});
@@ -666,7 +679,59 @@ report::RunReport MasterProtocol::report() const {
   report.set_frame_rate(config_.frame_rate);
   report.set_stopped_because(stopped_because_);
   report.set_connections_refused(refused_connections_);
+  if (head_tracker_) {
+    const config::Tracking& settings = *installation_.viewer.tracking;
+    const tracking::TrackingCounts& counts = head_tracker_->counts();
+    report::TrackingReport& t = *report.mutable_tracking();
+    t.set_source(std::string(config::to_string(settings.source)));
+    t.set_prediction(std::string(config::to_string(settings.prediction)));
+    t.set_datagrams(counts.datagrams);
+    t.set_samples(counts.samples);
+    t.set_malformed(counts.malformed);
+    t.set_without_body(counts.without_body);
+    t.set_backwards(counts.backwards);
+    t.set_flood(counts.flood);
+    t.set_losses(counts.losses);
+    t.set_lost_seconds(static_cast<double>(counts.lost_ns) / 1e9);
+    t.set_state(std::string(tracking::to_string(head_tracker_->state())));
+  }
   return report;
+}
+
+// ---------------------------------------------------------------- the head
+
+Actions MasterProtocol::tracker_datagram(std::string_view bytes, clock::Nanos now) {
+  Actions out;
+  if (!head_tracker_) return out;
+  if (auto said = head_tracker_->datagram(bytes, now)) out.push_back(Log{spdlog::level::warn, *said});
+  return out;
+}
+
+tracking::TrackerState MasterProtocol::head_into(scene::SceneState& state, clock::Nanos display) const {
+  // Where the viewer rests (eye or path) is what the authority gave.
+  const tracking::HeadAt now_head = head_tracker_->at(display, state.eye_now);
+  const tracking::HeadAt next_head = head_tracker_->at(display + frame_period_, state.eye_next);
+  state.eye_now = now_head.pose.position;
+  state.eye_next = next_head.pose.position;
+  state.head_now = now_head.pose.orientation;
+  state.head_next = next_head.pose.orientation;
+  return now_head.state;
+}
+
+void MasterProtocol::track_head(scene::SceneState& state, std::uint64_t frame, clock::Nanos display, clock::Nanos now,
+                                Actions& out) {
+  if (replay_) replay_->feed(now, *head_tracker_);
+  std::vector<std::string> said;
+  head_tracker_->notice(now, said);
+  for (std::string& text : said) out.push_back(Log{spdlog::level::warn, std::move(text)});
+  const tracking::TrackerState tracker = head_into(state, display);
+  if (settings_.head_csv != nullptr) {
+    const glm::dvec3 right = state.head_now * installation_.viewer.head_right;
+    *settings_.head_csv << frame << ',' << display << ',' << tracking::to_string(tracker) << ','
+                        << fmt::format("{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f}", state.eye_now.x, state.eye_now.y,
+                                       state.eye_now.z, right.x, right.y, right.z)
+                        << '\n';
+  }
 }
 
 Actions MasterProtocol::local_node_exited(const std::string& id, const std::string& how, bool clean,

@@ -32,6 +32,7 @@
 #include "optique/report.pb.h"
 #include "optique/wire.pb.h"
 #include "scene/load_scene.h"
+#include "tracking/head_tracker.h"
 
 namespace optique::master {
 
@@ -103,6 +104,12 @@ struct RunSettings {
   std::uint64_t capture_every = 0;  // ask nodes to capture every K-th frame (0: never)
   // Nodes must prove they hold it; without one only loopback peers are accepted.
   std::optional<net::Secret> secret;
+  // A `replay` tracker's samples (tracking/replay.h), loaded before the run:
+  // fed at their times from the start.
+  std::vector<tracking::ReplaySample> replay;
+  // Where the head shown each frame goes (frame, display time, tracker state,
+  // the eyes' centre and the axis to the right eye), CSV; none: nowhere.
+  std::ostream* head_csv = nullptr;
   // Reads the clock at the instant a FrameBegin goes out, once the frame's state
   // is computed: a barrier round is from then to the Swap, not the master's own
   // work on the frame. Unset (tests): the time of the event that began the frame.
@@ -133,6 +140,8 @@ class MasterProtocol {
   // SIGINT or SIGTERM: the first finishes the frame and shuts down in order, a
   // second stops at once.
   [[nodiscard]] Actions interrupted(const std::string& signal_name, clock::Nanos now);
+  // A UDP datagram from the head tracker (viewer.tracking with source dtrack).
+  [[nodiscard]] Actions tracker_datagram(std::string_view bytes, clock::Nanos now);
 
   // For the status line and the outputs.
   [[nodiscard]] std::uint64_t next_frame() const { return next_frame_; }
@@ -199,6 +208,13 @@ class MasterProtocol {
   SceneAuthority authority_;
   LightPlan light_plan_;
   std::optional<FocusSchedule> focus_;
+  std::optional<tracking::HeadTracker> head_tracker_;  // viewer.tracking
+  std::optional<tracking::ReplayFeed> replay_;
+  // The head as the tracker says at `display` and a frame later, into `state`;
+  // the tracker's state then.
+  [[nodiscard]] tracking::TrackerState head_into(scene::SceneState& state, clock::Nanos display) const;
+  // Feeds a replay, notices loss (logged), and puts the head into the frame's state.
+  void track_head(scene::SceneState& state, std::uint64_t frame, clock::Nanos display, clock::Nanos now, Actions& out);
   scene::SceneState current_state_;
   std::uint64_t current_hash_ = 0;
   Barrier barrier_;

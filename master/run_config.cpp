@@ -22,7 +22,14 @@ Result<RunConfig> load_run_config(const std::string& path, const scene::ImageDec
   if (auto secret = load_installation_secret(loaded.value()); !secret) {
     return Error{config::describe_problems({{"master.secret_file", secret.error()}}, path)};
   }
-  return RunConfig{std::move(loaded).value(), std::move(scene).value()};
+  std::vector<tracking::ReplaySample> replay;
+  const auto& tracking = loaded.value().installation.viewer.tracking;
+  if (tracking && tracking->source == config::TrackingSource::replay) {
+    auto samples = tracking::load_replay(tracking->file);
+    if (!samples) return Error{config::describe_problems({{"viewer.tracking.file", samples.error()}}, path)};
+    replay = std::move(samples).value();
+  }
+  return RunConfig{std::move(loaded).value(), std::move(scene).value(), std::move(replay)};
 }
 
 }  // namespace optique::master

@@ -111,6 +111,20 @@ std::string summarize(const config::LoadedConfig& config) {
     out << "scripted path of " << v.path.size() << " points over " << v.path.back().time - v.path.front().time << " s";
   }
   out << ", eye separation " << v.eye_separation << " m\n";
+  if (v.tracking) {
+    const config::Tracking& t = *v.tracking;
+    out << "  tracking: ";
+    if (t.source == config::TrackingSource::dtrack) {
+      out << "DTrack's ASCII output on " << t.listen << ":" << t.port << " (UDP), body " << t.body;
+    } else {
+      out << "replay of " << t.file << " (looped)";
+    }
+    out << "; the head predicted at each display time by " << config::to_string(t.prediction);
+    if (t.prediction == config::HeadPrediction::double_exponential) out << " (alpha " << t.smoothing << ")";
+    out << ", latency " << static_cast<double>(t.latency.count()) / 1000.0 << " ms";
+    out << "; lost after " << t.lost_after.count() << " ms: the last pose held " << t.hold.count()
+        << " ms, then eased to the eye above over " << t.ease.count() << " ms\n";
+  }
   const config::MasterSettings& m = inst.master;
   out << "  master: " << m.listen << ":" << m.port << (m.port == 0 ? " (ephemeral)" : "") << ", " << m.frame_rate
       << " Hz, frame timeout " << m.frame_timeout.count() << " ms (then "

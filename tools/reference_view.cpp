@@ -30,8 +30,9 @@ Result<ReferenceView> ReferenceView::make(const config::Installation& installati
 
 Result<image::FloatImage> ReferenceView::draw(const scene::SceneState& state, double fraction) const {
   const config::Viewer& viewer = *viewer_;
-  const glm::dvec3 centre = glm::mix(state.eye_now, state.eye_next, fraction);
-  const glm::dvec3 eye = geometry::eye_position(centre, viewer.head_right, viewer.eye_separation, eye_);
+  const glm::dvec3 eye =
+      geometry::eye_position(scene::eyes_at(state, fraction), scene::head_at(state, fraction) * viewer.head_right,
+                             viewer.eye_separation, eye_);
   auto frustum = geometry::off_axis_frustum(screen_->world(), eye, viewer.near, viewer.far);
   if (!frustum) return Error{frustum.error()};
   renderer_->draw(state, fraction, eye, frustum.value());

@@ -19,6 +19,7 @@
 #include "config/color_fields.h"
 #include "config/defaults.h"
 #include "config/response.h"
+#include "config/tracking.h"
 #include "config/up_conversion.h"
 #include "geometry/projection.h"
 #include "geometry/projector_geometry.h"
@@ -130,7 +131,13 @@ struct Viewer {
   double eye_separation = defaults::kEyeSeparation;
   double near = defaults::kNear;  // metres from the eye
   double far = defaults::kFar;
-  glm::dvec3 head_right{1.0, 0.0, 0.0};  // unit vector from the left eye to the right
+  // Unit vector from the left eye to the right, as the head is at rest (with
+  // tracking: in the tracked body's own frame); the scene state's head
+  // orientation turns it.
+  glm::dvec3 head_right{1.0, 0.0, 0.0};
+  // A tracked head: the master predicts it at each frame's display time, and
+  // eye/path are where it rests while the tracker is lost.
+  std::optional<Tracking> tracking;
 
   [[nodiscard]] glm::dvec3 eye_at(double seconds) const;
   [[nodiscard]] bool moves() const { return path.size() > 1; }

@@ -20,6 +20,8 @@ ProjectorJob job_for(const Installation& installation, std::size_t projector) {
     part.projectors.back().screen = 0;
   }
   part.viewer = installation.viewer;
+  // A tracked head reaches the node in the scene state; the tracker is the master's.
+  part.viewer.tracking.reset();
   part.scene = installation.scene;
   if (installation.depth_of_field) {
     DepthOfField range;

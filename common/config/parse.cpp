@@ -173,7 +173,7 @@ void resolve_geometry(const schema::Installation& inst, Installation& out, const
   }
 }
 
-Viewer build_viewer(const schema::Viewer& v) {
+Viewer build_viewer(const schema::Viewer& v, const std::string& config_dir) {
   Viewer viewer;
   if (v.path().empty()) {
     viewer.path.push_back({0.0, vec3(v.eye())});
@@ -184,6 +184,11 @@ Viewer build_viewer(const schema::Viewer& v) {
   viewer.near = or_default(v.near(), defaults::kNear);
   viewer.far = or_default(v.far(), defaults::kFar);
   if (!v.head_right().empty()) viewer.head_right = glm::normalize(vec3(v.head_right()));
+  if (v.has_tracking()) {
+    std::vector<Problem> problems;  // none: validated
+    viewer.tracking = parse_tracking(v.tracking(), "viewer.tracking", problems);
+    if (!viewer.tracking->file.empty()) viewer.tracking->file = scene::resolve_asset(viewer.tracking->file, config_dir);
+  }
   return viewer;
 }
 
@@ -258,7 +263,7 @@ Result<Installation> build(const schema::Installation& inst, const std::string& 
   out.name = inst.name();
   for (const schema::Screen& s : inst.screens()) out.screens.push_back(build_screen(s));
   for (const schema::Projector& p : inst.projectors()) out.projectors.push_back(build_projector(p, out.screens));
-  out.viewer = build_viewer(inst.viewer());
+  out.viewer = build_viewer(inst.viewer(), config_dir);
   out.master = build_master(inst.master());
   out.scene = build_scene(inst.scene(), config_dir);
   out.depth_of_field = build_depth_of_field(inst, out);

@@ -114,6 +114,28 @@ schema::Viewer to_schema(const Viewer& viewer) {
   out.set_near(viewer.near);
   out.set_far(viewer.far);
   put(*out.mutable_head_right(), viewer.head_right);
+  if (viewer.tracking) *out.mutable_tracking() = to_schema(*viewer.tracking);
+  return out;
+}
+
+schema::Tracking to_schema(const Tracking& tracking) {
+  schema::Tracking out;
+  out.set_source(std::string(to_string(tracking.source)));
+  out.set_listen(tracking.listen);
+  out.set_port(tracking.port);
+  out.set_file(tracking.file);
+  out.set_body(tracking.body);
+  put(*out.mutable_tracker_origin(), tracking.tracker_origin);
+  put(*out.mutable_tracker_axes()->mutable_x(), tracking.tracker_axes[0]);
+  put(*out.mutable_tracker_axes()->mutable_y(), tracking.tracker_axes[1]);
+  put(*out.mutable_tracker_axes()->mutable_z(), tracking.tracker_axes[2]);
+  put(*out.mutable_eye_offset(), tracking.eye_offset);
+  out.set_prediction(std::string(to_string(tracking.prediction)));
+  out.set_smoothing(tracking.smoothing);
+  out.set_latency_ms(static_cast<double>(tracking.latency.count()) / 1000.0);
+  out.set_lost_after_ms(static_cast<std::uint32_t>(tracking.lost_after.count()));
+  out.set_hold_ms(static_cast<std::uint32_t>(tracking.hold.count()));
+  out.set_ease_ms(static_cast<std::uint32_t>(tracking.ease.count()));
   return out;
 }
 

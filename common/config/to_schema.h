@@ -17,6 +17,7 @@ namespace optique::config {
 // `screens`: the installation's, to name the projector's screen.
 [[nodiscard]] schema::Projector to_schema(const Projector& projector, const std::vector<Screen>& screens);
 [[nodiscard]] schema::Viewer to_schema(const Viewer& viewer);
+[[nodiscard]] schema::Tracking to_schema(const Tracking& tracking);
 [[nodiscard]] schema::Scene to_schema(const SceneSource& scene);
 [[nodiscard]] schema::MasterSettings to_schema(const MasterSettings& master);
 [[nodiscard]] schema::DepthOfField to_schema(const DepthOfField& depth_of_field, const std::vector<Screen>& screens);

@@ -1,16 +1,16 @@
 #include "config/validate.h"
 
-#include <arpa/inet.h>
-
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <set>
 
+#include "config/address.h"
 #include "config/color_fields.h"
 #include "config/defaults.h"
 #include "config/light_list.h"
 #include "config/response.h"
+#include "config/tracking.h"
 #include "config/up_conversion.h"
 #include "scene/builtin.h"
 #include "util/number_text.h"
@@ -380,12 +380,12 @@ void check_viewer(Checker& check, const schema::Viewer& v) {
   if (v.eye_separation() > 1.0)
     check.fail("viewer.eye_separation",
                "is in metres; " + number_text(v.eye_separation()) + " m is not an eye separation");
+  if (v.has_tracking()) (void)parse_tracking(v.tracking(), "viewer.tracking", check.problems());
 }
 
 void check_master(Checker& check, const schema::MasterSettings& m) {
   if (!m.listen().empty()) {
-    in6_addr buffer{};
-    if (inet_pton(AF_INET, m.listen().c_str(), &buffer) != 1 && inet_pton(AF_INET6, m.listen().c_str(), &buffer) != 1) {
+    if (!is_ip_address(m.listen())) {
       check.fail("master.listen", "'" + m.listen() + "' is not an IPv4 or IPv6 address");
     }
   }

@@ -92,8 +92,9 @@ void ProjectorPipeline::set_focus(const protocol::Focus& focus) {
   renderer_->set_focus(frame);
 }
 
-glm::dvec3 ProjectorPipeline::eye(const glm::dvec3& centre) const {
-  return geometry::eye_position(centre, viewer_.head_right, viewer_.eye_separation, eye_);
+glm::dvec3 ProjectorPipeline::eye(const scene::SceneState& state, double fraction) const {
+  return geometry::eye_position(scene::eyes_at(state, fraction), scene::head_at(state, fraction) * viewer_.head_right,
+                                viewer_.eye_separation, eye_);
 }
 
 Result<FieldPass> ProjectorPipeline::moment(const scene::SceneState& state, double fraction) const {
@@ -102,7 +103,7 @@ Result<FieldPass> ProjectorPipeline::moment(const scene::SceneState& state, doub
   // A still viewer is exactly where it stands at every moment: mix() would
   // round it differently per fraction, and the fields would no longer share one
   // view (what lets still objects be drawn once).
-  pass.eye = eye(state.eye_now == state.eye_next ? state.eye_now : glm::mix(state.eye_now, state.eye_next, fraction));
+  pass.eye = eye(state, fraction);
   auto frustum = view_.frustum(pass.eye, viewer_.near, viewer_.far);
   if (!frustum) return Error{frustum.error()};
   pass.frustum = frustum.value();

@@ -77,8 +77,9 @@ class ProjectorPipeline {
   // The frame's focal depth and gaze (focus/defocus projectors; ignored by others).
   void set_focus(const protocol::Focus& focus);
 
-  // Where this projector's eye is when the viewer's eyes are centred at `centre`.
-  [[nodiscard]] glm::dvec3 eye(const glm::dvec3& centre) const;
+  // Where this projector's eye is `fraction` of a frame after the frame time of
+  // `state` (its eyes' centre and its head's turn then).
+  [[nodiscard]] glm::dvec3 eye(const scene::SceneState& state, double fraction) const;
   // Draws the scene in `state` as it is `fraction` of a frame after the display
   // time (objects and the viewer's eyes that far towards their next pose) from
   // this projector's eye. When the eye is not in front of the screen, nothing of

@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cmath>
+#include <glm/common.hpp>
 #include <string>
 
 namespace optique::scene {
@@ -21,12 +22,15 @@ class Fnv1a {
     add(v.y);
     add(v.z);
   }
+  void add(const glm::dquat& q) {
+    add(q.w);
+    add(q.x);
+    add(q.y);
+    add(q.z);
+  }
   void add(const Pose& p) {
     add(p.position);
-    add(p.rotation.w);
-    add(p.rotation.x);
-    add(p.rotation.y);
-    add(p.rotation.z);
+    add(p.rotation);
     add(p.scale);
   }
   [[nodiscard]] std::uint64_t value() const { return hash_; }
@@ -43,10 +47,12 @@ bool identical(const glm::dvec3& a, const glm::dvec3& b) {
   return same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z);
 }
 
+bool identical(const glm::dquat& a, const glm::dquat& b) {
+  return same_bits(a.w, b.w) && same_bits(a.x, b.x) && same_bits(a.y, b.y) && same_bits(a.z, b.z);
+}
+
 bool identical(const Pose& a, const Pose& b) {
-  return identical(a.position, b.position) && same_bits(a.rotation.w, b.rotation.w) &&
-         same_bits(a.rotation.x, b.rotation.x) && same_bits(a.rotation.y, b.rotation.y) &&
-         same_bits(a.rotation.z, b.rotation.z) && identical(a.scale, b.scale);
+  return identical(a.position, b.position) && identical(a.rotation, b.rotation) && identical(a.scale, b.scale);
 }
 
 bool identical(const ObjectState& a, const ObjectState& b) {
@@ -59,13 +65,16 @@ void to_wire(const glm::dvec3& v, wire::Vec3& out) {
   out.set_z(v.z);
 }
 
+void to_wire(const glm::dquat& q, wire::Quat& out) {
+  out.set_w(q.w);
+  out.set_x(q.x);
+  out.set_y(q.y);
+  out.set_z(q.z);
+}
+
 void to_wire(const Pose& p, wire::Pose& out) {
   to_wire(p.position, *out.mutable_position());
-  auto& q = *out.mutable_rotation();
-  q.set_w(p.rotation.w);
-  q.set_x(p.rotation.x);
-  q.set_y(p.rotation.y);
-  q.set_z(p.rotation.z);
+  to_wire(p.rotation, *out.mutable_rotation());
   to_wire(p.scale, *out.mutable_scale());
 }
 
@@ -75,9 +84,16 @@ void to_wire(std::uint32_t id, const ObjectState& o, wire::ObjectState& out) {
   to_wire(o.next, *out.mutable_next());
 }
 
+const glm::dquat kNoTurn{1.0, 0.0, 0.0, 0.0};
+
 void to_wire(const SceneState& s, wire::ViewerState& out) {
   to_wire(s.eye_now, *out.mutable_eye_now());
   to_wire(s.eye_next, *out.mutable_eye_next());
+  // Only a turned head is written: an untracked viewer's state stays as it was.
+  if (!identical(s.head_now, kNoTurn) || !identical(s.head_next, kNoTurn)) {
+    to_wire(s.head_now, *out.mutable_head_now());
+    to_wire(s.head_next, *out.mutable_head_next());
+  }
 }
 
 // Reading from the wire checks every number: NaN or Inf never reaches a matrix.
@@ -86,6 +102,16 @@ Result<glm::dvec3> from_wire(const wire::Vec3& v, const std::string& what) {
     return Error{what + " has a non-finite coordinate"};
   }
   return glm::dvec3(v.x(), v.y(), v.z());
+}
+
+Result<glm::dquat> from_wire(const wire::Quat& q, const std::string& what) {
+  const glm::dquat rotation(q.w(), q.x(), q.y(), q.z());
+  const double norm =
+      std::sqrt(rotation.w * rotation.w + rotation.x * rotation.x + rotation.y * rotation.y + rotation.z * rotation.z);
+  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-6) {
+    return Error{what + " is not a unit quaternion (norm " + std::to_string(norm) + ")"};
+  }
+  return rotation;
 }
 
 Result<Pose> from_wire(const wire::Pose& p, const std::string& what) {
@@ -100,14 +126,9 @@ Result<Pose> from_wire(const wire::Pose& p, const std::string& what) {
     pose.scale = scale.value();
   }
   if (p.has_rotation()) {
-    const auto& q = p.rotation();
-    const glm::dquat rotation(q.w(), q.x(), q.y(), q.z());
-    const double norm = std::sqrt(rotation.w * rotation.w + rotation.x * rotation.x + rotation.y * rotation.y +
-                                  rotation.z * rotation.z);
-    if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-6) {
-      return Error{what + " rotation is not a unit quaternion (norm " + std::to_string(norm) + ")"};
-    }
-    pose.rotation = rotation;
+    auto rotation = from_wire(p.rotation(), what + " rotation");
+    if (!rotation) return Error{rotation.error()};
+    pose.rotation = rotation.value();
   }
   return pose;
 }
@@ -121,20 +142,51 @@ Result<ObjectState> from_wire(const wire::ObjectState& o) {
   return ObjectState{now.value(), next.value()};
 }
 
-struct EyePair {
-  glm::dvec3 now;
-  glm::dvec3 next;
+struct ViewerPair {
+  glm::dvec3 eye_now;
+  glm::dvec3 eye_next;
+  glm::dquat head_now{kNoTurn};
+  glm::dquat head_next{kNoTurn};
 };
 
-Result<EyePair> viewer_from_wire(const wire::ViewerState& v) {
+Result<ViewerPair> viewer_from_wire(const wire::ViewerState& v) {
+  ViewerPair out;
   auto now = from_wire(v.eye_now(), "viewer eye (now)");
   if (!now) return Error{now.error()};
+  out.eye_now = now.value();
   auto next = from_wire(v.eye_next(), "viewer eye (next)");
   if (!next) return Error{next.error()};
-  return EyePair{now.value(), next.value()};
+  out.eye_next = next.value();
+  if (v.has_head_now() != v.has_head_next()) return Error{"viewer head: give its turn now and next, or neither"};
+  if (v.has_head_now()) {
+    auto head_now = from_wire(v.head_now(), "viewer head (now)");
+    if (!head_now) return Error{head_now.error()};
+    out.head_now = head_now.value();
+    auto head_next = from_wire(v.head_next(), "viewer head (next)");
+    if (!head_next) return Error{head_next.error()};
+    out.head_next = head_next.value();
+  }
+  return out;
+}
+
+void set_viewer(SceneState& state, const ViewerPair& viewer) {
+  state.eye_now = viewer.eye_now;
+  state.eye_next = viewer.eye_next;
+  state.head_now = viewer.head_now;
+  state.head_next = viewer.head_next;
 }
 
 }  // namespace
+
+// A viewer that does not move is where it is, to the bit.
+glm::dvec3 eyes_at(const SceneState& state, double fraction) {
+  return identical(state.eye_now, state.eye_next) ? state.eye_now : glm::mix(state.eye_now, state.eye_next, fraction);
+}
+
+glm::dquat head_at(const SceneState& state, double fraction) {
+  return identical(state.head_now, state.head_next) ? state.head_now
+                                                    : glm::slerp(state.head_now, state.head_next, fraction);
+}
 
 std::uint64_t state_hash(const SceneState& state) {
   Fnv1a h;
@@ -146,6 +198,8 @@ std::uint64_t state_hash(const SceneState& state) {
   }
   h.add(state.eye_now);
   h.add(state.eye_next);
+  h.add(state.head_now);
+  h.add(state.head_next);
   h.add(static_cast<std::uint64_t>(state.lights_off.size()));
   for (std::uint32_t light : state.lights_off) h.add(static_cast<std::uint64_t>(light));
   return h.value();
@@ -168,10 +222,9 @@ Result<SceneState> from_snapshot(const wire::Snapshot& snapshot) {
       return Error{"snapshot lists object " + std::to_string(o.id()) + " twice"};
     }
   }
-  auto eye = viewer_from_wire(snapshot.viewer());
-  if (!eye) return Error{eye.error()};
-  state.eye_now = eye.value().now;
-  state.eye_next = eye.value().next;
+  auto viewer = viewer_from_wire(snapshot.viewer());
+  if (!viewer) return Error{viewer.error()};
+  set_viewer(state, viewer.value());
   for (std::uint32_t light : snapshot.lights_off()) {
     if (!state.lights_off.insert(light).second) {
       return Error{"snapshot lists light " + std::to_string(light) + " as off twice"};
@@ -189,7 +242,8 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
   for (const auto& [id, object] : before.objects) {
     if (!after.objects.contains(id)) delta.add_removed(id);
   }
-  if (!identical(before.eye_now, after.eye_now) || !identical(before.eye_next, after.eye_next)) {
+  if (!identical(before.eye_now, after.eye_now) || !identical(before.eye_next, after.eye_next) ||
+      !identical(before.head_now, after.head_now) || !identical(before.head_next, after.head_next)) {
     to_wire(after, *delta.mutable_viewer());
   }
   for (std::uint32_t light : after.lights_off) {
@@ -214,11 +268,11 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
     if (!state.objects.contains(id))
       return Error{"delta removes object " + std::to_string(id) + ", which does not exist"};
   }
-  EyePair eye{state.eye_now, state.eye_next};
+  ViewerPair viewer{state.eye_now, state.eye_next, state.head_now, state.head_next};
   if (delta.has_viewer()) {
     auto moved = viewer_from_wire(delta.viewer());
     if (!moved) return Error{"delta: " + moved.error()};
-    eye = moved.value();
+    viewer = moved.value();
   }
   std::set<std::uint32_t> lights_off = state.lights_off;
   for (std::uint32_t light : delta.lights_off()) {
@@ -235,8 +289,7 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
 
   for (auto& [id, object] : changed) state.objects.insert_or_assign(id, object);
   for (std::uint32_t id : delta.removed()) state.objects.erase(id);
-  state.eye_now = eye.now;
-  state.eye_next = eye.next;
+  set_viewer(state, viewer);
   state.lights_off = std::move(lights_off);
   return {};
 }

@@ -1,6 +1,6 @@
 #pragma once
 // The scene state every node must agree on: dynamic objects, each with its pose at
-// the frame time and at the next frame time, the viewer's eye at both times, and
+// the frame time and at the next frame time, the viewer's eyes and head at both times, and
 // which of the scene's point lights are switched off.
 // A snapshot on join, then per frame only what changed; a hash both sides compare.
 
@@ -33,14 +33,23 @@ struct ObjectState {
 
 struct SceneState {
   std::map<std::uint32_t, ObjectState> objects;
-  glm::dvec3 eye_now{0.0};
+  glm::dvec3 eye_now{0.0};  // the centre of the eyes
   glm::dvec3 eye_next{0.0};
+  // The head's turn from rest (identity but for a tracked head): it turns the
+  // viewer's head_right, the axis from the left eye to the right.
+  glm::dquat head_now{1.0, 0.0, 0.0, 0.0};
+  glm::dquat head_next{1.0, 0.0, 0.0, 0.0};
   // Indices into the scene's lights. A light that goes dark costs nothing: no node
   // draws it, and the automatic light split shares out only the others.
   std::set<std::uint32_t> lights_off;
 
   bool operator==(const SceneState&) const = default;
 };
+
+// The centre of the eyes and the head's turn `fraction` of a frame after the
+// frame time (linear, and spherical between the turns).
+[[nodiscard]] glm::dvec3 eyes_at(const SceneState& state, double fraction);
+[[nodiscard]] glm::dquat head_at(const SceneState& state, double fraction);
 
 // FNV-1a over a canonical encoding (ids in order, the bits of every double), so
 // equal states hash equally on every machine.

@@ -249,6 +249,45 @@ TEST_F(MasterTest, FramesStartWhenAllAreUpAndSwapWhenAllAreReady) {
   EXPECT_EQ(*armed(a, Timer::next_frame), now_ - 3 * kMs + 16'666'666) << "on schedule from the first frame";
 }
 
+// A tracked head: the eyes rest where the config puts them until the tracker's
+// first sample; then each frame carries the head the tracker saw, predicted at
+// the frame's display time, turn and all; what it ignored is in the report.
+TEST_F(MasterTest, EachFrameCarriesTheTrackedHead) {
+  load("single-wall.json", [](config::Installation& inst) {
+    config::Tracking tracking;
+    tracking.prediction = config::HeadPrediction::none;
+    tracking.body = 2;
+    inst.viewer.tracking = tracking;
+  });
+  Actions a = join_all();
+  ASSERT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u);
+  const wire::FrameBegin& first = sent_to(a, 1, wire::Envelope::kFrameBegin).front().frame_begin();
+  EXPECT_FALSE(first.delta().has_viewer()) << "resting where the config's eye is";
+  // Turned a quarter about the tracker's z, 0.5 m to the right of the rest.
+  EXPECT_TRUE(master_->tracker_datagram("fr 1\n6d 1 [2 1.0][500 1600 2000][0 1 0 -1 0 0 0 0 1]\n", now_).empty());
+  const auto garbage = master_->tracker_datagram("not dtrack", now_ + 5 * kMs);
+  ASSERT_EQ(garbage.size(), 1u);
+  ASSERT_TRUE(std::holds_alternative<Log>(garbage.front()));
+  EXPECT_NE(std::get<Log>(garbage.front()).text.find("not DTrack's ASCII output"), std::string::npos);
+  a = ready(1, 0, hash_of(a, 1));
+  now_ += 16'666'666;
+  a = master_->timer(Timer::next_frame, now_);
+  const auto begins = sent_to(a, 1, wire::Envelope::kFrameBegin);
+  ASSERT_EQ(begins.size(), 1u);
+  const wire::ViewerState& viewer = begins.front().frame_begin().delta().viewer();
+  EXPECT_DOUBLE_EQ(viewer.eye_now().x(), 0.5);
+  EXPECT_DOUBLE_EQ(viewer.eye_now().z(), 2.0);
+  ASSERT_TRUE(viewer.has_head_now());
+  EXPECT_NEAR(viewer.head_now().w(), std::sqrt(0.5), 1e-9);
+  EXPECT_NEAR(viewer.head_now().z(), std::sqrt(0.5), 1e-9);
+  const report::RunReport report = master_->report();
+  const report::TrackingReport& t = report.tracking();
+  EXPECT_EQ(t.source(), "dtrack");
+  EXPECT_EQ(t.samples(), 1u);
+  EXPECT_EQ(t.malformed(), 1u);
+  EXPECT_EQ(t.state(), "tracking");
+}
+
 // A node that interpolates gets, with each frame, the scene ratio − 1 frames
 // on (the scene is a function of time; 2·ratio − 1 where it draws its key
 // frames a band a frame); the others get the frame alone. What

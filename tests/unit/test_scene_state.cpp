@@ -101,6 +101,49 @@ TEST(SceneDelta, EyeOnlyMoveCarriesViewerOnly) {
   EXPECT_EQ(state, after);
 }
 
+// A tracked head's turn travels with the eyes: in the delta, the snapshot and
+// the hash; an untracked viewer's state is written as before.
+TEST(SceneDelta, TheHeadsTurnTravelsWithTheEyes) {
+  const SceneState before = before_state();
+  SceneState turned = before;
+  turned.head_now = glm::angleAxis(0.3, glm::dvec3(0.0, 1.0, 0.0));
+  turned.head_next = glm::angleAxis(0.31, glm::dvec3(0.0, 1.0, 0.0));
+  EXPECT_NE(state_hash(turned), state_hash(before));
+  const wire::StateDelta delta = make_delta(before, turned);
+  ASSERT_TRUE(delta.has_viewer());
+  EXPECT_TRUE(delta.viewer().has_head_now());
+  SceneState applied = before;
+  ASSERT_TRUE(apply_delta(applied, delta));
+  EXPECT_EQ(applied, turned);
+  auto back = from_snapshot(to_snapshot(turned));
+  ASSERT_TRUE(back) << back.error();
+  EXPECT_EQ(back.value(), turned);
+  EXPECT_FALSE(to_snapshot(before).viewer().has_head_now()) << "untracked: no head written";
+  // Half a frame on, halfway through the turn.
+  EXPECT_NEAR(glm::angle(head_at(turned, 0.5)), 0.305, 1e-12);
+  EXPECT_EQ(eyes_at(before, 0.5), before.eye_now) << "an eye that stays stays to the bit";
+}
+
+TEST(ApplyDelta, AHeadTurnThatIsNoRotationIsRefused) {
+  SceneState state = before_state();
+  const SceneState kept = state;
+  wire::StateDelta delta = make_delta(state, state);
+  auto& viewer = *delta.mutable_viewer();
+  viewer.mutable_eye_now()->set_y(1.6);
+  viewer.mutable_eye_next()->set_y(1.6);
+  viewer.mutable_head_now()->set_w(2.0);
+  viewer.mutable_head_next()->set_w(1.0);
+  auto applied = apply_delta(state, delta);
+  ASSERT_FALSE(applied);
+  EXPECT_NE(applied.error().find("viewer head (now) is not a unit quaternion"), std::string::npos) << applied.error();
+  viewer.clear_head_next();
+  viewer.mutable_head_now()->set_w(1.0);
+  applied = apply_delta(state, delta);
+  ASSERT_FALSE(applied);
+  EXPECT_NE(applied.error().find("give its turn now and next, or neither"), std::string::npos) << applied.error();
+  EXPECT_EQ(state, kept);
+}
+
 TEST(SceneDelta, RemovingEveryObject) {
   const SceneState before = before_state();
   SceneState after = before;

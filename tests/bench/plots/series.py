@@ -5,7 +5,8 @@ error. Writes gnuplot data: one block per series group, blocks apart by two blan
 lines (gnuplot's `index`), one number per column, NaN where there is none.
 
 usage: series.py NAME CSV OUT.dat   (NAME: barrier, calibration, dof, fields,
-                                     lighting, oblique, oblique-depth, upconversion)
+                                     lighting, oblique, oblique-depth, tracking,
+                                     upconversion)
 
 The drawing is tests/bench/plots/NAME.gp; scripts/plot-bench.sh runs both."""
 
@@ -262,8 +263,22 @@ def upconversion(rows):
     return blocks
 
 
+def tracking(rows):
+    """One block per prediction (method and smoothing, in the bench's order), one
+    row per tracker latency: latency ms, median and p99 of the eyes' error mm.
+    Simulated time: one run, no spread over runs."""
+    order = []
+    by = defaultdict(list)
+    for r in rows:
+        key = (r["method"], r["smoothing"])
+        if key not in by:
+            order.append(key)
+        by[key].append([float(r["latency_ms"]), float(r["median_mm"]), float(r["p99_mm"])])
+    return [by[key] for key in order]
+
+
 SERIES = {"barrier": barrier, "calibration": calibration, "dof": dof, "fields": fields, "lighting": lighting,
-          "oblique": oblique, "oblique-depth": oblique_depth, "upconversion": upconversion}
+          "oblique": oblique, "oblique-depth": oblique_depth, "tracking": tracking, "upconversion": upconversion}
 
 
 def main():

@@ -1,0 +1,205 @@
+#include "tracking/head_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "tracking/dtrack.h"
+
+namespace optique::tracking {
+namespace {
+
+constexpr double kNanosPerSecond = 1e9;
+// A frame counter this far back, or a timestamp this many seconds, is a
+// tracker that started again, not an old datagram.
+constexpr std::uint64_t kRestartFrames = 1000;
+constexpr double kRestartSeconds = 10.0;
+
+Nanos seconds_to_nanos(double seconds) { return static_cast<Nanos>(std::llround(seconds * kNanosPerSecond)); }
+
+double smoothstep(double x) {
+  x = std::clamp(x, 0.0, 1.0);
+  return x * x * (3.0 - 2.0 * x);
+}
+
+}  // namespace
+
+std::string_view to_string(TrackerState state) {
+  switch (state) {
+    case TrackerState::waiting:
+      return "waiting";
+    case TrackerState::tracking:
+      return "tracking";
+    case TrackerState::holding:
+      return "holding";
+    case TrackerState::easing:
+      return "easing";
+    case TrackerState::resting:
+      break;
+  }
+  return "resting";
+}
+
+HeadTracker::HeadTracker(const config::Tracking& settings)
+    : settings_(settings), predictor_(settings.prediction, settings.smoothing) {}
+
+std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos arrival) {
+  ++counts_.datagrams;
+  const auto once = [](bool& said, std::string text) -> std::optional<std::string> {
+    if (said) return std::nullopt;
+    said = true;
+    return text + " (further ones are only counted)";
+  };
+  if (last_read_ && arrival - *last_read_ < kFloodInterval) {
+    ++counts_.flood;
+    return once(said_flood_, "tracker: datagrams come faster than " + std::to_string(1'000'000'000 / kFloodInterval) +
+                                 " a second; the extra ones are dropped unread");
+  }
+  last_read_ = arrival;
+  auto frame = parse_dtrack(bytes);
+  if (!frame) {
+    ++counts_.malformed;
+    return once(said_malformed_, "tracker: ignored a datagram that is not DTrack's ASCII output: " + frame.error());
+  }
+  const DTrackFrame& f = frame.value();
+  const auto body =
+      std::find_if(f.bodies.begin(), f.bodies.end(), [&](const DTrackBody& b) { return b.id == settings_.body; });
+  if (body == f.bodies.end()) {
+    ++counts_.without_body;
+    std::string seen;
+    for (const DTrackBody& b : f.bodies) seen += (seen.empty() ? "" : ", ") + std::to_string(b.id);
+    return once(said_without_body_, "tracker: a frame without body " + std::to_string(settings_.body) +
+                                        (seen.empty() ? " (no body tracked)" : " (bodies " + seen + ")"));
+  }
+  // Order: by the frame counter, else the timestamp; far back is a restart.
+  bool restarted = false;
+  bool older = false;
+  if (f.frame && last_frame_) {
+    older = *f.frame <= *last_frame_;
+    restarted = older && *last_frame_ - *f.frame > kRestartFrames;
+  } else if (f.timestamp && last_timestamp_) {
+    older = *f.timestamp <= *last_timestamp_;
+    restarted = older && *last_timestamp_ - *f.timestamp > kRestartSeconds;
+  }
+  const Nanos shows = arrival - seconds_to_nanos(f.latency.value_or(0.0)) -
+                      std::chrono::duration_cast<std::chrono::nanoseconds>(settings_.latency).count();
+  if (!restarted && (older || (!predictor_.empty() && shows <= predictor_.newest_time()))) {
+    ++counts_.backwards;
+    return once(said_backwards_, "tracker: ignored a frame older than the last one taken");
+  }
+  if (restarted) predictor_.reset();
+  last_frame_ = f.frame;
+  last_timestamp_ = f.timestamp;
+  const glm::dquat orientation = glm::quat_cast(body->rotation);
+  take(shows, arrival, body->position * 0.001, orientation);
+  if (restarted) return "tracker: its frame counter started again; following it";
+  return std::nullopt;
+}
+
+void HeadTracker::sample(Nanos time, const glm::dvec3& position, const glm::dquat& orientation) {
+  ++counts_.datagrams;
+  if (!predictor_.empty() && time <= predictor_.newest_time()) {
+    ++counts_.backwards;
+    return;
+  }
+  take(time, time, position, orientation);
+}
+
+void HeadTracker::take(Nanos time, Nanos arrival, const glm::dvec3& position, const glm::dquat& orientation) {
+  const glm::dmat3& axes = settings_.tracker_axes;
+  const glm::dvec3 body = axes * position + settings_.tracker_origin;
+  const glm::dquat turn = glm::normalize(glm::quat_cast(axes) * orientation);
+  HeadPose pose;
+  pose.position = body + turn * settings_.eye_offset;
+  pose.orientation = turn;
+  if (lost_since_ || (last_arrival_ && arrival - *last_arrival_ > settings_.lost_after.count() * 1'000'000)) {
+    predictor_.reset();  // what it knew is stale
+  }
+  predictor_.add(time, pose);
+  last_arrival_ = arrival;
+  ++counts_.samples;
+}
+
+void HeadTracker::notice(Nanos now, std::vector<std::string>& said) {
+  const Nanos lost_after = settings_.lost_after.count() * 1'000'000;
+  const std::optional<Nanos> before = last_now_;
+  last_now_ = now;
+  if (!last_arrival_) return;
+  const bool lost = now - *last_arrival_ > lost_after;
+  // The time lost, counted from the moment the tracker was lost to now.
+  const auto count_lost = [&] {
+    counts_.lost_ns += std::max<Nanos>(0, now - std::max(before.value_or(now), *lost_since_));
+  };
+  if (!lost) {
+    if (lost_since_) {
+      count_lost();
+      said.push_back("tracker: back after " + std::to_string((now - *lost_since_) / 1'000'000) + " ms");
+      lost_since_.reset();
+    }
+    state_ = TrackerState::tracking;
+    return;
+  }
+  if (!lost_since_) {
+    lost_since_ = *last_arrival_ + lost_after;
+    ++counts_.losses;
+    said.push_back("tracker: lost (no sample for " + std::to_string(settings_.lost_after.count()) +
+                   " ms); holding the last pose for " + std::to_string(settings_.hold.count()) +
+                   " ms, then easing to the viewer's eye over " + std::to_string(settings_.ease.count()) + " ms");
+    counts_.lost_ns += now - *lost_since_;
+  } else {
+    count_lost();
+  }
+  const Nanos since = now - *lost_since_;
+  const Nanos hold = settings_.hold.count() * 1'000'000;
+  const Nanos ease = settings_.ease.count() * 1'000'000;
+  state_ = since < hold ? TrackerState::holding : since < hold + ease ? TrackerState::easing : TrackerState::resting;
+}
+
+HeadAt HeadTracker::at(Nanos time, const glm::dvec3& rest) const {
+  const HeadPose resting{rest, glm::dquat(1.0, 0.0, 0.0, 0.0)};
+  switch (state_) {
+    case TrackerState::waiting:
+      return {resting, state_};
+    case TrackerState::tracking:
+      return {predictor_.predict(time), state_};
+    case TrackerState::holding:
+      return {predictor_.newest(), state_};
+    case TrackerState::easing:
+    case TrackerState::resting:
+      break;
+  }
+  const Nanos hold = settings_.hold.count() * 1'000'000;
+  const Nanos ease = settings_.ease.count() * 1'000'000;
+  const Nanos since = *last_now_ - *lost_since_;
+  const double f = ease > 0 ? smoothstep(static_cast<double>(since - hold) / static_cast<double>(ease)) : 1.0;
+  const HeadPose last = predictor_.newest();
+  HeadPose out;
+  out.position = glm::mix(last.position, rest, f);
+  out.orientation = glm::normalize(glm::slerp(last.orientation, resting.orientation, f));
+  return {out, state_};
+}
+
+ReplayFeed::ReplayFeed(std::vector<ReplaySample> samples, Nanos start) : samples_(std::move(samples)), start_(start) {
+  const double last = samples_.empty() ? 0.0 : samples_.back().time;
+  const double interval =
+      samples_.size() > 1 ? (samples_.back().time - samples_.front().time) / static_cast<double>(samples_.size() - 1)
+                          : 0.0;
+  period_ = seconds_to_nanos(last + interval);
+}
+
+void ReplayFeed::feed(Nanos now, HeadTracker& tracker) {
+  const auto n = static_cast<std::uint64_t>(samples_.size());
+  if (n == 0) return;
+  while (true) {
+    if (n == 1 && next_ >= 1) return;
+    const std::uint64_t loop = next_ / n;
+    const ReplaySample& s = samples_[next_ % n];
+    const Nanos due = start_ + static_cast<Nanos>(loop) * period_ + seconds_to_nanos(s.time);
+    if (due > now) return;
+    tracker.sample(due, s.position, s.orientation);
+    ++next_;
+  }
+}
+
+}  // namespace optique::tracking

@@ -1,0 +1,327 @@
+// A tracked head without IO (common/tracking): DTrack's ASCII output and replay
+// files parsed, samples stamped and carried to the world, the head predicted,
+// bad input ignored and counted, a lost tracker held and eased to rest.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "config/tracking.h"
+#include "tracking/dtrack.h"
+#include "tracking/head_tracker.h"
+#include "tracking/predictor.h"
+#include "tracking/replay.h"
+
+namespace optique::tracking {
+namespace {
+
+constexpr Nanos kMs = 1'000'000;
+
+// The head at display time `time`, noticed at `now`.
+HeadAt at(HeadTracker& tracker, Nanos time, Nanos now, const glm::dvec3& rest, std::vector<std::string>& said) {
+  tracker.notice(now, said);
+  return tracker.at(time, rest);
+}
+
+// A DTrack frame with body `id` at `mm` (tracker space), turned `degrees` about
+// the tracker's z axis.
+std::string datagram(std::uint64_t frame, std::uint32_t id, glm::dvec3 mm, double degrees = 0.0) {
+  const double a = glm::radians(degrees);
+  const double c = std::cos(a);
+  const double s = std::sin(a);
+  char text[512];
+  // Column by column: the body's x axis (c, s, 0), y (−s, c, 0), z (0, 0, 1).
+  std::snprintf(text, sizeof text,
+                "fr %llu\r\nts %.6f\r\n6dcal 2\r\n6d 1 [%u 1.000][%.3f %.3f %.3f][%.6f %.6f %.6f %.6f %.6f %.6f 0 0 "
+                "1]\r\n6df 0\r\n",
+                static_cast<unsigned long long>(frame), 0.01 * static_cast<double>(frame), id, mm.x, mm.y, mm.z, c, s,
+                0.0, -s, c, 0.0);
+  return text;
+}
+
+TEST(DTrack, ParsesFramesTimestampsAndBodies) {
+  const auto parsed = parse_dtrack(
+      "fr 21753\r\nts 39596.024831\r\n6dcal 2\r\n"
+      "6d 2 [0 1.000][326.848 -187.216 109.503][1 0 0 0 1 0 0 0 1] "
+      "[3 0.500][-1 2 3 -160.4704 -3.6963 -7.0913][0 1 0 -1 0 0 0 0 1]\r\n"
+      "3d 1 [7 1.000][1 2 3]\r\n");
+  ASSERT_TRUE(parsed) << parsed.error();
+  const DTrackFrame& f = parsed.value();
+  EXPECT_EQ(f.frame, 21753u);
+  ASSERT_TRUE(f.timestamp);
+  EXPECT_DOUBLE_EQ(*f.timestamp, 39596.024831);
+  ASSERT_EQ(f.bodies.size(), 2u);
+  EXPECT_EQ(f.bodies[0].id, 0u);
+  EXPECT_DOUBLE_EQ(f.bodies[0].position.y, -187.216);
+  EXPECT_EQ(f.bodies[1].id, 3u);
+  EXPECT_DOUBLE_EQ(f.bodies[1].quality, 0.5);
+  // Column by column: the body's x axis is the tracker's y.
+  EXPECT_DOUBLE_EQ(f.bodies[1].rotation[0][1], 1.0);
+  EXPECT_DOUBLE_EQ(f.bodies[1].rotation[1][0], -1.0);
+}
+
+TEST(DTrack, TheExtendedTimestampCarriesTheTrackersLatency) {
+  const auto parsed = parse_dtrack("ts2 1700000000 250000 18000\n6d 0\n");
+  ASSERT_TRUE(parsed) << parsed.error();
+  ASSERT_TRUE(parsed.value().latency);
+  EXPECT_DOUBLE_EQ(*parsed.value().latency, 0.018);
+  EXPECT_TRUE(parsed.value().bodies.empty());
+}
+
+TEST(DTrack, MalformedDatagramsAreRefusedNamingTheLine) {
+  const struct {
+    const char* text;
+    const char* says;
+  } cases[] = {
+      {"fr 1\n6d 1 [0 1][nan 0 0][1 0 0 0 1 0 0 0 1]\n", "line 2 (6d): body 1 of 1: expected [x y z]"},
+      {"6d 1 [0 1][0 0 0][1 0 0 0 1 0 0 0 2]\n", "the rotation matrix is not a rotation"},
+      {"6d 1 [0 1][0 0 0][-1 0 0 0 1 0 0 0 1]\n", "the rotation matrix is not a rotation"},  // a mirror
+      {"6d 2 [0 1][0 0 0][1 0 0 0 1 0 0 0 1]\n", "body 2 of 2: expected [id quality]"},
+      {"6d 1 [0 1][0 0 0][1 0 0 0 1 0 0 0 1] junk\n", "more after the 1 bodies"},
+      {"6d 99999 \n", "99999 bodies"},
+      {"fr x\n", "line 1 (fr): expected a frame counter"},
+      {"ts -3\n", "expected seconds since midnight"},
+      {"ts2 1 2000000 0\n", "expected seconds, microseconds"},
+      {"fr 1\x01\n", "a byte that is not printable ASCII"},
+      {"\x7f\x45\x4c\x46\n", "a byte that is not printable ASCII"},
+      {"hello\nworld\n", "no fr, ts or 6d line"},
+      {"6d 1 [0 7][0 0 0][1 0 0 0 1 0 0 0 1]\n", "quality 7"},
+  };
+  for (const auto& c : cases) {
+    const auto parsed = parse_dtrack(c.text);
+    ASSERT_FALSE(parsed) << c.text;
+    EXPECT_NE(parsed.error().find(c.says), std::string::npos) << parsed.error();
+  }
+  EXPECT_FALSE(parse_dtrack(std::string(kMaxDTrackDatagram + 1, ' ')));
+}
+
+TEST(DTrack, DTrackOnesPositionBlockWithAnglesIsRead) {
+  const auto parsed = parse_dtrack("6d 1 [2 1.0][10 20 30 1 2 3][1 0 0 0 1 0 0 0 1]");
+  ASSERT_TRUE(parsed) << parsed.error();
+  EXPECT_DOUBLE_EQ(parsed.value().bodies.at(0).position.z, 30.0);
+}
+
+config::Tracking settings(config::HeadPrediction prediction = config::HeadPrediction::none) {
+  config::Tracking t;
+  t.body = 4;
+  t.prediction = prediction;
+  return t;
+}
+
+// A tracker whose z is the world's up (y): its x is the world's x, its y the
+// world's −z. The eyes sit 10 cm in front of the tracked body (its own −z).
+TEST(HeadTracker, SamplesAreCarriedToTheWorldAndToTheEyes) {
+  config::Tracking t = settings();
+  t.tracker_axes = glm::dmat3(glm::dvec3(1, 0, 0), glm::dvec3(0, 0, -1), glm::dvec3(0, 1, 0));
+  t.tracker_origin = {0.0, 0.0, 1.0};
+  t.eye_offset = {0.0, 0.0, -0.1};
+  HeadTracker tracker(t);
+  EXPECT_FALSE(tracker.datagram(datagram(1, 4, {100.0, 200.0, 1700.0}), 10 * kMs));
+  std::vector<std::string> said;
+  const HeadAt head = at(tracker, 10 * kMs, 10 * kMs, {0.0, 1.2, 2.0}, said);
+  EXPECT_EQ(head.state, TrackerState::tracking);
+  // Body at (0.1, 1.7, 1 − 0.2); the body unturned, its −z is the world's −y.
+  EXPECT_NEAR(head.pose.position.x, 0.1, 1e-12);
+  EXPECT_NEAR(head.pose.position.y, 1.7 - 0.1, 1e-12);
+  EXPECT_NEAR(head.pose.position.z, 0.8, 1e-12);
+  // Turned 90° about the tracker's z (the world's up): the head's right (x) is
+  // the tracker's y, the world's −z.
+  EXPECT_FALSE(tracker.datagram(datagram(2, 4, {0.0, 0.0, 1700.0}, 90.0), 20 * kMs));
+  const HeadAt turned = at(tracker, 20 * kMs, 20 * kMs, {0.0, 1.2, 2.0}, said);
+  const glm::dvec3 right = turned.pose.orientation * glm::dvec3(1.0, 0.0, 0.0);
+  EXPECT_NEAR(right.x, 0.0, 1e-6);
+  EXPECT_NEAR(right.z, -1.0, 1e-6);
+  EXPECT_TRUE(said.empty());
+}
+
+// What a bad tracker sends is ignored and counted, and the frame goes on with
+// the good samples.
+TEST(HeadTracker, BadInputIsIgnoredAndCounted) {
+  HeadTracker tracker(settings());
+  Nanos t = 0;
+  const auto next = [&] { return t += 10 * kMs; };
+  EXPECT_FALSE(tracker.datagram(datagram(10, 4, {0, 1000, 0}), next()));
+  const auto garbage = tracker.datagram("GET / HTTP/1.1", next());
+  ASSERT_TRUE(garbage);
+  EXPECT_NE(garbage->find("not DTrack's ASCII output"), std::string::npos) << *garbage;
+  EXPECT_FALSE(tracker.datagram("6d 1 [4 1][nan 0 0][1 0 0 0 1 0 0 0 1]", next())) << "said once only";
+  const auto other = tracker.datagram(datagram(11, 5, {0, 1000, 0}), next());
+  ASSERT_TRUE(other);
+  EXPECT_NE(other->find("without body 4 (bodies 5)"), std::string::npos) << *other;
+  const auto old = tracker.datagram(datagram(9, 4, {0, 1000, 0}), next());
+  ASSERT_TRUE(old);
+  EXPECT_NE(old->find("older than the last one"), std::string::npos);
+  // A flood: 100 datagrams 10 µs apart; one is read every kFloodInterval.
+  const Nanos flood_start = next();
+  for (int i = 0; i < 100; ++i) (void)tracker.datagram(datagram(2000 + i, 4, {0, 1000, 0}), flood_start + i * 10'000);
+  const TrackingCounts& counts = tracker.counts();
+  EXPECT_EQ(counts.samples, 3u);
+  EXPECT_EQ(counts.malformed, 2u);
+  EXPECT_EQ(counts.without_body, 1u);
+  EXPECT_EQ(counts.backwards, 1u);
+  EXPECT_EQ(counts.flood, 98u);
+  EXPECT_EQ(counts.datagrams, 105u);
+  // A tracker that started again (its counter far back) is followed.
+  const auto restarted = tracker.datagram(datagram(3, 4, {0, 1500, 0}), flood_start + 20 * kMs);
+  ASSERT_TRUE(restarted);
+  EXPECT_NE(restarted->find("started again"), std::string::npos);
+  std::vector<std::string> said;
+  EXPECT_NEAR(at(tracker, flood_start + 20 * kMs, flood_start + 20 * kMs, {}, said).pose.position.y, 1.5, 1e-12);
+}
+
+// The tracker's own latency (ts2) and the configured one place a sample at the
+// moment it shows; a prediction from constant motion is exact.
+TEST(HeadTracker, ConstantVelocityPredictsConstantMotionExactly) {
+  config::Tracking t = settings(config::HeadPrediction::constant_velocity);
+  t.latency = std::chrono::milliseconds(5);
+  HeadTracker tracker(t);
+  // 1.5 m/s along x; each sample shows the head 15 + 5 ms before it arrives.
+  for (int i = 0; i < 10; ++i) {
+    const Nanos shows = i * 16 * kMs;
+    const double x = 1.5 * static_cast<double>(shows) / 1e9;
+    const std::string text = "fr " + std::to_string(i) + "\nts2 0 0 15000\n6d 1 [4 1][" + std::to_string(x * 1000.0) +
+                             " 0 0][1 0 0 0 1 0 0 0 1]\n";
+    EXPECT_FALSE(tracker.datagram(text, shows + 20 * kMs));
+  }
+  std::vector<std::string> said;
+  const Nanos display = 9 * 16 * kMs + 50 * kMs;
+  const HeadAt head = at(tracker, display, 9 * 16 * kMs + 20 * kMs, {}, said);
+  EXPECT_NEAR(head.pose.position.x, 1.5 * static_cast<double>(display) / 1e9, 1e-6);
+}
+
+TEST(HeadPredictor, DoubleExponentialFollowsSteadyMotionWithoutLag) {
+  HeadPredictor predictor(config::HeadPrediction::double_exponential, 0.5);
+  const glm::dvec3 velocity{0.5, 0.0, -1.0};  // m/s
+  const double spin = 1.0;                    // rad/s about y
+  Nanos t = 0;
+  for (int i = 0; i < 60; ++i) {
+    t = i * 10 * kMs;
+    const double s = static_cast<double>(t) / 1e9;
+    predictor.add(t, {velocity * s, glm::angleAxis(spin * s, glm::dvec3(0, 1, 0))});
+  }
+  const Nanos ahead = t + 50 * kMs;
+  const double s = static_cast<double>(ahead) / 1e9;
+  const HeadPose p = predictor.predict(ahead);
+  EXPECT_LT(glm::length(p.position - velocity * s), 1e-6);
+  EXPECT_LT(glm::angle(p.orientation * glm::inverse(glm::angleAxis(spin * s, glm::dvec3(0, 1, 0)))), 2e-3);
+  // Without prediction, 50 ms behind.
+  HeadPredictor none(config::HeadPrediction::none, 0.5);
+  none.add(t, {velocity * (static_cast<double>(t) / 1e9), {}});
+  EXPECT_NEAR(glm::length(none.predict(ahead).position - velocity * s), glm::length(velocity) * 0.05, 1e-9);
+}
+
+// Lost: held, eased (smoothstep) to the rest, resting; back on the next sample.
+TEST(HeadTracker, ALostTrackerIsHeldThenEasedToRest) {
+  config::Tracking t = settings();
+  t.lost_after = std::chrono::milliseconds(100);
+  t.hold = std::chrono::milliseconds(200);
+  t.ease = std::chrono::milliseconds(400);
+  HeadTracker tracker(t);
+  std::vector<std::string> said;
+  const glm::dvec3 rest{0.0, 1.2, 2.0};
+  EXPECT_EQ(at(tracker, 0, 0, rest, said).state, TrackerState::waiting);
+  EXPECT_EQ(at(tracker, 0, 0, rest, said).pose.position, rest);
+  EXPECT_FALSE(tracker.datagram(datagram(1, 4, {1000, 1000, 1000}, 30.0), 0));
+  const glm::dvec3 seen{1.0, 1.0, 1.0};
+  EXPECT_EQ(at(tracker, 50 * kMs, 50 * kMs, rest, said).state, TrackerState::tracking);
+  HeadAt held = at(tracker, 150 * kMs, 150 * kMs, rest, said);
+  EXPECT_EQ(held.state, TrackerState::holding);
+  EXPECT_EQ(held.pose.position, seen);
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_NE(said[0].find("tracker: lost (no sample for 100 ms)"), std::string::npos) << said[0];
+  const HeadAt half = at(tracker, 500 * kMs, 500 * kMs, rest, said);  // lost at 100, eased from 300 to 700
+  EXPECT_EQ(half.state, TrackerState::easing);
+  EXPECT_LT(glm::length(half.pose.position - (seen + rest) * 0.5), 1e-12);
+  const HeadAt rested = at(tracker, 800 * kMs, 800 * kMs, rest, said);
+  EXPECT_EQ(rested.state, TrackerState::resting);
+  EXPECT_EQ(rested.pose.position, rest);
+  EXPECT_LT(glm::angle(rested.pose.orientation), 1e-9);
+  EXPECT_EQ(said.size(), 1u) << "lost once, said once";
+  EXPECT_FALSE(tracker.datagram(datagram(2, 4, {0, 1600, 0}), 900 * kMs));
+  const HeadAt back = at(tracker, 900 * kMs, 900 * kMs, rest, said);
+  EXPECT_EQ(back.state, TrackerState::tracking);
+  EXPECT_NEAR(back.pose.position.y, 1.6, 1e-12);
+  ASSERT_EQ(said.size(), 2u);
+  EXPECT_NE(said[1].find("tracker: back after 800 ms"), std::string::npos) << said[1];
+  EXPECT_EQ(tracker.counts().losses, 1u);
+  EXPECT_EQ(tracker.counts().lost_ns, 800 * kMs);
+}
+
+TEST(Replay, ParsesRowsAfterAHeaderAndRefusesBadOnes) {
+  const auto parsed =
+      parse_replay("time,x,y,z,qw,qx,qy,qz\n# a comment\n0, 0,1.6,0, 1,0,0,0\n\n0.5,0.1,1.6,0,1,0,0,0\n", "head.csv");
+  ASSERT_TRUE(parsed) << parsed.error();
+  ASSERT_EQ(parsed.value().size(), 2u);
+  EXPECT_DOUBLE_EQ(parsed.value()[1].position.x, 0.1);
+  const struct {
+    const char* text;
+    const char* says;
+  } bad[] = {
+      {"0,0,0,0,1,0,0\n", "head.csv:1: 7 fields"},
+      {"0,0,0,0,2,0,0,0\n", "head.csv:1: qw, qx, qy, qz is not a unit quaternion"},
+      {"0,0,0,0,1,0,0,0\n0,0,0,0,1,0,0,0\n", "head.csv:2: times must increase"},
+      {"t,x\n0,nan,0,0,1,0,0,0\n", "head.csv:2: x is not a finite number"},
+      {"time\n", "head.csv: no samples"},
+  };
+  for (const auto& b : bad) {
+    const auto refused = parse_replay(b.text, "head.csv");
+    ASSERT_FALSE(refused) << b.text;
+    EXPECT_NE(refused.error().find(b.says), std::string::npos) << refused.error();
+  }
+  EXPECT_FALSE(load_replay("/nonexistent/head.csv"));
+}
+
+TEST(Replay, TheFeedLoopsAtItsTimes) {
+  config::Tracking t = settings();
+  t.source = config::TrackingSource::replay;
+  HeadTracker tracker(t);
+  const auto samples = parse_replay("0,0,0,0,1,0,0,0\n0.1,1,0,0,1,0,0,0\n", "loop.csv");
+  ASSERT_TRUE(samples);
+  ReplayFeed feed(samples.value(), 1000 * kMs);
+  std::vector<std::string> said;
+  feed.feed(999 * kMs, tracker);
+  EXPECT_EQ(tracker.counts().samples, 0u);
+  feed.feed(1150 * kMs, tracker);  // 0 and 0.1 s
+  EXPECT_EQ(tracker.counts().samples, 2u);
+  EXPECT_DOUBLE_EQ(at(tracker, 1150 * kMs, 1150 * kMs, {}, said).pose.position.x, 1.0);
+  feed.feed(1200 * kMs, tracker);  // a loop is 0.2 s: the first again
+  EXPECT_EQ(tracker.counts().samples, 3u);
+  EXPECT_DOUBLE_EQ(at(tracker, 1200 * kMs, 1200 * kMs, {}, said).pose.position.x, 0.0);
+}
+
+TEST(TrackingConfig, EveryProblemIsNamed) {
+  schema::Tracking t;
+  t.set_source("optitrack");
+  t.set_listen("not-an-address");
+  t.set_smoothing(1.0);
+  t.set_latency_ms(900.0);
+  t.add_eye_offset(0.0);
+  t.add_eye_offset(2.0);
+  t.add_eye_offset(0.0);
+  for (double v : {1.0, 0.0, 0.0}) t.mutable_tracker_axes()->add_x(v);
+  for (double v : {0.0, 0.0, 1.0}) t.mutable_tracker_axes()->add_y(v);
+  for (double v : {0.0, 1.0, 0.0}) t.mutable_tracker_axes()->add_z(v);  // left-handed
+  std::vector<config::Problem> problems;
+  (void)config::parse_tracking(t, "viewer.tracking", problems);
+  std::string all;
+  for (const auto& p : problems) all += p.path + ": " + p.message + "\n";
+  for (const char* says :
+       {"viewer.tracking.source: must be dtrack or replay (got 'optitrack')",
+        "viewer.tracking.listen: 'not-an-address' is not an IPv4 or IPv6 address",
+        "viewer.tracking.smoothing: must be in (0, 1)", "viewer.tracking.latency_ms: must be 0…500",
+        "viewer.tracking.eye_offset: is in metres", "viewer.tracking.tracker_axes: must be right-handed"}) {
+    EXPECT_NE(all.find(says), std::string::npos) << says << "\n" << all;
+  }
+  schema::Tracking replay;
+  replay.set_source("replay");
+  problems.clear();
+  (void)config::parse_tracking(replay, "viewer.tracking", problems);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].path, "viewer.tracking.file");
+}
+
+}  // namespace
+}  // namespace optique::tracking
