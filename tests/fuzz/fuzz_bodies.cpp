@@ -8,6 +8,8 @@
 #include "net/envelope.h"
 #include "net/framing.h"
 #include "scene/state.h"
+#include "tracking/dtrack.h"
+#include "tracking/head_tracker.h"
 #include "util/finite.h"
 
 namespace optique::fuzz {
@@ -248,7 +250,59 @@ std::string deltas(std::span<const std::uint8_t> input, Outcome& out) {
   return {};
 }
 
+std::string check_head(const tracking::HeadPose& pose) {
+  OPTIQUE_FUZZ_REQUIRE(util::finite(pose.position));
+  const glm::dquat& q = pose.orientation;
+  const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  OPTIQUE_FUZZ_REQUIRE(std::abs(norm - 1.0) < 1e-6);
+  return {};
+}
+
+std::string tracker(std::span<const std::uint8_t> input, Outcome& out) {
+  const auto chunks = split_chunks(input);
+  for (const config::HeadPrediction prediction :
+       {config::HeadPrediction::none, config::HeadPrediction::constant_velocity,
+        config::HeadPrediction::double_exponential}) {
+    config::Tracking settings;
+    settings.prediction = prediction;
+    tracking::HeadTracker head(settings);
+    tracking::Nanos now = 1'000'000'000;
+    std::vector<std::string> said;
+    for (const auto& chunk : chunks) {
+      if (chunk.empty()) continue;
+      now += static_cast<tracking::Nanos>(chunk[0]) * 100'000;
+      const std::string_view datagram(reinterpret_cast<const char*>(chunk.data()) + 1, chunk.size() - 1);
+      if (prediction == config::HeadPrediction::none) {
+        auto parsed = tracking::parse_dtrack(datagram);
+        if (parsed.ok()) {
+          ++out.datagrams_parsed;
+          for (const tracking::DTrackBody& body : parsed.value().bodies) {
+            OPTIQUE_FUZZ_REQUIRE(util::finite(body.position));
+            OPTIQUE_FUZZ_REQUIRE(std::abs(glm::determinant(body.rotation) - 1.0) < 0.01);
+          }
+        } else {
+          OPTIQUE_FUZZ_REQUIRE(!parsed.error().empty());
+        }
+      }
+      (void)head.datagram(datagram, now);
+      head.notice(now, said);
+      const tracking::HeadAt at = head.at(now + 16'666'666, glm::dvec3(0.0, 1.6, 2.0));
+      if (auto broken = check_head(at.pose); !broken.empty()) return broken;
+      const tracking::TrackingCounts& c = head.counts();
+      OPTIQUE_FUZZ_REQUIRE(c.datagrams == c.samples + c.malformed + c.without_body + c.backwards + c.flood);
+    }
+    if (prediction == config::HeadPrediction::none) out.samples += static_cast<int>(head.counts().samples);
+  }
+  return {};
+}
+
 }  // namespace
+
+Outcome run_tracker(std::span<const std::uint8_t> input) {
+  Outcome out;
+  out.broken = tracker(input, out);
+  return out;
+}
 
 Outcome run_frames(std::span<const std::uint8_t> input) {
   const QuietProtobuf quiet;

@@ -59,6 +59,8 @@ struct Outcome {
   int renders = 0;           // run_node: frames the node drew
   int closes = 0;            // run_node: messages that made it close or stop
   bool finished = false;     // run_protocol: the master's run ended
+  int datagrams_parsed = 0;  // run_tracker: datagrams parse_dtrack took
+  int samples = 0;           // run_tracker: samples the head tracker took
 };
 
 // Input: byte 0 picks how the rest is cut into fragments (0: all at once, 1: byte
@@ -91,5 +93,14 @@ struct Outcome {
 // lights the scene has (ascending), a finite focus; garbage closes the
 // connection, it never crashes the node.
 [[nodiscard]] Outcome run_node(std::span<const std::uint8_t> input);
+
+// Input: UDP datagrams from a head tracker, separated by kChunkSeparator; each
+// chunk's first byte is the gap before it in tenths of a millisecond, the rest
+// the datagram. Each goes to parse_dtrack and to a HeadTracker (body 0, each
+// prediction in turn), which is asked for the head a frame on. Invariants: a
+// parsed body's numbers are finite and its matrix a rotation; the head is finite,
+// its turn a unit quaternion; every datagram is counted once (taken, malformed,
+// without the body, backwards or flood).
+[[nodiscard]] Outcome run_tracker(std::span<const std::uint8_t> input);
 
 }  // namespace optique::fuzz

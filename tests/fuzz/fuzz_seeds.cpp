@@ -550,4 +550,58 @@ std::vector<Seed> node_seeds() {
   return seeds;
 }
 
+namespace {
+
+// A tracker datagram after `gap_tenths` tenths of a millisecond.
+Bytes datagram(std::uint8_t gap_tenths, const std::string& text) {
+  Bytes out;
+  out.reserve(text.size() + 1);
+  out.push_back(gap_tenths);
+  for (const char c : text) out.push_back(static_cast<std::uint8_t>(c));
+  return out;
+}
+
+// Body 0 at x millimetres, turned `quarter` quarter turns about z, DTrack 2's way.
+std::string frame_text(unsigned long long frame, double x, int quarter = 0) {
+  static const char* const kTurns[] = {"1 0 0 0 1 0 0 0 1", "0 1 0 -1 0 0 0 0 1", "-1 0 0 0 -1 0 0 0 1",
+                                       "0 -1 0 1 0 0 0 0 1"};
+  return "fr " + std::to_string(frame) + "\r\nts2 1700000000 " + std::to_string(frame * 16667 % 1000000) +
+         " 18000\r\n6dcal 1\r\n6d 1 [0 1.000][" + std::to_string(x) + " 1600.0 2000.0][" + kTurns[quarter & 3] +
+         "]\r\n";
+}
+
+}  // namespace
+
+std::vector<Seed> tracker_seeds() {
+  std::vector<Seed> seeds;
+  {
+    std::vector<Bytes> walk;
+    for (int i = 0; i < 12; ++i) walk.push_back(datagram(167, frame_text(100 + i, 10.0 * i, i / 3)));
+    seeds.push_back({"walk", join(walk)});
+  }
+  seeds.push_back({"dtrack1_angles", join({datagram(167,
+                                                    "fr 7\nts 39596.024831\n6d 1 [0 1.0][1 2 3 -160.4 -3.7 "
+                                                    "-7.1][1 0 0 0 1 0 0 0 1]\n")})});
+  seeds.push_back({"two_bodies_other_lines",
+                   join({datagram(100,
+                                  "fr 1\n6d 2 [3 0.5][0 0 0][1 0 0 0 1 0 0 0 1] [0 1][5 6 7][0 1 0 -1 0 0 0 0 "
+                                  "1]\n6df 1 [0 1.000 0][1 2 3][1 0 0 0 1 0 0 0 1]\n3d 1 [7 1.0][1 2 3]\n")})});
+  seeds.push_back({"garbage_nan_mirror",
+                   join({datagram(50, "\x7f\x45\x4c\x46 elf"), datagram(50, "6d 1 [0 1][nan 0 0][1 0 0 0 1 0 0 0 1]"),
+                         datagram(50, "6d 1 [0 1][0 0 0][-1 0 0 0 1 0 0 0 1]"), datagram(50, frame_text(1, 0.0))})});
+  seeds.push_back(
+      {"backwards_and_restart", join({datagram(167, frame_text(5000, 0.0)), datagram(167, frame_text(4999, 1.0)),
+                                      datagram(167, frame_text(3, 2.0)), datagram(167, frame_text(4, 3.0))})});
+  {
+    std::vector<Bytes> flood{datagram(167, frame_text(1, 0.0))};
+    for (int i = 0; i < 20; ++i) flood.push_back(datagram(1, frame_text(2 + i, 1.0 * i)));
+    seeds.push_back({"flood", join(flood)});
+  }
+  seeds.push_back({"lost_and_back", join({datagram(167, frame_text(1, 0.0)), datagram(167, frame_text(2, 5.0)),
+                                          datagram(255, "fr 3\n6d 0\n"), datagram(255, "fr 4\n6d 0\n"),
+                                          datagram(255, "fr 5\n6d 0\n"), datagram(167, frame_text(6, 9.0))})});
+  seeds.push_back({"empty", {}});
+  return seeds;
+}
+
 }  // namespace optique::fuzz

@@ -26,4 +26,7 @@ struct Seed {
 // Inputs for run_node: a Welcome, then Envelopes, joined by kChunkSeparator.
 [[nodiscard]] std::vector<Seed> node_seeds();
 
+// Inputs for run_tracker: a gap byte and a datagram each, joined by kChunkSeparator.
+[[nodiscard]] std::vector<Seed> tracker_seeds();
+
 }  // namespace optique::fuzz

@@ -1,5 +1,5 @@
 // Writes the seed corpus: optique-fuzz-corpus DIR fills DIR/frames, DIR/deltas,
-// DIR/protocol and DIR/node (tests/fuzz/corpus is the committed one). Files already there and not seeds,
+// DIR/protocol, DIR/node and DIR/tracker (tests/fuzz/corpus is the committed one). Files already there and not seeds,
 // e.g. crash inputs kept as regressions, are left alone.
 
 #include <cstdio>
@@ -35,6 +35,7 @@ int main(int argc, char** argv) {
   const bool ok = write_all(dir / "frames", optique::fuzz::frame_seeds()) &&
                   write_all(dir / "deltas", optique::fuzz::delta_seeds()) &&
                   write_all(dir / "protocol", optique::fuzz::protocol_seeds()) &&
-                  write_all(dir / "node", optique::fuzz::node_seeds());
+                  write_all(dir / "node", optique::fuzz::node_seeds()) &&
+                  write_all(dir / "tracker", optique::fuzz::tracker_seeds());
   return ok ? 0 : 1;
 }
