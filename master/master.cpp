@@ -44,8 +44,7 @@ Result<void> Master::listen_to_tracker(const config::Tracking& tracking) {
   if (ec) return Error{"viewer.tracking.listen: '" + tracking.listen + "' is not an address"};
   const asio::ip::udp::endpoint endpoint(address, tracking.port);
   tracker_socket_.open(endpoint.protocol(), ec);
-  if (!ec) tracker_socket_.set_option(asio::socket_base::reuse_address(true), ec);
-  if (!ec) tracker_socket_.bind(endpoint, ec);
+  if (!ec) tracker_socket_.bind(endpoint, ec);  // no reuse: a second receiver on the port is an error, said
   if (ec) {
     return Error{"viewer.tracking: cannot receive on " + tracking.listen + ":" + std::to_string(tracking.port) +
                  " (UDP): " + ec.message()};

@@ -49,7 +49,7 @@ MasterProtocol::MasterProtocol(const config::Installation& installation, const s
       focus_(FocusSchedule::make(installation)) {
   frame_period_ = authority_.frame_period();
   if (installation.viewer.tracking) {
-    head_tracker_.emplace(*installation.viewer.tracking);
+    head_tracker_.emplace(*installation.viewer.tracking, tracking::turn_onto_x(installation.viewer.head_right));
     if (settings_.head_csv != nullptr) {
       *settings_.head_csv << "frame_id,display_ns,tracker,eye_x,eye_y,eye_z,right_x,right_y,right_z\n";
     }

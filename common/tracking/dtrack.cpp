@@ -94,6 +94,11 @@ Result<std::vector<DTrackBody>> parse_6d(Cursor& c) {
       return Error{which + ": quality " + std::to_string(body.quality) + " is outside -1…1"};
     }
     if (!is_rotation(body.rotation)) return Error{which + ": the rotation matrix is not a rotation"};
+    if (std::abs(body.position.x) > kMostDTrackPosition || std::abs(body.position.y) > kMostDTrackPosition ||
+        std::abs(body.position.z) > kMostDTrackPosition) {
+      return Error{which + ": a position more than " + std::to_string(static_cast<int>(kMostDTrackPosition / 1000)) +
+                   " m from the tracker's origin"};
+    }
     bodies.push_back(body);
   }
   if (!c.done()) return Error{"more after the " + std::to_string(count) + " bodies"};
@@ -144,6 +149,7 @@ Result<DTrackFrame> parse_dtrack(std::string_view datagram) {
       }
       frame.timestamp = static_cast<double>(seconds % (24 * 3600)) + micro * 1e-6;
       frame.latency = latency * 1e-6;
+      if (*frame.latency > kMostDTrackLatency) return wrong("a latency of more than a second");
     } else if (kind == "6d") {
       if (bodies_seen) return wrong("a second 6d line");
       auto bodies = parse_6d(c);

@@ -27,7 +27,11 @@ namespace optique::tracking {
 // Datagrams longer than this are refused unread (a DTrack frame with every
 // kind of output is a few kilobytes).
 inline constexpr std::size_t kMaxDTrackDatagram = 65507;
-inline constexpr std::uint32_t kMaxDTrackBodies = 1024;
+inline constexpr std::uint32_t kMaxDTrackBodies = 256;
+// Farther than this from the tracker's origin (mm) is no room's tracking; a
+// latency beyond this (s) no tracker's.
+inline constexpr double kMostDTrackPosition = 100'000.0;
+inline constexpr double kMostDTrackLatency = 1.0;
 
 struct DTrackBody {
   std::uint32_t id = 0;

@@ -1,6 +1,7 @@
 #include "tracking/head_tracker.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 #include <glm/gtc/quaternion.hpp>
@@ -15,6 +16,7 @@ constexpr double kNanosPerSecond = 1e9;
 // tracker that started again, not an old datagram.
 constexpr std::uint64_t kRestartFrames = 1000;
 constexpr double kRestartSeconds = 10.0;
+constexpr int kRestartAfter = 30;  // frames back in a row: half a second at 60 Hz
 
 Nanos seconds_to_nanos(double seconds) { return static_cast<Nanos>(std::llround(seconds * kNanosPerSecond)); }
 
@@ -41,8 +43,8 @@ std::string_view to_string(TrackerState state) {
   return "resting";
 }
 
-HeadTracker::HeadTracker(const config::Tracking& settings)
-    : settings_(settings), predictor_(settings.prediction, settings.smoothing) {}
+HeadTracker::HeadTracker(const config::Tracking& settings, const glm::dquat& rest_turn)
+    : settings_(settings), rest_turn_(rest_turn), predictor_(settings.prediction, settings.smoothing) {}
 
 std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos arrival) {
   ++counts_.datagrams;
@@ -72,7 +74,8 @@ std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos a
     return once(said_without_body_, "tracker: a frame without body " + std::to_string(settings_.body) +
                                         (seen.empty() ? " (no body tracked)" : " (bodies " + seen + ")"));
   }
-  // Order: by the frame counter, else the timestamp; far back is a restart.
+  // Order: by the frame counter, else the timestamp. Far back, or back frame
+  // after frame for kRestartAfter frames, is a tracker that started again.
   bool restarted = false;
   bool older = false;
   if (f.frame && last_frame_) {
@@ -82,18 +85,27 @@ std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos a
     older = *f.timestamp <= *last_timestamp_;
     restarted = older && *last_timestamp_ - *f.timestamp > kRestartSeconds;
   }
+  backwards_in_a_row_ = older ? backwards_in_a_row_ + 1 : 0;
+  restarted = restarted || backwards_in_a_row_ >= kRestartAfter;
   const Nanos shows = arrival - seconds_to_nanos(f.latency.value_or(0.0)) -
                       std::chrono::duration_cast<std::chrono::nanoseconds>(settings_.latency).count();
   if (!restarted && (older || (!predictor_.empty() && shows <= predictor_.newest_time()))) {
     ++counts_.backwards;
     return once(said_backwards_, "tracker: ignored a frame older than the last one taken");
   }
-  if (restarted) predictor_.reset();
+  if (!restarted && !predictor_.empty() && shows - predictor_.newest_time() < kLeastSampleInterval) {
+    ++counts_.flood;
+    return once(said_flood_, "tracker: a frame less than 1 ms after the last one taken; dropped");
+  }
+  if (restarted) {
+    predictor_.reset();
+    backwards_in_a_row_ = 0;
+  }
   last_frame_ = f.frame;
   last_timestamp_ = f.timestamp;
   const glm::dquat orientation = glm::quat_cast(body->rotation);
   take(shows, arrival, body->position * 0.001, orientation);
-  if (restarted) return "tracker: its frame counter started again; following it";
+  if (restarted) return "tracker: its frame counter (or clock) started again; following it";
   return std::nullopt;
 }
 
@@ -101,6 +113,10 @@ void HeadTracker::sample(Nanos time, const glm::dvec3& position, const glm::dqua
   ++counts_.datagrams;
   if (!predictor_.empty() && time <= predictor_.newest_time()) {
     ++counts_.backwards;
+    return;
+  }
+  if (!predictor_.empty() && time - predictor_.newest_time() < kLeastSampleInterval) {
+    ++counts_.flood;
     return;
   }
   take(time, time, position, orientation);
@@ -113,7 +129,7 @@ void HeadTracker::take(Nanos time, Nanos arrival, const glm::dvec3& position, co
   HeadPose pose;
   pose.position = body + turn * settings_.eye_offset;
   pose.orientation = turn;
-  if (lost_since_ || (last_arrival_ && arrival - *last_arrival_ > settings_.lost_after.count() * 1'000'000)) {
+  if (last_arrival_ && arrival - *last_arrival_ > settings_.lost_after.count() * 1'000'000) {
     predictor_.reset();  // what it knew is stale
   }
   predictor_.add(time, pose);
@@ -142,6 +158,8 @@ void HeadTracker::notice(Nanos now, std::vector<std::string>& said) {
   }
   if (!lost_since_) {
     lost_since_ = *last_arrival_ + lost_after;
+    // Held where the eyes were shown as the tracker went quiet: no snap back.
+    held_ = predictor_.predict(*lost_since_);
     ++counts_.losses;
     said.push_back("tracker: lost (no sample for " + std::to_string(settings_.lost_after.count()) +
                    " ms); holding the last pose for " + std::to_string(settings_.hold.count()) +
@@ -157,14 +175,14 @@ void HeadTracker::notice(Nanos now, std::vector<std::string>& said) {
 }
 
 HeadAt HeadTracker::at(Nanos time, const glm::dvec3& rest) const {
-  const HeadPose resting{rest, glm::dquat(1.0, 0.0, 0.0, 0.0)};
+  const HeadPose resting{rest, rest_turn_};
   switch (state_) {
     case TrackerState::waiting:
       return {resting, state_};
     case TrackerState::tracking:
       return {predictor_.predict(time), state_};
     case TrackerState::holding:
-      return {predictor_.newest(), state_};
+      return {held_, state_};
     case TrackerState::easing:
     case TrackerState::resting:
       break;
@@ -173,15 +191,24 @@ HeadAt HeadTracker::at(Nanos time, const glm::dvec3& rest) const {
   const Nanos ease = settings_.ease.count() * 1'000'000;
   const Nanos since = *last_now_ - *lost_since_;
   const double f = ease > 0 ? smoothstep(static_cast<double>(since - hold) / static_cast<double>(ease)) : 1.0;
-  const HeadPose last = predictor_.newest();
   HeadPose out;
-  out.position = glm::mix(last.position, rest, f);
-  out.orientation = glm::normalize(glm::slerp(last.orientation, resting.orientation, f));
+  out.position = glm::mix(held_.position, rest, f);
+  out.orientation = glm::normalize(glm::slerp(held_.orientation, resting.orientation, f));
   return {out, state_};
 }
 
+glm::dquat turn_onto_x(const glm::dvec3& head_right) {
+  const glm::dvec3 from = glm::normalize(head_right);
+  const glm::dvec3 to{1.0, 0.0, 0.0};
+  const double c = glm::dot(from, to);
+  if (c < -1.0 + 1e-12) return glm::angleAxis(M_PI, glm::dvec3(0.0, 1.0, 0.0));  // half a turn about up
+  const glm::dvec3 axis = glm::cross(from, to);
+  // (1 + c, axis) normalized: half the angle between them.
+  return glm::normalize(glm::dquat(1.0 + c, axis.x, axis.y, axis.z));
+}
+
 ReplayFeed::ReplayFeed(std::vector<ReplaySample> samples, Nanos start) : samples_(std::move(samples)), start_(start) {
-  const double last = samples_.empty() ? 0.0 : samples_.back().time;
+  const double last = samples_.empty() ? 0.0 : samples_.back().time - samples_.front().time;
   const double interval =
       samples_.size() > 1 ? (samples_.back().time - samples_.front().time) / static_cast<double>(samples_.size() - 1)
                           : 0.0;
@@ -191,11 +218,12 @@ ReplayFeed::ReplayFeed(std::vector<ReplaySample> samples, Nanos start) : samples
 void ReplayFeed::feed(Nanos now, HeadTracker& tracker) {
   const auto n = static_cast<std::uint64_t>(samples_.size());
   if (n == 0) return;
+  assert(n == 1 || period_ >= kLeastSampleInterval);  // parse_replay: samples 1 ms apart at least
   while (true) {
     if (n == 1 && next_ >= 1) return;
     const std::uint64_t loop = next_ / n;
     const ReplaySample& s = samples_[next_ % n];
-    const Nanos due = start_ + static_cast<Nanos>(loop) * period_ + seconds_to_nanos(s.time);
+    const Nanos due = start_ + static_cast<Nanos>(loop) * period_ + seconds_to_nanos(s.time - samples_.front().time);
     if (due > now) return;
     tracker.sample(due, s.position, s.orientation);
     ++next_;

@@ -8,13 +8,14 @@
 // What it ignores, and counts: datagrams that do not parse (garbage, NaN, a
 // matrix that is not a rotation), frames without the configured body, frames
 // older than the last one (a frame counter or timestamp that goes backwards;
-// far backwards is a tracker that restarted, and is followed), and datagrams
-// that come sooner than kFloodInterval after the last one read (a flood is
-// dropped unread, so it costs the frame loop nothing).
+// far backwards, or backwards for half a second, is a tracker that restarted,
+// and is followed), and datagrams that come sooner than kFloodInterval after
+// the last one read, or samples less than kLeastSampleInterval after the last
+// one taken (a flood is dropped unread: it costs the io thread a receive each).
 //
-// Lost (no sample for `lost_after`): the last sample's pose is held for `hold`,
-// then eased (smoothstep) over `ease` to where the viewer rests (its eye or
-// path, facing the world's way); back on the first sample. Each loss and each
+// Lost (no sample for `lost_after`): the pose shown as it went quiet is held for
+// `hold`, then eased (smoothstep) over `ease` to where the viewer rests (its eye
+// or path, its eyes along the world's x); back on the first sample. Each loss and each
 // return is said once.
 
 #include <cstdint>
@@ -52,7 +53,10 @@ struct HeadAt {
 
 class HeadTracker {
  public:
-  explicit HeadTracker(const config::Tracking& settings);
+  // `rest_turn`: the head's turn where it rests (waiting for a first sample,
+  // or eased to after a loss): the viewer's head_right, in the body's frame,
+  // turned to the world's right (the master's: rotation(head_right, x)).
+  explicit HeadTracker(const config::Tracking& settings, const glm::dquat& rest_turn = {1.0, 0.0, 0.0, 0.0});
 
   // A DTrack datagram that arrived at `arrival` (master clock). What is worth
   // a log line (the first of each kind of refusal; further ones are counted).
@@ -75,7 +79,10 @@ class HeadTracker {
   void take(Nanos time, Nanos arrival, const glm::dvec3& position, const glm::dquat& orientation);
 
   config::Tracking settings_;
+  glm::dquat rest_turn_;
   HeadPredictor predictor_;
+  HeadPose held_;  // where the eyes were shown as the tracker went quiet
+  int backwards_in_a_row_ = 0;
   TrackingCounts counts_;
   TrackerState state_ = TrackerState::waiting;
   std::optional<Nanos> last_read_;     // the last datagram parsed (flood)
@@ -89,6 +96,11 @@ class HeadTracker {
   bool said_backwards_ = false;
   bool said_flood_ = false;
 };
+
+// The turn that carries `head_right` (a unit vector in the tracked body's
+// frame) onto the world's x: the rest turn of a tracked head whose eyes, at
+// rest, lie along x as an untracked viewer's do.
+[[nodiscard]] glm::dquat turn_onto_x(const glm::dvec3& head_right);
 
 // A replay's samples fed at their times from `start` on the master's clock,
 // looped (one loop: the last sample's time and one mean interval; a single

@@ -47,7 +47,7 @@ void HeadPredictor::add(Nanos time, const HeadPose& pose) {
     s1_ = s2_ = p.position;
     q1_ = q2_ = as_vector(p.orientation);
   } else {
-    assert(time > samples_.back().time);
+    assert(time - samples_.back().time >= kLeastSampleInterval);
     p.orientation = beside(p.orientation, samples_.back().pose.orientation);
     const double interval = static_cast<double>(time - samples_.back().time);
     period_ = period_ == 0.0 ? interval : 0.9 * period_ + 0.1 * interval;
@@ -63,6 +63,24 @@ void HeadPredictor::add(Nanos time, const HeadPose& pose) {
 
 HeadPose HeadPredictor::predict(Nanos time) const {
   assert(!samples_.empty());
+  HeadPose out = extrapolate(time);
+  const HeadPose& last = samples_.back().pose;
+  // Bounded by what a head can do, and finite whatever the samples were.
+  const double ahead = static_cast<double>(std::clamp<Nanos>(time - samples_.back().time, 0, kMostPredictionAhead));
+  const glm::dvec3 moved = out.position - last.position;
+  const double most = kMostHeadSpeed * ahead / 1e9;
+  const double length = glm::length(moved);
+  if (!std::isfinite(length)) return last;
+  if (length > most) out.position = last.position + moved * (most / length);
+  const glm::dquat& q = out.orientation;
+  if (!std::isfinite(q.w) || !std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z)) {
+    out.orientation = last.orientation;
+  }
+  return out;
+}
+
+HeadPose HeadPredictor::extrapolate(Nanos time) const {
+  assert(!samples_.empty());
   const Sample& last = samples_.back();
   const Nanos ahead = std::clamp<Nanos>(time - last.time, 0, kMostPredictionAhead);
   if (method_ == config::HeadPrediction::none || samples_.size() < 2 || ahead == 0) return last.pose;
@@ -72,15 +90,17 @@ HeadPose HeadPredictor::predict(Nanos time) const {
     const double f = static_cast<double>(ahead) / span;
     HeadPose out;
     out.position = last.pose.position + (last.pose.position - first.pose.position) * f;
-    // The turn over the span, carried on for as long again times f.
-    const glm::dquat turn = last.pose.orientation * glm::inverse(first.pose.orientation);
-    const double angle = glm::angle(turn);
-    const glm::dquat more = std::isfinite(angle) && angle > 1e-12 ? glm::angleAxis(angle * f, glm::axis(turn))
-                                                                  : glm::dquat(1.0, 0.0, 0.0, 0.0);
+    // The turn over the span (the short way round), carried on f times over.
+    glm::dquat turn = last.pose.orientation * glm::inverse(first.pose.orientation);
+    if (turn.w < 0.0) turn = -turn;
+    const glm::dvec3 v{turn.x, turn.y, turn.z};
+    const double sine = glm::length(v);
+    const double angle = 2.0 * std::atan2(sine, turn.w);
+    const glm::dquat more = sine > 1e-12 ? glm::angleAxis(angle * f, v / sine) : glm::dquat(1.0, 0.0, 0.0, 0.0);
     out.orientation = glm::normalize(more * last.pose.orientation);
     return out;
   }
-  const double tau = static_cast<double>(ahead) / std::max(period_, 1.0);
+  const double tau = static_cast<double>(ahead) / std::max(period_, static_cast<double>(kLeastSampleInterval));
   const double k = alpha_ * tau / (1.0 - alpha_);
   HeadPose out;
   out.position = (2.0 + k) * s1_ - (1.0 + k) * s2_;

@@ -36,21 +36,29 @@ inline constexpr int kVelocitySpan = 3;  // constant-velocity: samples to take t
 // Predictions are not made further ahead than this past the newest sample: a
 // tracker that stalls without being lost yet does not send the head flying.
 inline constexpr Nanos kMostPredictionAhead = 200'000'000;
+// Samples closer than this are not taken (a tracker sends at most 300 a
+// second): velocities stay those of motion, not of the stamps' noise.
+inline constexpr Nanos kLeastSampleInterval = 1'000'000;
+// No head moves faster than this (m/s): a prediction past it is cut short.
+inline constexpr double kMostHeadSpeed = 10.0;
 
 class HeadPredictor {
  public:
   HeadPredictor(config::HeadPrediction method, double smoothing);
 
-  // A sample of `pose` at `time` (after the previous one's).
+  // A sample of `pose` at `time` (at least kLeastSampleInterval after the
+  // previous one's).
   void add(Nanos time, const HeadPose& pose);
   [[nodiscard]] bool empty() const { return samples_.empty(); }
   [[nodiscard]] Nanos newest_time() const;  // !empty()
   [[nodiscard]] HeadPose newest() const;    // !empty()
-  // The head at `time` (not before the newest sample: then the newest as it is).
+  // The head at `time` (not before the newest sample: then the newest as it
+  // is), at most kMostHeadSpeed away from the newest; always finite.
   [[nodiscard]] HeadPose predict(Nanos time) const;
   void reset();
 
  private:
+  [[nodiscard]] HeadPose extrapolate(Nanos time) const;  // predict() before its bounds
   config::HeadPrediction method_;
   double alpha_;
   struct Sample {

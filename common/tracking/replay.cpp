@@ -72,8 +72,8 @@ Result<std::vector<ReplaySample>> parse_replay(std::string_view text, const std:
     }
     s.orientation = q / norm;
     if (s.time < 0.0) return Error{where + ": time must be 0 or more (got " + std::to_string(s.time) + ")"};
-    if (!samples.empty() && !(s.time > samples.back().time)) {
-      return Error{where + ": times must increase (" + std::to_string(s.time) + " after " +
+    if (!samples.empty() && !(s.time >= samples.back().time + 0.001)) {
+      return Error{where + ": times must increase by 1 ms at least (" + std::to_string(s.time) + " after " +
                    std::to_string(samples.back().time) + ")"};
     }
     if (samples.size() >= kMostReplaySamples) {

@@ -1,6 +1,6 @@
 #pragma once
 // A recorded head path for tracking's `replay` source: a CSV file of time
-// (seconds from the start, increasing), the head's position x, y, z (metres,
+// (seconds, increasing by 1 ms at least; the first is the start), the head's position x, y, z (metres,
 // tracker space) and its orientation qw, qx, qy, qz (a unit quaternion, head →
 // tracker space), one sample a row. A first row that is not numbers is a header;
 // blank lines and lines starting with # are skipped. Looped over its last time.

@@ -4,7 +4,7 @@
 // latency in ts2 and 0.5 mm of jitter, and asked for the head at each 60 Hz frame's display time, one
 // frame after the frame begins (as the master does); the eyes against the walk
 // then. In-process, simulated time: what is measured is the prediction, not
-// the network (the process test tests/process/test_tracked_head does that).
+// the network (the timing test tests/timing/test_tracked_head does that).
 //
 //   optique-bench-tracking --out docs/bench     (a second)
 

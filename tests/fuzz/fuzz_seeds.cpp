@@ -600,6 +600,10 @@ std::vector<Seed> tracker_seeds() {
   seeds.push_back({"lost_and_back", join({datagram(167, frame_text(1, 0.0)), datagram(167, frame_text(2, 5.0)),
                                           datagram(255, "fr 3\n6d 0\n"), datagram(255, "fr 4\n6d 0\n"),
                                           datagram(255, "fr 5\n6d 0\n"), datagram(167, frame_text(6, 9.0))})});
+  seeds.push_back({"stamps_too_close_far_apart",
+                   join({datagram(100, "fr 1\nts2 0 0 0\n6d 1 [0 1][-99000 0 0][1 0 0 0 1 0 0 0 1]"),
+                         datagram(5, "fr 2\nts2 0 0 499\n6d 1 [0 1][99000 0 0][1 0 0 0 1 0 0 0 1]"),
+                         datagram(200, "fr 3\nts2 0 0 0\n6d 1 [0 1][99000 0 0][0 1 0 -1 0 0 0 0 1]")})});
   seeds.push_back({"empty", {}});
   return seeds;
 }

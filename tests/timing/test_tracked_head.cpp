@@ -194,7 +194,8 @@ TEST(Tracking, PredictionPutsTheEyesWhereTheWalkingHeadIsAtDisplayTime) {
     EXPECT_LT(by[predicted].median_mm, by["none"].median_mm / 4.0) << predicted << " against no prediction";
   }
   // The stereo axis turns with the head.
-  EXPECT_LE(by["double-exponential"].right_p99_degrees, 2.0);
+  // Measured 0.003–0.06° (1.6° without prediction).
+  EXPECT_LE(by["double-exponential"].right_p99_degrees, 0.5);
 }
 
 // Bad tracker input is ignored and counted; the frame rate holds (side by side

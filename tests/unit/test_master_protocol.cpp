@@ -260,9 +260,9 @@ TEST_F(MasterTest, EachFrameCarriesTheTrackedHead) {
     inst.viewer.tracking = tracking;
   });
   Actions a = join_all();
-  ASSERT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u);
-  const wire::FrameBegin& first = sent_to(a, 1, wire::Envelope::kFrameBegin).front().frame_begin();
-  EXPECT_FALSE(first.delta().has_viewer()) << "resting where the config's eye is";
+  const auto first = sent_to(a, 1, wire::Envelope::kFrameBegin);
+  ASSERT_EQ(first.size(), 1u);
+  EXPECT_FALSE(first.front().frame_begin().delta().has_viewer()) << "resting where the config's eye is";
   // Turned a quarter about the tracker's z, 0.5 m to the right of the rest.
   EXPECT_TRUE(master_->tracker_datagram("fr 1\n6d 1 [2 1.0][500 1600 2000][0 1 0 -1 0 0 0 0 1]\n", now_).empty());
   const auto garbage = master_->tracker_datagram("not dtrack", now_ + 5 * kMs);

@@ -158,11 +158,11 @@ TEST(HeadTracker, BadInputIsIgnoredAndCounted) {
   const Nanos flood_start = next();
   for (int i = 0; i < 100; ++i) (void)tracker.datagram(datagram(2000 + i, 4, {0, 1000, 0}), flood_start + i * 10'000);
   const TrackingCounts& counts = tracker.counts();
-  EXPECT_EQ(counts.samples, 3u);
+  EXPECT_EQ(counts.samples, 2u);
   EXPECT_EQ(counts.malformed, 2u);
   EXPECT_EQ(counts.without_body, 1u);
   EXPECT_EQ(counts.backwards, 1u);
-  EXPECT_EQ(counts.flood, 98u);
+  EXPECT_EQ(counts.flood, 99u);  // 98 unread, one read but under 1 ms after the last sample
   EXPECT_EQ(counts.datagrams, 105u);
   // A tracker that started again (its counter far back) is followed.
   const auto restarted = tracker.datagram(datagram(3, 4, {0, 1500, 0}), flood_start + 20 * kMs);
@@ -190,6 +190,66 @@ TEST(HeadTracker, ConstantVelocityPredictsConstantMotionExactly) {
   const Nanos display = 9 * 16 * kMs + 50 * kMs;
   const HeadAt head = at(tracker, display, 9 * 16 * kMs + 20 * kMs, {}, said);
   EXPECT_NEAR(head.pose.position.x, 1.5 * static_cast<double>(display) / 1e9, 1e-6);
+}
+
+// Hostile stamps: two samples 0.5 ms apart by arrival but stamped 1 ns apart
+// by their latencies, at the ends of the room; the head stays finite and moves
+// no faster than a head can.
+TEST(HeadTracker, StampsTooCloseAndFarPositionsCannotThrowTheHead) {
+  for (auto prediction : {config::HeadPrediction::constant_velocity, config::HeadPrediction::double_exponential}) {
+    HeadTracker tracker(settings(prediction));
+    EXPECT_FALSE(tracker.datagram("fr 1\nts2 0 0 0\n6d 1 [4 1][-99000 0 0][1 0 0 0 1 0 0 0 1]", 10 * kMs));
+    EXPECT_TRUE(tracker.datagram("fr 2\nts2 0 0 499\n6d 1 [4 1][99000 0 0][1 0 0 0 1 0 0 0 1]", 10 * kMs + 500'000));
+    EXPECT_FALSE(tracker.datagram("fr 3\nts2 0 0 0\n6d 1 [4 1][99000 0 0][1 0 0 0 1 0 0 0 1]", 30 * kMs));
+    std::vector<std::string> said;
+    const HeadAt head = at(tracker, 80 * kMs, 30 * kMs, {}, said);
+    EXPECT_TRUE(std::isfinite(head.pose.position.x));
+    EXPECT_LE(glm::distance(head.pose.position, glm::dvec3(99.0, 0.0, 0.0)), kMostHeadSpeed * 0.05 + 1e-9);
+    EXPECT_EQ(tracker.counts().flood, 1u) << "the second is under 1 ms after the first";
+  }
+  EXPECT_FALSE(parse_dtrack("6d 1 [4 1][1e308 0 0][1 0 0 0 1 0 0 0 1]"));
+  EXPECT_FALSE(parse_dtrack("ts2 0 0 5000000\n"));
+}
+
+// A tracker started again within 1000 frames is followed after half a second.
+TEST(HeadTracker, ATrackerThatStartsAgainIsFollowed) {
+  HeadTracker tracker(settings());
+  EXPECT_FALSE(tracker.datagram(datagram(500, 4, {0, 1000, 0}), 10 * kMs));
+  int followed_at = -1;
+  for (int i = 0; i < 40 && followed_at < 0; ++i) {
+    const auto said = tracker.datagram(datagram(1 + i, 4, {0, 1500, 0}), (30 + 16 * i) * kMs);
+    if (said && said->find("started again") != std::string::npos) followed_at = i;
+  }
+  // The first is said as backwards; the 30th in a row is taken as a restart.
+  EXPECT_EQ(followed_at, 29);
+  std::vector<std::string> said;
+  EXPECT_NEAR(at(tracker, 600 * kMs, 600 * kMs, {}, said).pose.position.y, 1.5, 1e-12);
+}
+
+// Lost, the eyes stay where they were shown as the tracker went quiet (the
+// prediction then), not where the last sample was: no snap back.
+TEST(HeadTracker, ALostHeadIsHeldWhereItWasShown) {
+  config::Tracking t = settings(config::HeadPrediction::constant_velocity);
+  t.lost_after = std::chrono::milliseconds(100);
+  HeadTracker tracker(t);
+  for (int i = 0; i < 4; ++i)
+    EXPECT_FALSE(tracker.datagram(datagram(1 + i, 4, {1000.0 * 0.01 * i, 0, 0}), i * 10 * kMs));
+  std::vector<std::string> said;
+  const double shown = at(tracker, 130 * kMs, 130 * kMs, {}, said).pose.position.x;  // 1 m/s, 100 ms on
+  EXPECT_NEAR(shown, 0.13, 1e-9);
+  const HeadAt held = at(tracker, 140 * kMs, 140 * kMs, {}, said);  // lost at 130
+  EXPECT_EQ(held.state, TrackerState::holding);
+  EXPECT_NEAR(held.pose.position.x, 0.13, 1e-9);
+}
+
+// At rest, the eyes lie along the world's x, whatever axis of the body is its right.
+TEST(HeadTracker, AtRestTheEyesLieAlongTheWorldsX) {
+  for (const glm::dvec3 right :
+       {glm::dvec3(0, 1, 0), glm::dvec3(0, 0, -1), glm::dvec3(-1, 0, 0), glm::dvec3(1, 0, 0)}) {
+    HeadTracker tracker(settings(), turn_onto_x(right));
+    const glm::dvec3 seen = tracker.at(0, {}).pose.orientation * right;
+    EXPECT_LT(glm::distance(seen, glm::dvec3(1.0, 0.0, 0.0)), 1e-12) << right.x << " " << right.y << " " << right.z;
+  }
 }
 
 TEST(HeadPredictor, DoubleExponentialFollowsSteadyMotionWithoutLag) {
