@@ -84,7 +84,11 @@ Result<void> Master::start() {
     if (!csv_) return Error{"cannot write " + csv_path.string()};
   }
   recorder_.emplace(ids, csv_.is_open() ? &csv_ : nullptr);
+  // A replay (up to millions of samples) is moved, not copied, into the protocol.
+  const std::size_t replay_samples = options_.run.replay.size();
+  std::vector<tracking::ReplaySample> replay = std::move(options_.run.replay);
   RunSettings run = options_.run;
+  run.replay = std::move(replay);
   run.send_clock = clock::monotonic_now;
   const std::optional<config::Tracking>& tracking = installation.viewer.tracking;
   if (tracking && !options_.out_dir.empty()) {
@@ -121,7 +125,7 @@ Result<void> Master::start() {
   if (tracking && tracking->source == config::TrackingSource::dtrack) {
     if (auto listening = listen_to_tracker(*tracking); !listening) return listening;
   } else if (tracking) {
-    log_.info("tracking: replaying {} ({} samples), predicted {}", tracking->file, options_.run.replay.size(),
+    log_.info("tracking: replaying {} ({} samples), predicted {}", tracking->file, replay_samples,
               config::to_string(tracking->prediction));
   }
   if (options_.run.secret) {

@@ -30,9 +30,7 @@ Result<ReferenceView> ReferenceView::make(const config::Installation& installati
 
 Result<image::FloatImage> ReferenceView::draw(const scene::SceneState& state, double fraction) const {
   const config::Viewer& viewer = *viewer_;
-  const glm::dvec3 eye =
-      geometry::eye_position(scene::eyes_at(state, fraction), scene::head_at(state, fraction) * viewer.head_right,
-                             viewer.eye_separation, eye_);
+  const glm::dvec3 eye = viewer.eye_in(state, fraction, eye_);
   auto frustum = geometry::off_axis_frustum(screen_->world(), eye, viewer.near, viewer.far);
   if (!frustum) return Error{frustum.error()};
   renderer_->draw(state, fraction, eye, frustum.value());

@@ -62,6 +62,11 @@ glm::dvec3 Viewer::eye_at(double seconds) const {
   return scene::path_value(path, seconds, [](const PathPoint& p) { return p.position; });
 }
 
+glm::dvec3 Viewer::eye_in(const scene::SceneState& state, double fraction, Eye eye) const {
+  return geometry::eye_position(scene::eyes_at(state, fraction), scene::head_at(state, fraction) * head_right,
+                                eye_separation, eye);
+}
+
 glm::dvec2 Gaze::at(double seconds) const {
   assert(!path.empty());
   return scene::path_value(path, seconds, [](const GazePoint& p) { return p.point; });

@@ -23,6 +23,7 @@
 #include "config/up_conversion.h"
 #include "geometry/projection.h"
 #include "geometry/projector_geometry.h"
+#include "scene/state.h"
 
 namespace optique::config {
 
@@ -141,6 +142,9 @@ struct Viewer {
 
   [[nodiscard]] glm::dvec3 eye_at(double seconds) const;
   [[nodiscard]] bool moves() const { return path.size() > 1; }
+  // Where `eye` is `fraction` of a frame after `state`'s frame time: the eyes'
+  // centre then, apart along head_right turned with the head.
+  [[nodiscard]] glm::dvec3 eye_in(const scene::SceneState& state, double fraction, Eye eye) const;
 };
 
 struct MasterSettings {

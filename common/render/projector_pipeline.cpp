@@ -93,8 +93,7 @@ void ProjectorPipeline::set_focus(const protocol::Focus& focus) {
 }
 
 glm::dvec3 ProjectorPipeline::eye(const scene::SceneState& state, double fraction) const {
-  return geometry::eye_position(scene::eyes_at(state, fraction), scene::head_at(state, fraction) * viewer_.head_right,
-                                viewer_.eye_separation, eye_);
+  return viewer_.eye_in(state, fraction, eye_);
 }
 
 Result<FieldPass> ProjectorPipeline::moment(const scene::SceneState& state, double fraction) const {

@@ -11,14 +11,20 @@
 namespace optique::tracking {
 namespace {
 
-constexpr double kNanosPerSecond = 1e9;
 // A frame counter this far back, or a timestamp this many seconds, is a
 // tracker that started again, not an old datagram.
 constexpr std::uint64_t kRestartFrames = 1000;
 constexpr double kRestartSeconds = 10.0;
 constexpr int kRestartAfter = 30;  // frames back in a row: half a second at 60 Hz
 
-Nanos seconds_to_nanos(double seconds) { return static_cast<Nanos>(std::llround(seconds * kNanosPerSecond)); }
+Nanos seconds_to_nanos(double seconds) {
+  return static_cast<Nanos>(std::llround(seconds * static_cast<double>(clock::kNanosPerSecond)));
+}
+
+template <class Duration>
+Nanos nanos(Duration d) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
+}
 
 double smoothstep(double x) {
   x = std::clamp(x, 0.0, 1.0);
@@ -55,7 +61,8 @@ std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos a
   };
   if (last_read_ && arrival - *last_read_ < kFloodInterval) {
     ++counts_.flood;
-    return once(said_flood_, "tracker: datagrams come faster than " + std::to_string(1'000'000'000 / kFloodInterval) +
+    return once(said_flood_, "tracker: datagrams come faster than " +
+                                 std::to_string(clock::kNanosPerSecond / kFloodInterval) +
                                  " a second; the extra ones are dropped unread");
   }
   last_read_ = arrival;
@@ -87,8 +94,7 @@ std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos a
   }
   backwards_in_a_row_ = older ? backwards_in_a_row_ + 1 : 0;
   restarted = restarted || backwards_in_a_row_ >= kRestartAfter;
-  const Nanos shows = arrival - seconds_to_nanos(f.latency.value_or(0.0)) -
-                      std::chrono::duration_cast<std::chrono::nanoseconds>(settings_.latency).count();
+  const Nanos shows = arrival - seconds_to_nanos(f.latency.value_or(0.0)) - nanos(settings_.latency);
   if (!restarted && (older || (!predictor_.empty() && shows <= predictor_.newest_time()))) {
     ++counts_.backwards;
     return once(said_backwards_, "tracker: ignored a frame older than the last one taken");
@@ -129,7 +135,7 @@ void HeadTracker::take(Nanos time, Nanos arrival, const glm::dvec3& position, co
   HeadPose pose;
   pose.position = body + turn * settings_.eye_offset;
   pose.orientation = turn;
-  if (last_arrival_ && arrival - *last_arrival_ > settings_.lost_after.count() * 1'000'000) {
+  if (last_arrival_ && arrival - *last_arrival_ > nanos(settings_.lost_after)) {
     predictor_.reset();  // what it knew is stale
   }
   predictor_.add(time, pose);
@@ -138,7 +144,7 @@ void HeadTracker::take(Nanos time, Nanos arrival, const glm::dvec3& position, co
 }
 
 void HeadTracker::notice(Nanos now, std::vector<std::string>& said) {
-  const Nanos lost_after = settings_.lost_after.count() * 1'000'000;
+  const Nanos lost_after = nanos(settings_.lost_after);
   const std::optional<Nanos> before = last_now_;
   last_now_ = now;
   if (!last_arrival_) return;
@@ -150,7 +156,7 @@ void HeadTracker::notice(Nanos now, std::vector<std::string>& said) {
   if (!lost) {
     if (lost_since_) {
       count_lost();
-      said.push_back("tracker: back after " + std::to_string((now - *lost_since_) / 1'000'000) + " ms");
+      said.push_back("tracker: back after " + std::to_string((now - *lost_since_) / clock::kNanosPerMilli) + " ms");
       lost_since_.reset();
     }
     state_ = TrackerState::tracking;
@@ -169,9 +175,12 @@ void HeadTracker::notice(Nanos now, std::vector<std::string>& said) {
     count_lost();
   }
   const Nanos since = now - *lost_since_;
-  const Nanos hold = settings_.hold.count() * 1'000'000;
-  const Nanos ease = settings_.ease.count() * 1'000'000;
+  const Nanos hold = nanos(settings_.hold);
+  const Nanos ease = nanos(settings_.ease);
   state_ = since < hold ? TrackerState::holding : since < hold + ease ? TrackerState::easing : TrackerState::resting;
+  eased_ = state_ == TrackerState::holding ? 0.0
+           : ease > 0                      ? smoothstep(static_cast<double>(since - hold) / static_cast<double>(ease))
+                                           : 1.0;
 }
 
 HeadAt HeadTracker::at(Nanos time, const glm::dvec3& rest) const {
@@ -187,13 +196,9 @@ HeadAt HeadTracker::at(Nanos time, const glm::dvec3& rest) const {
     case TrackerState::resting:
       break;
   }
-  const Nanos hold = settings_.hold.count() * 1'000'000;
-  const Nanos ease = settings_.ease.count() * 1'000'000;
-  const Nanos since = *last_now_ - *lost_since_;
-  const double f = ease > 0 ? smoothstep(static_cast<double>(since - hold) / static_cast<double>(ease)) : 1.0;
   HeadPose out;
-  out.position = glm::mix(held_.position, rest, f);
-  out.orientation = glm::normalize(glm::slerp(held_.orientation, resting.orientation, f));
+  out.position = glm::mix(held_.position, rest, eased_);
+  out.orientation = glm::normalize(glm::slerp(held_.orientation, resting.orientation, eased_));
   return {out, state_};
 }
 

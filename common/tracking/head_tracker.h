@@ -81,7 +81,8 @@ class HeadTracker {
   config::Tracking settings_;
   glm::dquat rest_turn_;
   HeadPredictor predictor_;
-  HeadPose held_;  // where the eyes were shown as the tracker went quiet
+  HeadPose held_;       // where the eyes were shown as the tracker went quiet
+  double eased_ = 0.0;  // how far from held_ to the rest, as of the last notice (smoothstep)
   int backwards_in_a_row_ = 0;
   TrackingCounts counts_;
   TrackerState state_ = TrackerState::waiting;

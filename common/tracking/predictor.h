@@ -19,11 +19,12 @@
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
 
+#include "clock/clock.h"
 #include "config/tracking.h"
 
 namespace optique::tracking {
 
-using Nanos = std::int64_t;
+using clock::Nanos;
 
 struct HeadPose {
   glm::dvec3 position{0.0};                    // the eyes' centre, metres
