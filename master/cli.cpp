@@ -48,6 +48,8 @@ int run_cli(int argc, char** argv) {
   std::string listen;
   int port = -1;
   bool no_status = false;
+  int status_port = -1;
+  bool print_status_token = false;
   app.add_option("-c,--config", config_path, "installation file (configs/*.json)");
   app.add_flag("--local", options.local, "start one optique-node per projector on this machine (127.0.0.1)");
   app.add_option("-n,--frames", options.run.frames, "run this many frames, then shut down (default: until Ctrl-C)");
@@ -64,6 +66,14 @@ int run_cli(int argc, char** argv) {
   app.add_option("--node-log-level", options.node_log_level, "log level for local nodes")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   app.add_flag("--no-status", no_status, "no live status line, even on a terminal");
+  app.add_option("--status-port", status_port,
+                 "serve the operator page, status and metrics on this port (0: ephemeral); overrides "
+                 "master.status.port, and turns it on (on 127.0.0.1) if the config does not")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--status-port-file", options.status_port_file,
+                 "write the status server's port once listening (for scripts)");
+  app.add_flag("--print-status-token", print_status_token,
+               "print the status server's bearer token (derived from master.secret_file) and exit");
   app.add_option("--capture-every", options.run.capture_every,
                  "nodes write every K-th frame (frame 0, K, 2K, ...); with --local into OUT/nodes/<projector-id>/");
 
@@ -112,7 +122,20 @@ int run_cli(int argc, char** argv) {
   }
   options.run.secret = std::move(secret).value();
   options.secret_path = secret_path(options.config);
+  if (print_status_token) {
+    if (!options.run.secret) {
+      std::cerr << "optique-master: " << config_path
+                << " names no master.secret_file: the status server has no token without one\n";
+      return kExitUsage;
+    }
+    std::cout << net::status_token(*options.run.secret) << "\n";
+    return kExitOk;
+  }
   config::MasterSettings& settings = options.config.installation.master;
+  if (status_port >= 0) {
+    if (!settings.status) settings.status.emplace();
+    settings.status->port = static_cast<std::uint16_t>(status_port);
+  }
   if (options.local) {
     settings.listen = "127.0.0.1";
     settings.port = 0;
@@ -142,6 +165,10 @@ int run_cli(int argc, char** argv) {
   auto logger = log::make_logger("master", log_level, log_file);
   // On a terminal, each log line first clears the status line (stderr only, not the log file).
   if (options.status_line) logger->sinks().front()->set_pattern("\r\033[K%H:%M:%S.%e %^%-5l%$ [%n] %v");
+  if (settings.status) {
+    options.warnings = make_warning_sink();
+    logger->sinks().push_back(options.warnings);
+  }
 
   boost::asio::io_context io;
   Master master(io, std::move(options), *logger);

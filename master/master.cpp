@@ -1,10 +1,13 @@
 #include "master/master.h"
 
+#include <boost/asio/post.hpp>
+
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
+#include "config/address.h"
 #include "master/report_json.h"
 #include "tracking/dtrack.h"
 #include "util/overloaded.h"
@@ -71,6 +74,7 @@ void Master::receive_tracker() {
 }
 
 Result<void> Master::start() {
+  started_ = clock::monotonic_now();
   const config::Installation& installation = options_.config.installation;
   const config::MasterSettings& settings = installation.master;
   std::vector<std::string> ids;
@@ -128,6 +132,9 @@ Result<void> Master::start() {
     log_.info("tracking: replaying {} ({} samples), predicted {}", tracking->file, replay_samples,
               config::to_string(tracking->prediction));
   }
+  if (settings.status) {
+    if (auto serving = start_status_service(*settings.status); !serving) return serving;
+  }
   if (options_.run.secret) {
     log_.info("nodes must prove they hold the shared secret in {}", options_.secret_path);
   } else {
@@ -163,6 +170,49 @@ Result<void> Master::start() {
   carry_out(protocol_->start(now));
   housekeeping();
   return {};
+}
+
+Result<void> Master::start_status_service(const config::StatusServer& settings) {
+  OperatorAccess access;
+  access.reads_need_token = !config::is_loopback_address(settings.listen);
+  if (options_.run.secret) access.token = net::status_token(*options_.run.secret);
+  // Asked on the server's thread, carried out on this one.
+  auto on_command = [this](OperatorCommand command, const std::string& from) {
+    asio::post(io_, [this, command, from] {
+      if (!finished_) carry_out(protocol_->operator_command(command, from, clock::monotonic_now()));
+    });
+  };
+  status_service_ = std::make_unique<StatusService>(settings, std::move(access), std::move(on_command), log_);
+  auto port = status_service_->start();
+  if (!port) return Error{port.error()};
+  std::string host = settings.listen.find(':') != std::string::npos ? "[" + settings.listen + "]" : settings.listen;
+  log_.info("operator page on http://{}:{}/ (status.json, metrics); reads {}; controls {}", host, port.value(),
+            config::is_loopback_address(settings.listen) ? "open on loopback" : "need the token",
+            options_.run.secret ? "need the token (optique-master --print-status-token)"
+                                : "off (no master.secret_file, so no token)");
+  if (!options_.status_port_file.empty()) {
+    const std::string temp = options_.status_port_file + ".tmp";
+    std::ofstream(temp) << port.value() << "\n";
+    std::error_code renamed;
+    std::filesystem::rename(temp, options_.status_port_file, renamed);
+    if (renamed) {
+      return Error{"cannot write the status port file '" + options_.status_port_file + "': " + renamed.message()};
+    }
+  }
+  publish_status();
+  return {};
+}
+
+void Master::publish_status() {
+  if (!status_service_) return;
+  const clock::Nanos now = clock::monotonic_now();
+  last_published_ = now;
+  LiveStatus status = protocol_->live(now);
+  status.config_file = options_.config.path;
+  status.uptime_s = static_cast<double>(now - started_) / 1e9;
+  if (options_.warnings) status.warnings = last_warnings(*options_.warnings);
+  status.clients = status_service_->clients();
+  status_service_->publish(status);
 }
 
 // ---------------------------------------------------------------- connections
@@ -288,6 +338,7 @@ void Master::housekeeping() {
   }
   if (finished_) return;
   update_status();
+  if (clock::monotonic_now() - last_published_ >= 200 * clock::kNanosPerMilli) publish_status();
   housekeeping_timer_.expires_after(milliseconds(100));
   housekeeping_timer_.async_wait([this](const boost::system::error_code& error) {
     if (!error) housekeeping();
@@ -342,6 +393,7 @@ void Master::finish(int exit_code) {
     }
   }
   write_outputs();
+  publish_status();  // the last word: done
   io_.stop();
 }
 

@@ -26,6 +26,7 @@
 #include "master/protocol.h"
 #include "master/run_recorder.h"
 #include "master/status_line.h"
+#include "master/status_service.h"
 #include "net/auth.h"
 #include "net/connection.h"
 #include "scene/load_scene.h"
@@ -47,6 +48,10 @@ struct MasterOptions {
   std::string node_log_level = "info";
   bool status_line = false;
   std::string secret_path;  // handed to local nodes
+  // The log's last warnings, for the status page (make_warning_sink(), added to
+  // the logger by whoever made it); none: the page lists none.
+  std::shared_ptr<WarningSink> warnings;
+  std::string status_port_file;  // write the status server's port once listening
 };
 
 class Master {
@@ -72,6 +77,8 @@ class Master {
   void housekeeping();
   void on_signal(int signal);
   void update_status();
+  [[nodiscard]] Result<void> start_status_service(const config::StatusServer& settings);
+  void publish_status();
   void finish(int exit_code);
   void write_outputs();
   // Where a local node's output goes (empty without --out).
@@ -100,6 +107,9 @@ class Master {
   PeerId next_peer_ = 1;
 
   std::optional<LocalLauncher> launcher_;
+  std::unique_ptr<StatusService> status_service_;  // master.status
+  clock::Nanos started_ = 0;
+  clock::Nanos last_published_ = 0;
   StatusLine status_;
   clock::Nanos last_status_ = 0;
   std::uint64_t status_frame_ = 0;

@@ -85,6 +85,10 @@ MasterProtocol::Session* MasterProtocol::session_of(std::size_t slot) {
   return slots_[slot].peer ? &sessions_.at(*slots_[slot].peer) : nullptr;
 }
 
+const MasterProtocol::Session* MasterProtocol::session_of(std::size_t slot) const {
+  return slots_[slot].peer ? &sessions_.at(*slots_[slot].peer) : nullptr;
+}
+
 Actions MasterProtocol::start(clock::Nanos now) {
   Actions out;
   if (head_tracker_ && !settings_.replay.empty()) replay_.emplace(std::move(settings_.replay), now);
@@ -181,7 +185,7 @@ Actions MasterProtocol::message(PeerId peer, const wire::Envelope& message, cloc
       on_ready(session, message.frame_ready(), now, now, out);
       break;
     case wire::Envelope::kPresented:
-      on_presented(session, message.presented());
+      on_presented(session, message.presented(), now, out);
       break;
     case wire::Envelope::kGoodbye:
       out.push_back(Close{peer, "node said goodbye (" + message.goodbye().reason() + ")"});
@@ -329,6 +333,7 @@ Actions MasterProtocol::closed(PeerId peer, const std::string& reason, clock::Na
       }
     }
     std::erase(ready_for_swap_, slot);  // a node that is gone is not told to swap
+    present_owed(slot, now, out);       // nor waited for to show the last one
     if (state_ != RunState::closing && state_ != RunState::done) rebalance_lights(true);
     if (barrier_.active()) {
       barrier_.leave(slot);
@@ -376,6 +381,13 @@ Actions MasterProtocol::timer(Timer timer, clock::Nanos now) {
       start_frames(now, out);
       break;
     case Timer::next_frame:
+      if (!presents_owed_.empty() && now < presents_grace_end_) {
+        // Its time has come, but a node is still to show the last frame: the
+        // next one begins when it has (or when it no longer would).
+        begin_when_presented_ = true;
+        out.push_back(Arm{Timer::next_frame, presents_grace_end_});
+        break;
+      }
       begin_frame(now, out);
       break;
     case Timer::barrier:
@@ -431,6 +443,12 @@ void MasterProtocol::start_frames(clock::Nanos now, Actions& out) {
 
 void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   if (state_ != RunState::running) return;
+  if (paused_) {
+    begin_on_resume_ = true;
+    return;
+  }
+  begin_when_presented_ = false;
+  presents_owed_.clear();
   const std::uint64_t frame = next_frame_;
   if (settings_.frames != 0 && frame >= settings_.frames) {
     drain("ran " + std::to_string(settings_.frames) + " frames", now, out);
@@ -579,9 +597,15 @@ void MasterProtocol::swap(clock::Nanos now, Actions& out) {
   swap.set_frame_id(frame);
   const clock::Nanos sent = settings_.send_clock ? settings_.send_clock() : now;
   swap.set_present_deadline_ns(sent + nanos(config_.present_lead));
+  presents_owed_.clear();
   for (std::size_t slot : ready_for_swap_) {
-    if (slots_[slot].peer) out.push_back(Send{*slots_[slot].peer, envelope});
+    if (!slots_[slot].peer) continue;
+    out.push_back(Send{*slots_[slot].peer, envelope});
+    presents_owed_.push_back(slot);
   }
+  presents_owed_frame_ = frame;
+  // A node shows a frame no later than a period after its deadline (then it is stale).
+  presents_grace_end_ = swap.present_deadline_ns() + frame_period_;
   recorder_.swapped(frame, sent, ready_for_swap_);
   ready_for_swap_.clear();
   if (state_ == RunState::draining) {
@@ -598,7 +622,8 @@ void MasterProtocol::swap(clock::Nanos now, Actions& out) {
   out.push_back(Arm{Timer::next_frame, due});
 }
 
-void MasterProtocol::on_presented(Session& session, const wire::Presented& presented) {
+void MasterProtocol::on_presented(Session& session, const wire::Presented& presented, clock::Nanos now, Actions& out) {
+  if (presented.frame_id() == presents_owed_frame_) present_owed(*session.slot, now, out);
   recorder_.presented(presented.frame_id(), *session.slot, presented.presented_ns(), presented.content_frame_id());
   report::ClockReport clock;
   clock.set_offset_ns(presented.clock_offset_ns());
@@ -608,6 +633,12 @@ void MasterProtocol::on_presented(Session& session, const wire::Presented& prese
   recorder_.clock_estimated(
       presented.frame_id(), *session.slot, clock,
       presented.clock_truth_known() ? std::optional(presented.clock_true_error_ns()) : std::nullopt);
+}
+
+void MasterProtocol::present_owed(std::size_t slot, clock::Nanos now, Actions& out) {
+  if (std::erase(presents_owed_, slot) == 0 || !presents_owed_.empty() || !begin_when_presented_) return;
+  out.push_back(Disarm{Timer::next_frame});
+  begin_frame(now, out);
 }
 
 // ---------------------------------------------------------------- stopping
@@ -679,23 +710,131 @@ report::RunReport MasterProtocol::report() const {
   report.set_frame_rate(config_.frame_rate);
   report.set_stopped_because(stopped_because_);
   report.set_connections_refused(refused_connections_);
-  if (head_tracker_) {
-    const config::Tracking& settings = *installation_.viewer.tracking;
-    const tracking::TrackingCounts& counts = head_tracker_->counts();
-    report::TrackingReport& t = *report.mutable_tracking();
-    t.set_source(std::string(config::to_string(settings.source)));
-    t.set_prediction(std::string(config::to_string(settings.prediction)));
-    t.set_datagrams(counts.datagrams);
-    t.set_samples(counts.samples);
-    t.set_malformed(counts.malformed);
-    t.set_without_body(counts.without_body);
-    t.set_backwards(counts.backwards);
-    t.set_flood(counts.flood);
-    t.set_losses(counts.losses);
-    t.set_lost_seconds(static_cast<double>(counts.lost_ns) / 1e9);
-    t.set_state(std::string(tracking::to_string(head_tracker_->state())));
-  }
+  if (auto tracking = tracking_report()) *report.mutable_tracking() = std::move(*tracking);
   return report;
+}
+
+std::optional<report::TrackingReport> MasterProtocol::tracking_report() const {
+  if (!head_tracker_) return std::nullopt;
+  const config::Tracking& settings = *installation_.viewer.tracking;
+  const tracking::TrackingCounts& counts = head_tracker_->counts();
+  report::TrackingReport t;
+  t.set_source(std::string(config::to_string(settings.source)));
+  t.set_prediction(std::string(config::to_string(settings.prediction)));
+  t.set_datagrams(counts.datagrams);
+  t.set_samples(counts.samples);
+  t.set_malformed(counts.malformed);
+  t.set_without_body(counts.without_body);
+  t.set_backwards(counts.backwards);
+  t.set_flood(counts.flood);
+  t.set_losses(counts.losses);
+  t.set_lost_seconds(static_cast<double>(counts.lost_ns) / 1e9);
+  t.set_state(std::string(tracking::to_string(head_tracker_->state())));
+  return t;
+}
+
+LiveStatus MasterProtocol::live(clock::Nanos now) const {
+  LiveStatus status;
+  switch (state_) {
+    case RunState::starting:
+      status.state = "starting";
+      break;
+    case RunState::running:
+      status.state = paused_ ? "paused" : "running";
+      break;
+    case RunState::draining:
+    case RunState::closing:
+      status.state = "stopping";
+      break;
+    case RunState::done:
+      status.state = "done";
+      break;
+  }
+  status.next_frame = next_frame_;
+  status.frames_target = settings_.frames;
+  status.target_rate_hz = config_.frame_rate;
+  status.frames_finalized = recorder_.frames_finalized();
+  status.frames_with_missing_node = recorder_.frames_with_missing_node();
+  status.frames_incoherent = recorder_.frames_incoherent();
+  status.frames_dropped = recorder_.frames_dropped();
+  status.skew_us_sum = recorder_.present_skew_us_sum();
+  status.skew_count = recorder_.present_skew_count();
+  status.nodes_up = nodes_up();
+  for (std::size_t i = 0; i < slots_.size(); ++i) {
+    LiveNode node;
+    node.id = slot_id(i);
+    node.counts = recorder_.node_counts(i);
+    if (const Session* session = session_of(i)) {
+      node.peer = session->peer_text;
+      switch (session->phase) {
+        case Phase::handshake:
+          node.link = NodeLink::connecting;
+          break;
+        case Phase::configuring:
+          node.link = NodeLink::configuring;
+          break;
+        case Phase::joined:
+        case Phase::in_barrier:
+          node.link = NodeLink::up;
+          break;
+        case Phase::out_of_barrier:
+          node.link = NodeLink::behind;
+          break;
+      }
+    } else {
+      node.link = node.counts.joins > 0 ? NodeLink::gone : NodeLink::absent;
+    }
+    status.nodes.push_back(std::move(node));
+  }
+  status.tracking = tracking_report();
+  summarize_recent(recorder_.recent(), now, status);
+  return status;
+}
+
+Actions MasterProtocol::operator_command(OperatorCommand command, const std::string& from, clock::Nanos now) {
+  Actions out;
+  const std::string who = "the operator (" + from + ")";
+  const auto say = [&](spdlog::level::level_enum level, const std::string& text) { out.push_back(Log{level, text}); };
+  switch (command) {
+    case OperatorCommand::pause:
+      if (state_ != RunState::running) {
+        say(spdlog::level::info, who + " asked to pause, but frames are not running");
+      } else if (paused_) {
+        say(spdlog::level::info, who + " asked to pause: paused already");
+      } else {
+        paused_ = true;
+        say(spdlog::level::warn, fmt::format("paused by {}: no frame after frame {}; every projector keeps showing "
+                                             "its last",
+                                             who, next_frame_ == 0 ? 0 : next_frame_ - 1));
+      }
+      break;
+    case OperatorCommand::resume:
+      if (!paused_) {
+        say(spdlog::level::info, who + " asked to resume, but nothing is paused");
+        break;
+      }
+      paused_ = false;
+      say(spdlog::level::warn, fmt::format("resumed by {} at frame {}", who, next_frame_));
+      if (begin_on_resume_) {
+        // The schedule starts again from now: no rush of frames to catch up.
+        begin_on_resume_ = false;
+        schedule_origin_ = now;
+        schedule_origin_frame_ = next_frame_;
+        begin_frame(now, out);
+      }
+      break;
+    case OperatorCommand::stop:
+      if (state_ != RunState::starting && state_ != RunState::running) {
+        say(spdlog::level::info, who + " asked to stop: stopping already");
+        break;
+      }
+      say(spdlog::level::warn, "stop asked by " + who + ": finishing the current frame and shutting down");
+      paused_ = false;
+      begin_on_resume_ = false;
+      drain("stopped by " + who, now, out);
+      break;
+  }
+  return out;
 }
 
 // ---------------------------------------------------------------- the head

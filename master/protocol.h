@@ -25,6 +25,8 @@
 #include "master/barrier.h"
 #include "master/exit_codes.h"
 #include "master/focus_schedule.h"
+#include "master/live_status.h"
+#include "master/operator_api.h"
 #include "master/run_recorder.h"
 #include "master/scene_authority.h"
 #include "master/stacked_groups.h"
@@ -142,6 +144,11 @@ class MasterProtocol {
   [[nodiscard]] Actions interrupted(const std::string& signal_name, clock::Nanos now);
   // A UDP datagram from the head tracker (viewer.tracking with source dtrack).
   [[nodiscard]] Actions tracker_datagram(std::string_view bytes, clock::Nanos now);
+  // The operator's page asked (`from`: who, for the log). Pause: no frame
+  // begins after the one under way, whose picture stays on every projector;
+  // the scene waits too. Resume: frames go on from where they stopped. Stop:
+  // as a first interrupt, the run finishes in order.
+  [[nodiscard]] Actions operator_command(OperatorCommand command, const std::string& from, clock::Nanos now);
 
   // For the status line and the outputs.
   [[nodiscard]] std::uint64_t next_frame() const { return next_frame_; }
@@ -151,6 +158,8 @@ class MasterProtocol {
   [[nodiscard]] bool running() const { return state_ == RunState::running; }
   // The run's summary (after Finish: every frame finalized).
   [[nodiscard]] report::RunReport report() const;
+  // What the operator sees now; the shell adds uptime, warnings and clients.
+  [[nodiscard]] LiveStatus live(clock::Nanos now) const;
 
  private:
   enum class Phase { handshake, configuring, joined, in_barrier, out_of_barrier };
@@ -171,7 +180,10 @@ class MasterProtocol {
   void on_hello(PeerId peer, Session& session, const wire::Envelope& message, clock::Nanos now, Actions& out);
   void on_configured(PeerId peer, Session& session, const wire::Configured& configured, clock::Nanos now, Actions& out);
   void on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now, Actions& out);
-  void on_presented(Session& session, const wire::Presented& presented);
+  void on_presented(Session& session, const wire::Presented& presented, clock::Nanos now, Actions& out);
+  // `slot` showed the last swapped frame, or is gone: the next frame may begin
+  // once no node is still to show it.
+  void present_owed(std::size_t slot, clock::Nanos now, Actions& out);
   void refuse(PeerId peer, Session& session, const std::string& node_id, const std::string& reason, bool retriable,
               Actions& out);
   void send_resync(PeerId peer, Actions& out) const;
@@ -196,6 +208,8 @@ class MasterProtocol {
   [[nodiscard]] std::vector<std::size_t> slots_configuring() const;
   [[nodiscard]] std::string slot_id(std::size_t slot) const;
   [[nodiscard]] Session* session_of(std::size_t slot);
+  [[nodiscard]] const Session* session_of(std::size_t slot) const;
+  [[nodiscard]] std::optional<report::TrackingReport> tracking_report() const;
 
   const config::Installation& installation_;
   const config::MasterSettings& config_;
@@ -219,6 +233,13 @@ class MasterProtocol {
   std::uint64_t current_hash_ = 0;
   Barrier barrier_;
   std::vector<std::size_t> ready_for_swap_;
+  // The nodes told to show the last swapped frame that have not said they did.
+  // A frame never begins while one of them still waits for its deadline: its
+  // drawing on a shared machine (local nodes, llvmpipe) would delay that present.
+  std::vector<std::size_t> presents_owed_;
+  std::uint64_t presents_owed_frame_ = 0;
+  clock::Nanos presents_grace_end_ = 0;
+  bool begin_when_presented_ = false;  // the next frame's time came while presents were owed
 
   std::uint64_t next_frame_ = 0;
   clock::Nanos frame_period_ = 0;
@@ -229,7 +250,9 @@ class MasterProtocol {
   // The startup timeout passed while nodes were still configuring: the frames
   // start once each of those is up or gone.
   bool startup_passed_ = false;
-  bool terminating_ = false;  // goodbye's grace is over: SIGTERM sent, SIGKILL next
+  bool terminating_ = false;      // goodbye's grace is over: SIGTERM sent, SIGKILL next
+  bool paused_ = false;           // by the operator
+  bool begin_on_resume_ = false;  // a frame's time came while paused
   std::string stopped_because_;
   std::uint64_t refused_connections_ = 0;
   std::size_t local_running_ = 0;

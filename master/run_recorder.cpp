@@ -36,9 +36,11 @@ void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos rece
   if (record == nullptr || record->nodes[node].ready != 0) return;
   record->nodes[node].ready = received;
   NodeTotals& t = totals_[node];
-  t.rendered += 1;
+  t.counts.rendered += 1;
   const double us = static_cast<double>(render_time) / 1e3;
   t.render_us.add(us);
+  t.counts.render_us_sum += us;
+  record->nodes[node].render_us = static_cast<float>(us);
   // A value this master does not know (a newer node) counts as a full frame.
   if (drawn_as == wire::DRAWN_FULL || !wire::DrawnAs_IsValid(drawn_as)) return;
   t.render_us_drawn_as[drawn_as].add(us);
@@ -63,7 +65,7 @@ void RunRecorder::presented(std::uint64_t frame, std::size_t node, clock::Nanos 
   if (record == nullptr || !record->nodes[node].swapped || record->nodes[node].presented != 0) return;
   record->nodes[node].presented = at;
   record->nodes[node].content_frame = content_frame;
-  totals_[node].presented += 1;
+  totals_[node].counts.presented += 1;
 }
 
 void RunRecorder::clock_estimated(std::uint64_t frame, std::size_t node, const report::ClockReport& latest,
@@ -71,7 +73,7 @@ void RunRecorder::clock_estimated(std::uint64_t frame, std::size_t node, const r
   // The first two seconds are the estimator's to settle in (the bar is set after them).
   constexpr clock::Nanos kSettling = 2 * clock::kNanosPerSecond;
   NodeTotals& t = totals_[node];
-  t.clock = latest;
+  t.counts.clock = latest;
   const FrameRecord* record = find(frame);
   if (true_error && record != nullptr && record->begin_sent - first_begin_ >= kSettling) {
     t.clock_true_error_us.add(std::abs(static_cast<double>(*true_error)) / 1e3);
@@ -80,17 +82,22 @@ void RunRecorder::clock_estimated(std::uint64_t frame, std::size_t node, const r
 
 void RunRecorder::frame_dropped(std::uint64_t) { ++frames_dropped_; }
 
-void RunRecorder::node_joined(std::size_t node) { totals_[node].joins += 1; }
-void RunRecorder::node_missed_barrier(std::size_t node) { totals_[node].misses += 1; }
-void RunRecorder::hash_mismatch(std::size_t node) { totals_[node].mismatches += 1; }
+void RunRecorder::node_joined(std::size_t node) { totals_[node].counts.joins += 1; }
+void RunRecorder::node_missed_barrier(std::size_t node) { totals_[node].counts.barrier_misses += 1; }
+void RunRecorder::hash_mismatch(std::size_t node) { totals_[node].counts.hash_mismatches += 1; }
 
 void RunRecorder::finalize(const FrameRecord& record) {
   clock::Nanos earliest = 0;
   clock::Nanos latest = 0;
   std::size_t presented = 0;
   bool incoherent = false;
+  RecentFrame recent;
+  recent.id = record.id;
+  recent.begin_sent = record.begin_sent;
+  recent.render_us.reserve(record.nodes.size());
   for (std::size_t n = 0; n < record.nodes.size(); ++n) {
     const NodeFrame& f = record.nodes[n];
+    recent.render_us.push_back(f.render_us);
     if (f.presented != 0) {
       earliest = presented == 0 ? f.presented : std::min(earliest, f.presented);
       latest = presented == 0 ? f.presented : std::max(latest, f.presented);
@@ -113,7 +120,11 @@ void RunRecorder::finalize(const FrameRecord& record) {
     // In double: present times come from the network and may be anything.
     last_skew_us_ = (static_cast<double>(latest) - static_cast<double>(earliest)) / 1e3;
     present_skew_us_.add(last_skew_us_);
+    skew_us_sum_ += last_skew_us_;
+    recent.skew_us = last_skew_us_;
   }
+  recent_.push_back(std::move(recent));
+  if (recent_.size() > kRecentFrames) recent_.pop_front();
   if (presented < record.nodes.size()) ++frames_missing_;
   if (incoherent) ++frames_incoherent_;
   ++frames_finalized_;
@@ -142,8 +153,8 @@ report::RunReport RunRecorder::report() const {
     const NodeTotals& t = totals_[n];
     auto& node = *r.add_nodes();
     node.set_id(ids_[n]);
-    node.set_frames_rendered(t.rendered);
-    node.set_frames_presented(t.presented);
+    node.set_frames_rendered(t.counts.rendered);
+    node.set_frames_presented(t.counts.presented);
     *node.mutable_render_us() = t.render_us.summary();
     if (!t.render_us_drawn_as.empty()) {
       report::UpConversionReport& up = *node.mutable_up_conversion();
@@ -159,10 +170,10 @@ report::RunReport RunRecorder::report() const {
       summary(wire::DRAWN_BETWEEN_AND_KEY_AHEAD, up.mutable_between_and_ahead_render_us());
       summary(wire::DRAWN_KEY_SHOWN, up.mutable_shown_render_us());
     }
-    node.set_barrier_misses(t.misses);
-    node.set_hash_mismatches(t.mismatches);
-    node.set_joins(t.joins);
-    *node.mutable_clock() = t.clock;
+    node.set_barrier_misses(t.counts.barrier_misses);
+    node.set_hash_mismatches(t.counts.hash_mismatches);
+    node.set_joins(t.counts.joins);
+    *node.mutable_clock() = t.counts.clock;
     if (t.clock_true_error_us.count() > 0)
       *node.mutable_clock()->mutable_true_error_us() = t.clock_true_error_us.summary();
   }

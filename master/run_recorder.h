@@ -22,6 +22,27 @@ namespace optique::master {
 // at 60 Hz and 4:1 would be 1.3 million); all are counted.
 inline constexpr std::size_t kMostKeyFramesListed = 100000;
 
+// The last frames finalized, for the live status: ten seconds at 60 Hz.
+inline constexpr std::size_t kRecentFrames = 600;
+
+struct RecentFrame {
+  std::uint64_t id = 0;
+  clock::Nanos begin_sent = 0;
+  std::optional<double> skew_us;  // when two or more nodes presented it
+  std::vector<float> render_us;   // per node; negative: not rendered
+};
+
+// A node's running totals, cheap to read at any time (no percentiles).
+struct NodeCounts {
+  std::uint64_t rendered = 0;
+  std::uint64_t presented = 0;
+  std::uint64_t barrier_misses = 0;
+  std::uint64_t hash_mismatches = 0;
+  std::uint64_t joins = 0;
+  double render_us_sum = 0.0;
+  report::ClockReport clock;  // the latest estimate
+};
+
 class RunRecorder {
  public:
   // `csv` may be null (no --out); otherwise it receives the header now and a row
@@ -60,6 +81,13 @@ class RunRecorder {
   // presented, for the status line.
   [[nodiscard]] double last_present_skew_us() const { return last_skew_us_; }
   [[nodiscard]] std::uint64_t frames_with_missing_node() const { return frames_missing_; }
+  [[nodiscard]] std::uint64_t frames_incoherent() const { return frames_incoherent_; }
+  [[nodiscard]] std::uint64_t frames_dropped() const { return frames_dropped_; }
+  [[nodiscard]] const std::deque<RecentFrame>& recent() const { return recent_; }
+  [[nodiscard]] const NodeCounts& node_counts(std::size_t node) const { return totals_.at(node).counts; }
+  // Over every finalized frame that two or more nodes presented.
+  [[nodiscard]] double present_skew_us_sum() const { return skew_us_sum_; }
+  [[nodiscard]] std::uint64_t present_skew_count() const { return present_skew_us_.count(); }
 
  private:
   struct NodeFrame {
@@ -68,6 +96,7 @@ class RunRecorder {
     clock::Nanos ready = 0;
     clock::Nanos presented = 0;
     std::uint64_t content_frame = 0;
+    float render_us = -1.0F;
   };
   struct FrameRecord {
     std::uint64_t id = 0;
@@ -76,11 +105,7 @@ class RunRecorder {
     std::vector<NodeFrame> nodes;
   };
   struct NodeTotals {
-    std::uint64_t rendered = 0;
-    std::uint64_t presented = 0;
-    std::uint64_t misses = 0;
-    std::uint64_t mismatches = 0;
-    std::uint64_t joins = 0;
+    NodeCounts counts;
     metrics::Reservoir render_us;
     // Up-conversion: frames that showed a key frame, frames between, and the
     // render time of each way of drawing a frame (by wire::DrawnAs).
@@ -88,7 +113,6 @@ class RunRecorder {
     std::uint64_t key_frames_total = 0;
     std::uint64_t between = 0;
     std::map<int, metrics::Reservoir> render_us_drawn_as;
-    report::ClockReport clock;
     metrics::Reservoir clock_true_error_us;
   };
 
@@ -108,6 +132,8 @@ class RunRecorder {
   clock::Nanos first_begin_ = 0;
   clock::Nanos last_begin_ = 0;
   double last_skew_us_ = 0.0;
+  double skew_us_sum_ = 0.0;
+  std::deque<RecentFrame> recent_;
 };
 
 }  // namespace optique::master

@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "config/address.h"
 #include "config/load.h"
 
 namespace optique::tools {
@@ -130,6 +131,11 @@ std::string summarize(const config::LoadedConfig& config) {
       << " Hz, frame timeout " << m.frame_timeout.count() << " ms (then "
       << (m.straggler_policy == config::StragglerPolicy::drop ? "drop the frame" : "present without the late node")
       << "), present lead " << m.present_lead.count() << " µs\n";
+  if (m.status) {
+    out << "  status: http://" << m.status->listen << ":" << m.status->port << "/ (page, /status.json, /metrics); "
+        << (config::is_loopback_address(m.status->listen) ? "reads open on loopback" : "reads need the token")
+        << ", controls need the token; at most " << m.status->max_connections << " connections\n";
+  }
   out << "  scene: " << (inst.scene.builtin.empty() ? "glTF " + inst.scene.gltf : "builtin " + inst.scene.builtin);
   if (!inst.scene.light_switches.empty()) {
     out << ", " << inst.scene.light_switches.size() << " light switch(es) from "

@@ -147,6 +147,13 @@ struct Viewer {
   [[nodiscard]] glm::dvec3 eye_in(const scene::SceneState& state, double fraction, Eye eye) const;
 };
 
+// master.status: the operator's page, status and metrics over HTTP.
+struct StatusServer {
+  std::string listen = "127.0.0.1";
+  std::uint16_t port = defaults::kStatusPort;  // 0: ephemeral
+  std::uint32_t max_connections = defaults::kStatusMaxConnections;
+};
+
 struct MasterSettings {
   std::string listen = "0.0.0.0";
   std::uint16_t port = 0;  // 0: ephemeral
@@ -161,6 +168,7 @@ struct MasterSettings {
   std::string secret_file;  // as written, relative to the config file; empty: none
   std::uint32_t max_pending_connections = defaults::kMaxPendingConnections;
   StragglerPolicy straggler_policy = StragglerPolicy::present;
+  std::optional<StatusServer> status;
 };
 
 // At `time`, these of the scene's point lights go dark and these come on again.

@@ -211,6 +211,14 @@ MasterSettings build_master(const schema::MasterSettings& m) {
   master.secret_file = m.secret_file();
   master.max_pending_connections = or_default(m.max_pending_connections(), defaults::kMaxPendingConnections);
   master.straggler_policy = m.straggler_policy() == "drop" ? StragglerPolicy::drop : StragglerPolicy::present;
+  if (m.has_status()) {
+    const schema::StatusServer& st = m.status();
+    StatusServer status;
+    if (!st.listen().empty()) status.listen = st.listen();
+    if (st.has_port()) status.port = static_cast<std::uint16_t>(st.port());
+    status.max_connections = or_default(st.max_connections(), defaults::kStatusMaxConnections);
+    master.status = status;
+  }
   return master;
 }
 

@@ -167,6 +167,12 @@ schema::MasterSettings to_schema(const MasterSettings& m) {
   out.set_secret_file(m.secret_file);
   out.set_max_pending_connections(m.max_pending_connections);
   out.set_straggler_policy(std::string(to_string(m.straggler_policy)));
+  if (m.status) {
+    schema::StatusServer& status = *out.mutable_status();
+    status.set_listen(m.status->listen);
+    status.set_port(m.status->port);
+    status.set_max_connections(m.status->max_connections);
+  }
   return out;
 }
 

@@ -402,6 +402,22 @@ void check_master(Checker& check, const schema::MasterSettings& m) {
   if (m.max_message_bytes() != 0 && m.max_message_bytes() < 1024) {
     check.fail("master.max_message_bytes", "must be at least 1024 (got " + std::to_string(m.max_message_bytes()) + ")");
   }
+  if (m.has_status()) {
+    const schema::StatusServer& st = m.status();
+    if (!st.listen().empty() && !is_ip_address(st.listen())) {
+      check.fail("master.status.listen", "'" + st.listen() + "' is not an IPv4 or IPv6 address");
+    } else if (!st.listen().empty() && !is_loopback_address(st.listen()) && m.secret_file().empty()) {
+      check.fail("master.status.listen",
+                 "'" + st.listen() +
+                     "' is reached from other machines, so the status needs a bearer token, derived from the "
+                     "shared secret: set master.secret_file (or listen on 127.0.0.1)");
+    }
+    if (st.port() > 65535) check.fail("master.status.port", "must be 0..65535 (got " + std::to_string(st.port()) + ")");
+    if (st.max_connections() > 100000) {
+      check.fail("master.status.max_connections",
+                 "must be at most 100000 (got " + std::to_string(st.max_connections()) + ")");
+    }
+  }
   const std::uint32_t heartbeat = m.heartbeat_ms() != 0 ? m.heartbeat_ms() : defaults::kHeartbeatMs;
   if (m.liveness_timeout_ms() != 0 && m.liveness_timeout_ms() <= 2 * heartbeat) {
     check.fail("master.liveness_timeout_ms", "must be more than twice heartbeat_ms (" + std::to_string(heartbeat) +

@@ -151,21 +151,16 @@ std::vector<std::uint8_t> random_nonce(std::size_t bytes) {
   return nonce;
 }
 
-std::array<std::uint8_t, kHelloMacBytes> hello_mac(const Secret& secret, std::span<const std::uint8_t> nonce,
-                                                   std::string_view node_id, std::uint32_t protocol_version) {
+namespace {
+
+std::array<std::uint8_t, kHelloMacBytes> hmac_sha256(const Secret& secret, const std::vector<std::uint8_t>& message,
+                                                     const char* what) {
   if (secret.bytes.empty()) {
-    throw std::invalid_argument("hello_mac: empty secret");
+    throw std::invalid_argument(std::string(what) + ": empty secret");
   }
   if (secret.bytes.size() > static_cast<std::size_t>(INT_MAX)) {
-    throw std::invalid_argument("hello_mac: secret too long");
+    throw std::invalid_argument(std::string(what) + ": secret too long");
   }
-  std::vector<std::uint8_t> message;
-  message.reserve(kHelloLabel.size() + 4 + nonce.size() + 4 + node_id.size() + 4);
-  message.insert(message.end(), kHelloLabel.begin(), kHelloLabel.end());
-  append_field(message, nonce.data(), nonce.size());
-  append_field(message, reinterpret_cast<const std::uint8_t*>(node_id.data()), node_id.size());
-  append_be32(message, protocol_version);
-
   std::array<std::uint8_t, kHelloMacBytes> mac{};
   unsigned int mac_length = 0;
   const unsigned char* done = HMAC(EVP_sha256(), secret.bytes.data(), static_cast<int>(secret.bytes.size()),
@@ -175,6 +170,32 @@ std::array<std::uint8_t, kHelloMacBytes> hello_mac(const Secret& secret, std::sp
     throw std::runtime_error("HMAC-SHA256 failed: " + openssl_error());
   }
   return mac;
+}
+
+}  // namespace
+
+std::array<std::uint8_t, kHelloMacBytes> hello_mac(const Secret& secret, std::span<const std::uint8_t> nonce,
+                                                   std::string_view node_id, std::uint32_t protocol_version) {
+  std::vector<std::uint8_t> message;
+  message.reserve(kHelloLabel.size() + 4 + nonce.size() + 4 + node_id.size() + 4);
+  message.insert(message.end(), kHelloLabel.begin(), kHelloLabel.end());
+  append_field(message, nonce.data(), nonce.size());
+  append_field(message, reinterpret_cast<const std::uint8_t*>(node_id.data()), node_id.size());
+  append_be32(message, protocol_version);
+  return hmac_sha256(secret, message, "hello_mac");
+}
+
+std::string status_token(const Secret& secret) {
+  constexpr std::string_view kLabel = "optique status token v1";
+  const std::array<std::uint8_t, kHelloMacBytes> mac =
+      hmac_sha256(secret, std::vector<std::uint8_t>(kLabel.begin(), kLabel.end()), "status_token");
+  constexpr char kHex[] = "0123456789abcdef";
+  std::string token;
+  for (const std::uint8_t byte : mac) {
+    token += kHex[byte >> 4];
+    token += kHex[byte & 15];
+  }
+  return token;
 }
 
 bool verify_hello_mac(const Secret& secret, std::span<const std::uint8_t> nonce, std::string_view node_id,

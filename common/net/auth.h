@@ -55,6 +55,12 @@ struct Secret {
                                                                  std::string_view node_id,
                                                                  std::uint32_t protocol_version);
 
+// The bearer token of the master's status server: HMAC-SHA256(secret,
+// "optique status token v1") in lower-case hex, 64 characters. Derived, not the
+// secret itself: the status server speaks plain HTTP, and a token seen on the
+// way must not let a node in. Throws as hello_mac does.
+[[nodiscard]] std::string status_token(const Secret& secret);
+
 // The master's check of a Hello: recomputes hello_mac and compares in constant
 // time. False for a mac of the wrong length and for an empty secret.
 [[nodiscard]] bool verify_hello_mac(const Secret& secret, std::span<const std::uint8_t> nonce, std::string_view node_id,

@@ -134,6 +134,18 @@ TEST_F(VerifyHelloMac, RejectsTruncatedAndEmptyMac) {
 
 // --- nonces --------------------------------------------------------------------
 
+// --- status token ------------------------------------------------------------
+
+// The known answer comes from OpenSSL's command line:
+//   echo -n "optique status token v1" | openssl dgst -sha256 -hmac "0123456789abcdef-secret"
+TEST(StatusToken, IsTheSecretsHmacOfItsLabelInHex) {
+  const std::string text = "0123456789abcdef-secret";
+  const Secret secret{std::vector<std::uint8_t>(text.begin(), text.end())};
+  EXPECT_EQ(status_token(secret), "2d1c8c6e625b065097a52658dc42eb22ed0ecd6c863d254624feb957808e35f2");
+  EXPECT_EQ(status_token(secret).find(text), std::string::npos) << "the secret itself never shows";
+  EXPECT_THROW((void)status_token(Secret{}), std::invalid_argument);
+}
+
 TEST(RandomNonce, Is32BytesAndDiffers) {
   const Bytes first = random_nonce();
   const Bytes second = random_nonce();

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "config/address.h"
 #include "config/load.h"
 #include "config/parse.h"
 #include "config/to_schema.h"
@@ -389,6 +390,36 @@ TEST(ParseInstallation, IPv4AndIPv6ListenAddressesAreFine) {
   for (const char* address : {"127.0.0.1", "::1", "0.0.0.0"}) {
     auto parsed = parse(with(R"("port": 7400)", std::string(R"("port": 7400, "listen": ")") + address + "\""));
     EXPECT_TRUE(parsed.ok()) << address << ": " << parsed.error();
+  }
+}
+
+// master.status: loopback by default, port 7480; an explicit 0 is ephemeral.
+TEST(ParseInstallation, StatusServerDefaults) {
+  auto parsed = parse(with(R"("port": 7400)", R"("port": 7400, "status": {})"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  ASSERT_TRUE(parsed.value().master.status);
+  EXPECT_EQ(parsed.value().master.status->listen, "127.0.0.1");
+  EXPECT_EQ(parsed.value().master.status->port, 7480u);
+  EXPECT_EQ(parsed.value().master.status->max_connections, 256u);
+  parsed = parse(with(R"("port": 7400)", R"("port": 7400, "status": {"port": 0, "listen": "::1"})"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().master.status->port, 0u);
+  EXPECT_FALSE(parse(kValid).value().master.status) << "off unless asked for";
+}
+
+// Beyond loopback the status needs the token, and the token the shared secret.
+TEST(ParseInstallation, StatusBeyondLoopbackNeedsTheSecret) {
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "status": {"listen": "0.0.0.0"})")),
+                 "master.status.listen", {"'0.0.0.0' is reached from other machines", "master.secret_file"});
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "status": {"listen": "lobby", "port": 70000})")),
+                 "master.status.listen", {"'lobby' is not an IPv4 or IPv6 address"});
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "status": {"port": 70000})")), "master.status.port",
+                 {"got 70000"});
+  for (const char* loopback : {"127.0.0.1", "127.8.9.10", "::1", "::ffff:127.0.0.1"}) {
+    EXPECT_TRUE(is_loopback_address(loopback)) << loopback;
+  }
+  for (const char* beyond : {"0.0.0.0", "10.0.0.7", "::", "::ffff:10.0.0.7", "128.0.0.1", "host"}) {
+    EXPECT_FALSE(is_loopback_address(beyond)) << beyond;
   }
 }
 

@@ -95,6 +95,18 @@ class MasterTest : public ::testing::Test {
     return master_->message(peer, e, now_);
   }
 
+  // `peer` says it showed `frame`.
+  Actions shown(PeerId peer, std::uint64_t frame) {
+    wire::Envelope e = envelope();
+    e.mutable_presented()->set_frame_id(frame);
+    e.mutable_presented()->set_content_frame_id(frame);
+    e.mutable_presented()->set_presented_ns(now_);
+    return master_->message(peer, e, now_);
+  }
+  void all_shown(std::uint64_t frame, std::initializer_list<PeerId> peers) {
+    for (PeerId p : peers) (void)shown(p, frame);
+  }
+
   // The hash of the frame begun in `actions` for `peer`.
   static std::uint64_t hash_of(const Actions& actions, PeerId peer) {
     const auto begins = sent_to(actions, peer, wire::Envelope::kFrameBegin);
@@ -249,6 +261,40 @@ TEST_F(MasterTest, FramesStartWhenAllAreUpAndSwapWhenAllAreReady) {
   EXPECT_EQ(*armed(a, Timer::next_frame), now_ - 3 * kMs + 16'666'666) << "on schedule from the first frame";
 }
 
+// Behind schedule, the next frame's time comes as soon as a frame is swapped;
+// it begins only once every node told to show that frame has (on one machine,
+// their drawing would delay the one still waiting for its deadline), or a
+// period after the deadline, when a node would no longer show it.
+TEST_F(MasterTest, TheNextFrameBeginsOnceTheLastIsShown) {
+  load("powerwall-2x2.json");
+  Actions a = join_all();
+  const std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 4; ++p) a = ready(p, 0, hash);
+  const clock::Nanos deadline = now_ + 2 * kMs;
+  a = master_->timer(Timer::next_frame, now_ + 1 * kMs);
+  EXPECT_TRUE(sent_to(a, 1, wire::Envelope::kFrameBegin).empty()) << "no node has shown frame 0 yet";
+  ASSERT_NE(armed(a, Timer::next_frame), nullptr);
+  EXPECT_EQ(*armed(a, Timer::next_frame), deadline + 16'666'666);
+  all_shown(0, {1, 2, 3});
+  EXPECT_TRUE(shown(2, 0).empty()) << "a second report changes nothing";
+  a = shown(4, 0);
+  EXPECT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u) << "the last one showed it";
+  EXPECT_NE(std::find_if(a.begin(), a.end(),
+                         [](const Action& x) {
+                           return std::holds_alternative<Disarm>(x) && std::get<Disarm>(x).timer == Timer::next_frame;
+                         }),
+            a.end());
+  // Frame 1: node 3 never says it showed it, then leaves; node 4 never says.
+  const std::uint64_t hash1 = hash_of(a, 1);
+  for (PeerId p = 1; p <= 4; ++p) (void)ready(p, 1, hash1);
+  all_shown(1, {1, 2});
+  a = master_->timer(Timer::next_frame, now_ + 1 * kMs);
+  EXPECT_TRUE(sent_to(a, 1, wire::Envelope::kFrameBegin).empty());
+  EXPECT_TRUE(sent_to(master_->closed(3, "reset", now_ + 2 * kMs), 1, wire::Envelope::kFrameBegin).empty());
+  a = master_->timer(Timer::next_frame, deadline + 16'666'666);
+  EXPECT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u) << "it would not show it any more";
+}
+
 // A tracked head: the eyes rest where the config puts them until the tracker's
 // first sample; then each frame carries the head the tracker saw, predicted at
 // the frame's display time, turn and all; what it ignored is in the report.
@@ -270,6 +316,7 @@ TEST_F(MasterTest, EachFrameCarriesTheTrackedHead) {
   ASSERT_TRUE(std::holds_alternative<Log>(garbage.front()));
   EXPECT_NE(std::get<Log>(garbage.front()).text.find("not DTrack's ASCII output"), std::string::npos);
   a = ready(1, 0, hash_of(a, 1));
+  (void)shown(1, 0);
   now_ += 16'666'666;
   a = master_->timer(Timer::next_frame, now_);
   const auto begins = sent_to(a, 1, wire::Envelope::kFrameBegin);
@@ -348,6 +395,7 @@ TEST_F(MasterTest, AStragglerIsLeftOutAndComesBack) {
   for (PeerId p = 1; p <= 3; ++p) EXPECT_EQ(sent_to(a, p, wire::Envelope::kSwap).size(), 1u);
   EXPECT_TRUE(sent_to(a, 4, wire::Envelope::kSwap).empty()) << "never a late frame";
   // Frame 1 does not wait for it: three readies swap it.
+  all_shown(0, {1, 2, 3});
   a = master_->timer(Timer::next_frame, now_);
   hash = hash_of(a, 1);
   EXPECT_EQ(sent_to(a, 4, wire::Envelope::kFrameBegin).size(), 1u) << "it is still sent the frames";
@@ -357,6 +405,7 @@ TEST_F(MasterTest, AStragglerIsLeftOutAndComesBack) {
   // It answers again: back in the barrier from the next frame.
   a = ready(4, 1, hash);
   EXPECT_TRUE(logged(a, "node 'top-right' answers again (frame 1)"));
+  all_shown(1, {1, 2, 3, 4});
   a = master_->timer(Timer::next_frame, now_);
   hash = hash_of(a, 1);
   for (PeerId p = 1; p <= 3; ++p) EXPECT_TRUE(sent_to(ready(p, 2, hash), p, wire::Envelope::kSwap).empty());
@@ -396,6 +445,7 @@ TEST_F(MasterTest, ANodeThatLeavesIsNotWaitedForAndMayRejoin) {
   EXPECT_TRUE(logged(a, "node 'top-right' left: connection reset (3/4 up)"));
   EXPECT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "the barrier completes without it";
   for (const Send* s : all_of<Send>(a)) EXPECT_NE(s->peer, 4u) << "nothing for a closed peer";
+  all_shown(0, {1, 2, 3});
   (void)master_->timer(Timer::next_frame, now_);
   // A new connection for the same projector takes it back, at the frame to come.
   a = hello(9, "top-right");
@@ -405,6 +455,68 @@ TEST_F(MasterTest, ANodeThatLeavesIsNotWaitedForAndMayRejoin) {
   ASSERT_EQ(resync.size(), 1u);
   EXPECT_EQ(resync.front().resync().next_frame_id(), 2u);
   EXPECT_EQ(master_->nodes_up(), 4u);
+}
+
+// The operator pauses: the frame under way finishes and no other begins; the
+// scene waits too. Resume: frames go on from where they stopped, on a schedule
+// from then. Stop: the run ends in order, as at Ctrl-C.
+TEST_F(MasterTest, TheOperatorPausesResumesAndStops) {
+  load("powerwall-2x2.json");
+  Actions a = join_all();
+  std::uint64_t hash = hash_of(a, 1);
+  a = master_->operator_command(OperatorCommand::pause, "127.0.0.1:6000", now_);
+  EXPECT_TRUE(logged(a, "paused by the operator (127.0.0.1:6000): no frame after frame 0"));
+  EXPECT_EQ(master_->live(now_).state, "paused");
+  for (PeerId p = 1; p <= 4; ++p) a = ready(p, 0, hash);
+  EXPECT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "the frame under way is shown";
+  all_shown(0, {1, 2, 3, 4});
+  now_ += 100 * kMs;
+  a = master_->timer(Timer::next_frame, now_);
+  EXPECT_TRUE(sent_to(a, 1, wire::Envelope::kFrameBegin).empty()) << "paused";
+  EXPECT_TRUE(logged(master_->operator_command(OperatorCommand::pause, "x", now_), "paused already"));
+  now_ += 5000 * kMs;
+  a = master_->operator_command(OperatorCommand::resume, "127.0.0.1:6001", now_);
+  EXPECT_TRUE(logged(a, "resumed by the operator (127.0.0.1:6001) at frame 1"));
+  const auto begins = sent_to(a, 1, wire::Envelope::kFrameBegin);
+  ASSERT_EQ(begins.size(), 1u);
+  EXPECT_EQ(begins.front().frame_begin().frame_id(), 1u);
+  EXPECT_EQ(begins.front().frame_begin().simulation_time_ns(), 16'666'666) << "the scene waited";
+  EXPECT_EQ(begins.front().frame_begin().present_time_ns(), now_ + 16'666'666) << "a schedule from now";
+  EXPECT_TRUE(logged(master_->operator_command(OperatorCommand::resume, "x", now_), "nothing is paused"));
+  hash = hash_of(a, 1);
+  a = master_->operator_command(OperatorCommand::stop, "127.0.0.1:6002", now_);
+  EXPECT_TRUE(logged(a, "stop asked by the operator (127.0.0.1:6002)"));
+  EXPECT_EQ(master_->live(now_).state, "stopping");
+  for (PeerId p = 1; p <= 4; ++p) a = ready(p, 1, hash);
+  EXPECT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "the frame under way finishes";
+  ASSERT_NE(armed(a, Timer::last_presents), nullptr);
+  EXPECT_EQ(master_->report().stopped_because(), "stopped by the operator (127.0.0.1:6002)");
+}
+
+// What the page shows: each node's state and counts, the run's.
+TEST_F(MasterTest, TheLiveStatusFollowsTheNodes) {
+  load("powerwall-2x2.json");
+  LiveStatus s = master_->live(now_);
+  EXPECT_EQ(s.state, "starting");
+  ASSERT_EQ(s.nodes.size(), 4u);
+  for (const LiveNode& n : s.nodes) EXPECT_EQ(n.link, NodeLink::absent) << n.id;
+  (void)hello(1, "bottom-left");
+  s = master_->live(now_);
+  EXPECT_EQ(s.nodes[0].id, "bottom-left");
+  EXPECT_EQ(s.nodes[0].link, NodeLink::configuring);
+  EXPECT_EQ(s.nodes[0].peer, "127.0.0.1:40001");
+  Actions a = join_all();
+  const std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 3; ++p) (void)ready(p, 0, hash);
+  (void)master_->timer(Timer::barrier, now_ + 500 * kMs);
+  s = master_->live(now_);
+  EXPECT_EQ(s.state, "running");
+  EXPECT_EQ(s.nodes_up, 4u);
+  EXPECT_EQ(s.nodes[3].link, NodeLink::behind);
+  EXPECT_EQ(s.nodes[3].counts.barrier_misses, 1u);
+  EXPECT_EQ(s.nodes[0].counts.rendered, 1u);
+  (void)master_->closed(4, "reset", now_);
+  EXPECT_EQ(master_->live(now_).nodes[3].link, NodeLink::gone);
 }
 
 TEST_F(MasterTest, PingsAreAnsweredWithTheirTimes) {
@@ -425,7 +537,8 @@ TEST_F(MasterTest, AfterItsFramesItSaysGoodbyeAndFinishes) {
   Actions a = join_all();
   const std::uint64_t hash = hash_of(a, 1);
   for (PeerId p = 1; p <= 4; ++p) a = ready(p, 0, hash);
-  a = master_->timer(Timer::next_frame, now_ + 17 * kMs);
+  // No node says it showed frame 0: the next frame's time is a period after its deadline.
+  a = master_->timer(Timer::next_frame, now_ + 19 * kMs);
   EXPECT_TRUE(logged(a, "stopping: ran 1 frames"));
   ASSERT_NE(armed(a, Timer::last_presents), nullptr);
   a = master_->timer(Timer::last_presents, now_ + 300 * kMs);
@@ -570,6 +683,7 @@ TEST_F(MasterTest, AnAutomaticGroupsSharesFollowTheNodesThatAreUp) {
   const std::uint64_t hash = hash_of(a, 1);
   for (PeerId p = 1; p <= 3; ++p) (void)ready(p, 0, hash);
   (void)master_->closed(3, "killed", now_);
+  all_shown(0, {1, 2});
   a = master_->timer(Timer::next_frame, now_);
   for (PeerId p = 1; p <= 2; ++p) take(a, p);
   EXPECT_TRUE(every_light_once({1, 2})) << "its lights are shared out among the two left";

@@ -1,0 +1,304 @@
+#include "http/server.h"
+
+#include <boost/asio/post.hpp>
+#include <boost/asio/write.hpp>
+#include <boost/beast/core.hpp>
+#include <boost/beast/http.hpp>
+#include <boost/beast/http/span_body.hpp>
+
+#include <deque>
+#include <optional>
+
+namespace optique::http {
+namespace {
+
+namespace beast = boost::beast;
+namespace bhttp = boost::beast::http;
+
+Method method_of(bhttp::verb verb) {
+  switch (verb) {
+    case bhttp::verb::get:
+      return Method::get;
+    case bhttp::verb::head:
+      return Method::head;
+    case bhttp::verb::post:
+      return Method::post;
+    default:
+      return Method::other;
+  }
+}
+
+}  // namespace
+
+class Server::Session : public std::enable_shared_from_this<Session> {
+ public:
+  Session(Server& server, std::uint64_t id, asio::ip::tcp::socket socket)
+      : server_(server), counters_(server.counters_), id_(id), stream_(std::move(socket)) {
+    boost::system::error_code ec;
+    const auto peer = stream_.socket().remote_endpoint(ec);
+    if (!ec) peer_ = peer.address().to_string() + ":" + std::to_string(peer.port());
+    counters_->open += 1;
+  }
+  ~Session() {
+    counters_->open -= 1;
+    if (streaming_) counters_->streams -= 1;
+  }
+
+  void start() { read_request(); }
+
+  // Over the connection limit: told so, and closed.
+  void refuse_busy() {
+    counters_->refused_busy += 1;
+    Response busy = text_response(503, "too many connections to this status server; try again shortly");
+    busy.headers.emplace_back("Retry-After", "1");
+    write_response(std::move(busy), 11, false);
+  }
+
+  void push(const std::shared_ptr<const std::string>& event) {
+    if (!streaming_ || closed_) return;
+    if (events_.size() >= server_.limits_.max_queued_events) {
+      counters_->streams_behind += 1;
+      server_.log_.debug("status: closing the event stream to {}: {} events behind", peer_, events_.size());
+      close();
+      return;
+    }
+    events_.push_back(event);
+    if (!writing_) write_next_event();
+  }
+
+  void close() {
+    if (closed_) return;
+    closed_ = true;
+    beast::error_code ignored;
+    stream_.socket().shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+    stream_.close();
+    server_.on_closed(id_);
+  }
+
+ private:
+  void read_request() {
+    parser_.emplace();
+    parser_->header_limit(server_.limits_.max_header_bytes);
+    parser_->body_limit(server_.limits_.max_body_bytes);
+    stream_.expires_after(server_.limits_.request_timeout);
+    bhttp::async_read(stream_, buffer_, *parser_,
+                      [self = shared_from_this()](beast::error_code error, std::size_t) { self->on_request(error); });
+  }
+
+  void on_request(beast::error_code error) {
+    if (closed_) return;
+    if (error == bhttp::error::header_limit || error == bhttp::error::body_limit) {
+      counters_->too_large += 1;
+      const bool header = error == bhttp::error::header_limit;
+      write_response(
+          text_response(header ? 431 : 413, header ? "request header too large (the limit is " +
+                                                         std::to_string(server_.limits_.max_header_bytes) + " bytes)"
+                                                   : "request body too large (the limit is " +
+                                                         std::to_string(server_.limits_.max_body_bytes) + " bytes)"),
+          11, false);
+      return;
+    }
+    if (error == beast::error::timeout) {
+      counters_->timed_out += 1;
+      server_.log_.debug("status: closed {}: no whole request within {} ms", peer_,
+                         server_.limits_.request_timeout.count());
+      close();
+      return;
+    }
+    if (error && error.category() == bhttp::make_error_code(bhttp::error::end_of_stream).category() &&
+        error != bhttp::error::end_of_stream && error != bhttp::error::partial_message) {
+      counters_->bad_requests += 1;
+      write_response(text_response(400, "not an HTTP request: " + error.message()), 11, false);
+      return;
+    }
+    if (error) {  // the client went away (end_of_stream, reset)
+      close();
+      return;
+    }
+    counters_->requests += 1;
+    const auto& message = parser_->get();
+    Request request;
+    request.method = method_of(message.method());
+    request.method_text = std::string(message.method_string());
+    const std::string_view target(message.target().data(), message.target().size());
+    const auto question = target.find('?');
+    request.path = std::string(target.substr(0, question));
+    if (question != std::string_view::npos) request.query = std::string(target.substr(question + 1));
+    if (const auto found = message.find(bhttp::field::authorization); found != message.end()) {
+      request.authorization = std::string(found->value());
+    }
+    request.peer = peer_;
+    Response response = server_.handler_(request);
+    if (response.event_stream && response.status == 200) {
+      start_stream();
+      return;
+    }
+    const bool head = request.method == Method::head;
+    write_response(std::move(response), message.version(), message.keep_alive(), head);
+  }
+
+  void write_response(Response response, unsigned version, bool keep_alive, bool head = false) {
+    body_ = std::move(response.body);
+    response_.emplace();
+    response_->version(version);
+    response_->result(response.status);
+    response_->set(bhttp::field::server, "optique");
+    response_->set(bhttp::field::content_type, response.content_type);
+    response_->set(bhttp::field::cache_control, "no-store");
+    for (const auto& [name, value] : response.headers) response_->set(name, value);
+    response_->body() = boost::beast::span<const char>(body_->data(), body_->size());
+    response_->prepare_payload();
+    response_->keep_alive(keep_alive);
+    if (head) response_->body() = {};  // the length of what a GET would get, no body
+    stream_.expires_after(server_.limits_.write_timeout);
+    bhttp::async_write(stream_, *response_,
+                       [self = shared_from_this(), keep_alive](beast::error_code error, std::size_t) {
+                         self->on_written(error, keep_alive);
+                       });
+  }
+
+  void on_written(beast::error_code error, bool keep_alive) {
+    if (closed_) return;
+    if (error == beast::error::timeout) counters_->timed_out += 1;
+    if (error || !keep_alive) {
+      close();
+      return;
+    }
+    read_request();
+  }
+
+  // No length and no chunks: the stream ends when the connection does.
+  void start_stream() {
+    streaming_ = true;
+    counters_->streams += 1;
+    server_.streams_[id_] = shared_from_this();  // between events nothing else holds it
+    events_.push_back(std::make_shared<const std::string>(
+        "HTTP/1.1 200 OK\r\nServer: optique\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n"
+        "Connection: close\r\n\r\n"));
+    write_next_event();
+  }
+
+  void write_next_event() {
+    if (events_.empty() || closed_) {
+      writing_ = false;
+      return;
+    }
+    writing_ = true;
+    const std::shared_ptr<const std::string> next = events_.front();
+    stream_.expires_after(server_.limits_.write_timeout);
+    asio::async_write(stream_, asio::buffer(*next),
+                      [self = shared_from_this(), next](beast::error_code error, std::size_t) {
+                        if (self->closed_) return;
+                        if (error) {
+                          if (error == beast::error::timeout) self->counters_->timed_out += 1;
+                          self->close();
+                          return;
+                        }
+                        self->events_.pop_front();
+                        self->write_next_event();
+                      });
+  }
+
+  Server& server_;
+  std::shared_ptr<Counters> counters_;
+  std::uint64_t id_;
+  beast::tcp_stream stream_;
+  beast::flat_buffer buffer_;
+  std::string peer_;
+  std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
+  std::optional<bhttp::response<bhttp::span_body<const char>>> response_;
+  std::shared_ptr<const std::string> body_;  // what response_ points into, while it is written
+  std::deque<std::shared_ptr<const std::string>> events_;
+  bool streaming_ = false;
+  bool writing_ = false;
+  bool closed_ = false;
+};
+
+Server::Server(asio::io_context& io, ServerLimits limits, Handler handler, spdlog::logger& log)
+    : io_(io), limits_(limits), handler_(std::move(handler)), log_(log), acceptor_(io) {}
+
+Server::~Server() = default;
+
+Result<std::uint16_t> Server::listen(const std::string& address, std::uint16_t port) {
+  boost::system::error_code ec;
+  const auto ip = asio::ip::make_address(address, ec);
+  if (ec) return Error{"'" + address + "' is not an address"};
+  const asio::ip::tcp::endpoint endpoint(ip, port);
+  acceptor_.open(endpoint.protocol(), ec);
+  if (!ec) acceptor_.set_option(asio::ip::tcp::acceptor::reuse_address(true), ec);
+  if (!ec) acceptor_.bind(endpoint, ec);
+  if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec) return Error{"cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message()};
+  const std::uint16_t bound = acceptor_.local_endpoint().port();
+  accept_next();
+  return bound;
+}
+
+void Server::accept_next() {
+  acceptor_.async_accept([this](const boost::system::error_code& error, asio::ip::tcp::socket socket) {
+    if (stopped_ || error == asio::error::operation_aborted) return;
+    if (!error) {
+      counters_->accepted += 1;
+      const std::uint64_t id = next_id_++;
+      auto session = std::make_shared<Session>(*this, id, std::move(socket));
+      if (sessions_.size() >= limits_.max_connections) {
+        session->refuse_busy();  // not counted among the sessions: it only says so
+      } else {
+        sessions_[id] = session;
+        session->start();
+      }
+    } else {
+      log_.debug("status: accept failed: {}", error.message());
+    }
+    accept_next();
+  });
+}
+
+void Server::on_closed(std::uint64_t id) {
+  sessions_.erase(id);
+  streams_.erase(id);  // may be the last hold on the session: its caller holds another
+}
+
+void Server::publish(std::shared_ptr<const std::string> data) {
+  asio::post(io_, [this, data = std::move(data)] {
+    if (stopped_) return;
+    const auto event = std::make_shared<const std::string>("data: " + *data + "\n\n");
+    for (auto it = sessions_.begin(); it != sessions_.end();) {
+      const auto session = it->second.lock();
+      ++it;  // push() may close the session, which erases it
+      if (session) session->push(event);
+    }
+  });
+}
+
+void Server::stop() {
+  asio::post(io_, [this] {
+    if (stopped_) return;
+    stopped_ = true;
+    boost::system::error_code ignored;
+    acceptor_.close(ignored);
+    std::vector<std::shared_ptr<Session>> open;
+    for (auto& [id, weak] : sessions_) {
+      if (auto session = weak.lock()) open.push_back(std::move(session));
+    }
+    for (auto& session : open) session->close();
+    sessions_.clear();
+    streams_.clear();
+  });
+}
+
+ServerCounts Server::counts() const {
+  ServerCounts c;
+  c.accepted = counters_->accepted;
+  c.requests = counters_->requests;
+  c.refused_busy = counters_->refused_busy;
+  c.timed_out = counters_->timed_out;
+  c.too_large = counters_->too_large;
+  c.bad_requests = counters_->bad_requests;
+  c.streams_behind = counters_->streams_behind;
+  c.open = counters_->open;
+  c.streams = counters_->streams;
+  return c;
+}
+
+}  // namespace optique::http

@@ -1,0 +1,100 @@
+#pragma once
+// A small HTTP/1.1 server (Boost.Beast) for the operator's page and metrics: it
+// reads and bounds requests, asks a Handler what to answer, and writes the
+// answer; it decides nothing else. Answers that are event streams stay open and
+// get every publish(). Limits like the node port's: a connection limit (the
+// next one is answered 503 and closed), a whole request within a time (slow
+// clients are closed), header and body sizes (431/413, then closed), and event
+// streams that fall behind are closed rather than buffered without end.
+//
+// Runs on the io_context it is given, meant to be its own thread's, so that
+// clients never delay the frame loop; publish() and stop() may be called from
+// any thread.
+
+#include <spdlog/logger.h>
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "http/message.h"
+#include "util/result.h"
+
+namespace optique::http {
+
+namespace asio = boost::asio;
+
+struct ServerLimits {
+  std::size_t max_connections = 256;
+  std::uint32_t max_header_bytes = 8 * 1024;
+  std::uint32_t max_body_bytes = 1024;
+  // From a connection's start, or the end of its last answer, to a whole request.
+  std::chrono::milliseconds request_timeout{5000};
+  // To write one answer or one event.
+  std::chrono::milliseconds write_timeout{5000};
+  // Events queued for one stream beyond these close it.
+  std::size_t max_queued_events = 32;
+};
+
+// What the server did, for the status and the tests; read from any thread.
+struct ServerCounts {
+  std::uint64_t accepted = 0;
+  std::uint64_t requests = 0;
+  std::uint64_t refused_busy = 0;    // over max_connections
+  std::uint64_t timed_out = 0;       // a request or a write took too long
+  std::uint64_t too_large = 0;       // header or body over the limit
+  std::uint64_t bad_requests = 0;    // not HTTP
+  std::uint64_t streams_behind = 0;  // event streams closed for falling behind
+  std::uint64_t open = 0;            // connections open now
+  std::uint64_t streams = 0;         // event streams open now
+};
+
+class Server {
+ public:
+  using Handler = std::function<Response(const Request&)>;
+
+  Server(asio::io_context& io, ServerLimits limits, Handler handler, spdlog::logger& log);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Binds and starts accepting; the port bound (port 0: an ephemeral one).
+  [[nodiscard]] Result<std::uint16_t> listen(const std::string& address, std::uint16_t port);
+  // One event, `data` a line of text (no newline), to every event stream.
+  void publish(std::shared_ptr<const std::string> data);
+  // Stops accepting and closes every connection.
+  void stop();
+  [[nodiscard]] ServerCounts counts() const;
+
+  class Session;  // one connection
+
+ private:
+  friend class Session;
+  void accept_next();
+  void on_closed(std::uint64_t id);
+
+  asio::io_context& io_;
+  ServerLimits limits_;
+  Handler handler_;
+  spdlog::logger& log_;
+  asio::ip::tcp::acceptor acceptor_;
+  // On the io thread only. A session lives while an operation of its own is
+  // pending; an event stream waits for events, so the server holds it.
+  std::map<std::uint64_t, std::weak_ptr<Session>> sessions_;
+  std::map<std::uint64_t, std::shared_ptr<Session>> streams_;
+  std::uint64_t next_id_ = 1;
+  bool stopped_ = false;
+  struct Counters {
+    std::atomic<std::uint64_t> accepted{0}, requests{0}, refused_busy{0}, timed_out{0}, too_large{0}, bad_requests{0},
+        streams_behind{0}, open{0}, streams{0};
+  };
+  std::shared_ptr<Counters> counters_ = std::make_shared<Counters>();
+};
+
+}  // namespace optique::http

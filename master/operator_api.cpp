@@ -1,0 +1,130 @@
+#include "master/operator_api.h"
+
+#include <openssl/crypto.h>
+
+#include <array>
+#include <cctype>
+
+#include "master/status_metrics.h"
+
+namespace optique::master {
+namespace {
+
+bool starts_with_ignoring_case(std::string_view text, std::string_view prefix) {
+  if (text.size() < prefix.size()) return false;
+  for (std::size_t i = 0; i < prefix.size(); ++i) {
+    if (std::tolower(static_cast<unsigned char>(text[i])) != std::tolower(static_cast<unsigned char>(prefix[i])))
+      return false;
+  }
+  return true;
+}
+
+// "Bearer <token>" with the right token, compared in constant time.
+bool authorized(const http::Request& request, const std::string& token) {
+  constexpr std::string_view kScheme = "Bearer ";
+  if (!starts_with_ignoring_case(request.authorization, kScheme)) return false;
+  std::string_view given = std::string_view(request.authorization).substr(kScheme.size());
+  while (!given.empty() && given.front() == ' ') given.remove_prefix(1);
+  while (!given.empty() && given.back() == ' ') given.remove_suffix(1);
+  return given.size() == token.size() && CRYPTO_memcmp(given.data(), token.data(), token.size()) == 0;
+}
+
+http::Response unauthorized(std::string why) {
+  http::Response response = http::text_response(401, std::move(why));
+  response.headers.emplace_back("WWW-Authenticate", "Bearer realm=\"optique\"");
+  return response;
+}
+
+http::Response serve(std::shared_ptr<const std::string> body, const char* content_type) {
+  if (!body) return http::text_response(503, "the master has not published its status yet; try again shortly");
+  http::Response response;
+  response.content_type = content_type;
+  response.body = std::move(body);
+  return response;
+}
+
+http::Response method_not_allowed(const http::Request& request, const char* allow) {
+  http::Response response =
+      http::text_response(405, request.method_text + " " + request.path + ": not allowed (allowed: " + allow + ")");
+  response.headers.emplace_back("Allow", allow);
+  return response;
+}
+
+struct Control {
+  std::string_view path;
+  OperatorCommand command;
+};
+constexpr std::array<Control, 3> kControls{{{"/control/pause", OperatorCommand::pause},
+                                            {"/control/resume", OperatorCommand::resume},
+                                            {"/control/stop", OperatorCommand::stop}}};
+
+}  // namespace
+
+std::string_view to_string(OperatorCommand command) {
+  switch (command) {
+    case OperatorCommand::pause:
+      return "pause";
+    case OperatorCommand::resume:
+      return "resume";
+    case OperatorCommand::stop:
+      return "stop";
+  }
+  return "unknown";
+}
+
+void StatusBoard::set(StatusTexts texts) {
+  const std::lock_guard lock(mutex_);
+  texts_ = std::move(texts);
+}
+
+StatusTexts StatusBoard::get() const {
+  const std::lock_guard lock(mutex_);
+  return texts_;
+}
+
+Routed route(const http::Request& request, const OperatorAccess& access, const StatusTexts& latest) {
+  const bool read = request.method == http::Method::get || request.method == http::Method::head;
+  for (const Control& control : kControls) {
+    if (request.path != control.path) continue;
+    if (request.method != http::Method::post) return {method_not_allowed(request, "POST"), std::nullopt};
+    if (!access.token) {
+      return {http::text_response(403,
+                                  "controls need a bearer token, and this master has none: it is derived from "
+                                  "the shared secret (master.secret_file)"),
+              std::nullopt};
+    }
+    if (!authorized(request, *access.token)) {
+      return {unauthorized("controls need the bearer token (optique-master --print-status-token)"), std::nullopt};
+    }
+    http::Response accepted;
+    accepted.status = 202;
+    accepted.content_type = "application/json";
+    accepted.body = std::make_shared<const std::string>("{\"command\":\"" + std::string(to_string(control.command)) +
+                                                        "\",\"accepted\":true}\n");
+    return {std::move(accepted), control.command};
+  }
+
+  // The page holds no data: it asks for it with the token it is given.
+  if (request.path == "/" || request.path == "/index.html") {
+    if (!read) return {method_not_allowed(request, "GET, HEAD"), std::nullopt};
+    return {serve(latest.page, "text/html; charset=utf-8"), std::nullopt};
+  }
+  const bool data = request.path == "/status.json" || request.path == "/metrics" || request.path == "/events";
+  if (!data) return {http::text_response(404, request.path + ": no such page (try /, /status.json or /metrics)"), {}};
+  if (!read) return {method_not_allowed(request, "GET, HEAD"), std::nullopt};
+  if (access.reads_need_token) {
+    if (!access.token) return {http::text_response(403, "this status server needs a token and has none"), {}};
+    if (!authorized(request, *access.token)) {
+      return {unauthorized("this status server listens beyond loopback: it needs the bearer token "
+                           "(optique-master --print-status-token)"),
+              std::nullopt};
+    }
+  }
+  if (request.path == "/status.json") return {serve(latest.json, "application/json"), std::nullopt};
+  if (request.path == "/metrics") return {serve(latest.metrics, kMetricsContentType), std::nullopt};
+  http::Response stream;
+  stream.event_stream = true;
+  return {std::move(stream), std::nullopt};
+}
+
+}  // namespace optique::master

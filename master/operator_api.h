@@ -1,0 +1,55 @@
+#pragma once
+// What the status server answers, decided without sockets: the operator's page,
+// /status.json, /metrics, the page's event stream, and the controls
+// (POST /control/pause, /control/resume, /control/stop). Who may ask:
+// - reads are open when the server listens on loopback only; otherwise they
+//   need the bearer token;
+// - controls always need the token, and without a shared secret there is none.
+// The token is derived from the installation's shared secret
+// (net::status_token), so that a token seen on the network does not let a
+// node in.
+
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "http/message.h"
+
+namespace optique::master {
+
+enum class OperatorCommand { pause, resume, stop };
+[[nodiscard]] std::string_view to_string(OperatorCommand command);
+
+// What is served: the page (set once), and the latest status (null until the
+// first is published).
+struct StatusTexts {
+  std::shared_ptr<const std::string> page;
+  std::shared_ptr<const std::string> json;
+  std::shared_ptr<const std::string> metrics;
+};
+
+// Handed from the frame loop's thread to the server's.
+class StatusBoard {
+ public:
+  void set(StatusTexts texts);
+  [[nodiscard]] StatusTexts get() const;
+
+ private:
+  mutable std::mutex mutex_;
+  StatusTexts texts_;
+};
+
+struct OperatorAccess {
+  bool reads_need_token = false;     // the server listens beyond loopback
+  std::optional<std::string> token;  // none without a shared secret
+};
+
+struct Routed {
+  http::Response response;
+  std::optional<OperatorCommand> command;  // for the master to carry out
+};
+
+[[nodiscard]] Routed route(const http::Request& request, const OperatorAccess& access, const StatusTexts& latest);
+
+}  // namespace optique::master
