@@ -1,6 +1,10 @@
 #include "node/cli.h"
 
+#include <sched.h>
 #include <sys/prctl.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <CLI/CLI.hpp>
 #include <boost/asio/io_context.hpp>
@@ -42,6 +46,10 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
                  "the installation's shared secret (the file its master.secret_file names; mode 600)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn or error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
+  int realtime_priority = 0;
+  app.add_option("--realtime-priority", realtime_priority,
+                 "run with real-time priority (SCHED_FIFO, as chrt -f) where permitted; 0: normal priority")
+      ->check(CLI::Range(0, 99));
   // Test hooks, hidden from --help.
   app.add_option("--protocol-version", options.protocol.protocol_version, "speak this protocol version")->group("");
   app.add_option("--clock-offset-ns", clock_offset_ns, "skew this node's clock")->group("");
@@ -98,6 +106,21 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
   // presents are timed to tens of microseconds.
   prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   auto logger = log::make_logger("node " + options.protocol.id, log_level);
+  if (realtime_priority > 0) {
+    // Before any thread starts, so that the renderer's threads have it too (as
+    // under chrt). Not permitted (no CAP_SYS_NICE, RLIMIT_RTPRIO too low): said,
+    // and the node runs at normal priority.
+    sched_param param{};
+    param.sched_priority = realtime_priority;
+    if (sched_setscheduler(0, SCHED_FIFO, &param) == 0) {
+      logger->info("real-time priority {} (SCHED_FIFO)", realtime_priority);
+    } else {
+      logger->warn(
+          "running at normal priority: real-time priority {} is not permitted ({}; the systemd unit's "
+          "LimitRTPRIO, or rtprio in /etc/security/limits.conf, allows it)",
+          realtime_priority, std::strerror(errno));
+    }
+  }
   boost::asio::io_context io;
   if (capture_dir.empty()) capture_dir = "captures/" + options.protocol.id;
   std::unique_ptr<Renderer> renderer;

@@ -22,6 +22,9 @@ packages=(
   libssl-dev                         # SHA-256 of configs, HMAC (libcrypto)
   python3                            # helper scripts, bench plot series
   gnuplot-nox                        # bench plots (scripts/plot-bench.sh)
+  chromium fonts-dejavu-core         # the operator's page in a real browser (headless), with a font
+  prometheus                         # promtool checks /metrics as a site's Prometheus reads it
+  systemd                            # systemd-analyze verifies the service units
 )
 # scripts/install-deps.sh --fuzz: also what scripts/fuzz.sh needs (CI runs it).
 if [ "${1:-}" = --fuzz ]; then
