@@ -9,6 +9,7 @@
 
 #include "config/address.h"
 #include "master/report_json.h"
+#include "net/stamped_receive.h"
 #include "tracking/dtrack.h"
 #include "util/overloaded.h"
 
@@ -55,21 +56,39 @@ Result<void> Master::listen_to_tracker(const config::Tracking& tracking) {
   log_.info("tracking: DTrack's ASCII output on {}:{} (UDP), body {}, predicted {}", tracking.listen,
             tracker_socket_.local_endpoint().port(), tracking.body, config::to_string(tracking.prediction));
   tracker_buffer_.resize(tracking::kMaxDTrackDatagram + 1);
+  // Each sample is stamped when the kernel received it, not when this thread got to it.
+  if (!net::enable_receive_stamps(tracker_socket_.native_handle())) {
+    log_.warn("tracking: the kernel does not stamp datagrams here; samples are stamped when read");
+  }
+  tracker_socket_.non_blocking(true, ec);
   receive_tracker();
   return {};
 }
 
+// Once readable, what has come is read at once, up to a bound: a flood then
+// costs a read each and never holds up the frame loop for long.
 void Master::receive_tracker() {
-  tracker_socket_.async_receive(asio::buffer(tracker_buffer_), [this](const boost::system::error_code& error,
-                                                                      std::size_t bytes) {
+  tracker_socket_.async_wait(asio::socket_base::wait_read, [this](const boost::system::error_code& error) {
     if (error == asio::error::operation_aborted || finished_) return;
-    if (error) {
-      if (!tracker_error_said_) log_.warn("tracking: receiving failed: {} (going on)", error.message());
-      tracker_error_said_ = true;
-    } else {
-      carry_out(protocol_->tracker_datagram(std::string_view(tracker_buffer_.data(), bytes), clock::monotonic_now()));
+    constexpr int kMostPerWake = 256;
+    for (int i = 0; i < kMostPerWake && !error && !finished_; ++i) {
+      const net::StampedDatagram got = net::read_datagram_stamped(
+          tracker_socket_.native_handle(),
+          std::span(reinterpret_cast<std::uint8_t*>(tracker_buffer_.data()), tracker_buffer_.size()));
+      if (got.read.status == net::StampedRead::Status::would_block) break;
+      if (got.read.status != net::StampedRead::Status::data) {
+        if (!tracker_error_said_) log_.warn("tracking: receiving failed: {} (going on)", std::strerror(got.read.error));
+        tracker_error_said_ = true;
+        break;
+      }
+      carry_out(protocol_->tracker_datagram(std::string_view(tracker_buffer_.data(), got.read.count), got.sender,
+                                            got.read.received));
     }
-    receive_tracker();
+    if (error && !tracker_error_said_) {
+      log_.warn("tracking: waiting for datagrams failed: {} (going on)", error.message());
+      tracker_error_said_ = true;
+    }
+    if (!finished_) receive_tracker();
   });
 }
 

@@ -727,6 +727,7 @@ std::optional<report::TrackingReport> MasterProtocol::tracking_report() const {
   t.set_without_body(counts.without_body);
   t.set_backwards(counts.backwards);
   t.set_flood(counts.flood);
+  t.set_other_sender(counts.other_sender);
   t.set_losses(counts.losses);
   t.set_lost_seconds(static_cast<double>(counts.lost_ns) / 1e9);
   t.set_state(std::string(tracking::to_string(head_tracker_->state())));
@@ -839,10 +840,10 @@ Actions MasterProtocol::operator_command(OperatorCommand command, const std::str
 
 // ---------------------------------------------------------------- the head
 
-Actions MasterProtocol::tracker_datagram(std::string_view bytes, clock::Nanos now) {
+Actions MasterProtocol::tracker_datagram(std::string_view bytes, const std::string& sender, clock::Nanos now) {
   Actions out;
   if (!head_tracker_) return out;
-  if (auto said = head_tracker_->datagram(bytes, now)) out.push_back(Log{spdlog::level::warn, *said});
+  if (auto said = head_tracker_->datagram(bytes, now, sender)) out.push_back(Log{spdlog::level::warn, *said});
   return out;
 }
 

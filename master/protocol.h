@@ -143,7 +143,8 @@ class MasterProtocol {
   // second stops at once.
   [[nodiscard]] Actions interrupted(const std::string& signal_name, clock::Nanos now);
   // A UDP datagram from the head tracker (viewer.tracking with source dtrack).
-  [[nodiscard]] Actions tracker_datagram(std::string_view bytes, clock::Nanos now);
+  // `sender`: its address.
+  [[nodiscard]] Actions tracker_datagram(std::string_view bytes, const std::string& sender, clock::Nanos now);
   // The operator's page asked (`from`: who, for the log). Pause: no frame
   // begins after the one under way, whose picture stays on every projector;
   // the scene waits too. Resume: frames go on from where they stopped. Stop:

@@ -19,6 +19,7 @@ json tracking_json(const report::TrackingReport& t) {
           {"without_body", t.without_body()},
           {"backwards", t.backwards()},
           {"flood", t.flood()},
+          {"other_sender", t.other_sender()},
           {"losses", t.losses()},
           {"lost_seconds", t.lost_seconds()}};
 }

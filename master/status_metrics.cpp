@@ -151,6 +151,7 @@ std::string status_metrics(const LiveStatus& s) {
     w.sample("optique_tracker_ignored_total", {{"reason", "without_body"}}, t.without_body());
     w.sample("optique_tracker_ignored_total", {{"reason", "backwards"}}, t.backwards());
     w.sample("optique_tracker_ignored_total", {{"reason", "flood"}}, t.flood());
+    w.sample("optique_tracker_ignored_total", {{"reason", "other_sender"}}, t.other_sender());
     w.single("optique_tracker_losses_total", "counter", "Times the tracker was lost.", t.losses());
     w.single("optique_tracker_lost_seconds_total", "counter", "Seconds the tracker was lost.", t.lost_seconds());
   }

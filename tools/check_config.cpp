@@ -116,7 +116,8 @@ std::string summarize(const config::LoadedConfig& config) {
     const config::Tracking& t = *v.tracking;
     out << "  tracking: ";
     if (t.source == config::TrackingSource::dtrack) {
-      out << "DTrack's ASCII output on " << t.listen << ":" << t.port << " (UDP), body " << t.body;
+      out << "DTrack's ASCII output on " << t.listen << ":" << t.port << " (UDP)"
+          << (t.from.empty() ? std::string() : " from " + t.from + " only") << ", body " << t.body;
     } else {
       out << "replay of " << t.file << " (looped)";
     }

@@ -122,6 +122,7 @@ schema::Tracking to_schema(const Tracking& tracking) {
   schema::Tracking out;
   out.set_source(std::string(to_string(tracking.source)));
   out.set_listen(tracking.listen);
+  out.set_from(tracking.from);
   out.set_port(tracking.port);
   out.set_file(tracking.file);
   out.set_body(tracking.body);

@@ -97,6 +97,13 @@ Tracking parse_tracking(const schema::Tracking& t, const std::string& path, std:
       out.listen = t.listen();
     }
   }
+  if (!t.from().empty()) {
+    if (!is_ip_address(t.from())) {
+      problems.push_back({path + ".from", "'" + t.from() + "' is not an IPv4 or IPv6 address (the tracker's)"});
+    } else {
+      out.from = t.from();
+    }
+  }
   if (t.port() > 65535) {
     problems.push_back({path + ".port", "must be 1..65535, or 0 for " + std::to_string(kDefaultTrackingPort) +
                                             " (got " + std::to_string(t.port()) + ")"});

@@ -35,6 +35,7 @@ inline constexpr double kMostTrackingLatencyMs = 500.0;
 struct Tracking {
   TrackingSource source = TrackingSource::dtrack;
   std::string listen = "0.0.0.0";  // dtrack
+  std::string from;                // dtrack: the tracker's address, datagrams from others ignored; empty: any
   std::uint16_t port = kDefaultTrackingPort;
   std::string file;        // replay: resolved against the config file's folder when parsed
   std::uint32_t body = 0;  // dtrack: the body's id in DTrack's output

@@ -1,5 +1,7 @@
 #include "net/stamped_receive.h"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <sys/socket.h>
 
 #include <cerrno>
@@ -33,13 +35,14 @@ clock::Nanos monotonic_from_realtime(clock::Nanos realtime) {
   return mapped;
 }
 
-}  // namespace
-
-StampedRead read_stamped(int fd, std::span<std::uint8_t> buffer) {
+// One recvmsg; `from` (may be null) gets the sender's address.
+StampedRead receive(int fd, std::span<std::uint8_t> buffer, sockaddr_storage* from, bool datagram) {
   StampedRead read;
   iovec io{buffer.data(), buffer.size()};
   alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
   msghdr message{};
+  message.msg_name = from;
+  message.msg_namelen = from != nullptr ? sizeof(sockaddr_storage) : 0;
   message.msg_iov = &io;
   message.msg_iovlen = 1;
   message.msg_control = control;
@@ -54,7 +57,7 @@ StampedRead read_stamped(int fd, std::span<std::uint8_t> buffer) {
         (errno == EAGAIN || errno == EWOULDBLOCK) ? StampedRead::Status::would_block : StampedRead::Status::failed;
     return read;
   }
-  if (count == 0) {
+  if (count == 0 && !datagram) {
     read.status = StampedRead::Status::closed;
     return read;
   }
@@ -71,6 +74,34 @@ StampedRead read_stamped(int fd, std::span<std::uint8_t> buffer) {
   }
   if (!stamped) read.received = clock::monotonic_now();
   return read;
+}
+
+std::string address_text(const sockaddr_storage& from) {
+  char text[INET6_ADDRSTRLEN] = {};
+  if (from.ss_family == AF_INET) {
+    const auto& v4 = reinterpret_cast<const sockaddr_in&>(from);
+    ::inet_ntop(AF_INET, &v4.sin_addr, text, sizeof text);
+  } else if (from.ss_family == AF_INET6) {
+    const auto& v6 = reinterpret_cast<const sockaddr_in6&>(from);
+    if (IN6_IS_ADDR_V4MAPPED(&v6.sin6_addr)) {
+      ::inet_ntop(AF_INET, &v6.sin6_addr.s6_addr[12], text, sizeof text);
+    } else {
+      ::inet_ntop(AF_INET6, &v6.sin6_addr, text, sizeof text);
+    }
+  }
+  return text;
+}
+
+}  // namespace
+
+StampedRead read_stamped(int fd, std::span<std::uint8_t> buffer) { return receive(fd, buffer, nullptr, false); }
+
+StampedDatagram read_datagram_stamped(int fd, std::span<std::uint8_t> buffer) {
+  sockaddr_storage from{};
+  StampedDatagram datagram;
+  datagram.read = receive(fd, buffer, &from, true);
+  if (datagram.read.status == StampedRead::Status::data) datagram.sender = address_text(from);
+  return datagram;
 }
 
 }  // namespace optique::net

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 
 #include "clock/clock.h"
 
@@ -33,5 +34,12 @@ struct StampedRead {
 };
 
 [[nodiscard]] StampedRead read_stamped(int fd, std::span<std::uint8_t> buffer);
+
+// One datagram (UDP) and who sent it; an empty datagram is data of 0 bytes.
+struct StampedDatagram {
+  StampedRead read;
+  std::string sender;  // its address (an IPv4-mapped one as IPv4); empty if unknown
+};
+[[nodiscard]] StampedDatagram read_datagram_stamped(int fd, std::span<std::uint8_t> buffer);
 
 }  // namespace optique::net

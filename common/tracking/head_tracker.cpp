@@ -52,20 +52,34 @@ std::string_view to_string(TrackerState state) {
 HeadTracker::HeadTracker(const config::Tracking& settings, const glm::dquat& rest_turn)
     : settings_(settings), rest_turn_(rest_turn), predictor_(settings.prediction, settings.smoothing) {}
 
-std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos arrival) {
+std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos arrival, std::string_view sender) {
   ++counts_.datagrams;
   const auto once = [](bool& said, std::string text) -> std::optional<std::string> {
     if (said) return std::nullopt;
     said = true;
     return text + " (further ones are only counted)";
   };
-  if (last_read_ && arrival - *last_read_ < kFloodInterval) {
+  if (!settings_.from.empty() && sender != settings_.from) {
+    ++counts_.other_sender;
+    return once(said_other_sender_, "tracker: ignored datagrams from " + std::string(sender) +
+                                        ": viewer.tracking.from is " + settings_.from);
+  }
+  auto last = last_read_.find(sender);
+  if (last != last_read_.end() && arrival - last->second < kFloodInterval) {
     ++counts_.flood;
-    return once(said_flood_, "tracker: datagrams come faster than " +
-                                 std::to_string(clock::kNanosPerSecond / kFloodInterval) +
+    return once(said_flood_, "tracker: datagrams from " +
+                                 (sender.empty() ? std::string("one sender") : std::string(sender)) +
+                                 " come faster than " + std::to_string(clock::kNanosPerSecond / kFloodInterval) +
                                  " a second; the extra ones are dropped unread");
   }
-  last_read_ = arrival;
+  if (last == last_read_.end()) {
+    if (last_read_.size() >= kMostSenders) {
+      last_read_.erase(std::min_element(last_read_.begin(), last_read_.end(),
+                                        [](const auto& a, const auto& b) { return a.second < b.second; }));
+    }
+    last = last_read_.emplace(std::string(sender), arrival).first;
+  }
+  last->second = arrival;
   auto frame = parse_dtrack(bytes);
   if (!frame) {
     ++counts_.malformed;

@@ -19,6 +19,7 @@
 // return is said once.
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -31,6 +32,9 @@
 namespace optique::tracking {
 
 inline constexpr Nanos kFloodInterval = 500'000;  // 2 kHz: DTrack sends at most 300 frames a second
+// The senders whose last datagram is remembered for the flood rule; beyond
+// these, the one heard from longest ago is forgotten.
+inline constexpr std::size_t kMostSenders = 64;
 
 enum class TrackerState { waiting, tracking, holding, easing, resting };
 [[nodiscard]] std::string_view to_string(TrackerState state);
@@ -41,7 +45,8 @@ struct TrackingCounts {
   std::uint64_t malformed = 0;     // did not parse: garbage, NaN, not a rotation
   std::uint64_t without_body = 0;  // parsed, but the configured body was not in it
   std::uint64_t backwards = 0;     // older than the last sample taken
-  std::uint64_t flood = 0;         // dropped unread, too soon after the last
+  std::uint64_t flood = 0;         // dropped unread, too soon after the sender's last
+  std::uint64_t other_sender = 0;  // dropped unread, not from viewer.tracking.from
   std::uint64_t losses = 0;        // times the tracker was lost
   Nanos lost_ns = 0;               // time spent lost, up to the last frame
 };
@@ -58,9 +63,12 @@ class HeadTracker {
   // turned to the world's right (the master's: rotation(head_right, x)).
   explicit HeadTracker(const config::Tracking& settings, const glm::dquat& rest_turn = {1.0, 0.0, 0.0, 0.0});
 
-  // A DTrack datagram that arrived at `arrival` (master clock). What is worth
-  // a log line (the first of each kind of refusal; further ones are counted).
-  [[nodiscard]] std::optional<std::string> datagram(std::string_view bytes, Nanos arrival);
+  // A DTrack datagram that arrived at `arrival` (master clock) from `sender`
+  // (its address). What is worth a log line (the first of each kind of refusal;
+  // further ones are counted). The flood rule is each sender's: a host that
+  // floods the port does not starve the tracker.
+  [[nodiscard]] std::optional<std::string> datagram(std::string_view bytes, Nanos arrival,
+                                                    std::string_view sender = {});
   // A sample in tracker space (metres) that shows the head at `time` and
   // arrived then (replay).
   void sample(Nanos time, const glm::dvec3& position, const glm::dquat& orientation);
@@ -86,8 +94,8 @@ class HeadTracker {
   int backwards_in_a_row_ = 0;
   TrackingCounts counts_;
   TrackerState state_ = TrackerState::waiting;
-  std::optional<Nanos> last_read_;     // the last datagram parsed (flood)
-  std::optional<Nanos> last_arrival_;  // the last sample taken
+  std::map<std::string, Nanos, std::less<>> last_read_;  // each sender's last datagram parsed (flood)
+  std::optional<Nanos> last_arrival_;                    // the last sample taken
   std::optional<std::uint64_t> last_frame_;
   std::optional<double> last_timestamp_;
   std::optional<Nanos> lost_since_;
@@ -96,6 +104,7 @@ class HeadTracker {
   bool said_without_body_ = false;
   bool said_backwards_ = false;
   bool said_flood_ = false;
+  bool said_other_sender_ = false;
 };
 
 // The turn that carries `head_right` (a unit vector in the tracked body's

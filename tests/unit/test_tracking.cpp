@@ -172,6 +172,37 @@ TEST(HeadTracker, BadInputIsIgnoredAndCounted) {
   EXPECT_NEAR(at(tracker, flood_start + 20 * kMs, flood_start + 20 * kMs, {}, said).pose.position.y, 1.5, 1e-12);
 }
 
+// The flood rule is each sender's: a host that floods the port at 100 kHz does
+// not starve the tracker's 60 Hz. With `from`, only the tracker is heard.
+TEST(HeadTracker, AFloodingHostDoesNotStarveTheTracker) {
+  HeadTracker tracker(settings());
+  std::uint64_t frame = 1;
+  for (Nanos t = 0; t < 1000 * kMs; t += 10'000) {
+    if (t % (16 * kMs) == 0) {
+      EXPECT_FALSE(tracker.datagram(datagram(frame++, 4, {0, 1000, 0}), t, "10.0.0.2")) << "the tracker at " << t;
+    }
+    (void)tracker.datagram("junk", t + 1'000, "10.0.0.66");
+  }
+  EXPECT_EQ(tracker.counts().samples, frame - 1) << "every sample of the tracker taken";
+  EXPECT_GT(tracker.counts().flood, 90'000u) << "the flood dropped unread";
+  EXPECT_LT(tracker.counts().malformed, 2'100u) << "at most one junk datagram read every 0.5 ms";
+
+  config::Tracking only = settings();
+  only.from = "10.0.0.2";
+  HeadTracker filtered(only);
+  const auto said = filtered.datagram(datagram(1, 4, {0, 1000, 0}), 10 * kMs, "10.0.0.66");
+  ASSERT_TRUE(said);
+  EXPECT_NE(said->find("ignored datagrams from 10.0.0.66: viewer.tracking.from is 10.0.0.2"), std::string::npos);
+  EXPECT_FALSE(filtered.datagram(datagram(2, 4, {0, 1000, 0}), 20 * kMs, "10.0.0.2"));
+  EXPECT_EQ(filtered.counts().other_sender, 1u);
+  EXPECT_EQ(filtered.counts().samples, 1u);
+  // Many senders: the oldest are forgotten, the flood rule still holds for each.
+  HeadTracker crowded(settings());
+  for (int i = 0; i < 1000; ++i)
+    (void)crowded.datagram("junk", 10 * kMs + i, "10.1." + std::to_string(i / 256) + "." + std::to_string(i % 256));
+  EXPECT_EQ(crowded.counts().malformed, 1000u) << "each sender's first datagram is read";
+}
+
 // The tracker's own latency (ts2) and the configured one place a sample at the
 // moment it shows; a prediction from constant motion is exact.
 TEST(HeadTracker, ConstantVelocityPredictsConstantMotionExactly) {
