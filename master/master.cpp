@@ -209,6 +209,7 @@ Result<void> Master::start_status_service(const config::StatusServer& settings) 
             config::is_loopback_address(settings.listen) ? "open on loopback" : "need the token",
             options_.run.secret ? "need the token (optique-master --print-status-token)"
                                 : "off (no master.secret_file, so no token)");
+  publish_status();  // before the port is told: a first request finds a status
   if (!options_.status_port_file.empty()) {
     const std::string temp = options_.status_port_file + ".tmp";
     std::ofstream(temp) << port.value() << "\n";
@@ -218,7 +219,6 @@ Result<void> Master::start_status_service(const config::StatusServer& settings) 
       return Error{"cannot write the status port file '" + options_.status_port_file + "': " + renamed.message()};
     }
   }
-  publish_status();
   return {};
 }
 
@@ -320,7 +320,10 @@ void Master::carry_out(Action& action) {
                    if (net::Connection* c = connection(a.peer)) c->set_max_payload_bytes(a.bytes);
                  },
                  [&](Arm& a) { arm(a.timer, a.at); },
-                 [&](Disarm& a) { timers_[static_cast<std::size_t>(a.timer)]->cancel(); },
+                 [&](Disarm& a) {
+                   ++timer_generations_[static_cast<std::size_t>(a.timer)];
+                   timers_[static_cast<std::size_t>(a.timer)]->cancel();
+                 },
                  [&](StopAccepting&) {
                    boost::system::error_code ignored;
                    acceptor_.close(ignored);
@@ -337,8 +340,12 @@ void Master::carry_out(Action& action) {
 void Master::arm(Timer timer, clock::Nanos at) {
   asio::steady_timer& t = *timers_[static_cast<std::size_t>(timer)];
   t.expires_after(std::chrono::nanoseconds(std::max<clock::Nanos>(0, at - clock::monotonic_now())));
-  t.async_wait([this, timer](const boost::system::error_code& error) {
-    if (!error) carry_out(protocol_->timer(timer, clock::monotonic_now()));
+  // A timer that expired before it was disarmed or armed again still runs its
+  // handler, with success: the generation tells it that it is stale.
+  const std::uint64_t generation = ++timer_generations_[static_cast<std::size_t>(timer)];
+  t.async_wait([this, timer, generation](const boost::system::error_code& error) {
+    if (error || generation != timer_generations_[static_cast<std::size_t>(timer)]) return;
+    carry_out(protocol_->timer(timer, clock::monotonic_now()));
   });
 }
 

@@ -102,6 +102,7 @@ class Master {
   bool accept_failing_ = false;
   asio::signal_set signals_;
   std::array<std::unique_ptr<asio::steady_timer>, 6> timers_;  // one per Timer
+  std::array<std::uint64_t, 6> timer_generations_{};           // each arm or disarm: the one pending
   asio::steady_timer housekeeping_timer_;
   std::map<PeerId, std::shared_ptr<net::Connection>> connections_;
   PeerId next_peer_ = 1;

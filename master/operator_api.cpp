@@ -5,6 +5,7 @@
 #include <array>
 #include <cctype>
 
+#include "config/address.h"
 #include "master/status_metrics.h"
 
 namespace optique::master {
@@ -17,6 +18,19 @@ bool starts_with_ignoring_case(std::string_view text, std::string_view prefix) {
       return false;
   }
   return true;
+}
+
+// A Host that names this machine by number or as localhost. Reads open on
+// loopback answer only these: a web page whose name was rebound to 127.0.0.1
+// (DNS rebinding) sends its own name, and learns nothing.
+bool host_is_local(std::string host) {
+  if (host.empty()) return true;  // HTTP/1.0
+  if (host.front() == '[') {
+    const auto end = host.find(']');
+    return end != std::string::npos && config::is_ip_address(host.substr(1, end - 1));
+  }
+  if (const auto colon = host.rfind(':'); colon != std::string::npos) host.resize(colon);
+  return host == "localhost" || config::is_ip_address(host);
 }
 
 // "Bearer <token>" with the right token, compared in constant time.
@@ -99,8 +113,10 @@ Routed route(const http::Request& request, const OperatorAccess& access, const S
     http::Response accepted;
     accepted.status = 202;
     accepted.content_type = "application/json";
+    // Queued: the master carries it out on its own thread, and says in its log
+    // (and the page's warnings) what came of it.
     accepted.body = std::make_shared<const std::string>("{\"command\":\"" + std::string(to_string(control.command)) +
-                                                        "\",\"accepted\":true}\n");
+                                                        "\",\"queued\":true}\n");
     return {std::move(accepted), control.command};
   }
 
@@ -112,6 +128,12 @@ Routed route(const http::Request& request, const OperatorAccess& access, const S
   const bool data = request.path == "/status.json" || request.path == "/metrics" || request.path == "/events";
   if (!data) return {http::text_response(404, request.path + ": no such page (try /, /status.json or /metrics)"), {}};
   if (!read) return {method_not_allowed(request, "GET, HEAD"), std::nullopt};
+  if (!access.reads_need_token && !host_is_local(request.host)) {
+    return {http::text_response(403, "Host '" + request.host +
+                                         "': this status server answers reads without a token only to this machine "
+                                         "by its address or as localhost"),
+            std::nullopt};
+  }
   if (access.reads_need_token) {
     if (!access.token) return {http::text_response(403, "this status server needs a token and has none"), {}};
     if (!authorized(request, *access.token)) {
@@ -123,7 +145,8 @@ Routed route(const http::Request& request, const OperatorAccess& access, const S
   if (request.path == "/status.json") return {serve(latest.json, "application/json"), std::nullopt};
   if (request.path == "/metrics") return {serve(latest.metrics, kMetricsContentType), std::nullopt};
   http::Response stream;
-  stream.event_stream = true;
+  stream.content_type = "text/event-stream";
+  stream.event_stream = request.method == http::Method::get;  // HEAD: the header only
   return {std::move(stream), std::nullopt};
 }
 

@@ -333,12 +333,12 @@ Actions MasterProtocol::closed(PeerId peer, const std::string& reason, clock::Na
       }
     }
     std::erase(ready_for_swap_, slot);  // a node that is gone is not told to swap
-    present_owed(slot, now, out);       // nor waited for to show the last one
     if (state_ != RunState::closing && state_ != RunState::done) rebalance_lights(true);
     if (barrier_.active()) {
       barrier_.leave(slot);
       if (barrier_.complete()) swap(now, out);
     }
+    present_owed(slot, now, out);  // nor waited for to show the last one (after its lights moved)
   }
   finish_if_all_gone(out);
   return out;
@@ -381,6 +381,7 @@ Actions MasterProtocol::timer(Timer timer, clock::Nanos now) {
       start_frames(now, out);
       break;
     case Timer::next_frame:
+      if (barrier_.active()) break;  // begun already (the last one showed it)
       if (!presents_owed_.empty() && now < presents_grace_end_) {
         // Its time has come, but a node is still to show the last frame: the
         // next one begins when it has (or when it no longer would).
@@ -646,6 +647,8 @@ void MasterProtocol::present_owed(std::size_t slot, clock::Nanos now, Actions& o
 void MasterProtocol::drain(const std::string& reason, clock::Nanos now, Actions& out) {
   if (state_ != RunState::starting && state_ != RunState::running) return;
   stopped_because_ = reason;
+  paused_ = false;
+  begin_on_resume_ = false;
   const bool frames_ran = state_ == RunState::running;
   state_ = RunState::draining;
   out.push_back(Disarm{Timer::next_frame});
@@ -810,6 +813,10 @@ Actions MasterProtocol::operator_command(OperatorCommand command, const std::str
       }
       break;
     case OperatorCommand::resume:
+      if (state_ != RunState::running) {
+        say(spdlog::level::info, who + " asked to resume, but frames are not running");
+        break;
+      }
       if (!paused_) {
         say(spdlog::level::info, who + " asked to resume, but nothing is paused");
         break;
@@ -830,8 +837,6 @@ Actions MasterProtocol::operator_command(OperatorCommand command, const std::str
         break;
       }
       say(spdlog::level::warn, "stop asked by " + who + ": finishing the current frame and shutting down");
-      paused_ = false;
-      begin_on_resume_ = false;
       drain("stopped by " + who, now, out);
       break;
   }

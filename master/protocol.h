@@ -235,8 +235,10 @@ class MasterProtocol {
   Barrier barrier_;
   std::vector<std::size_t> ready_for_swap_;
   // The nodes told to show the last swapped frame that have not said they did.
-  // A frame never begins while one of them still waits for its deadline: its
-  // drawing on a shared machine (local nodes, llvmpipe) would delay that present.
+  // Behind schedule, the next frame waits for them (up to a period after the
+  // deadline, when they would no longer show it): its drawing on a shared
+  // machine (local nodes, llvmpipe) would delay their presents. On schedule the
+  // next frame's time comes after their presents anyway.
   std::vector<std::size_t> presents_owed_;
   std::uint64_t presents_owed_frame_ = 0;
   clock::Nanos presents_grace_end_ = 0;

@@ -133,9 +133,13 @@ std::string summarize(const config::LoadedConfig& config) {
       << (m.straggler_policy == config::StragglerPolicy::drop ? "drop the frame" : "present without the late node")
       << "), present lead " << m.present_lead.count() << " µs\n";
   if (m.status) {
-    out << "  status: http://" << m.status->listen << ":" << m.status->port << "/ (page, /status.json, /metrics); "
-        << (config::is_loopback_address(m.status->listen) ? "reads open on loopback" : "reads need the token")
-        << ", controls need the token; at most " << m.status->max_connections << " connections\n";
+    const std::string& listen = m.status->listen;
+    out << "  status: http://" << (listen.find(':') != std::string::npos ? "[" + listen + "]" : listen) << ":"
+        << m.status->port << "/ (page, /status.json, /metrics); "
+        << (config::is_loopback_address(listen) ? "reads open on loopback" : "reads need the token") << ", "
+        << (m.secret_file.empty() ? "controls off (they need a token, and there is no master.secret_file)"
+                                  : "controls need the token")
+        << "; at most " << m.status->max_connections << " connections\n";
   }
   out << "  scene: " << (inst.scene.builtin.empty() ? "glTF " + inst.scene.gltf : "builtin " + inst.scene.builtin);
   if (!inst.scene.light_switches.empty()) {

@@ -101,7 +101,7 @@ Tracking parse_tracking(const schema::Tracking& t, const std::string& path, std:
     if (!is_ip_address(t.from())) {
       problems.push_back({path + ".from", "'" + t.from() + "' is not an IPv4 or IPv6 address (the tracker's)"});
     } else {
-      out.from = t.from();
+      out.from = canonical_address(t.from());  // as senders are written (net::read_datagram_stamped)
     }
   }
   if (t.port() > 65535) {

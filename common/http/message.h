@@ -18,6 +18,7 @@ struct Request {
   std::string path;           // the target up to '?'
   std::string query;          // after '?', as sent
   std::string authorization;  // the Authorization header; empty: none
+  std::string host;           // the Host header; empty: none
   std::string peer;           // "address:port"
 };
 

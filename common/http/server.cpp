@@ -6,6 +6,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/http/span_body.hpp>
 
+#include <array>
 #include <deque>
 #include <optional>
 
@@ -51,6 +52,7 @@ class Server::Session : public std::enable_shared_from_this<Session> {
     counters_->refused_busy += 1;
     Response busy = text_response(503, "too many connections to this status server; try again shortly");
     busy.headers.emplace_back("Retry-After", "1");
+    refusing_ = true;  // closed once written: lingering is for the clients let in
     write_response(std::move(busy), 11, false);
   }
 
@@ -127,9 +129,12 @@ class Server::Session : public std::enable_shared_from_this<Session> {
     if (const auto found = message.find(bhttp::field::authorization); found != message.end()) {
       request.authorization = std::string(found->value());
     }
+    if (const auto found = message.find(bhttp::field::host); found != message.end()) {
+      request.host = std::string(found->value());
+    }
     request.peer = peer_;
     Response response = server_.handler_(request);
-    if (response.event_stream && response.status == 200) {
+    if (response.event_stream && response.status == 200 && request.method != Method::head) {
       start_stream();
       return;
     }
@@ -160,11 +165,35 @@ class Server::Session : public std::enable_shared_from_this<Session> {
   void on_written(beast::error_code error, bool keep_alive) {
     if (closed_) return;
     if (error == beast::error::timeout) counters_->timed_out += 1;
-    if (error || !keep_alive) {
+    if (error || refusing_) {
       close();
       return;
     }
+    if (!keep_alive) {
+      linger();
+      return;
+    }
     read_request();
+  }
+
+  // The answer is out; what the client still sends (the rest of a body too
+  // large) is read and dropped for a moment before closing, or the kernel would
+  // answer it with a reset that can overtake the answer.
+  void linger() {
+    beast::error_code ignored;
+    stream_.socket().shutdown(asio::ip::tcp::socket::shutdown_send, ignored);
+    stream_.expires_after(std::chrono::seconds(1));  // for every read from here on
+    drop_what_comes();
+  }
+  void drop_what_comes() {
+    stream_.async_read_some(asio::buffer(discard_), [self = shared_from_this()](beast::error_code error, std::size_t) {
+      if (self->closed_) return;
+      if (error) {
+        self->close();  // the client closed too, or a second passed
+        return;
+      }
+      self->drop_what_comes();
+    });
   }
 
   // No length and no chunks: the stream ends when the connection does.
@@ -212,10 +241,12 @@ class Server::Session : public std::enable_shared_from_this<Session> {
   bool streaming_ = false;
   bool writing_ = false;
   bool closed_ = false;
+  bool refusing_ = false;
+  std::array<char, 4096> discard_{};
 };
 
 Server::Server(asio::io_context& io, ServerLimits limits, Handler handler, spdlog::logger& log)
-    : io_(io), limits_(limits), handler_(std::move(handler)), log_(log), acceptor_(io) {}
+    : io_(io), limits_(limits), handler_(std::move(handler)), log_(log), acceptor_(io), accept_retry_(io) {}
 
 Server::~Server() = default;
 
@@ -238,6 +269,7 @@ void Server::accept_next() {
   acceptor_.async_accept([this](const boost::system::error_code& error, asio::ip::tcp::socket socket) {
     if (stopped_ || error == asio::error::operation_aborted) return;
     if (!error) {
+      accept_failing_ = false;
       counters_->accepted += 1;
       const std::uint64_t id = next_id_++;
       auto session = std::make_shared<Session>(*this, id, std::move(socket));
@@ -248,7 +280,14 @@ void Server::accept_next() {
         session->start();
       }
     } else {
-      log_.debug("status: accept failed: {}", error.message());
+      // Out of file descriptors and the like: again in a moment, not in a spin.
+      if (!accept_failing_) log_.warn("status: accept failed: {}; trying again every 100 ms", error.message());
+      accept_failing_ = true;
+      accept_retry_.expires_after(std::chrono::milliseconds(100));
+      accept_retry_.async_wait([this](const boost::system::error_code& e) {
+        if (!e && !stopped_) accept_next();
+      });
+      return;
     }
     accept_next();
   });
@@ -277,6 +316,7 @@ void Server::stop() {
     stopped_ = true;
     boost::system::error_code ignored;
     acceptor_.close(ignored);
+    accept_retry_.cancel();
     std::vector<std::shared_ptr<Session>> open;
     for (auto& [id, weak] : sessions_) {
       if (auto session = weak.lock()) open.push_back(std::move(session));

@@ -14,6 +14,7 @@
 #include <spdlog/logger.h>
 #include <boost/asio/io_context.hpp>
 #include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
 
 #include <atomic>
 #include <chrono>
@@ -84,12 +85,14 @@ class Server {
   Handler handler_;
   spdlog::logger& log_;
   asio::ip::tcp::acceptor acceptor_;
+  asio::steady_timer accept_retry_;
   // On the io thread only. A session lives while an operation of its own is
   // pending; an event stream waits for events, so the server holds it.
   std::map<std::uint64_t, std::weak_ptr<Session>> sessions_;
   std::map<std::uint64_t, std::shared_ptr<Session>> streams_;
   std::uint64_t next_id_ = 1;
   bool stopped_ = false;
+  bool accept_failing_ = false;  // said once per streak
   struct Counters {
     std::atomic<std::uint64_t> accepted{0}, requests{0}, refused_busy{0}, timed_out{0}, too_large{0}, bad_requests{0},
         streams_behind{0}, open{0}, streams{0};

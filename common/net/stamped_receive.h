@@ -38,7 +38,7 @@ struct StampedRead {
 // One datagram (UDP) and who sent it; an empty datagram is data of 0 bytes.
 struct StampedDatagram {
   StampedRead read;
-  std::string sender;  // its address (an IPv4-mapped one as IPv4); empty if unknown
+  std::string sender;  // its address as inet_ntop writes it (an IPv4-mapped one as IPv4); empty if unknown
 };
 [[nodiscard]] StampedDatagram read_datagram_stamped(int fd, std::span<std::uint8_t> buffer);
 

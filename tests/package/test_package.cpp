@@ -65,7 +65,7 @@ TEST(Package, TheDebianPackageHoldsEverythingAndRunsFromAnExtractedCopy) {
   for (const char* path :
        {"./usr/bin/optique-master", "./usr/bin/optique-node", "./usr/bin/optique-node-gl", "./usr/bin/optique-tools",
         "./usr/share/optique/configs/powerwall-2x2.json", "./usr/share/doc/optique/README.md",
-        "./lib/systemd/system/optique-master.service", "./lib/systemd/system/optique-node@.service",
+        "./usr/lib/systemd/system/optique-master.service", "./usr/lib/systemd/system/optique-node@.service",
         "./etc/optique/master.env", "./etc/optique/node.env"}) {
     EXPECT_NE(contents.find(std::string(path) + "\n"), std::string::npos) << path << " not in\n" << contents;
   }
@@ -100,7 +100,9 @@ TEST(Package, TheDebianPackageHoldsEverythingAndRunsFromAnExtractedCopy) {
   const std::string units = root + "/usr/lib/systemd/system";
   fs::create_directories(units);
   for (const auto& entry : fs::directory_iterator("/lib/systemd/system")) {
-    if (entry.is_regular_file()) fs::copy_file(entry.path(), units / entry.path().filename());
+    if (entry.is_regular_file() && !fs::exists(units / entry.path().filename())) {
+      fs::copy_file(entry.path(), units / entry.path().filename());
+    }
   }
   const std::string verify_log = dir + "/verify.log";
   EXPECT_EQ(run({"/usr/bin/systemd-analyze", "verify", "--man=no", "--root=" + root, "optique-master.service",

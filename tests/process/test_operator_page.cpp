@@ -42,14 +42,16 @@ struct StatusRun {
   [[nodiscard]] nlohmann::json status(const std::string& token = "") const {
     const HttpReply reply = http_request(port, "GET", "/status.json", token);
     EXPECT_EQ(reply.status, 200) << reply.error << reply.body;
-    return reply.status == 200 ? nlohmann::json::parse(reply.body) : nlohmann::json();
+    return reply.status == 200 ? nlohmann::json::parse(reply.body, nullptr, false) : nlohmann::json();
   }
   // Polls /status.json until `done` holds.
   bool status_until(const std::function<bool(const nlohmann::json&)>& done, const std::string& token = "") const {
     return poll_until(
         [&] {
           const HttpReply reply = http_request(port, "GET", "/status.json", token);
-          return reply.status == 200 && done(nlohmann::json::parse(reply.body));
+          if (reply.status != 200 || !reply.error.empty()) return false;
+          const auto status = nlohmann::json::parse(reply.body, nullptr, false);
+          return !status.is_discarded() && done(status);
         },
         20s);
   }

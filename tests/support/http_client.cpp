@@ -107,6 +107,15 @@ bool RawClient::read_until(const std::string& needle, std::chrono::milliseconds 
   return true;
 }
 
+bool RawClient::discard_for(std::chrono::milliseconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (!closed_ && std::chrono::steady_clock::now() < until) {
+    (void)read_once(std::chrono::duration_cast<std::chrono::milliseconds>(until - std::chrono::steady_clock::now()));
+    received_.clear();
+  }
+  return !closed_;
+}
+
 bool RawClient::closed_within(std::chrono::milliseconds timeout) {
   (void)read_until_closed(timeout);
   return closed_;

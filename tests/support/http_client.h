@@ -36,6 +36,8 @@ class RawClient {
   bool read_until(const std::string& needle, std::chrono::milliseconds timeout);
   // Whether the peer closed (or reset) the connection within `timeout`.
   [[nodiscard]] bool closed_within(std::chrono::milliseconds timeout);
+  // Reads and drops what arrives for `timeout`; whether the connection is still open.
+  bool discard_for(std::chrono::milliseconds timeout);
   [[nodiscard]] const std::string& received() const { return received_; }
   // Reads one whole reply (by Content-Length) off a kept-alive connection.
   [[nodiscard]] HttpReply read_reply(std::chrono::milliseconds timeout);

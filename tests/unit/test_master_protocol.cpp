@@ -279,6 +279,10 @@ TEST_F(MasterTest, TheNextFrameBeginsOnceTheLastIsShown) {
   EXPECT_TRUE(shown(2, 0).empty()) << "a second report changes nothing";
   a = shown(4, 0);
   EXPECT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u) << "the last one showed it";
+  // The grace timer may have expired already, its handler queued: when it
+  // comes, the frame is under way and nothing more begins.
+  EXPECT_TRUE(sent_to(master_->timer(Timer::next_frame, deadline + 16'666'666), 1, wire::Envelope::kFrameBegin).empty())
+      << "never two frames begun at once";
   EXPECT_NE(std::find_if(a.begin(), a.end(),
                          [](const Action& x) {
                            return std::holds_alternative<Disarm>(x) && std::get<Disarm>(x).timer == Timer::next_frame;
@@ -310,7 +314,8 @@ TEST_F(MasterTest, EachFrameCarriesTheTrackedHead) {
   ASSERT_EQ(first.size(), 1u);
   EXPECT_FALSE(first.front().frame_begin().delta().has_viewer()) << "resting where the config's eye is";
   // Turned a quarter about the tracker's z, 0.5 m to the right of the rest.
-  EXPECT_TRUE(master_->tracker_datagram("fr 1\n6d 1 [2 1.0][500 1600 2000][0 1 0 -1 0 0 0 0 1]\n", "10.0.0.9", now_).empty());
+  EXPECT_TRUE(
+      master_->tracker_datagram("fr 1\n6d 1 [2 1.0][500 1600 2000][0 1 0 -1 0 0 0 0 1]\n", "10.0.0.9", now_).empty());
   const auto garbage = master_->tracker_datagram("not dtrack", "10.0.0.9", now_ + 5 * kMs);
   ASSERT_EQ(garbage.size(), 1u);
   ASSERT_TRUE(std::holds_alternative<Log>(garbage.front()));
@@ -491,6 +496,20 @@ TEST_F(MasterTest, TheOperatorPausesResumesAndStops) {
   EXPECT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "the frame under way finishes";
   ASSERT_NE(armed(a, Timer::last_presents), nullptr);
   EXPECT_EQ(master_->report().stopped_because(), "stopped by the operator (127.0.0.1:6002)");
+}
+
+// Paused, then interrupted: a resume after that resumes nothing, and says so.
+TEST_F(MasterTest, NoResumeWhileStopping) {
+  load("powerwall-2x2.json");
+  Actions a = join_all();
+  const std::uint64_t hash = hash_of(a, 1);
+  (void)master_->operator_command(OperatorCommand::pause, "x", now_);
+  for (PeerId p = 1; p <= 4; ++p) (void)ready(p, 0, hash);
+  (void)master_->interrupted("SIGINT", now_);
+  a = master_->operator_command(OperatorCommand::resume, "127.0.0.1:6001", now_);
+  EXPECT_TRUE(logged(a, "asked to resume, but frames are not running"));
+  EXPECT_FALSE(logged(a, "resumed by"));
+  EXPECT_TRUE(sent_to(a, 1, wire::Envelope::kFrameBegin).empty());
 }
 
 // What the page shows: each node's state and counts, the run's.

@@ -48,6 +48,28 @@ TEST(OperatorApi, OnLoopbackReadsAreOpen) {
   EXPECT_FALSE(r.command);
   r = route(request(http::Method::head, "/status.json"), kLoopback, texts);
   EXPECT_EQ(r.response.status, 200u) << "HEAD as GET (the server sends no body)";
+  r = route(request(http::Method::head, "/events"), kLoopback, texts);
+  EXPECT_EQ(r.response.status, 200u);
+  EXPECT_FALSE(r.response.event_stream) << "HEAD gets the header, not a stream";
+  EXPECT_EQ(r.response.content_type, "text/event-stream");
+}
+
+// Reads open on loopback answer this machine by its address or as localhost
+// only: a page whose name was rebound to 127.0.0.1 sends its own name.
+TEST(OperatorApi, OpenReadsRefuseAForeignHost) {
+  const StatusTexts texts = published();
+  for (const char* host : {"127.0.0.1:7480", "localhost:7480", "[::1]:7480", "localhost", ""}) {
+    http::Request r = request(http::Method::get, "/status.json");
+    r.host = host;
+    EXPECT_EQ(route(r, kLoopback, texts).response.status, 200u) << host;
+  }
+  http::Request rebound = request(http::Method::get, "/metrics");
+  rebound.host = "attacker.example:7480";
+  const Routed r = route(rebound, kLoopback, texts);
+  EXPECT_EQ(r.response.status, 403u);
+  EXPECT_NE(r.response.body->find("Host 'attacker.example:7480'"), std::string::npos);
+  rebound.authorization = "Bearer " + kToken;
+  EXPECT_EQ(route(rebound, kBeyondLoopback, texts).response.status, 200u) << "with the token, any name";
 }
 
 TEST(OperatorApi, BeyondLoopbackDataNeedsTheToken) {
@@ -85,6 +107,7 @@ TEST(OperatorApi, ControlsAlwaysNeedTheToken) {
   EXPECT_FALSE(r.command);
   r = route(request(http::Method::post, "/control/pause", "Bearer " + kToken), kLoopback, texts);
   EXPECT_EQ(r.response.status, 202u);
+  EXPECT_EQ(*r.response.body, "{\"command\":\"pause\",\"queued\":true}\n");
   EXPECT_EQ(r.command, OperatorCommand::pause);
   EXPECT_EQ(route(request(http::Method::post, "/control/resume", "Bearer " + kToken), kLoopback, texts).command,
             OperatorCommand::resume);

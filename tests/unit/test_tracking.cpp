@@ -9,6 +9,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "config/address.h"
 #include "config/tracking.h"
 #include "tracking/dtrack.h"
 #include "tracking/head_tracker.h"
@@ -196,11 +197,21 @@ TEST(HeadTracker, AFloodingHostDoesNotStarveTheTracker) {
   EXPECT_FALSE(filtered.datagram(datagram(2, 4, {0, 1000, 0}), 20 * kMs, "10.0.0.2"));
   EXPECT_EQ(filtered.counts().other_sender, 1u);
   EXPECT_EQ(filtered.counts().samples, 1u);
-  // Many senders: the oldest are forgotten, the flood rule still holds for each.
+  // Many senders: the one heard from longest ago is forgotten; the flood rule
+  // still holds for those remembered.
   HeadTracker crowded(settings());
-  for (int i = 0; i < 1000; ++i)
-    (void)crowded.datagram("junk", 10 * kMs + i, "10.1." + std::to_string(i / 256) + "." + std::to_string(i % 256));
+  const auto sender = [](int i) { return "10.1." + std::to_string(i / 256) + "." + std::to_string(i % 256); };
+  for (int i = 0; i < 1000; ++i) (void)crowded.datagram("junk", 10 * kMs + i, sender(i));
   EXPECT_EQ(crowded.counts().malformed, 1000u) << "each sender's first datagram is read";
+  (void)crowded.datagram("junk", 10 * kMs + 1000, sender(999));
+  EXPECT_EQ(crowded.counts().flood, 1u) << "a remembered sender, again within 0.5 ms";
+  (void)crowded.datagram("junk", 10 * kMs + 1001, sender(0));
+  EXPECT_EQ(crowded.counts().malformed, 1001u) << "a forgotten sender is read again";
+  // Spelled otherwise, the tracker's address is still the tracker's.
+  config::Tracking mapped = settings();
+  mapped.from = config::canonical_address("::ffff:10.0.0.2");
+  EXPECT_EQ(mapped.from, "10.0.0.2");
+  EXPECT_EQ(config::canonical_address("2001:DB8:0:0::1"), "2001:db8::1");
 }
 
 // The tracker's own latency (ts2) and the configured one place a sample at the
