@@ -1,4 +1,5 @@
 #include "master/run_config.h"
+#include "config/installation_scene.h"
 
 #include "master/light_switches.h"
 #include "master/shared_secret.h"
@@ -10,7 +11,7 @@ Result<RunConfig> load_run_config(const std::string& path, const scene::ImageDec
   auto loaded = config::load_installation(path);
   if (!loaded) return Error{loaded.error()};
   const config::SceneSource& source = loaded.value().installation.scene;
-  auto scene = scene::load_scene(source.builtin, source.gltf, decode);
+  auto scene = config::load_scene(loaded.value().installation, decode);
   if (!scene) return Error{path + ": scene: " + scene.error()};
   const std::size_t light_count = scene.value().definition.lights.size();
   auto problems = check_lighting_groups(loaded.value().installation, light_count);

@@ -12,6 +12,7 @@ packages=(
   libspdlog-dev libcli11-dev         # logging, command lines
   nlohmann-json3-dev                 # JSON syntax errors with line and column
   libtinygltf-dev                    # glTF 2.0 scene files
+  libdraco-dev                       # Draco-compressed glTF meshes (KHR_draco_mesh_compression)
   libglfw3-dev libglm-dev            # windows on projectors, render math
   libeigen3-dev                      # SVD and least squares for calibration
   libopenimageio-dev openimageio-tools  # image files and operations; oiiotool to inspect them

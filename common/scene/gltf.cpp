@@ -26,6 +26,8 @@
 #include <glm/mat3x3.hpp>
 #include <glm/vec4.hpp>
 
+#include "scene/draco_primitive.h"
+#include "scene/gltf_source.h"
 #include "util/finite.h"
 #include "util/message_text.h"
 #include "util/sha256.h"
@@ -48,14 +50,10 @@ namespace {
 // built-in scenes use intensities of about 1 to 3. So 100 cd ↦ 1.
 constexpr double kCandelaToIntensity = 1.0 / 100.0;
 
-// The light added when a file has none: white, as bright as a built-in key light,
-// 2 m above and 2 m in front of the centre of the scene's bounding box.
-constexpr float kDefaultLightIntensity = 2.0f;
-const glm::dvec3 kDefaultLightOffset{0.0, 2.0, 2.0};
-
-// Extensions a file may require: we read the first, and the second only scales a
-// factor we read.
-const std::vector<std::string> kSupportedRequiredExtensions{"KHR_lights_punctual", "KHR_materials_emissive_strength"};
+// Extensions a file may require: we read the first and the third, and the
+// second only scales a factor we read.
+const std::vector<std::string> kSupportedRequiredExtensions{"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                                            kDracoExtension};
 
 // Thrown inside the loader, caught in load_gltf: the message already starts with
 // the path.
@@ -65,39 +63,33 @@ class GltfError : public std::runtime_error {
 };
 
 // ---------------------------------------------------------------------------
-// File access for tinygltf: only below the .gltf's own folder, and every byte
-// read kept for the content hash.
+// File access for tinygltf: only the files scene/gltf_source.h read, by the
+// names it gave their buffers (source_file_name) in the folder kSourceFolder.
 
-struct FsContext {
-  std::string prefix;         // the .gltf's folder and a slash
-  std::string bytes;          // every external file read, in order
-  std::string first_missing;  // the first buffer file looked for and not found
-};
+std::optional<std::size_t> source_index(const std::string& path, const GltfSource& source) {
+  const std::string prefix = std::string(kSourceFolder) + "/";
+  if (!path.starts_with(prefix)) return std::nullopt;
+  for (std::size_t i = 1; i < source.files.size(); ++i) {
+    if (path.compare(prefix.size(), std::string::npos, source_file_name(i)) == 0) return i;
+  }
+  return std::nullopt;
+}
 
 bool fs_file_exists(const std::string& path, void* user) {
-  auto* context = static_cast<FsContext*>(user);
-  // tinygltf also looks in the working directory: not for us.
-  if (!path.starts_with(context->prefix)) return false;
-  std::error_code error;
-  const bool exists = std::filesystem::is_regular_file(path, error);
-  if (!exists && context->first_missing.empty()) context->first_missing = path;
-  return exists;
+  return source_index(path, *static_cast<const GltfSource*>(user)).has_value();
 }
 
 std::string fs_expand_path(const std::string& path, void*) { return path; }
 
 bool fs_read_whole_file(std::vector<unsigned char>* out, std::string* error, const std::string& path, void* user) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    if (error != nullptr) *error = "cannot open";
+  const auto& source = *static_cast<const GltfSource*>(user);
+  const auto index = source_index(path, source);
+  if (!index) {
+    if (error != nullptr) *error = "not a file the glTF references";
     return false;
   }
-  out->assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (in.bad()) {
-    if (error != nullptr) *error = "read error";
-    return false;
-  }
-  static_cast<FsContext*>(user)->bytes.append(out->begin(), out->end());
+  const std::string& bytes = *source.files[*index].second;
+  out->assign(bytes.begin(), bytes.end());
   return true;
 }
 
@@ -469,12 +461,12 @@ struct Track {
 
 class Loader {
  public:
-  Loader(std::string path, const tinygltf::Model& model, const ImageDecoder& decode, std::vector<std::string>& warnings)
-      : path_(std::move(path)), model_(model), decode_(decode), warnings_(warnings) {}
+  Loader(const GltfSource& source, const tinygltf::Model& model, const ImageDecoder& decode,
+         std::vector<std::string>& warnings)
+      : path_(source.path), source_(source), model_(model), decode_(decode), warnings_(warnings) {}
 
   SceneDefinition build() {
     check_version();
-    check_required_extensions();
     check_skins();
     read_animations();
     walk_scene();
@@ -483,7 +475,6 @@ class Loader {
     scene.name = scene_name();
     add_instances(scene);
     add_lights(scene);
-    if (scene.lights.empty()) add_default_light(scene);
     return scene;
   }
 
@@ -503,15 +494,6 @@ class Loader {
   void check_version() const {
     const auto& version = model_.asset.version;
     if (!version.starts_with("2.")) fail("glTF version '" + version + "' is not supported (2.x only)");
-  }
-
-  void check_required_extensions() const {
-    for (const auto& extension : model_.extensionsRequired) {
-      if (std::find(kSupportedRequiredExtensions.begin(), kSupportedRequiredExtensions.end(), extension) ==
-          kSupportedRequiredExtensions.end()) {
-        fail("required extension " + extension + " is not supported");
-      }
-    }
   }
 
   void check_skins() const {
@@ -889,6 +871,138 @@ class Loader {
     return *cached;
   }
 
+  // A primitive's vertices (positions, and normals and texture coordinates where
+  // it has them) and the order they are drawn in.
+  struct Attributes {
+    std::vector<double> positions;
+    std::vector<double> normals;
+    std::vector<double> uvs;
+    std::vector<std::uint32_t> order;
+  };
+
+  // An attribute's values, checked to be one per vertex.
+  std::vector<double> per_vertex(std::vector<double> values, std::size_t width, std::size_t vertex_count,
+                                 const std::string& label, const std::string& name) const {
+    if (values.size() / width != vertex_count) {
+      fail(label + ": " + name + " has " + std::to_string(values.size() / width) + " elements but POSITION has " +
+           std::to_string(vertex_count));
+    }
+    return values;
+  }
+
+  // Texture coordinates: FLOAT, or normalized UNSIGNED_BYTE / UNSIGNED_SHORT.
+  std::vector<double> read_uvs(int index, const std::string& label) const {
+    const auto& acc = accessor(index, label + " TEXCOORD_0");
+    if (acc.componentType == TINYGLTF_COMPONENT_TYPE_BYTE || acc.componentType == TINYGLTF_COMPONENT_TYPE_SHORT) {
+      fail(accessor_label(index, label + " TEXCOORD_0") + ": component type " + component_type_name(acc.componentType) +
+           " is not allowed for texture coordinates (FLOAT, or normalized UNSIGNED_BYTE or UNSIGNED_SHORT)");
+    }
+    return read_floats(index, label + " TEXCOORD_0", TINYGLTF_TYPE_VEC2, /*normalized_ok=*/true);
+  }
+
+  static std::optional<int> attribute(const tinygltf::Primitive& primitive, const std::string& name) {
+    const auto found = primitive.attributes.find(name);
+    if (found == primitive.attributes.end()) return std::nullopt;
+    return found->second;
+  }
+
+  Attributes read_accessors(const tinygltf::Primitive& primitive, const std::string& label) const {
+    Attributes out;
+    const auto position = attribute(primitive, "POSITION");
+    if (!position) fail(label + " has no POSITION attribute");
+    out.positions = read_floats(*position, label + " POSITION", TINYGLTF_TYPE_VEC3);
+    const std::size_t vertex_count = out.positions.size() / 3;
+    if (vertex_count > std::numeric_limits<std::uint32_t>::max()) fail(label + " has too many vertices");
+    if (const auto normal = attribute(primitive, "NORMAL")) {
+      out.normals = per_vertex(read_floats(*normal, label + " NORMAL", TINYGLTF_TYPE_VEC3), 3, vertex_count, label,
+                               "NORMAL");
+    }
+    if (const auto uv = attribute(primitive, "TEXCOORD_0")) {
+      out.uvs = per_vertex(read_uvs(*uv, label), 2, vertex_count, label, "TEXCOORD_0");
+    }
+    if (primitive.indices >= 0) {
+      out.order = read_indices(primitive.indices, label + " indices");
+      for (std::size_t i = 0; i < out.order.size(); ++i) {
+        if (out.order[i] >= vertex_count) {
+          fail(label + ": index " + std::to_string(out.order[i]) + " (at " + std::to_string(i) +
+               ") is out of range: there are " + std::to_string(vertex_count) + " vertices");
+        }
+      }
+    } else {
+      out.order.resize(vertex_count);
+      for (std::size_t i = 0; i < vertex_count; ++i) out.order[i] = static_cast<std::uint32_t>(i);
+    }
+    return out;
+  }
+
+  // A KHR_draco_mesh_compression primitive: the attributes the extension maps
+  // come from the compressed data, any other from its accessor (the extension
+  // allows both); the accessors' counts must agree with what was decoded.
+  Attributes read_draco(const tinygltf::Primitive& primitive, const std::string& label, int indices, int mode) const {
+    const std::string what = label + ": " + kDracoExtension;
+    if (mode != TINYGLTF_MODE_TRIANGLES) fail(what + " needs mode TRIANGLES");
+    const tinygltf::Value& extension = primitive.extensions.at(kDracoExtension);
+    if (!extension.IsObject() || !extension.Get("bufferView").IsInt() || !extension.Get("attributes").IsObject()) {
+      fail(what + " must have a bufferView and attributes");
+    }
+    const int view_index = extension.Get("bufferView").GetNumberAsInt();
+    if (view_index < 0 || static_cast<std::size_t>(view_index) >= model_.bufferViews.size()) {
+      fail(what + ": buffer view " + std::to_string(view_index) + " is out of range");
+    }
+    const auto& view = model_.bufferViews[static_cast<std::size_t>(view_index)];
+    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model_.buffers.size()) {
+      fail(what + ": buffer view " + std::to_string(view_index) + " names a buffer out of range");
+    }
+    const auto& buffer = model_.buffers[static_cast<std::size_t>(view.buffer)];
+    if (view.byteOffset > buffer.data.size() || view.byteLength > buffer.data.size() - view.byteOffset) {
+      fail(what + ": buffer view " + std::to_string(view_index) + " is out of range of its buffer");
+    }
+    const tinygltf::Value& ids = extension.Get("attributes");
+    const auto id_of = [&](const std::string& name) -> std::optional<int> {
+      if (!ids.Has(name)) return std::nullopt;
+      if (!ids.Get(name).IsInt()) fail(what + ": the id of " + name + " is not an integer");
+      return ids.Get(name).GetNumberAsInt();
+    };
+    const auto position = attribute(primitive, "POSITION");
+    if (!position) fail(label + " has no POSITION attribute");
+    const auto position_id = id_of("POSITION");
+    if (!position_id) fail(what + " does not compress POSITION");
+    const bool has_normal = attribute(primitive, "NORMAL").has_value();
+    const bool has_uv = attribute(primitive, "TEXCOORD_0").has_value();
+    const std::optional<int> normal_id = has_normal ? id_of("NORMAL") : std::nullopt;
+    const std::optional<int> uv_id = has_uv ? id_of("TEXCOORD_0") : std::nullopt;
+    auto decoded = decode_draco_primitive(
+        std::string_view(reinterpret_cast<const char*>(buffer.data.data() + view.byteOffset), view.byteLength),
+        *position_id, normal_id, uv_id);
+    if (!decoded) fail(what + ": " + decoded.error());
+    DracoPrimitive& mesh = decoded.value();
+    if (mesh.points > std::numeric_limits<std::uint32_t>::max()) fail(label + " has too many vertices");
+    const auto expect_count = [&](int index, std::size_t count, const std::string& name) {
+      const auto& acc = accessor(index, label + " " + name);
+      if (acc.count != count) {
+        fail(what + ": " + accessor_label(index, label + " " + name) + " has count " + std::to_string(acc.count) +
+             " but the compressed data holds " + std::to_string(count));
+      }
+    };
+    expect_count(*position, mesh.points, "POSITION");
+    if (indices >= 0) expect_count(indices, mesh.indices.size(), "indices");
+    Attributes out;
+    out.positions = std::move(mesh.positions);
+    if (has_normal) {
+      out.normals = normal_id ? std::move(mesh.normals)
+                              : per_vertex(read_floats(*attribute(primitive, "NORMAL"), label + " NORMAL",
+                                                       TINYGLTF_TYPE_VEC3),
+                                           3, mesh.points, label, "NORMAL");
+    }
+    if (has_uv) {
+      out.uvs = uv_id ? std::move(mesh.uvs)
+                      : per_vertex(read_uvs(*attribute(primitive, "TEXCOORD_0"), label), 2, mesh.points, label,
+                                   "TEXCOORD_0");
+    }
+    out.order = std::move(mesh.indices);
+    return out;
+  }
+
   std::optional<Part> convert_primitive(std::size_t mesh_index, std::size_t p) {
     const auto& mesh = model_.meshes[mesh_index];
     const auto& primitive = mesh.primitives[p];
@@ -911,56 +1025,18 @@ class Loader {
     }
     if (!primitive.targets.empty()) fail(label + ": morph targets are not supported");
 
-    const auto position_it = primitive.attributes.find("POSITION");
-    if (position_it == primitive.attributes.end()) fail(label + " has no POSITION attribute");
-    const auto positions = read_floats(position_it->second, label + " POSITION", TINYGLTF_TYPE_VEC3);
+    Attributes read = source_.draco_indices.contains({mesh_index, p})
+                                ? read_draco(primitive, label, source_.draco_indices.at({mesh_index, p}), mode)
+                                : read_accessors(primitive, label);
+    const std::vector<double>& positions = read.positions;
+    const std::vector<double>& normals = read.normals;
+    const std::vector<double>& uvs = read.uvs;
     const std::size_t vertex_count = positions.size() / 3;
-    if (vertex_count > std::numeric_limits<std::uint32_t>::max()) fail(label + " has too many vertices");
-
-    std::vector<double> normals;
-    const auto normal_it = primitive.attributes.find("NORMAL");
-    if (normal_it != primitive.attributes.end()) {
-      normals = read_floats(normal_it->second, label + " NORMAL", TINYGLTF_TYPE_VEC3);
-      if (normals.size() != positions.size()) {
-        fail(label + ": NORMAL has " + std::to_string(normals.size() / 3) + " elements but POSITION has " +
-             std::to_string(vertex_count));
-      }
-    }
-
-    // Texture coordinates: FLOAT, or normalized UNSIGNED_BYTE / UNSIGNED_SHORT.
-    std::vector<double> uvs;
-    const auto uv_it = primitive.attributes.find("TEXCOORD_0");
-    if (uv_it != primitive.attributes.end()) {
-      const auto& acc = accessor(uv_it->second, label + " TEXCOORD_0");
-      if (acc.componentType == TINYGLTF_COMPONENT_TYPE_BYTE || acc.componentType == TINYGLTF_COMPONENT_TYPE_SHORT) {
-        fail(accessor_label(uv_it->second, label + " TEXCOORD_0") + ": component type " +
-             component_type_name(acc.componentType) +
-             " is not allowed for texture coordinates (FLOAT, or normalized UNSIGNED_BYTE or UNSIGNED_SHORT)");
-      }
-      uvs = read_floats(uv_it->second, label + " TEXCOORD_0", TINYGLTF_TYPE_VEC2, /*normalized_ok=*/true);
-      if (uvs.size() / 2 != vertex_count) {
-        fail(label + ": TEXCOORD_0 has " + std::to_string(uvs.size() / 2) + " elements but POSITION has " +
-             std::to_string(vertex_count));
-      }
-    }
     const auto uv = [&](std::uint32_t i) {
       if (uvs.empty()) return glm::vec2(0.0f);
       return glm::vec2(static_cast<float>(uvs[2 * i]), static_cast<float>(uvs[2 * i + 1]));
     };
-
-    std::vector<std::uint32_t> order;
-    if (primitive.indices >= 0) {
-      order = read_indices(primitive.indices, label + " indices");
-      for (std::size_t i = 0; i < order.size(); ++i) {
-        if (order[i] >= vertex_count) {
-          fail(label + ": index " + std::to_string(order[i]) + " (at " + std::to_string(i) +
-               ") is out of range: there are " + std::to_string(vertex_count) + " vertices");
-        }
-      }
-    } else {
-      order.resize(vertex_count);
-      for (std::size_t i = 0; i < vertex_count; ++i) order[i] = static_cast<std::uint32_t>(i);
-    }
+    std::vector<std::uint32_t> order = std::move(read.order);
 
     // As a triangle list: strips and fans as the glTF spec orders them.
     std::vector<std::uint32_t> triangles;
@@ -1158,9 +1234,10 @@ class Loader {
       const auto begin = buffer.data.begin() + static_cast<std::ptrdiff_t>(view.byteOffset);
       view_bytes.assign(begin, begin + static_cast<std::ptrdiff_t>(view.byteLength));
       encoded = &view_bytes;
-    } else if (!image.uri.empty()) {
-      warn(what + ": " + image_label + " is an external file, which is not supported (embed it); ignored");
-      return std::nullopt;
+    } else if (image_index < source_.image_file.size() && source_.image_file[image_index]) {
+      const std::string& bytes = *source_.files[*source_.image_file[image_index]].second;
+      view_bytes.assign(bytes.begin(), bytes.end());
+      encoded = &view_bytes;
     }
     if (!decode_) return std::nullopt;  // not drawn here: the image is not needed
     auto decoded = decode_(std::span<const std::uint8_t>(encoded->data(), encoded->size()), image.mimeType);
@@ -1240,29 +1317,6 @@ class Loader {
     }
   }
 
-  void add_default_light(SceneDefinition& scene) {
-    glm::dvec3 low(std::numeric_limits<double>::infinity());
-    glm::dvec3 high(-std::numeric_limits<double>::infinity());
-    for (const auto& instance : scene.instances) {
-      glm::dmat4 transform = instance.transform;
-      if (instance.object) transform = model_matrix(scene.objects[*instance.object - 1].pose_at(0.0)) * transform;
-      for (const auto& vertex : scene.meshes[instance.mesh].vertices) {
-        const glm::dvec3 p(transform * glm::dvec4(glm::dvec3(vertex.position), 1.0));
-        low = glm::min(low, p);
-        high = glm::max(high, p);
-      }
-    }
-    const glm::dvec3 centre = finite(low) && finite(high) ? 0.5 * (low + high) : glm::dvec3(0.0);
-    PointLight light;
-    light.position = centre + kDefaultLightOffset;
-    light.intensity = kDefaultLightIntensity;
-    if (!finite(light.position)) light.position = kDefaultLightOffset;
-    scene.lights.push_back(light);
-    std::ostringstream where;
-    where << "(" << light.position.x << ", " << light.position.y << ", " << light.position.z << ")";
-    warn("the file has no point lights; added a white one at " + where.str());
-  }
-
   struct NodeTracks {
     std::optional<Sampler> translation;
     std::optional<Sampler> rotation;
@@ -1270,6 +1324,7 @@ class Loader {
   };
 
   std::string path_;
+  const GltfSource& source_;
   const tinygltf::Model& model_;
   const ImageDecoder& decode_;
   std::vector<std::string>& warnings_;
@@ -1293,45 +1348,32 @@ class Loader {
 };
 
 Result<LoadedGltf> load(const std::string& path, const ImageDecoder& decode) {
-  std::error_code error;
-  const auto status = std::filesystem::status(path, error);
-  if (!std::filesystem::exists(status)) return Error{path + ": no such file"};
-  if (!std::filesystem::is_regular_file(status)) return Error{path + ": not a regular file"};
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path + ": cannot open: " + std::strerror(errno)};
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) return Error{path + ": read error"};
-  if (bytes.size() > std::numeric_limits<unsigned int>::max()) return Error{path + ": file too large for glTF"};
-
-  std::string base_dir = std::filesystem::path(path).parent_path().string();
-  if (base_dir.empty()) base_dir = ".";
-  FsContext context;
-  context.prefix = base_dir + (base_dir.ends_with('/') ? "" : "/");
+  auto read = read_gltf_source(path, kSupportedRequiredExtensions);
+  if (!read) return Error{read.error()};
+  const GltfSource& source = read.value();
 
   tinygltf::TinyGLTF reader;
   reader.SetImageLoader(&keep_encoded_image, nullptr);
-  reader.SetFsCallbacks({&fs_file_exists, &fs_expand_path, &fs_read_whole_file, &fs_write_whole_file, &context});
+  reader.SetFsCallbacks({&fs_file_exists, &fs_expand_path, &fs_read_whole_file, &fs_write_whole_file,
+                         const_cast<GltfSource*>(&source)});
   tinygltf::Model model;
   std::string load_error;
   std::string load_warning;
-  const bool binary = bytes.size() >= 4 && bytes.compare(0, 4, "glTF") == 0;
-  const bool loaded = binary ? reader.LoadBinaryFromMemory(&model, &load_error, &load_warning,
-                                                           reinterpret_cast<const unsigned char*>(bytes.data()),
-                                                           static_cast<unsigned int>(bytes.size()), base_dir)
-                             : reader.LoadASCIIFromString(&model, &load_error, &load_warning, bytes.data(),
-                                                          static_cast<unsigned int>(bytes.size()), base_dir);
-  if (!loaded) {
-    if (!context.first_missing.empty()) {
-      return Error{path + ": missing buffer file " + context.first_missing + " (" + one_line(load_error) + ")"};
-    }
-    return Error{path + ": malformed glTF: " + one_line(load_error.empty() ? "unknown error" : load_error)};
-  }
+  const auto* bytes = reinterpret_cast<const unsigned char*>(source.document.data());
+  const auto size = static_cast<unsigned int>(source.document.size());
+  const bool loaded =
+      source.binary ? reader.LoadBinaryFromMemory(&model, &load_error, &load_warning, bytes, size, kSourceFolder)
+                    : reader.LoadASCIIFromString(&model, &load_error, &load_warning, source.document.data(), size,
+                                                 kSourceFolder);
+  if (!loaded) return Error{path + ": malformed glTF: " + one_line(load_error.empty() ? "unknown error" : load_error)};
 
   LoadedGltf loaded_gltf;
   for (const auto& line : lines_of(load_warning)) loaded_gltf.warnings.push_back(path + ": " + line);
-  Loader loader(path, model, decode, loaded_gltf.warnings);
+  Loader loader(source, model, decode, loaded_gltf.warnings);
   loaded_gltf.scene = loader.build();
-  loaded_gltf.content_sha256 = util::sha256_hex(bytes + context.bytes);
+  loaded_gltf.manifest = source.manifest();
+  loaded_gltf.content_sha256 = manifest_sha256(loaded_gltf.manifest);
+  for (const auto& file : source.files) loaded_gltf.files.push_back(file.second);
   return loaded_gltf;
 }
 

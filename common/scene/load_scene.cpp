@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "scene/builtin.h"
+#include "scene/default_lights.h"
 #include "scene/gltf.h"
 
 namespace optique::scene {
@@ -13,7 +14,8 @@ std::string resolve_asset(const std::string& path, const std::string& config_dir
   return std::filesystem::absolute(std::filesystem::path(config_dir) / asset).lexically_normal().string();
 }
 
-Result<LoadedScene> load_scene(const std::string& builtin, const std::string& path, const ImageDecoder& decode) {
+Result<LoadedScene> load_scene(const std::string& builtin, const std::string& path, const ImageDecoder& decode,
+                               const glm::dvec3& viewer) {
   LoadedScene loaded;
   if (!builtin.empty()) {
     auto definition = builtin_scene(builtin);
@@ -26,8 +28,13 @@ Result<LoadedScene> load_scene(const std::string& builtin, const std::string& pa
   if (!gltf) return Error{gltf.error()};
   loaded.definition = std::move(gltf.value().scene);
   loaded.content_sha256 = gltf.value().content_sha256;
+  loaded.manifest = std::move(gltf.value().manifest);
+  loaded.files = std::move(gltf.value().files);
   loaded.warnings = std::move(gltf.value().warnings);
   loaded.source = path;
+  if (loaded.definition.lights.empty()) {
+    loaded.warnings.push_back(path + ": " + add_default_lights(loaded.definition, viewer));
+  }
   return loaded;
 }
 

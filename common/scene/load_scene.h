@@ -1,12 +1,18 @@
 #pragma once
 // The scene an installation names, built in or from a glTF file, loaded the same
-// way by the master (to animate it) and by every node (to draw it).
+// way by the master (to animate it and to send its files to nodes that lack
+// them) and by every node (to draw it). The installation's own entry point is
+// config::load_scene (config/installation_scene.h).
 
+#include <memory>
 #include <string>
 #include <vector>
 
+#include <glm/vec3.hpp>
+
 #include "scene/definition.h"
 #include "scene/image_decoder.h"
+#include "scene/manifest.h"
 #include "util/result.h"
 
 namespace optique::scene {
@@ -14,7 +20,9 @@ namespace optique::scene {
 struct LoadedScene {
   SceneDefinition definition;
   std::string source;          // "builtin cubes" or the glTF file's path
-  std::string content_sha256;  // of the glTF content; empty for built-in scenes
+  std::string content_sha256;  // the glTF's identity (its manifest's SHA-256); empty for built-in scenes
+  SceneManifest manifest;      // the glTF's files; none for built-in scenes
+  std::vector<std::shared_ptr<const std::string>> files;  // their bytes, as manifest.files
   std::vector<std::string> warnings;
 };
 
@@ -24,8 +32,9 @@ struct LoadedScene {
 
 // The built-in scene `builtin`, or else the glTF file at `gltf` (absolute, or
 // relative to the working folder); `decode` reads its images (empty: none are
-// read; see scene/image_decoder.h).
+// read; see scene/image_decoder.h). A glTF without lights is lit by
+// scene/default_lights.h for a viewer at `viewer`.
 [[nodiscard]] Result<LoadedScene> load_scene(const std::string& builtin, const std::string& gltf,
-                                             const ImageDecoder& decode);
+                                             const ImageDecoder& decode, const glm::dvec3& viewer);
 
 }  // namespace optique::scene

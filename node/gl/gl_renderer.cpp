@@ -1,5 +1,6 @@
 #include "node/gl/gl_renderer.h"
 
+#include "config/installation_scene.h"
 #include "config/to_schema.h"
 #include "image/texture_decode.h"
 #include "scene/load_scene.h"
@@ -27,7 +28,7 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   }
 
   const config::SceneSource& source = job.installation.scene;
-  auto loaded = scene::load_scene(source.builtin, source.gltf, image::decode_texture);
+  auto loaded = config::load_scene(job.installation, image::decode_texture);
   if (!loaded) {
     return Error{"cannot load the scene: " + loaded.error() +
                  (source.gltf.empty() ? "" : " (a node needs the master's scene file at the same path)")};

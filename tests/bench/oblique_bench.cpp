@@ -19,6 +19,7 @@
 #include <map>
 
 #include "clock/clock.h"
+#include "config/installation_scene.h"
 #include "config/job.h"
 #include "config/load.h"
 #include "draw_plot.h"
@@ -102,7 +103,7 @@ int main(int argc, char** argv) {
     if (!loaded) throw std::runtime_error(loaded.error());
     const config::Installation& installation = loaded.value().installation;
     if (installation.viewer.moves()) throw std::runtime_error("the bench needs a fixed viewer eye");
-    auto scene = scene::load_scene(installation.scene.builtin, installation.scene.gltf, image::decode_texture);
+    auto scene = config::load_scene(installation, image::decode_texture);
     if (!scene) throw std::runtime_error(scene.error());
     const auto& definition = scene.value().definition;
     // Frames 0.25 s of animation apart, as the master would step them at 4 Hz.

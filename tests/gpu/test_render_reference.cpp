@@ -2,6 +2,7 @@
 // average of S × S samples. Needs GL (headless; llvmpipe in CI): label `gpu`.
 
 #include "image/texture_decode.h"
+#include "config/installation_scene.h"
 #include "tools/render_reference.h"
 
 #include <gtest/gtest.h>
@@ -60,8 +61,7 @@ References render_references(const config::LoadedConfig& config, const scene::Lo
 Rendered render(int supersample) {
   auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
   EXPECT_TRUE(config.ok()) << config.error();
-  auto scene = scene::load_scene(config.value().installation.scene.builtin, config.value().installation.scene.gltf,
-                                 image::decode_texture);
+  auto scene = config::load_scene(config.value().installation, image::decode_texture);
   EXPECT_TRUE(scene.ok()) << scene.error();
   if (!config.ok() || !scene.ok()) return {};
   return render_references(config.value(), scene.value(), 30, supersample).images["front"];
@@ -100,8 +100,7 @@ TEST(RenderReference, SupersampledHasTheScreensPixelsAndAveragesThem) {
 TEST(RenderReference, RefusesAZeroFactor) {
   auto config = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json");
   ASSERT_TRUE(config.ok()) << config.error();
-  auto scene = scene::load_scene(config.value().installation.scene.builtin, config.value().installation.scene.gltf,
-                                 image::decode_texture);
+  auto scene = config::load_scene(config.value().installation, image::decode_texture);
   ASSERT_TRUE(scene.ok()) << scene.error();
   spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
   auto written = render_reference(config.value(), scene.value(), 0, "/nonexistent", log, ReferenceOptions{0});
@@ -121,7 +120,7 @@ TEST(RenderReference, AStereoScreenHasAReferenceForEachEye) {
   right.eye = config::Eye::right;
   installation.projectors.front().eye = config::Eye::left;
   installation.projectors.push_back(right);
-  auto scene = scene::load_scene(installation.scene.builtin, installation.scene.gltf, image::decode_texture);
+  auto scene = config::load_scene(installation, image::decode_texture);
   ASSERT_TRUE(scene.ok()) << scene.error();
   References refs = render_references(config.value(), scene.value(), 30, 1);
   ASSERT_EQ(refs.images.count("front.left"), 1u);

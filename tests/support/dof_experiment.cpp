@@ -12,6 +12,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "config/installation_scene.h"
 #include "config/load.h"
 #include "config/parse.h"
 #include "image/compare.h"
@@ -78,7 +79,7 @@ Result<PairSetup> load_setup(const std::string& config_path, int divisor) {
   if (!inst.depth_of_field) return Error{config_path + ": has no depth_of_field"};
   setup.focus = config::job_for(inst, *focus);
   setup.defocus = config::job_for(inst, *defocus);
-  auto scene = scene::load_scene(inst.scene.builtin, inst.scene.gltf, image::decode_texture);
+  auto scene = config::load_scene(inst, image::decode_texture);
   if (!scene) return Error{scene.error()};
   setup.scene = std::move(scene).value().definition;
   for (const auto& object : setup.scene.objects) {

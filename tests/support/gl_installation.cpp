@@ -1,4 +1,5 @@
 #include "gl_installation.h"
+#include "config/installation_scene.h"
 
 #include "image/texture_decode.h"
 #include "scene/load_scene.h"
@@ -13,8 +14,7 @@ Result<GlInstallation> open_gl_installation(const std::string& config_path) {
   auto loaded = config::load_installation(config_path);
   if (!loaded) return Error{loaded.error()};
   out.config = std::move(loaded).value();
-  const config::SceneSource& source = out.config.installation.scene;
-  auto scene = scene::load_scene(source.builtin, source.gltf, image::decode_texture);
+  auto scene = config::load_scene(out.config.installation, image::decode_texture);
   if (!scene) return Error{scene.error()};
   out.scene = std::move(scene).value().definition;
   return out;

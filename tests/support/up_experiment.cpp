@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "config/installation_scene.h"
 #include "config/job.h"
 #include "config/load.h"
 #include "image/texture_decode.h"
@@ -113,8 +114,7 @@ Result<SceneResult> measure(const StageScene& stage, const Run& run, int frames,
   if (!up_installation) return Error{up_installation.error()};
   auto full_installation = parse(false);
   if (!full_installation) return Error{full_installation.error()};
-  const config::SceneSource& source = up_installation.value().scene;
-  auto loaded = scene::load_scene(source.builtin, source.gltf, image::decode_texture);
+  auto loaded = config::load_scene(up_installation.value(), image::decode_texture);
   if (!loaded) return Error{loaded.error()};
   const scene::SceneDefinition& scene = loaded.value().definition;
   render::PipelineOptions options;
