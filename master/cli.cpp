@@ -169,6 +169,9 @@ int run_cli(int argc, char** argv) {
     options.warnings = make_warning_sink();
     logger->sinks().push_back(options.warnings);
   }
+  // What the scene file asked for that is left out or assumed (default lights):
+  // the operator reads it here, not in each node's log.
+  for (const std::string& warning : options.scene.warnings) logger->warn("scene: {}", warning);
 
   boost::asio::io_context io;
   Master master(io, std::move(options), *logger);

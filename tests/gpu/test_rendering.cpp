@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "cluster_run.h"
+#include "local_capture.h"
 #include "config/load.h"
 #include "config/to_schema.h"
 #include "image/compare.h"
@@ -25,25 +26,6 @@ using namespace std::chrono_literals;
 
 const std::string kMaster = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
 const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
-
-// Runs a local cluster for `frames` frames, capturing every `capture_every`-th;
-// returns its output folder.
-std::string run_and_capture(const std::string& config, int frames, int capture_every) {
-  const std::string dir = make_temp_dir("optique-gl");
-  Process master({kMaster, "--config", config, "--local", "--frames", std::to_string(frames), "--capture-every",
-                  std::to_string(capture_every), "--out", dir + "/out", "--no-status"},
-                 dir + "/master.log");
-  const auto status = master.wait(120s);
-  EXPECT_TRUE(status.has_value()) << "master still running:\n" << master.output();
-  EXPECT_EQ(status.value_or(-1), 0) << master.output();
-  return dir + "/out";
-}
-
-image::FloatImage capture(const std::string& out, const std::string& projector, std::uint64_t frame) {
-  auto loaded = image::read_image(image::frame_path(out + "/nodes/" + projector, frame, "png"));
-  EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error());
-  return loaded.ok() ? std::move(loaded).value() : image::FloatImage();
-}
 
 // A shipped config with another scene and a fixed eye, written to a temp file.
 std::string variant(const std::string& shipped, const std::function<void(schema::Installation&)>& change) {

@@ -598,8 +598,8 @@ TEST(Gltf, TorusEmbeddedAndAsGlbAreTheSameMesh) {
 
 TEST(Gltf, DracoCompressedTorusDecodes) {
   const auto loaded = load_ok(kTorus + "torus-draco.glb");
-  // gltf-pipeline quantizes positions to 14 bits over the 1 m box: 0.06 mm.
-  expect_torus(loaded, 2e-4);
+  // gltf-pipeline quantizes positions to 11 bits over the 1 m box: 0.5 mm steps.
+  expect_torus(loaded, 5e-4);
   // The decoded triangles cover the torus's surface as the original's do: the
   // same total area, to the quantization.
   const auto area = [](const Mesh& mesh) {

@@ -1,0 +1,43 @@
+#include "local_capture.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+
+#include "image/frame_files.h"
+#include "image/image_io.h"
+#include "process.h"
+
+namespace optique::testing {
+
+using namespace std::chrono_literals;
+
+std::string run_and_capture(const std::string& config, int frames, int capture_every,
+                            const std::vector<std::string>& extra) {
+  const std::string dir = make_temp_dir("optique-gl");
+  std::vector<std::string> command{std::string(OPTIQUE_BIN_DIR) + "/optique-master",
+                                   "--config",
+                                   config,
+                                   "--local",
+                                   "--frames",
+                                   std::to_string(frames),
+                                   "--capture-every",
+                                   std::to_string(capture_every),
+                                   "--out",
+                                   dir + "/out",
+                                   "--no-status"};
+  command.insert(command.end(), extra.begin(), extra.end());
+  Process master(command, dir + "/master.log");
+  const auto status = master.wait(120s);
+  EXPECT_TRUE(status.has_value()) << "master still running:\n" << master.output();
+  EXPECT_EQ(status.value_or(-1), 0) << master.output();
+  return dir + "/out";
+}
+
+image::FloatImage capture(const std::string& out, const std::string& projector, std::uint64_t frame) {
+  auto loaded = image::read_image(image::frame_path(out + "/nodes/" + projector, frame, "png"));
+  EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error());
+  return loaded.ok() ? std::move(loaded).value() : image::FloatImage();
+}
+
+}  // namespace optique::testing

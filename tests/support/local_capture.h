@@ -1,0 +1,23 @@
+#pragma once
+// A shipped or written config run as a local cluster (optique-master --local,
+// real GL node processes) that captures frames, and its captures read back: what
+// gpu tests compare.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+
+namespace optique::testing {
+
+// Runs `config` for `frames` frames, capturing every `capture_every`-th, with
+// `extra` arguments for the master; expects it to succeed and returns its
+// output folder (in a fresh temporary folder).
+[[nodiscard]] std::string run_and_capture(const std::string& config, int frames, int capture_every,
+                                          const std::vector<std::string>& extra = {});
+
+// What node `projector` captured of `frame` (the projector's signal, PNG).
+[[nodiscard]] image::FloatImage capture(const std::string& out, const std::string& projector, std::uint64_t frame);
+
+}  // namespace optique::testing
