@@ -8,6 +8,7 @@
 #include "config/light_list.h"
 #include "net/envelope.h"
 #include "protocol/focus.h"
+#include "protocol/scene_fetch.h"
 #include "protocol/welcome.h"
 
 namespace optique::master {
@@ -174,6 +175,13 @@ Actions MasterProtocol::message(PeerId peer, const wire::Envelope& message, cloc
     }
     case wire::Envelope::kHeartbeat:
       break;
+    case wire::Envelope::kSceneRequest:
+      if (session.phase != Phase::configuring) {
+        out.push_back(Close{peer, "asked for the scene's files after setting up"});
+        break;
+      }
+      on_scene_request(peer, session, message.scene_request(), now, out);
+      break;
     case wire::Envelope::kConfigured:
       if (session.phase != Phase::configuring) {
         out.push_back(Close{peer, "configured twice"});
@@ -264,7 +272,7 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
   const LightShare* share = light_plan_.share(*slot);
   wire::Envelope envelope;
   *envelope.mutable_welcome() =
-      protocol::encode_welcome(installation_, *slot, scene_.content_sha256,
+      protocol::encode_welcome(installation_, *slot, scene_.manifest,
                                static_cast<std::uint32_t>(scene_.definition.lights.size()), frame_period_, share);
   // Its first frame repeats the share, so the log tells from which frame each node
   // draws what (and a share changed while it set itself up still reaches it).
@@ -289,6 +297,70 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
                                            session.peer_text, configured.renderer(), nodes_up(), slots_.size())});
   if (state_ == RunState::starting && (nodes_up() == slots_.size() || (startup_passed_ && slots_configuring().empty())))
     start_frames(now, out);
+}
+
+// A node without a copy of the scene asks for its files chunk by chunk while it
+// sets up: each request that names a chunk of this scene is answered from the
+// bytes the master loaded (scene/gltf_source.h: what it hashed), and gives the
+// node another kConfigureTimeout to finish.
+void MasterProtocol::on_scene_request(PeerId peer, Session& session, const wire::SceneRequest& request,
+                                      clock::Nanos now, Actions& out) {
+  const scene::SceneManifest& manifest = scene_.manifest;
+  const std::string id = slot_id(*session.slot);
+  if (manifest.files.empty() || request.scene_sha256() != scene_.content_sha256) {
+    out.push_back(Close{peer, "asked for the files of another scene"});
+    return;
+  }
+  if (request.file() >= manifest.files.size() ||
+      request.chunk() >= manifest.files[request.file()].chunks(manifest.chunk_bytes)) {
+    out.push_back(Close{peer, "asked for chunk " + std::to_string(request.chunk()) + " of file " +
+                                  std::to_string(request.file()) + ", which the scene does not have"});
+    return;
+  }
+  const std::uint64_t total = manifest.total_bytes();
+  if (!session.scene) {
+    session.scene.emplace();
+    session.scene->started = now;
+    out.push_back(Log{spdlog::level::info,
+                      fmt::format("sending the scene to '{}', which has no copy: {} file(s), {:.1f} MiB", id,
+                                  manifest.files.size(), static_cast<double>(total) / (1 << 20))});
+  }
+  SceneSending& sending = *session.scene;
+  const std::uint64_t offset = manifest.chunk_offset(request.chunk());
+  const std::uint64_t length = manifest.chunk_length(request.file(), request.chunk());
+  sending.bytes_asked += length;
+  if (sending.bytes_asked > kMostSceneRepeats * std::max<std::uint64_t>(total, manifest.chunk_bytes)) {
+    out.push_back(Close{peer, "asked for the scene " + std::to_string(kMostSceneRepeats) + " times over"});
+    return;
+  }
+  if (sending.sent.insert({request.file(), request.chunk()}).second) {
+    sending.bytes_new += length;
+  } else if (++sending.repeats <= kRepeatsLogged) {
+    // What a node asks for twice came spoilt (or not at all) the first time.
+    out.push_back(Log{spdlog::level::warn,
+                      fmt::format("'{}' asked again for chunk {} of '{}' of the scene (spoilt on the way?){}", id,
+                                  request.chunk(), manifest.files[request.file()].path,
+                                  sending.repeats == kRepeatsLogged ? "; further repeats are not logged" : "")});
+  }
+  wire::Envelope envelope;
+  auto& chunk = *envelope.mutable_scene_chunk();
+  chunk.set_file(request.file());
+  chunk.set_chunk(request.chunk());
+  chunk.set_data(scene_.files[request.file()]->substr(offset, length));
+  out.push_back(Send{peer, std::move(envelope)});
+  out.push_back(SetDeadline{peer, kConfigureTimeout,
+                            "node did not finish configuring within " + std::to_string(kConfigureTimeout.count()) +
+                                " s of its last request for the scene"});
+  const int quarters = static_cast<int>(4 * sending.bytes_new / std::max<std::uint64_t>(total, 1));
+  if (quarters > sending.quarters_logged) {
+    sending.quarters_logged = quarters;
+    if (quarters == 4) {
+      out.push_back(Log{spdlog::level::info,
+                        fmt::format("sent the scene to '{}': {}", id, protocol::transfer_text(total, now - sending.started))});
+    } else if (total >= protocol::kSceneProgressBytes) {
+      out.push_back(Log{spdlog::level::info, fmt::format("sending the scene to '{}': {} %", id, 25 * quarters)});
+    }
+  }
 }
 
 // The state as of the last frame begun; the next FrameBegin's delta applies to it.

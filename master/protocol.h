@@ -16,7 +16,9 @@
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -40,8 +42,11 @@ namespace optique::master {
 
 // The largest frame a peer may send before its hello is accepted.
 inline constexpr std::uint32_t kMaxHelloBytes = 4096;
-// How long a node may take to set itself up (GL context, scene) after the welcome.
+// How long a node may take to set itself up (GL context, scene) after the welcome,
+// or between two chunks of the scene it asks for.
 inline constexpr std::chrono::seconds kConfigureTimeout{30};
+// A node that asks for more than this many times the scene's bytes is broken.
+inline constexpr std::uint64_t kMostSceneRepeats = 4;
 
 using PeerId = std::uint64_t;
 
@@ -166,12 +171,23 @@ class MasterProtocol {
   enum class Phase { handshake, configuring, joined, in_barrier, out_of_barrier };
   enum class RunState { starting, running, draining, closing, done };
 
+  // The scene's files going to a node that has no copy.
+  struct SceneSending {
+    clock::Nanos started = 0;
+    std::uint64_t bytes_asked = 0;  // all chunks sent, repeats included
+    std::uint64_t bytes_new = 0;    // each chunk once
+    std::set<std::pair<std::uint32_t, std::uint64_t>> sent;
+    int quarters_logged = 0;
+    int repeats = 0;  // chunks asked for again
+  };
+  static constexpr int kRepeatsLogged = 10;
   struct Session {
     std::string peer_text;
     std::optional<std::size_t> slot;
     Phase phase = Phase::handshake;
     std::vector<std::uint8_t> nonce;  // of its challenge
     bool refused = false;             // said so in the log already
+    std::optional<SceneSending> scene;
   };
   struct Slot {
     std::optional<PeerId> peer;
@@ -180,6 +196,8 @@ class MasterProtocol {
 
   void on_hello(PeerId peer, Session& session, const wire::Envelope& message, clock::Nanos now, Actions& out);
   void on_configured(PeerId peer, Session& session, const wire::Configured& configured, clock::Nanos now, Actions& out);
+  void on_scene_request(PeerId peer, Session& session, const wire::SceneRequest& request, clock::Nanos now,
+                        Actions& out);
   void on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now, Actions& out);
   void on_presented(Session& session, const wire::Presented& presented, clock::Nanos now, Actions& out);
   // `slot` showed the last swapped frame, or is gone: the next frame may begin

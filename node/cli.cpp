@@ -44,6 +44,12 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
   std::string secret_file;
   app.add_option("--secret-file", secret_file,
                  "the installation's shared secret (the file its master.secret_file names; mode 600)");
+  app.add_option("--cache-dir", options.cache_dir,
+                 "where copies of the master's glTF scenes are kept, in its scenes/ (default: $CACHE_DIRECTORY, "
+                 "else $XDG_CACHE_HOME/optique, else ~/.cache/optique)");
+  std::uint64_t most_scene_mb = options.protocol.most_scene_bytes >> 20;
+  app.add_option("--max-scene-mb", most_scene_mb, "the largest scene (all its files, MiB) to fetch from the master")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 24));
   app.add_option("--log-level", log_level, "trace, debug, info, warn or error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}));
   int realtime_priority = 0;
@@ -85,6 +91,8 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
   options.protocol.give_up_after = std::chrono::milliseconds(give_up_ms);
   options.present_spin = std::chrono::microseconds(present_spin_us);
   options.protocol.hold_last_frame = on_master_lost == "hold";
+  options.protocol.most_scene_bytes = most_scene_mb << 20;
+  options.protocol.needs_scene_files = renderer_kind != "null";
   options.protocol.clock = clock::LocalClock(clock_offset_ns, clock_drift_ppm);
   if (!secret_file.empty()) {
     auto secret = net::load_secret_file(secret_file);

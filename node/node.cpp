@@ -28,7 +28,8 @@ Node::Node(asio::io_context& io, NodeOptions options, Renderer& renderer, spdlog
       ping_timer_(io),
       connect_timer_(io),
       present_timer_(io),
-      signals_(io, SIGINT, SIGTERM) {}
+      signals_(io, SIGINT, SIGTERM),
+      scene_cache_(options_.cache_dir) {}
 
 void Node::start() {
   signals_.async_wait([this](const boost::system::error_code& error, int signal) {
@@ -159,6 +160,23 @@ void Node::carry_out(Action& action) {
                    }
                  },
                  [&](Log& a) { log_.log(a.level, "{}", a.text); },
+                 [&](PrepareScene& a) {
+                   if (auto found = scene_cache_.find(a.manifest, a.sha256)) {
+                     carry_out(protocol_.scene_found(*found));
+                   } else {
+                     carry_out(protocol_.scene_copy_started(scene_cache_.begin(a.manifest, a.sha256),
+                                                            clock::monotonic_now()));
+                   }
+                 },
+                 [&](StoreSceneChunk& a) {
+                   if (auto stored = scene_cache_.write(a.file, a.offset, a.data); !stored) {
+                     carry_out(protocol_.scene_store_failed(stored.error()));
+                   }
+                 },
+                 [&](FinishScene&) {
+                   carry_out(protocol_.scene_copy_finished(scene_cache_.commit(), clock::monotonic_now()));
+                 },
+                 [&](AbandonScene&) { scene_cache_.abandon(); },
              },
              action);
 }

@@ -17,6 +17,7 @@
 #include "net/connection.h"
 #include "node/protocol.h"
 #include "node/renderer.h"
+#include "node/scene_cache.h"
 
 namespace optique::node {
 
@@ -29,6 +30,9 @@ struct NodeOptions {
   // Wake up this long before a present deadline, then spin: covers the
   // scheduler's wake-up delay when every node of a machine wakes at once.
   std::chrono::microseconds present_spin{200};
+  // Where copies of the master's glTF scenes are kept: in its scenes/
+  // (node/scene_cache.h).
+  std::string cache_dir = SceneCache::default_cache_dir().string();
 };
 
 class Node {
@@ -60,6 +64,7 @@ class Node {
   asio::steady_timer present_timer_;
   std::shared_ptr<asio::ip::tcp::socket> connecting_;
   asio::signal_set signals_;
+  SceneCache scene_cache_;
   std::shared_ptr<net::Connection> connection_;
   int exit_code_ = kExitOk;
 };

@@ -16,6 +16,8 @@ void NodeProtocol::log(Actions& out, spdlog::level::level_enum level, std::strin
 
 void NodeProtocol::stop(int exit_code, const std::string& reason, Actions& out) {
   if (phase_ == Phase::stopped) return;
+  if (fetch_) out.push_back(AbandonScene{});
+  fetch_.reset();
   const bool connected = connection_open_;
   phase_ = Phase::stopped;
   log(out, exit_code == kExitOk ? spdlog::level::info : spdlog::level::err, reason);
@@ -74,6 +76,10 @@ Actions NodeProtocol::closed(const std::string& reason, clock::Nanos now) {
   out.push_back(CancelPings{});
   if (phase_ == Phase::stopped) return out;
   const bool was_joined = phase_ == Phase::joined;
+  if (fetch_) {
+    out.push_back(AbandonScene{});
+    fetch_.reset();
+  }
   phase_ = Phase::disconnected;
   pending_.reset();
   held_.clear();
@@ -136,6 +142,14 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
   }
   if (phase_ == Phase::awaiting_welcome && message.body_case() == wire::Envelope::kWelcome) {
     on_welcome(message.welcome(), out);
+    return out;
+  }
+  if (phase_ == Phase::fetching_scene && message.body_case() == wire::Envelope::kSceneChunk) {
+    on_scene_chunk(message.scene_chunk(), now, out);
+    return out;
+  }
+  if ((phase_ == Phase::preparing_scene || phase_ == Phase::fetching_scene) &&
+      message.body_case() == wire::Envelope::kHeartbeat) {
     return out;
   }
   if ((phase_ == Phase::awaiting_state || phase_ == Phase::joined) && message.body_case() == wire::Envelope::kResync) {
@@ -214,8 +228,110 @@ void NodeProtocol::on_welcome(const wire::Welcome& welcome, Actions& out) {
     return;
   }
   job_ = std::move(job).value();
+  if (!settings_.needs_scene_files || job_->scene_files.files.empty()) {
+    configure(out);
+    return;
+  }
+  const std::uint64_t bytes = job_->scene_files.total_bytes();
+  if (bytes > settings_.most_scene_bytes) {
+    stop(kExitRefused,
+         fmt::format("the master's scene {} is {:.1f} MiB, more than the {:.1f} MiB this node takes "
+                     "(--max-scene-mb)",
+                     job_->job.installation.scene.gltf, static_cast<double>(bytes) / (1 << 20),
+                     static_cast<double>(settings_.most_scene_bytes) / (1 << 20)),
+         out);
+    return;
+  }
+  phase_ = Phase::preparing_scene;
+  out.push_back(PrepareScene{job_->scene_files, job_->scene_sha256});
+}
+
+void NodeProtocol::configure(Actions& out) {
   phase_ = Phase::configuring;
   out.push_back(Configure{*job_});
+}
+
+Actions NodeProtocol::scene_found(const std::string& gltf_path) {
+  Actions out;
+  if (phase_ != Phase::preparing_scene) return out;
+  job_->scene_path = gltf_path;
+  log(out, spdlog::level::info, "the scene " + job_->scene_sha256.substr(0, 12) + "… is here: " + gltf_path);
+  configure(out);
+  return out;
+}
+
+Actions NodeProtocol::scene_copy_started(const Result<void>& started, clock::Nanos now) {
+  Actions out;
+  if (phase_ != Phase::preparing_scene) return out;
+  if (!started) {
+    stop(kExitRefused, "cannot keep the master's scene here: " + started.error(), out);
+    return out;
+  }
+  fetch_.emplace(job_->scene_files, job_->scene_sha256);
+  fetch_started_ = now;
+  fetch_quarters_logged_ = 0;
+  phase_ = Phase::fetching_scene;
+  log(out, spdlog::level::info,
+      fmt::format("fetching the scene {} from the master: {} file(s), {:.1f} MiB", job_->job.installation.scene.gltf,
+                  job_->scene_files.files.size(), static_cast<double>(job_->scene_files.total_bytes()) / (1 << 20)));
+  out.push_back(SetDeadline{kSceneStall, "no part of the scene from the master for " +
+                                             std::to_string(kSceneStall.count() / 1000) + " s"});
+  for (wire::Envelope& request : fetch_->requests()) out.push_back(Send{std::move(request)});
+  if (fetch_->done()) out.push_back(FinishScene{});  // only empty files
+  return out;
+}
+
+void NodeProtocol::on_scene_chunk(const wire::SceneChunk& chunk, clock::Nanos now, Actions& out) {
+  const protocol::SceneFetch::Verdict verdict = fetch_->take(chunk);
+  switch (verdict.kind) {
+    case protocol::SceneFetch::Verdict::Kind::fail:
+      out.push_back(Close{"the scene from the master: " + verdict.problem});
+      return;
+    case protocol::SceneFetch::Verdict::Kind::ask_again:
+      log(out, spdlog::level::warn, "the scene from the master: " + verdict.problem + "; asking for it again");
+      break;
+    case protocol::SceneFetch::Verdict::Kind::store:
+      out.push_back(StoreSceneChunk{verdict.file, verdict.offset, chunk.data()});
+      break;
+  }
+  out.push_back(SetDeadline{kSceneStall, "no part of the scene from the master for " +
+                                             std::to_string(kSceneStall.count() / 1000) + " s"});
+  const std::uint64_t total = fetch_->manifest().total_bytes();
+  const int quarters = total == 0 ? 4 : static_cast<int>(4 * fetch_->bytes_stored() / total);
+  if (quarters > fetch_quarters_logged_ && quarters < 4 && total >= protocol::kSceneProgressBytes) {
+    fetch_quarters_logged_ = quarters;
+    log(out, spdlog::level::info, fmt::format("fetching the scene: {} %", 25 * quarters));
+  }
+  if (fetch_->done()) {
+    log(out, spdlog::level::info,
+        fmt::format("fetched the scene: {}{}", protocol::transfer_text(total, now - fetch_started_),
+                    fetch_->chunks_asked_again() > 0
+                        ? fmt::format(", {} chunk(s) asked for again", fetch_->chunks_asked_again())
+                        : ""));
+    out.push_back(FinishScene{});
+    return;
+  }
+  for (wire::Envelope& request : fetch_->requests()) out.push_back(Send{std::move(request)});
+}
+
+Actions NodeProtocol::scene_store_failed(const std::string& error) {
+  Actions out;
+  if (phase_ != Phase::fetching_scene) return out;
+  stop(kExitRefused, "cannot keep the master's scene here: " + error, out);
+  return out;
+}
+
+Actions NodeProtocol::scene_copy_finished(const Result<std::string>& gltf_path, clock::Nanos) {
+  Actions out;
+  if (phase_ != Phase::fetching_scene) return out;
+  fetch_.reset();
+  if (!gltf_path) {
+    stop(kExitRefused, "cannot keep the master's scene here: " + gltf_path.error(), out);
+    return out;
+  }
+  job_->scene_path = gltf_path.value();
+  configure(out);
+  return out;
 }
 
 Actions NodeProtocol::configured(const Result<void>& result, const std::string& renderer_description) {

@@ -24,6 +24,7 @@
 #include "net/envelope.h"
 #include "node/renderer.h"
 #include "optique/wire.pb.h"
+#include "protocol/scene_fetch.h"
 #include "protocol/welcome.h"
 #include "scene/state.h"
 
@@ -49,6 +50,11 @@ struct NodeSettings {
   // When the master is lost: show black (a frozen wall looks like a fault in the
   // show), or keep the last frame.
   bool hold_last_frame = false;
+  // The renderer draws the scene, so a glTF scene's files must be on this
+  // machine: from the cache, or fetched from the master (the null renderer: no).
+  bool needs_scene_files = true;
+  // The largest scene (all its files) this node fetches.
+  std::uint64_t most_scene_bytes = std::uint64_t{8} << 30;
 };
 
 // --- actions
@@ -107,9 +113,29 @@ struct Log {
   spdlog::level::level_enum level = spdlog::level::info;
   std::string text;
 };
+// The scene's files (node/scene_cache.h): answer with scene_found() and the
+// glTF's path when a whole copy is here; else start a new copy and answer with
+// scene_copy_started().
+struct PrepareScene {
+  scene::SceneManifest manifest;
+  std::string sha256;
+};
+// Write a chunk (checked against the manifest) into the copy; answer only a
+// failure, with scene_store_failed().
+struct StoreSceneChunk {
+  std::uint32_t file = 0;
+  std::uint64_t offset = 0;
+  std::string data;
+};
+// Every chunk is stored: check the copy whole, put it in place and answer with
+// scene_copy_finished().
+struct FinishScene {};
+// The copy will not be finished (the connection went, the node stops): remove it.
+struct AbandonScene {};
 
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, Configure, Render, PresentAt,
-                            Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log>;
+                            Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log, PrepareScene,
+                            StoreSceneChunk, FinishScene, AbandonScene>;
 using Actions = std::vector<Action>;
 
 class NodeProtocol {
@@ -131,6 +157,8 @@ class NodeProtocol {
   // p99 up by 15-25 % when sent whenever due).
   static constexpr std::chrono::milliseconds kPingDeferral{10};
   static constexpr std::chrono::microseconds kRoundGuard{1000};
+  // A scene being fetched: no chunk for this long and the connection is given up.
+  static constexpr std::chrono::milliseconds kSceneStall{10000};
 
   explicit NodeProtocol(NodeSettings settings);
 
@@ -140,6 +168,11 @@ class NodeProtocol {
   [[nodiscard]] Actions message(const wire::Envelope& message, clock::Nanos now);
   [[nodiscard]] Actions closed(const std::string& reason, clock::Nanos now);
   [[nodiscard]] Actions configured(const Result<void>& result, const std::string& renderer_description);
+  // Answers to PrepareScene, StoreSceneChunk and FinishScene.
+  [[nodiscard]] Actions scene_found(const std::string& gltf_path);
+  [[nodiscard]] Actions scene_copy_started(const Result<void>& started, clock::Nanos now);
+  [[nodiscard]] Actions scene_store_failed(const std::string& error);
+  [[nodiscard]] Actions scene_copy_finished(const Result<std::string>& gltf_path, clock::Nanos now);
   [[nodiscard]] Actions rendered(std::uint64_t frame_id, clock::Nanos render_time, const Rendered& how = {});
   [[nodiscard]] Actions ping_due(clock::Nanos now);
   [[nodiscard]] Actions present_due(clock::Nanos now);
@@ -153,10 +186,23 @@ class NodeProtocol {
   [[nodiscard]] const clock::OffsetEstimator& estimator() const { return estimator_; }
 
  private:
-  enum class Phase { disconnected, awaiting_challenge, awaiting_welcome, configuring, awaiting_state, joined, stopped };
+  enum class Phase {
+    disconnected,
+    awaiting_challenge,
+    awaiting_welcome,
+    preparing_scene,  // the shell looks for the scene's files, or starts a copy
+    fetching_scene,   // chunks of the scene's files come from the master
+    configuring,
+    awaiting_state,
+    joined,
+    stopped
+  };
 
   void on_challenge(const wire::Envelope& message, Actions& out);
   void on_welcome(const wire::Welcome& welcome, Actions& out);
+  void on_scene_chunk(const wire::SceneChunk& chunk, clock::Nanos now, Actions& out);
+  // The scene's files are here (or none are needed): set the renderer up.
+  void configure(Actions& out);
   void on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out);
   void on_frame_begin(const wire::FrameBegin& begin, clock::Nanos now, Actions& out);
   void on_swap(const wire::FrameSwap& swap, clock::Nanos now, Actions& out);
@@ -185,6 +231,9 @@ class NodeProtocol {
   Phase phase_ = Phase::disconnected;
   bool connection_open_ = false;
   std::optional<protocol::NodeJob> job_;
+  std::optional<protocol::SceneFetch> fetch_;  // the scene's files coming from the master
+  clock::Nanos fetch_started_ = 0;
+  int fetch_quarters_logged_ = 0;
   scene::SceneState state_;
   // The lag hook's memory: the last lag_frames + 1 frames as they came.
   struct PastFrame {

@@ -11,7 +11,9 @@
 namespace optique::net {
 
 // Bumped whenever a message changes meaning; master and node must agree exactly.
-inline constexpr std::uint32_t kProtocolVersion = 5;  // 5: the welcome says how many lights the scene has
+// 5: the welcome says how many lights the scene has; 6: the scene's files travel
+// from the master to nodes that lack them.
+inline constexpr std::uint32_t kProtocolVersion = 6;
 
 // Serializes `envelope` and appends it as one frame to `out`.
 void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envelope);

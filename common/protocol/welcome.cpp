@@ -17,6 +17,24 @@ schema::Installation job_of(const wire::Welcome& welcome) {
   return job;
 }
 
+// Checked here for shape and identity; each node holds the size to its own limit.
+constexpr std::uint64_t kMostSceneBytes = std::uint64_t{1} << 40;
+
+Result<scene::SceneManifest> decode_scene_manifest(const wire::SceneManifest& wire, const std::string& sha256) {
+  scene::SceneManifest manifest;
+  manifest.chunk_bytes = wire.chunk_bytes();
+  for (const wire::SceneFile& file : wire.files()) {
+    manifest.files.push_back({file.path(), file.size(), file.sha256(), file.chunk_sha256()});
+  }
+  if (auto checked = scene::check_manifest(manifest, {kMostSceneBytes, 1u << 16}); !checked) {
+    return Error{checked.error()};
+  }
+  if (scene::manifest_sha256(manifest) != sha256) {
+    return Error{"the scene's manifest does not hash to its SHA-256 (" + sha256.substr(0, 64) + ")"};
+  }
+  return manifest;
+}
+
 // Longer than any sane setting, short enough that doubling it cannot overflow.
 constexpr clock::Nanos kLongestPeriod = 10 * clock::kNanosPerSecond;
 constexpr std::uint32_t kLongestMs = 24 * 3600 * 1000;
@@ -24,8 +42,8 @@ constexpr std::uint32_t kLongestMs = 24 * 3600 * 1000;
 }  // namespace
 
 wire::Welcome encode_welcome(const config::Installation& installation, std::size_t projector,
-                             const std::string& scene_sha256, std::uint32_t light_count, clock::Nanos frame_period,
-                             const LightShare* share) {
+                             const scene::SceneManifest& scene_files, std::uint32_t light_count,
+                             clock::Nanos frame_period, const LightShare* share) {
   const config::ProjectorJob job = config::job_for(installation, projector);
   const config::Installation& part = job.installation;
   wire::Welcome welcome;
@@ -36,7 +54,10 @@ wire::Welcome encode_welcome(const config::Installation& installation, std::size
   *welcome.mutable_viewer() = config::to_schema(part.viewer);
   *welcome.mutable_scene() = config::to_schema(part.scene);
   if (part.depth_of_field) *welcome.mutable_depth_of_field() = config::to_schema(*part.depth_of_field, part.screens);
-  welcome.set_scene_sha256(scene_sha256);
+  if (!scene_files.files.empty()) {
+    welcome.set_scene_sha256(scene::manifest_sha256(scene_files));
+    *welcome.mutable_scene_files() = to_wire(scene_files);
+  }
   welcome.set_light_count(light_count);
   if (share != nullptr) *welcome.mutable_lights() = to_wire(*share);
   welcome.set_frame_period_ns(frame_period);
@@ -65,7 +86,12 @@ Result<NodeJob> decode_welcome(const wire::Welcome& welcome, std::string_view pr
   auto parsed = config::parse_job(job, projector_id, "welcome");
   if (!parsed) return Error{parsed.error()};
   node.job = std::move(parsed).value();
-  node.scene_sha256 = welcome.scene_sha256();
+  if (welcome.scene_files().files_size() > 0 || !welcome.scene_sha256().empty()) {
+    auto files = decode_scene_manifest(welcome.scene_files(), welcome.scene_sha256());
+    if (!files) return Error{"welcome: scene_files: " + files.error()};
+    node.scene_files = std::move(files).value();
+    node.scene_sha256 = welcome.scene_sha256();
+  }
   node.light_count = welcome.light_count();
   node.frame_period = welcome.frame_period_ns();
   node.heartbeat = std::chrono::milliseconds(welcome.heartbeat_ms());
@@ -82,6 +108,19 @@ wire::LightShare to_wire(const LightShare& share) {
   wire::LightShare out;
   out.mutable_lights()->Add(share.lights.begin(), share.lights.end());
   out.set_ambient(share.ambient);
+  return out;
+}
+
+wire::SceneManifest to_wire(const scene::SceneManifest& manifest) {
+  wire::SceneManifest out;
+  out.set_chunk_bytes(manifest.chunk_bytes);
+  for (const scene::SceneFile& file : manifest.files) {
+    wire::SceneFile& entry = *out.add_files();
+    entry.set_path(file.path);
+    entry.set_size(file.size);
+    entry.set_sha256(file.sha256);
+    entry.set_chunk_sha256(file.chunk_sha256);
+  }
   return out;
 }
 

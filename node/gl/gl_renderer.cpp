@@ -27,17 +27,13 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
     return {};
   }
 
-  const config::SceneSource& source = job.installation.scene;
-  auto loaded = config::load_scene(job.installation, image::decode_texture);
-  if (!loaded) {
-    return Error{"cannot load the scene: " + loaded.error() +
-                 (source.gltf.empty() ? "" : " (a node needs the master's scene file at the same path)")};
-  }
+  // A glTF scene is read from this node's copy of the master's files.
+  auto loaded = config::load_scene(job.installation, image::decode_texture, node.scene_path);
+  if (!loaded) return Error{"cannot load the scene: " + loaded.error()};
   const scene::LoadedScene& scene = loaded.value();
   if (scene.content_sha256 != node.scene_sha256) {
-    return Error{"the scene file " + scene.source + " differs from the master's (sha256 " +
-                 scene.content_sha256.substr(0, 12) + "… here, " + node.scene_sha256.substr(0, 12) +
-                 "… on the master)"};
+    return Error{"the scene " + scene.source + " is not the master's (sha256 " + scene.content_sha256.substr(0, 12) +
+                 "… here, " + node.scene_sha256.substr(0, 12) + "… on the master)"};
   }
   if (scene.definition.lights.size() != node.light_count) {
     return Error{"the scene " + scene.source + " has " + std::to_string(scene.definition.lights.size()) +

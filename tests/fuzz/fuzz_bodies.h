@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "scene/manifest.h"
+
 #if __has_include(<google/protobuf/stubs/logging.h>)
 #include <google/protobuf/stubs/logging.h>
 #define OPTIQUE_FUZZ_HAS_LOG_SILENCER 1
@@ -58,6 +60,9 @@ struct Outcome {
   int frames_presented = 0;  // run_protocol: by all nodes; run_node: by the node
   int renders = 0;           // run_node: frames the node drew
   int closes = 0;            // run_node: messages that made it close or stop
+  int configured = 0;        // run_node: times the node set its renderer up
+  int scene_chunks = 0;      // run_node: chunks of a scene's files it stored
+  scene::SceneManifest scene_files{};  // run_node: the scene being fetched
   bool finished = false;     // run_protocol: the master's run ended
   int datagrams_parsed = 0;  // run_tracker: datagrams parse_dtrack took
   int samples = 0;           // run_tracker: samples the head tracker took

@@ -82,6 +82,7 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
     std::visit(
         util::Overloaded{
             [&](node::Configure& a) {
+              ++outcome.configured;
               broken = check_job(a.job);
               light_count = a.job.light_count;
               if (broken.empty()) broken = carry_out(node, node.configured({}, "fuzz"), light_count, outcome);
@@ -100,6 +101,21 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
             },
             [&](node::Close&) { ++outcome.closes; },
             [&](node::Stop&) { ++outcome.closes; },
+            // A scene's files: fetched into a cache that takes everything.
+            [&](node::PrepareScene& a) {
+              outcome.scene_files = a.manifest;
+              broken = carry_out(node, node.scene_copy_started({}, 0), light_count, outcome);
+            },
+            [&](node::StoreSceneChunk& a) {
+              if (a.file >= outcome.scene_files.files.size() ||
+                  a.offset + a.data.size() > outcome.scene_files.files[a.file].size) {
+                broken = "a chunk stored outside its file";
+              }
+              ++outcome.scene_chunks;
+            },
+            [&](node::FinishScene&) {
+              broken = carry_out(node, node.scene_copy_finished(std::string("fuzz.gltf"), 0), light_count, outcome);
+            },
             [](auto&) {},
         },
         action);
@@ -109,7 +125,7 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
 }
 
 wire::Welcome good_welcome() {
-  return protocol::encode_welcome(wall().config.installation, 0, "", 4, 16'666'666, nullptr);
+  return protocol::encode_welcome(wall().config.installation, 0, {}, 4, 16'666'666, nullptr);
 }
 
 }  // namespace
@@ -166,19 +182,29 @@ Outcome run_node(std::span<const std::uint8_t> input) {
     return outcome;
   }
   if (node.stopped()) return outcome;  // a welcome it could not take: refused, as it should be
-  wire::Envelope resync;
-  resync.set_protocol_version(net::kProtocolVersion);
-  const scene::SceneState empty;
-  resync.mutable_resync()->set_state_hash(scene::state_hash(empty));
-  *resync.mutable_resync()->mutable_snapshot() = scene::to_snapshot(empty);
-  if (std::string broken = deliver(resync); !broken.empty()) {
+  // The state follows once the node is set up: at once, or after it fetched the
+  // scene's files from the messages that follow.
+  bool resynced = false;
+  const auto resync_when_configured = [&]() -> std::string {
+    if (resynced || outcome.configured == 0) return {};
+    resynced = true;
+    wire::Envelope resync;
+    resync.set_protocol_version(net::kProtocolVersion);
+    const scene::SceneState empty;
+    resync.mutable_resync()->set_state_hash(scene::state_hash(empty));
+    *resync.mutable_resync()->mutable_snapshot() = scene::to_snapshot(empty);
+    return deliver(resync);
+  };
+  if (std::string broken = resync_when_configured(); !broken.empty()) {
     outcome.broken = broken;
     return outcome;
   }
   for (std::size_t i = 1; i < chunks.size() && !node.stopped(); ++i) {
     wire::Envelope message;
     if (!message.ParseFromArray(chunks[i].data(), static_cast<int>(chunks[i].size()))) continue;
-    if (std::string broken = deliver(message); !broken.empty()) {
+    std::string broken = deliver(message);
+    if (broken.empty()) broken = resync_when_configured();
+    if (!broken.empty()) {
       outcome.broken = broken;
       return outcome;
     }

@@ -11,6 +11,7 @@
 #include "net/envelope.h"
 #include "net/framing.h"
 #include "protocol/welcome.h"
+#include "scene/manifest.h"
 #include "scene/state.h"
 
 namespace optique::fuzz {
@@ -128,6 +129,18 @@ std::vector<std::pair<std::string, wire::Envelope>> one_of_each_body() {
     refuse.set_retriable(true);
   }
   add("configured").mutable_configured()->set_renderer("llvmpipe (LLVM 15.0.6, 256 bits), headless");
+  {
+    auto& request = *add("scene_request").mutable_scene_request();
+    request.set_scene_sha256(std::string(64, 'a'));
+    request.set_file(1);
+    request.set_chunk(3);
+  }
+  {
+    auto& chunk = *add("scene_chunk").mutable_scene_chunk();
+    chunk.set_file(1);
+    chunk.set_chunk(3);
+    chunk.set_data(std::string(300, '\x5a'));
+  }
   {
     auto& resync = *add("resync").mutable_resync();
     auto& snapshot = *resync.mutable_snapshot();
@@ -451,7 +464,7 @@ void join_chunks(Bytes& out, const Bytes& chunk) {
 wire::Welcome wall_welcome() {
   auto run = master::load_run_config(std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-2x2.json", {});
   if (!run) throw std::runtime_error(run.error());
-  return protocol::encode_welcome(run.value().config.installation, 0, "", 4, 16'666'666, nullptr);
+  return protocol::encode_welcome(run.value().config.installation, 0, {}, 4, 16'666'666, nullptr);
 }
 
 Bytes frame_and_swap(std::uint64_t frame, const std::function<void(wire::FrameBegin&)>& change = {}) {
@@ -547,6 +560,32 @@ std::vector<Seed> node_seeds() {
                                                               b.mutable_lights()->add_lights(3);
                                                             })})});
   seeds.push_back({"not_a_welcome", node_seed(wire::Welcome{}, {noise(40, 3), frame_and_swap(0)})});
+  {
+    // A glTF scene of two files (the second two 4 KiB chunks): fetched with one
+    // chunk spoilt on the way and asked for again, then frames.
+    const std::string gltf = R"({"asset":{"version":"2.0"}})";
+    std::string bin(5000, '\0');
+    for (std::size_t i = 0; i < bin.size(); ++i) bin[i] = static_cast<char>(i * 13);
+    const scene::SceneManifest files{4096, {scene::describe_file("s.gltf", gltf, 4096),
+                                            scene::describe_file("s.bin", bin, 4096)}};
+    wire::Welcome with_files = welcome;
+    with_files.set_scene_sha256(scene::manifest_sha256(files));
+    *with_files.mutable_scene_files() = protocol::to_wire(files);
+    std::uint64_t sequence = 100;
+    const auto chunk = [&](std::uint32_t file, std::uint64_t index, std::string data) {
+      wire::Envelope e = envelope(sequence++);
+      e.mutable_scene_chunk()->set_file(file);
+      e.mutable_scene_chunk()->set_chunk(index);
+      e.mutable_scene_chunk()->set_data(std::move(data));
+      return serialize(e);
+    };
+    std::string spoilt = bin.substr(0, 4096);
+    spoilt[100] = static_cast<char>(spoilt[100] ^ 1);
+    seeds.push_back({"scene_fetched_with_a_spoilt_chunk",
+                     node_seed(with_files, {chunk(0, 0, gltf), chunk(1, 0, spoilt), chunk(1, 1, bin.substr(4096)),
+                                            chunk(1, 0, bin.substr(0, 4096)), frame_and_swap(0), frame_and_swap(1)})});
+    seeds.push_back({"scene_chunk_not_asked_for", node_seed(with_files, {chunk(1, 7, "x"), frame_and_swap(0)})});
+  }
   return seeds;
 }
 

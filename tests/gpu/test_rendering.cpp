@@ -300,27 +300,5 @@ TEST(Rendering, BadGltfInputStartsNothingAndSaysWhy) {
   }
 }
 
-TEST(Rendering, ANodeWhoseSceneFileDiffersIsRefusedWithAMessage) {
-  const std::string dir = make_temp_dir("optique-gl");
-  const std::string asset = dir + "/scene.gltf";
-  std::filesystem::copy_file(kAnimatedCubes, asset);
-  const std::string config = with_gltf(asset);
-  Process master({kMaster, "--config", config, "--listen", "127.0.0.1", "--port", "0", "--port-file", dir + "/port",
-                  "--no-status"},
-                 dir + "/master.log");
-  ASSERT_TRUE(wait_for_file(dir + "/port", 10s)) << master.output();
-  std::string port = read_file(dir + "/port");
-  port.pop_back();
-  // The master has loaded the file; now the copy the node will load changes.
-  std::ofstream(asset, std::ios::app) << "\n";
-  Process node({std::string(OPTIQUE_BIN_DIR) + "/optique-node", "--master", "127.0.0.1:" + port, "--id", "wall"},
-               dir + "/node.log");
-  EXPECT_EQ(node.wait(30s), 2) << node.output();
-  EXPECT_NE(node.output().find("differs from the master's"), std::string::npos) << node.output();
-  EXPECT_TRUE(master.wait_for_output("differs from the master's", 10s)) << master.output();
-  master.signal(SIGINT);
-  EXPECT_EQ(master.wait(10s), 0) << master.output();
-}
-
 }  // namespace
 }  // namespace optique::testing

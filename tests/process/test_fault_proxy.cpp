@@ -219,6 +219,24 @@ TEST_F(FaultProxyTest, PassesALargePayloadUnchangedBothWays) {
       << proxy_->bytes_forwarded();
 }
 
+TEST_F(FaultProxyTest, CorruptionSpoilsOneByteOfWhatTheTargetSendsOnce) {
+  proxy_->corrupt_from_target_at(70000);
+  const Bytes payload = random_bytes(200000, 3);
+  auto client = connect_client();
+  const Bytes echoed = client->exchange(payload, 5s);
+  ASSERT_EQ(echoed.size(), payload.size());
+  std::vector<std::size_t> differ;
+  for (std::size_t i = 0; i < payload.size(); ++i) {
+    if (echoed[i] != payload[i]) differ.push_back(i);
+  }
+  ASSERT_EQ(differ.size(), 1u);
+  EXPECT_EQ(differ.front(), 70000u);
+  EXPECT_EQ(echoed[70000], payload[70000] ^ 0x10);
+  EXPECT_EQ(proxy_->corruptions_done(), 1u);
+  // Once: the next exchange passes unchanged.
+  EXPECT_TRUE(client->exchange(payload, 5s) == payload);
+}
+
 TEST_F(FaultProxyTest, DelayAddsAtLeastTheBaseEachWay) {
   proxy_->set_delay(40ms, 0us);
   auto client = connect_client();

@@ -46,6 +46,8 @@ struct ProxyState {
   std::atomic<std::uint64_t> connections_accepted{0};
   std::atomic<std::uint64_t> resets_done{0};
   std::atomic<std::uint64_t> bytes_forwarded{0};
+  std::atomic<std::int64_t> corrupt_at{-1};  // in the target's stream; -1: none pending
+  std::atomic<std::uint64_t> corruptions_done{0};
 
   std::mutex faults_mutex;
   Faults faults;            // guarded by faults_mutex: the test thread changes it
@@ -122,6 +124,7 @@ class Session : public std::enable_shared_from_this<Session> {
     bool writing = false;
     bool sender_done = false;
     bool eof_passed_on = false;
+    std::uint64_t position = 0;  // bytes read from `from` so far
   };
 
   enum class Ending { kGraceful, kReset };
@@ -148,6 +151,16 @@ class Session : public std::enable_shared_from_this<Session> {
       return;
     }
     const auto first = direction.read_buffer.begin();
+    if (&direction == &downstream_) {
+      std::int64_t at = state_.corrupt_at.load();
+      const auto offset = static_cast<std::uint64_t>(at);
+      if (at >= 0 && offset >= direction.position && offset < direction.position + length &&
+          state_.corrupt_at.compare_exchange_strong(at, -1)) {
+        direction.read_buffer[offset - direction.position] ^= 0x10;
+        ++state_.corruptions_done;
+      }
+    }
+    direction.position += length;
     direction.queue.push_back(
         {{first, first + static_cast<std::ptrdiff_t>(length)}, 0, Clock::now() + state_.draw_delay()});
     direction.queued_bytes += length;
@@ -353,5 +366,11 @@ std::uint64_t FaultProxy::connections_accepted() const { return impl_->state().c
 std::uint64_t FaultProxy::resets_done() const { return impl_->state().resets_done; }
 
 std::uint64_t FaultProxy::bytes_forwarded() const { return impl_->state().bytes_forwarded; }
+
+void FaultProxy::corrupt_from_target_at(std::uint64_t offset) {
+  impl_->state().corrupt_at = static_cast<std::int64_t>(offset);
+}
+
+std::uint64_t FaultProxy::corruptions_done() const { return impl_->state().corruptions_done; }
 
 }  // namespace optique::testing

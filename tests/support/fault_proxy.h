@@ -33,6 +33,12 @@ class FaultProxy {
   void set_byte_interval(std::chrono::microseconds interval);
   // Close newly accepted connections at once, without connecting to the target.
   void set_refuse(bool enabled);
+  // Flips a bit of the byte at `offset` of what the target sends on a connection
+  // (counted from its first byte), once: on the first connection whose stream
+  // gets that far. A spoilt byte that TCP's checksum let through.
+  void corrupt_from_target_at(std::uint64_t offset);
+  // Bytes spoilt so far.
+  [[nodiscard]] std::uint64_t corruptions_done() const;
   // Aborts every open connection pair with a TCP RST on both sides; returns how many
   // it aborted once they are. Must not be called from the proxy's own thread.
   std::size_t reset_all();

@@ -306,6 +306,11 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
                 violation("node " + std::to_string(i) + ": " + a.text);
               }
             },
+            // Simulated clusters show built-in scenes: no files to fetch.
+            [&](node::PrepareScene&) { violation("node " + std::to_string(i) + " was sent a scene's files"); },
+            [&](node::StoreSceneChunk&) {},
+            [&](node::FinishScene&) {},
+            [&](node::AbandonScene&) {},
         },
         action);
   }

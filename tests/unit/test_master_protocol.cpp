@@ -708,5 +708,84 @@ TEST_F(MasterTest, AnAutomaticGroupsSharesFollowTheNodesThatAreUp) {
   EXPECT_TRUE(every_light_once({1, 2})) << "its lights are shared out among the two left";
 }
 
+// --- a node without a copy of the glTF scene asks for its files
+
+wire::Envelope scene_request(const std::string& sha256, std::uint32_t file, std::uint64_t chunk) {
+  wire::Envelope e = envelope();
+  e.mutable_scene_request()->set_scene_sha256(sha256);
+  e.mutable_scene_request()->set_file(file);
+  e.mutable_scene_request()->set_chunk(chunk);
+  return e;
+}
+
+TEST_F(MasterTest, TheWelcomeNamesTheScenesFilesAndEachChunkAskedForIsSent) {
+  load("gltf-torus.json");
+  const Actions welcomed = hello(1, "wall");
+  const auto welcome = sent_to(welcomed, 1, wire::Envelope::kWelcome);
+  ASSERT_EQ(welcome.size(), 1u);
+  const auto& files = welcome.front().welcome().scene_files();
+  ASSERT_EQ(files.files_size(), 3);  // the glTF, its buffer, its texture
+  EXPECT_EQ(files.files(1).path(), "torus.bin");
+  const std::string sha256 = welcome.front().welcome().scene_sha256();
+  EXPECT_EQ(sha256, run_.scene.content_sha256);
+
+  now_ += 25'000 * kMs;  // late in the configure timeout: each request extends it
+  Actions a = master_->message(1, scene_request(sha256, 1, 0), now_);
+  const auto chunks = sent_to(a, 1, wire::Envelope::kSceneChunk);
+  ASSERT_EQ(chunks.size(), 1u);
+  EXPECT_EQ(chunks.front().scene_chunk().data(), *run_.scene.files[1]);
+  ASSERT_NE(first<SetDeadline>(a), nullptr);
+  EXPECT_EQ(first<SetDeadline>(a)->after, std::chrono::milliseconds(kConfigureTimeout));
+  EXPECT_TRUE(logged(a, "sending the scene to 'wall', which has no copy: 3 file(s)"));
+  (void)master_->message(1, scene_request(sha256, 0, 0), now_);
+  a = master_->message(1, scene_request(sha256, 2, 0), now_ + 10 * kMs);
+  EXPECT_TRUE(logged(a, "sent the scene to 'wall'"));
+  EXPECT_FALSE(logged(a, "asked again"));
+  a = master_->message(1, scene_request(sha256, 2, 0), now_ + 20 * kMs);
+  EXPECT_TRUE(logged(a, "'wall' asked again for chunk 0 of 'torus.png'"));
+  // Then it is set up and asks no more.
+  (void)configured(1);
+  a = master_->message(1, scene_request(sha256, 0, 0), now_);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_NE(first<Close>(a)->reason.find("after setting up"), std::string::npos);
+}
+
+TEST_F(MasterTest, RequestsForAnotherSceneOrBeyondItsFilesCloseTheConnection) {
+  load("gltf-torus.json");
+  const std::string sha256 = run_.scene.content_sha256;
+  const std::vector<std::pair<wire::Envelope, std::string>> cases{
+      {scene_request(std::string(64, '0'), 0, 0), "another scene"},
+      {scene_request(sha256, 3, 0), "chunk 0 of file 3"},
+      {scene_request(sha256, 1, 1), "chunk 1 of file 1"},
+  };
+  PeerId peer = 1;
+  for (const auto& [request, reason] : cases) {
+    (void)hello(peer, "wall");
+    const Actions a = master_->message(peer, request, now_);
+    ASSERT_NE(first<Close>(a), nullptr) << reason;
+    EXPECT_NE(first<Close>(a)->reason.find(reason), std::string::npos) << first<Close>(a)->reason;
+    (void)master_->closed(peer, "closed", now_);
+    ++peer;
+  }
+  // A node asking for the same chunk over and over is cut off.
+  (void)hello(peer, "wall");
+  Actions a;
+  for (int i = 0; i < 100 && first<Close>(a) == nullptr; ++i) {
+    a = master_->message(peer, scene_request(sha256, 1, 0), now_);
+  }
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_NE(first<Close>(a)->reason.find("times over"), std::string::npos);
+}
+
+TEST_F(MasterTest, ABuiltInSceneHasNoFiles) {
+  load("powerwall-2x2.json");
+  const auto welcome = sent_to(hello(1, "top-left"), 1, wire::Envelope::kWelcome);
+  ASSERT_EQ(welcome.size(), 1u);
+  EXPECT_EQ(welcome.front().welcome().scene_files().files_size(), 0);
+  EXPECT_TRUE(welcome.front().welcome().scene_sha256().empty());
+  const Actions a = master_->message(1, scene_request("", 0, 0), now_);
+  EXPECT_NE(first<Close>(a), nullptr);
+}
+
 }  // namespace
 }  // namespace optique::master

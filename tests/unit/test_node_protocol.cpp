@@ -11,6 +11,7 @@
 #include "config/load.h"
 #include "net/auth.h"
 #include "protocol/welcome.h"
+#include "scene/manifest.h"
 #include "scene/state.h"
 
 namespace optique::node {
@@ -64,7 +65,7 @@ class NodeTest : public ::testing::Test {
     a = node.message(challenge, now_);
     ASSERT_EQ(sent(a, wire::Envelope::kHello).size(), 1u);
     wire::Envelope welcome = envelope();
-    *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, "", 4, kPeriod, nullptr);
+    *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr);
     a = node.message(welcome, now_);
     ASSERT_NE(first<Configure>(a), nullptr);
     a = node.configured({}, "test renderer");
@@ -162,7 +163,7 @@ TEST_F(NodeTest, ABadWelcomeStopsTheNodeNamingTheField) {
   challenge.mutable_challenge();
   ASSERT_EQ(sent(node.message(challenge, now_), wire::Envelope::kHello).size(), 1u);
   wire::Envelope welcome = envelope();
-  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, "", 4, kPeriod, nullptr);
+  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr);
   welcome.mutable_welcome()->mutable_screen()->set_width(-2.0);
   const Actions a = node.message(welcome, now_);
   ASSERT_NE(first<Stop>(a), nullptr);
@@ -623,6 +624,174 @@ TEST_F(NodeTest, APingDueDuringARoundWaitsUntilTheFrameIsShown) {
   (void)node.rendered(1, kMs);
   now_ += NodeProtocol::kPingDeferral.count() * kMs;
   EXPECT_EQ(sent(node.ping_due(now_), wire::Envelope::kPing).size(), 1u);
+}
+
+// --- a glTF scene's files, fetched from the master when this node has no copy
+
+// A scene of two files: a small glTF, and a binary of two 4 KiB chunks.
+struct TwoFileScene {
+  std::string gltf = R"({"asset":{"version":"2.0"}})";
+  std::string bin = std::string(5000, '\x42');
+  scene::SceneManifest files{4096, {scene::describe_file("s.gltf", gltf, 4096),
+                                    scene::describe_file("maps/s.bin", bin, 4096)}};
+  std::string sha256 = scene::manifest_sha256(files);
+};
+
+class SceneFetchTest : public NodeTest {
+ protected:
+  // Through the challenge to the welcome of a glTF scene.
+  Actions welcome_with_files(NodeProtocol& node) {
+    (void)node.connected(now_);
+    wire::Envelope challenge = envelope();
+    challenge.mutable_challenge();
+    (void)node.message(challenge, now_);
+    wire::Envelope welcome = envelope();
+    *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, scene_.files, 4, kPeriod, nullptr);
+    return node.message(welcome, now_);
+  }
+  wire::Envelope chunk(std::uint32_t file, std::uint64_t index, std::string data) {
+    wire::Envelope e = envelope();
+    e.mutable_scene_chunk()->set_file(file);
+    e.mutable_scene_chunk()->set_chunk(index);
+    e.mutable_scene_chunk()->set_data(std::move(data));
+    return e;
+  }
+  TwoFileScene scene_;
+};
+
+TEST_F(SceneFetchTest, ACopyInTheCacheIsUsedWithoutAFetch) {
+  NodeProtocol node(settings());
+  Actions a = welcome_with_files(node);
+  const PrepareScene* prepare = first<PrepareScene>(a);
+  ASSERT_NE(prepare, nullptr);
+  EXPECT_EQ(prepare->sha256, scene_.sha256);
+  EXPECT_EQ(prepare->manifest.files.size(), 2u);
+  EXPECT_EQ(first<Configure>(a), nullptr);
+  a = node.scene_found("/cache/scenes/abc/s.gltf");
+  ASSERT_NE(first<Configure>(a), nullptr);
+  EXPECT_EQ(first<Configure>(a)->job.scene_path, "/cache/scenes/abc/s.gltf");
+  EXPECT_TRUE(sent(a, wire::Envelope::kSceneRequest).empty());
+}
+
+TEST_F(SceneFetchTest, AMissingSceneIsFetchedChunkByChunkAndCheckedThenConfigured) {
+  NodeProtocol node(settings());
+  (void)welcome_with_files(node);
+  Actions a = node.scene_copy_started({}, now_);
+  auto requests = sent(a, wire::Envelope::kSceneRequest);
+  ASSERT_EQ(requests.size(), 3u);  // every chunk there is, up to four at once
+  EXPECT_EQ(requests[0].scene_request().scene_sha256(), scene_.sha256);
+  EXPECT_EQ(requests[1].scene_request().file(), 1u);
+  EXPECT_EQ(requests[2].scene_request().chunk(), 1u);
+  ASSERT_NE(first<SetDeadline>(a), nullptr);
+  EXPECT_TRUE(logged(a, "fetching the scene"));
+
+  a = node.message(chunk(0, 0, scene_.gltf), now_);
+  ASSERT_NE(first<StoreSceneChunk>(a), nullptr);
+  EXPECT_EQ(first<StoreSceneChunk>(a)->data, scene_.gltf);
+  // A chunk spoilt on the way is not stored but asked for again.
+  std::string spoilt = scene_.bin.substr(0, 4096);
+  spoilt[7] = 'x';
+  a = node.message(chunk(1, 0, spoilt), now_);
+  EXPECT_EQ(first<StoreSceneChunk>(a), nullptr);
+  EXPECT_TRUE(logged(a, "does not match its SHA-256; asking for it again"));
+  requests = sent(a, wire::Envelope::kSceneRequest);
+  ASSERT_EQ(requests.size(), 1u);
+  EXPECT_EQ(requests[0].scene_request().chunk(), 0u);
+  a = node.message(chunk(1, 1, scene_.bin.substr(4096)), now_);
+  ASSERT_NE(first<StoreSceneChunk>(a), nullptr);
+  EXPECT_EQ(first<StoreSceneChunk>(a)->offset, 4096u);
+  EXPECT_EQ(first<FinishScene>(a), nullptr);
+  a = node.message(chunk(1, 0, scene_.bin.substr(0, 4096)), now_ + 20 * kMs);
+  ASSERT_NE(first<StoreSceneChunk>(a), nullptr);
+  ASSERT_NE(first<FinishScene>(a), nullptr);
+  EXPECT_TRUE(logged(a, "fetched the scene"));
+  EXPECT_TRUE(logged(a, "1 chunk(s) asked for again"));
+
+  a = node.scene_copy_finished(std::string("/cache/scenes/x/s.gltf"), now_);
+  ASSERT_NE(first<Configure>(a), nullptr);
+  EXPECT_EQ(first<Configure>(a)->job.scene_path, "/cache/scenes/x/s.gltf");
+}
+
+TEST_F(SceneFetchTest, AChunkNotAskedForClosesAndAFailedCopyStopsTheNode) {
+  {
+    NodeProtocol node(settings());
+    (void)welcome_with_files(node);
+    (void)node.scene_copy_started({}, now_);
+    const Actions a = node.message(chunk(1, 9, "x"), now_);
+    ASSERT_NE(first<Close>(a), nullptr);
+    EXPECT_NE(first<Close>(a)->reason.find("not asked for"), std::string::npos);
+    // The connection goes: the partial copy with it.
+    EXPECT_NE(first<AbandonScene>(node.closed("gone", now_)), nullptr);
+  }
+  {
+    NodeProtocol node(settings());
+    (void)welcome_with_files(node);
+    const Actions a = node.scene_copy_started(Error{"no room"}, now_);
+    ASSERT_NE(first<Stop>(a), nullptr);
+    EXPECT_EQ(first<Stop>(a)->exit_code, kExitRefused);
+    EXPECT_TRUE(logged(a, "no room"));
+  }
+  {
+    NodeProtocol node(settings());
+    (void)welcome_with_files(node);
+    (void)node.scene_copy_started({}, now_);
+    const Actions a = node.scene_store_failed("disk full");
+    ASSERT_NE(first<Stop>(a), nullptr);
+    EXPECT_NE(first<AbandonScene>(a), nullptr);
+  }
+  {
+    // The same chunk spoilt on every try: the fetch gives the connection up.
+    NodeProtocol node(settings());
+    (void)welcome_with_files(node);
+    (void)node.scene_copy_started({}, now_);
+    Actions a;
+    for (int i = 0; i < protocol::SceneFetch::kMostTries; ++i) a = node.message(chunk(0, 0, "{}"), now_);
+    ASSERT_NE(first<Close>(a), nullptr);
+    EXPECT_NE(first<Close>(a)->reason.find("after 4 tries"), std::string::npos) << first<Close>(a)->reason;
+  }
+}
+
+TEST_F(SceneFetchTest, ANodeWithoutARendererOrTooSmallALimitFetchesNothing) {
+  {
+    NodeSettings s = settings();
+    s.needs_scene_files = false;
+    NodeProtocol node(s);
+    const Actions a = welcome_with_files(node);
+    EXPECT_NE(first<Configure>(a), nullptr);
+    EXPECT_EQ(first<PrepareScene>(a), nullptr);
+  }
+  {
+    NodeSettings s = settings();
+    s.most_scene_bytes = 1000;
+    NodeProtocol node(s);
+    const Actions a = welcome_with_files(node);
+    ASSERT_NE(first<Stop>(a), nullptr);
+    EXPECT_EQ(first<Stop>(a)->exit_code, kExitRefused);
+    EXPECT_TRUE(logged(a, "--max-scene-mb"));
+  }
+}
+
+TEST_F(SceneFetchTest, AWelcomeWhoseManifestDoesNotHashToTheSceneIsRefused) {
+  NodeProtocol node(settings());
+  (void)node.connected(now_);
+  wire::Envelope challenge = envelope();
+  challenge.mutable_challenge();
+  (void)node.message(challenge, now_);
+  wire::Envelope welcome = envelope();
+  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, scene_.files, 4, kPeriod, nullptr);
+  welcome.mutable_welcome()->mutable_scene_files()->mutable_files(1)->set_size(4999);
+  Actions a = node.message(welcome, now_);
+  ASSERT_NE(first<Stop>(a), nullptr);
+  EXPECT_TRUE(logged(a, "does not hash to its SHA-256")) << "the manifest is the scene's identity";
+
+  NodeProtocol other(settings());
+  (void)other.connected(now_);
+  (void)other.message(challenge, now_);
+  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, scene_.files, 4, kPeriod, nullptr);
+  welcome.mutable_welcome()->mutable_scene_files()->mutable_files(1)->set_path("../../etc/s.bin");
+  a = other.message(welcome, now_);
+  ASSERT_NE(first<Stop>(a), nullptr);
+  EXPECT_TRUE(logged(a, "leaves the scene's folder"));
 }
 
 }  // namespace

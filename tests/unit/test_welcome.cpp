@@ -33,6 +33,8 @@ std::string bytes_of(const config::ProjectorJob& job) {
 }
 
 TEST(Welcome, EveryShippedProjectorsJobArrivesAsItWasCut) {
+  const scene::SceneManifest files{4096, {scene::describe_file("s.gltf", "{}", 4096),
+                                          scene::describe_file("maps/a.png", std::string(9000, 'x'), 4096)}};
   std::size_t checked = 0;
   for (const auto& entry : fs::directory_iterator(kConfigs)) {
     if (entry.path().extension() != ".json") continue;
@@ -42,13 +44,15 @@ TEST(Welcome, EveryShippedProjectorsJobArrivesAsItWasCut) {
       const config::Projector& p = installation.projectors[i];
       const LightShare share{{0, 2}, true};
       const bool lights = p.content.role == config::ContentRole::lights;
-      const wire::Welcome welcome = encode_welcome(installation, i, "abc", 20, 16'666'666, lights ? &share : nullptr);
+      const wire::Welcome welcome = encode_welcome(installation, i, files, 20, 16'666'666, lights ? &share : nullptr);
       auto decoded = decode_welcome(welcome, p.id);
       ASSERT_TRUE(decoded.ok()) << p.id << ": " << decoded.error();
       const NodeJob& job = decoded.value();
       EXPECT_EQ(bytes_of(job.job), bytes_of(config::job_for(installation, i))) << p.id;
       EXPECT_EQ(job.job.self().id, p.id);
-      EXPECT_EQ(job.scene_sha256, "abc");
+      EXPECT_EQ(job.scene_sha256, scene::manifest_sha256(files));
+      EXPECT_EQ(job.scene_files.files.size(), 2u);
+      EXPECT_EQ(job.scene_files.files[1].chunk_sha256, files.files[1].chunk_sha256);
       EXPECT_EQ(job.light_count, 20u);
       EXPECT_EQ(job.frame_period, 16'666'666);
       EXPECT_EQ(job.heartbeat, installation.master.heartbeat);
@@ -64,7 +68,7 @@ TEST(Welcome, EveryShippedProjectorsJobArrivesAsItWasCut) {
 }
 
 // A welcome for the first projector of the 2×2 wall, for the tests below to spoil.
-wire::Welcome good_welcome() { return encode_welcome(load("powerwall-2x2.json"), 0, "", 0, 16'666'666, nullptr); }
+wire::Welcome good_welcome() { return encode_welcome(load("powerwall-2x2.json"), 0, {}, 0, 16'666'666, nullptr); }
 
 std::string error_of(const wire::Welcome& welcome, const std::string& id = "bottom-left") {
   auto decoded = decode_welcome(welcome, id);
@@ -111,12 +115,12 @@ TEST(Welcome, RefusesAProjectorThatWouldNotPassAsAConfig) {
 TEST(Welcome, RefusesAShareOfLightsTheSceneDoesNotHave) {
   config::Installation installation = load("stacked-lighting-3.json");
   const LightShare beyond{{3, 20}, false};
-  auto decoded = decode_welcome(encode_welcome(installation, 0, "", 20, 16'666'666, &beyond), "lights-a");
+  auto decoded = decode_welcome(encode_welcome(installation, 0, {}, 20, 16'666'666, &beyond), "lights-a");
   ASSERT_FALSE(decoded.ok());
   EXPECT_NE(decoded.error().find("welcome: lights: light 20 does not exist (the scene has 20)"), std::string::npos)
       << decoded.error();
   const LightShare twice{{4, 4}, false};
-  auto repeated = decode_welcome(encode_welcome(installation, 0, "", 20, 16'666'666, &twice), "lights-a");
+  auto repeated = decode_welcome(encode_welcome(installation, 0, {}, 20, 16'666'666, &twice), "lights-a");
   ASSERT_FALSE(repeated.ok());
   EXPECT_NE(repeated.error().find("lights must ascend, each once"), std::string::npos) << repeated.error();
 }
