@@ -145,7 +145,7 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
     return out;
   }
   if (phase_ == Phase::fetching_scene && message.body_case() == wire::Envelope::kSceneChunk) {
-    on_scene_chunk(message.scene_chunk(), now, out);
+    on_scene_chunk(message.scene_chunk(), out);
     return out;
   }
   if ((phase_ == Phase::preparing_scene || phase_ == Phase::fetching_scene) &&
@@ -274,14 +274,14 @@ Actions NodeProtocol::scene_copy_started(const Result<void>& started, clock::Nan
   log(out, spdlog::level::info,
       fmt::format("fetching the scene {} from the master: {} file(s), {:.1f} MiB", job_->job.installation.scene.gltf,
                   job_->scene_files.files.size(), static_cast<double>(job_->scene_files.total_bytes()) / (1 << 20)));
-  out.push_back(SetDeadline{kSceneStall, "no part of the scene from the master for " +
-                                             std::to_string(kSceneStall.count() / 1000) + " s"});
+  out.push_back(SetDeadline{
+      kSceneStall, "no part of the scene from the master for " + std::to_string(kSceneStall.count() / 1000) + " s"});
   for (wire::Envelope& request : fetch_->requests()) out.push_back(Send{std::move(request)});
   if (fetch_->done()) out.push_back(FinishScene{});  // only empty files
   return out;
 }
 
-void NodeProtocol::on_scene_chunk(const wire::SceneChunk& chunk, clock::Nanos now, Actions& out) {
+void NodeProtocol::on_scene_chunk(const wire::SceneChunk& chunk, Actions& out) {
   const protocol::SceneFetch::Verdict verdict = fetch_->take(chunk);
   switch (verdict.kind) {
     case protocol::SceneFetch::Verdict::Kind::fail:
@@ -294,8 +294,8 @@ void NodeProtocol::on_scene_chunk(const wire::SceneChunk& chunk, clock::Nanos no
       out.push_back(StoreSceneChunk{verdict.file, verdict.offset, chunk.data()});
       break;
   }
-  out.push_back(SetDeadline{kSceneStall, "no part of the scene from the master for " +
-                                             std::to_string(kSceneStall.count() / 1000) + " s"});
+  out.push_back(SetDeadline{
+      kSceneStall, "no part of the scene from the master for " + std::to_string(kSceneStall.count() / 1000) + " s"});
   const std::uint64_t total = fetch_->manifest().total_bytes();
   const int quarters = total == 0 ? 4 : static_cast<int>(4 * fetch_->bytes_stored() / total);
   if (quarters > fetch_quarters_logged_ && quarters < 4 && total >= protocol::kSceneProgressBytes) {
@@ -303,11 +303,6 @@ void NodeProtocol::on_scene_chunk(const wire::SceneChunk& chunk, clock::Nanos no
     log(out, spdlog::level::info, fmt::format("fetching the scene: {} %", 25 * quarters));
   }
   if (fetch_->done()) {
-    log(out, spdlog::level::info,
-        fmt::format("fetched the scene: {}{}", protocol::transfer_text(total, now - fetch_started_),
-                    fetch_->chunks_asked_again() > 0
-                        ? fmt::format(", {} chunk(s) asked for again", fetch_->chunks_asked_again())
-                        : ""));
     out.push_back(FinishScene{});
     return;
   }
@@ -321,14 +316,20 @@ Actions NodeProtocol::scene_store_failed(const std::string& error) {
   return out;
 }
 
-Actions NodeProtocol::scene_copy_finished(const Result<std::string>& gltf_path, clock::Nanos) {
+Actions NodeProtocol::scene_copy_finished(const Result<std::string>& gltf_path, clock::Nanos now) {
   Actions out;
   if (phase_ != Phase::fetching_scene) return out;
-  fetch_.reset();
   if (!gltf_path) {
     stop(kExitRefused, "cannot keep the master's scene here: " + gltf_path.error(), out);
     return out;
   }
+  // From the first request to the copy checked whole and in place.
+  log(out, spdlog::level::info,
+      fmt::format(
+          "fetched the scene: {}{}", protocol::transfer_text(fetch_->manifest().total_bytes(), now - fetch_started_),
+          fetch_->chunks_asked_again() > 0 ? fmt::format(", {} chunk(s) asked for again", fetch_->chunks_asked_again())
+                                           : ""));
+  fetch_.reset();
   job_->scene_path = gltf_path.value();
   configure(out);
   return out;

@@ -200,7 +200,7 @@ class NodeProtocol {
 
   void on_challenge(const wire::Envelope& message, Actions& out);
   void on_welcome(const wire::Welcome& welcome, Actions& out);
-  void on_scene_chunk(const wire::SceneChunk& chunk, clock::Nanos now, Actions& out);
+  void on_scene_chunk(const wire::SceneChunk& chunk, Actions& out);
   // The scene's files are here (or none are needed): set the renderer up.
   void configure(Actions& out);
   void on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out);

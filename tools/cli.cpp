@@ -1,5 +1,7 @@
 #include "tools/cli.h"
 
+#include <fmt/format.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cinttypes>
@@ -39,7 +41,16 @@ int check_config(const std::vector<std::string>& files) {
       continue;
     }
     std::cout << summarize(loaded.value().config);
-    for (const auto& warning : loaded.value().scene.warnings) std::cout << "  scene warning: " << warning << "\n";
+    const scene::LoadedScene& scene = loaded.value().scene;
+    if (!scene.manifest.files.empty()) {
+      std::string names;
+      for (const auto& f : scene.manifest.files) names += (names.empty() ? "" : ", ") + f.path;
+      std::cout << "  scene files: " << scene.manifest.files.size() << " (" << names << "), "
+                << fmt::format("{:.1f}", static_cast<double>(scene.manifest.total_bytes()) / (1 << 20))
+                << " MiB, identity " << scene.content_sha256.substr(0, 12)
+                << "…: sent to every node that has no copy\n";
+    }
+    for (const auto& warning : scene.warnings) std::cout << "  scene warning: " << warning << "\n";
   }
   return status;
 }

@@ -11,12 +11,12 @@
 #include <iostream>
 
 #include "cluster_run.h"
-#include "local_capture.h"
 #include "config/load.h"
 #include "config/to_schema.h"
 #include "image/compare.h"
 #include "image/frame_files.h"
 #include "image/image_io.h"
+#include "local_capture.h"
 #include "process.h"
 
 namespace optique::testing {
@@ -284,6 +284,25 @@ TEST(Rendering, BadGltfInputStartsNothingAndSaysWhy) {
   const std::string skinned = dir + "/skinned.gltf";
   std::ofstream(skinned) << skinned_text;
 
+  // The torus as obj2gltf wrote it (its buffer and texture beside it), spoilt
+  // as a user's export might be, each in a folder of its own.
+  const std::string torus = std::string(OPTIQUE_SOURCE_DIR) + "/configs/assets/torus/";
+  const auto torus_variant = [&](const std::string& name, const std::string& from, const std::string& to,
+                                 std::size_t bin_bytes) {
+    const std::string folder = dir + "/" + name;
+    std::filesystem::create_directories(folder);
+    std::string text = read_file(torus + "torus.gltf");
+    if (!from.empty()) {
+      const auto at = text.find(from);
+      EXPECT_NE(at, std::string::npos) << from;
+      if (at != std::string::npos) text.replace(at, from.size(), to);
+    }
+    std::ofstream(folder + "/torus.gltf") << text;
+    std::ofstream(folder + "/torus.bin", std::ios::binary) << read_file(torus + "torus.bin").substr(0, bin_bytes);
+    std::filesystem::copy_file(torus + "torus.png", folder + "/torus.png");
+    return folder + "/torus.gltf";
+  };
+  const std::size_t whole = 184352;
   const struct {
     std::string gltf;
     std::string expected;
@@ -291,6 +310,15 @@ TEST(Rendering, BadGltfInputStartsNothingAndSaysWhy) {
       {dir + "/missing.gltf", "missing.gltf"},
       {malformed, "malformed.gltf"},
       {skinned, "skin"},
+      {torus_variant("escaping", "\"uri\": \"torus.bin\"", "\"uri\": \"../escaping/torus.bin\"", whole),
+       "escaping/torus.gltf: buffer 0 '../escaping/torus.bin': its URI leaves the scene's folder"},
+      {torus_variant("no-image", "\"uri\": \"torus.png\"", "\"uri\": \"wood.png\"", whole),
+       "no-image/torus.gltf: image 0 'wood.png': missing"},
+      {torus_variant("truncated", "", "", 1000),
+       "truncated/torus.gltf: buffer 0 'torus.bin' is truncated: 1000 bytes where its byteLength says 184352"},
+      {torus_variant("meshopt", "\"asset\": {", "\"extensionsRequired\": [\"EXT_meshopt_compression\"], \"asset\": {",
+                     whole),
+       "meshopt/torus.gltf: requires an extension that optique cannot draw: EXT_meshopt_compression"},
   };
   for (const auto& c : cases) {
     const StandInStart start = start_with_stand_in_nodes(kMaster, with_gltf(c.gltf));

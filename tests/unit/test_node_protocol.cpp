@@ -632,8 +632,8 @@ TEST_F(NodeTest, APingDueDuringARoundWaitsUntilTheFrameIsShown) {
 struct TwoFileScene {
   std::string gltf = R"({"asset":{"version":"2.0"}})";
   std::string bin = std::string(5000, '\x42');
-  scene::SceneManifest files{4096, {scene::describe_file("s.gltf", gltf, 4096),
-                                    scene::describe_file("maps/s.bin", bin, 4096)}};
+  scene::SceneManifest files{
+      4096, {scene::describe_file("s.gltf", gltf, 4096), scene::describe_file("maps/s.bin", bin, 4096)}};
   std::string sha256 = scene::manifest_sha256(files);
 };
 
@@ -704,10 +704,10 @@ TEST_F(SceneFetchTest, AMissingSceneIsFetchedChunkByChunkAndCheckedThenConfigure
   a = node.message(chunk(1, 0, scene_.bin.substr(0, 4096)), now_ + 20 * kMs);
   ASSERT_NE(first<StoreSceneChunk>(a), nullptr);
   ASSERT_NE(first<FinishScene>(a), nullptr);
-  EXPECT_TRUE(logged(a, "fetched the scene"));
-  EXPECT_TRUE(logged(a, "1 chunk(s) asked for again"));
 
-  a = node.scene_copy_finished(std::string("/cache/scenes/x/s.gltf"), now_);
+  a = node.scene_copy_finished(std::string("/cache/scenes/x/s.gltf"), now_ + 30 * kMs);
+  EXPECT_TRUE(logged(a, "fetched the scene: 0.0 MiB in 0.03 s"));
+  EXPECT_TRUE(logged(a, "1 chunk(s) asked for again"));
   ASSERT_NE(first<Configure>(a), nullptr);
   EXPECT_EQ(first<Configure>(a)->job.scene_path, "/cache/scenes/x/s.gltf");
 }

@@ -5,8 +5,8 @@ error. Writes gnuplot data: one block per series group, blocks apart by two blan
 lines (gnuplot's `index`), one number per column, NaN where there is none.
 
 usage: series.py NAME CSV OUT.dat   (NAME: barrier, calibration, dof, fields,
-                                     lighting, oblique, oblique-depth, tracking,
-                                     upconversion)
+                                     lighting, oblique, oblique-depth,
+                                     scene-transfer, tracking, upconversion)
 
 The drawing is tests/bench/plots/NAME.gp; scripts/plot-bench.sh runs both."""
 
@@ -277,8 +277,21 @@ def tracking(rows):
     return [by[key] for key in order]
 
 
+def scene_transfer(rows):
+    """One row per method, in the bench's order: index, then the median, min and
+    max over runs of MiB/s."""
+    order = []
+    by = defaultdict(list)
+    for r in rows:
+        if r["method"] not in by:
+            order.append(r["method"])
+        by[r["method"]].append(float(r["mib_per_s"]))
+    return [[[i, *spread(by[method])] for i, method in enumerate(order)]]
+
+
 SERIES = {"barrier": barrier, "calibration": calibration, "dof": dof, "fields": fields, "lighting": lighting,
-          "oblique": oblique, "oblique-depth": oblique_depth, "tracking": tracking, "upconversion": upconversion}
+          "oblique": oblique, "oblique-depth": oblique_depth, "scene-transfer": scene_transfer, "tracking": tracking,
+          "upconversion": upconversion}
 
 
 def main():
