@@ -85,7 +85,7 @@ std::string add_default_lights(SceneDefinition& scene, const glm::dvec3& viewer)
   scene.lights.push_back(light(centre, forward + 0.9 * up + 0.3 * right, distance, kRim));
   scene.ambient = glm::max(scene.ambient, glm::vec3(kAmbient));
   return fmt::format(
-      "the file has no lights: lit by a key, a fill and a rim light {:.2f} m from the centre of the scene "
+      "no point lights to draw in the file: lit by a key, a fill and a rim light {:.2f} m from the centre of the scene "
       "({:.2f}, {:.2f}, {:.2f}; radius {:.2f} m) as seen from the viewer at ({:.2f}, {:.2f}, {:.2f})",
       distance, centre.x, centre.y, centre.z, radius, viewer.x, viewer.y, viewer.z);
 }
