@@ -267,8 +267,8 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
   // Setting up a GL context and compiling shaders can take seconds on a loaded
   // machine; the node is silent meanwhile.
   out.push_back(
-      SetDeadline{peer, kConfigureTimeout,
-                  "node did not finish configuring within " + std::to_string(kConfigureTimeout.count()) + " s"});
+      SetDeadline{peer, configure_timeout(),
+                  "node did not finish configuring within " + std::to_string(configure_timeout().count()) + " s"});
   const LightShare* share = light_plan_.share(*slot);
   wire::Envelope envelope;
   *envelope.mutable_welcome() =
@@ -302,7 +302,7 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
 // A node without a copy of the scene asks for its files chunk by chunk while it
 // sets up: each request that names a chunk of this scene is answered from the
 // bytes the master loaded (scene/gltf_source.h: what it hashed), and gives the
-// node another kConfigureTimeout to finish.
+// node another configure_timeout() to finish.
 void MasterProtocol::on_scene_request(PeerId peer, Session& session, const wire::SceneRequest& request,
                                       clock::Nanos now, Actions& out) {
   const scene::SceneManifest& manifest = scene_.manifest;
@@ -321,9 +321,9 @@ void MasterProtocol::on_scene_request(PeerId peer, Session& session, const wire:
   if (!session.scene) {
     session.scene.emplace();
     session.scene->started = now;
-    out.push_back(Log{spdlog::level::info,
-                      fmt::format("sending the scene to '{}', which has no copy: {} file(s), {:.1f} MiB", id,
-                                  manifest.files.size(), static_cast<double>(total) / (1 << 20))});
+    out.push_back(
+        Log{spdlog::level::info, fmt::format("sending the scene to '{}', which has no copy: {} file(s), {:.1f} MiB", id,
+                                             manifest.files.size(), static_cast<double>(total) / (1 << 20))});
   }
   SceneSending& sending = *session.scene;
   const std::uint64_t offset = manifest.chunk_offset(request.chunk());
@@ -348,19 +348,24 @@ void MasterProtocol::on_scene_request(PeerId peer, Session& session, const wire:
   chunk.set_chunk(request.chunk());
   chunk.set_data(scene_.files[request.file()]->substr(offset, length));
   out.push_back(Send{peer, std::move(envelope)});
-  out.push_back(SetDeadline{peer, kConfigureTimeout,
-                            "node did not finish configuring within " + std::to_string(kConfigureTimeout.count()) +
+  out.push_back(SetDeadline{peer, configure_timeout(),
+                            "node did not finish configuring within " + std::to_string(configure_timeout().count()) +
                                 " s of its last request for the scene"});
   const int quarters = static_cast<int>(4 * sending.bytes_new / std::max<std::uint64_t>(total, 1));
   if (quarters > sending.quarters_logged) {
     sending.quarters_logged = quarters;
     if (quarters == 4) {
-      out.push_back(Log{spdlog::level::info,
-                        fmt::format("sent the scene to '{}': {}", id, protocol::transfer_text(total, now - sending.started))});
+      out.push_back(Log{spdlog::level::info, fmt::format("sent the scene to '{}': {}", id,
+                                                         protocol::transfer_text(total, now - sending.started))});
     } else if (total >= protocol::kSceneProgressBytes) {
       out.push_back(Log{spdlog::level::info, fmt::format("sending the scene to '{}': {} %", id, 25 * quarters)});
     }
   }
+}
+
+std::chrono::seconds MasterProtocol::configure_timeout() const {
+  const std::uint64_t bytes = scene_.manifest.total_bytes();
+  return kConfigureTimeout + std::chrono::seconds((bytes + kSceneBytesPerExtraSecond - 1) / kSceneBytesPerExtraSecond);
 }
 
 // The state as of the last frame begun; the next FrameBegin's delta applies to it.
@@ -438,7 +443,7 @@ Actions MasterProtocol::timer(Timer timer, clock::Nanos now) {
         out.push_back(Log{spdlog::level::warn,
                           fmt::format("no node ready after {} ms; waiting for {} (connected, still configuring, "
                                       "at most {} s each) before starting",
-                                      config_.startup_timeout.count(), ids, kConfigureTimeout.count())});
+                                      config_.startup_timeout.count(), ids, configure_timeout().count())});
         break;
       }
       {

@@ -43,8 +43,11 @@ namespace optique::master {
 // The largest frame a peer may send before its hello is accepted.
 inline constexpr std::uint32_t kMaxHelloBytes = 4096;
 // How long a node may take to set itself up (GL context, scene) after the welcome,
-// or between two chunks of the scene it asks for.
+// or after the last chunk of the scene it asks for: this, and a second more for
+// every kSceneBytesPerExtraSecond of a glTF scene's files (which a node reads and
+// hashes once or twice while it sets up: 8 GiB is 158 s in all).
 inline constexpr std::chrono::seconds kConfigureTimeout{30};
+inline constexpr std::uint64_t kSceneBytesPerExtraSecond = 64u << 20;
 // A node that asks for more than this many times the scene's bytes is broken.
 inline constexpr std::uint64_t kMostSceneRepeats = 4;
 
@@ -123,6 +126,18 @@ struct RunSettings {
   std::function<clock::Nanos()> send_clock;
 };
 
+// The scene's files going to a node that has no copy (a session's bookkeeping;
+// outside MasterProtocol so that it is a complete type where the session's
+// std::optional of it is used).
+struct SceneSending {
+  clock::Nanos started = 0;
+  std::uint64_t bytes_asked = 0;  // all chunks sent, repeats included
+  std::uint64_t bytes_new = 0;    // each chunk once
+  std::set<std::pair<std::uint32_t, std::uint64_t>> sent;
+  int quarters_logged = 0;
+  int repeats = 0;  // chunks asked for again
+};
+
 class MasterProtocol {
  public:
   // Keeps references to all four; they must outlive it.
@@ -171,15 +186,6 @@ class MasterProtocol {
   enum class Phase { handshake, configuring, joined, in_barrier, out_of_barrier };
   enum class RunState { starting, running, draining, closing, done };
 
-  // The scene's files going to a node that has no copy.
-  struct SceneSending {
-    clock::Nanos started = 0;
-    std::uint64_t bytes_asked = 0;  // all chunks sent, repeats included
-    std::uint64_t bytes_new = 0;    // each chunk once
-    std::set<std::pair<std::uint32_t, std::uint64_t>> sent;
-    int quarters_logged = 0;
-    int repeats = 0;  // chunks asked for again
-  };
   static constexpr int kRepeatsLogged = 10;
   struct Session {
     std::string peer_text;
@@ -226,6 +232,7 @@ class MasterProtocol {
   // The projectors whose node has said hello and is setting up (GL, scene, shaders).
   [[nodiscard]] std::vector<std::size_t> slots_configuring() const;
   [[nodiscard]] std::string slot_id(std::size_t slot) const;
+  [[nodiscard]] std::chrono::seconds configure_timeout() const;
   [[nodiscard]] Session* session_of(std::size_t slot);
   [[nodiscard]] const Session* session_of(std::size_t slot) const;
   [[nodiscard]] std::optional<report::TrackingReport> tracking_report() const;

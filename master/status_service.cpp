@@ -32,7 +32,6 @@ StatusService::StatusService(const config::StatusServer& settings, OperatorAcces
     : settings_(settings),
       access_(std::move(access)),
       on_command_(std::move(on_command)),
-      log_(log),
       server_(
           io_,
           [&] {

@@ -50,7 +50,6 @@ class StatusService {
   config::StatusServer settings_;
   OperatorAccess access_;
   CommandSink on_command_;
-  spdlog::logger& log_;
   StatusBoard board_;
   boost::asio::io_context io_;
   http::Server server_;

@@ -85,100 +85,107 @@ void Node::connect() {
 }
 
 void Node::carry_out(Actions actions) {
-  for (Action& action : actions) carry_out(action);
+  // Once an action's answer stopped the protocol, what came after it in this
+  // list is moot (a deadline, a step of a fetch that has ended); the stop's
+  // own list (goodbye, close, stop) began stopped and runs whole.
+  const bool stopped_before = protocol_.stopped();
+  for (Action& action : actions) {
+    if (!stopped_before && protocol_.stopped()) break;
+    carry_out(action);
+  }
 }
 
 void Node::carry_out(Action& action) {
-  std::visit(util::Overloaded{
-                 [&](Send& a) {
-                   if (!connection_ || !connection_->is_open()) return;
-                   // A ping's t1 is when it leaves, as the master's pong t3 is: the
-                   // legs are measured alike.
-                   if (a.message.has_ping()) a.message.mutable_ping()->set_t1(options_.protocol.clock.now());
-                   connection_->send(a.message);
-                 },
-                 [&](Close& a) {
-                   if (!connection_ || !connection_->is_open()) return;
-                   if (a.after_sending) {
-                     connection_->close_after_sending(a.reason);
-                   } else {
-                     connection_->close(a.reason);
-                   }
-                 },
-                 [&](SetDeadline& a) {
-                   if (connection_) connection_->set_deadline(a.after, a.reason);
-                 },
-                 [&](CancelDeadline&) {
-                   if (connection_) connection_->cancel_deadline();
-                 },
-                 [&](SetLiveness& a) {
-                   if (connection_) connection_->set_liveness_timeout(a.timeout, a.reason);
-                 },
-                 [&](Configure& a) {
-                   const Result<void> result = renderer_.configure(a.job);
-                   carry_out(protocol_.configured(result, renderer_.description()));
-                 },
-                 [&](Render& a) {
-                   const clock::Nanos started = clock::monotonic_now();
-                   const Rendered how = renderer_.render(a.frame);
-                   carry_out(protocol_.rendered(a.frame.frame_id, clock::monotonic_now() - started, how));
-                 },
-                 [&](PresentAt& a) { wait_for_present(a.deadline); },
-                 [&](Present& a) {
-                   renderer_.present(a.image);
-                   const clock::Nanos shown = clock::monotonic_now();
-                   // Nodes sharing a machine present at the same instant: let the others
-                   // on this core show theirs before this one does its bookkeeping.
-                   std::this_thread::yield();
-                   carry_out(protocol_.presented(shown));
-                 },
-                 [&](ShowBlack&) { renderer_.show_black(); },
-                 [&](PingIn& a) {
-                   ping_timer_.expires_after(a.after);
-                   ping_timer_.async_wait([this](const boost::system::error_code& error) {
-                     if (!error) carry_out(protocol_.ping_due(clock::monotonic_now()));
-                   });
-                 },
-                 [&](CancelPings&) { ping_timer_.cancel(); },
-                 [&](Reconnect& a) {
-                   retry_timer_.expires_after(a.after);
-                   retry_timer_.async_wait([this](const boost::system::error_code& error) {
-                     if (!error) connect();
-                   });
-                 },
-                 [&](Stop& a) {
-                   exit_code_ = a.exit_code;
-                   retry_timer_.cancel();
-                   ping_timer_.cancel();
-                   connect_timer_.cancel();
-                   present_timer_.cancel();
-                   signals_.cancel();
-                   resolver_.cancel();
-                   if (connecting_) {
-                     boost::system::error_code ignored;
-                     connecting_->close(ignored);
-                   }
-                 },
-                 [&](Log& a) { log_.log(a.level, "{}", a.text); },
-                 [&](PrepareScene& a) {
-                   if (auto found = scene_cache_.find(a.manifest, a.sha256)) {
-                     carry_out(protocol_.scene_found(*found));
-                   } else {
-                     carry_out(protocol_.scene_copy_started(scene_cache_.begin(a.manifest, a.sha256),
-                                                            clock::monotonic_now()));
-                   }
-                 },
-                 [&](StoreSceneChunk& a) {
-                   if (auto stored = scene_cache_.write(a.file, a.offset, a.data); !stored) {
-                     carry_out(protocol_.scene_store_failed(stored.error()));
-                   }
-                 },
-                 [&](FinishScene&) {
-                   carry_out(protocol_.scene_copy_finished(scene_cache_.commit(), clock::monotonic_now()));
-                 },
-                 [&](AbandonScene&) { scene_cache_.abandon(); },
-             },
-             action);
+  std::visit(
+      util::Overloaded{
+          [&](Send& a) {
+            if (!connection_ || !connection_->is_open()) return;
+            // A ping's t1 is when it leaves, as the master's pong t3 is: the
+            // legs are measured alike.
+            if (a.message.has_ping()) a.message.mutable_ping()->set_t1(options_.protocol.clock.now());
+            connection_->send(a.message);
+          },
+          [&](Close& a) {
+            if (!connection_ || !connection_->is_open()) return;
+            if (a.after_sending) {
+              connection_->close_after_sending(a.reason);
+            } else {
+              connection_->close(a.reason);
+            }
+          },
+          [&](SetDeadline& a) {
+            if (connection_) connection_->set_deadline(a.after, a.reason);
+          },
+          [&](CancelDeadline&) {
+            if (connection_) connection_->cancel_deadline();
+          },
+          [&](SetLiveness& a) {
+            if (connection_) connection_->set_liveness_timeout(a.timeout, a.reason);
+          },
+          [&](Configure& a) {
+            const Result<void> result = renderer_.configure(a.job);
+            carry_out(protocol_.configured(result, renderer_.description()));
+          },
+          [&](Render& a) {
+            const clock::Nanos started = clock::monotonic_now();
+            const Rendered how = renderer_.render(a.frame);
+            carry_out(protocol_.rendered(a.frame.frame_id, clock::monotonic_now() - started, how));
+          },
+          [&](PresentAt& a) { wait_for_present(a.deadline); },
+          [&](Present& a) {
+            renderer_.present(a.image);
+            const clock::Nanos shown = clock::monotonic_now();
+            // Nodes sharing a machine present at the same instant: let the others
+            // on this core show theirs before this one does its bookkeeping.
+            std::this_thread::yield();
+            carry_out(protocol_.presented(shown));
+          },
+          [&](ShowBlack&) { renderer_.show_black(); },
+          [&](PingIn& a) {
+            ping_timer_.expires_after(a.after);
+            ping_timer_.async_wait([this](const boost::system::error_code& error) {
+              if (!error) carry_out(protocol_.ping_due(clock::monotonic_now()));
+            });
+          },
+          [&](CancelPings&) { ping_timer_.cancel(); },
+          [&](Reconnect& a) {
+            retry_timer_.expires_after(a.after);
+            retry_timer_.async_wait([this](const boost::system::error_code& error) {
+              if (!error) connect();
+            });
+          },
+          [&](Stop& a) {
+            exit_code_ = a.exit_code;
+            retry_timer_.cancel();
+            ping_timer_.cancel();
+            connect_timer_.cancel();
+            present_timer_.cancel();
+            signals_.cancel();
+            resolver_.cancel();
+            if (connecting_) {
+              boost::system::error_code ignored;
+              connecting_->close(ignored);
+            }
+          },
+          [&](Log& a) { log_.log(a.level, "{}", a.text); },
+          [&](PrepareScene& a) {
+            if (auto found = scene_cache_.find(a.manifest, a.sha256)) {
+              carry_out(protocol_.scene_found(*found));
+            } else {
+              carry_out(protocol_.scene_copy_started(scene_cache_.begin(a.manifest, a.sha256), clock::monotonic_now()));
+            }
+          },
+          [&](StoreSceneChunk& a) {
+            if (auto stored = scene_cache_.write(a.file, a.offset, a.data); !stored) {
+              carry_out(protocol_.scene_store_failed(stored.error()));
+            }
+          },
+          [&](FinishScene&) {
+            carry_out(protocol_.scene_copy_finished(scene_cache_.commit(), clock::monotonic_now()));
+          },
+          [&](AbandonScene&) { scene_cache_.abandon(); },
+      },
+      action);
 }
 
 // The wait for a present deadline holds up nothing: pongs keep being stamped as

@@ -16,7 +16,8 @@ void NodeProtocol::log(Actions& out, spdlog::level::level_enum level, std::strin
 
 void NodeProtocol::stop(int exit_code, const std::string& reason, Actions& out) {
   if (phase_ == Phase::stopped) return;
-  if (fetch_) out.push_back(AbandonScene{});
+  if (copy_unfinished_) out.push_back(AbandonScene{});
+  copy_unfinished_ = false;
   fetch_.reset();
   const bool connected = connection_open_;
   phase_ = Phase::stopped;
@@ -76,10 +77,7 @@ Actions NodeProtocol::closed(const std::string& reason, clock::Nanos now) {
   out.push_back(CancelPings{});
   if (phase_ == Phase::stopped) return out;
   const bool was_joined = phase_ == Phase::joined;
-  if (fetch_) {
-    out.push_back(AbandonScene{});
-    fetch_.reset();
-  }
+  fetch_.reset();  // its copy is kept: the fetch goes on from it after the reconnect
   phase_ = Phase::disconnected;
   pending_.reset();
   held_.clear();
@@ -260,20 +258,27 @@ Actions NodeProtocol::scene_found(const std::string& gltf_path) {
   return out;
 }
 
-Actions NodeProtocol::scene_copy_started(const Result<void>& started, clock::Nanos now) {
+Actions NodeProtocol::scene_copy_started(const Result<protocol::SceneFetch::Present>& started, clock::Nanos now) {
   Actions out;
   if (phase_ != Phase::preparing_scene) return out;
   if (!started) {
     stop(kExitRefused, "cannot keep the master's scene here: " + started.error(), out);
     return out;
   }
-  fetch_.emplace(job_->scene_files, job_->scene_sha256);
+  copy_unfinished_ = true;
+  fetch_.emplace(job_->scene_files, job_->scene_sha256, started.value());
   fetch_started_ = now;
+  fetch_had_bytes_ = fetch_->bytes_stored();
   fetch_quarters_logged_ = 0;
   phase_ = Phase::fetching_scene;
+  const double total = static_cast<double>(job_->scene_files.total_bytes()) / (1 << 20);
   log(out, spdlog::level::info,
-      fmt::format("fetching the scene {} from the master: {} file(s), {:.1f} MiB", job_->job.installation.scene.gltf,
-                  job_->scene_files.files.size(), static_cast<double>(job_->scene_files.total_bytes()) / (1 << 20)));
+      fetch_->bytes_stored() == 0
+          ? fmt::format("fetching the scene {} from the master: {} file(s), {:.1f} MiB",
+                        job_->job.installation.scene.gltf, job_->scene_files.files.size(), total)
+          : fmt::format("fetching the rest of the scene {} from the master: {:.1f} of {:.1f} MiB were here already",
+                        job_->job.installation.scene.gltf, static_cast<double>(fetch_->bytes_stored()) / (1 << 20),
+                        total));
   out.push_back(SetDeadline{
       kSceneStall, "no part of the scene from the master for " + std::to_string(kSceneStall.count() / 1000) + " s"});
   for (wire::Envelope& request : fetch_->requests()) out.push_back(Send{std::move(request)});
@@ -323,12 +328,14 @@ Actions NodeProtocol::scene_copy_finished(const Result<std::string>& gltf_path, 
     stop(kExitRefused, "cannot keep the master's scene here: " + gltf_path.error(), out);
     return out;
   }
-  // From the first request to the copy checked whole and in place.
+  copy_unfinished_ = false;
+  // From the first request to the copy in place.
   log(out, spdlog::level::info,
-      fmt::format(
-          "fetched the scene: {}{}", protocol::transfer_text(fetch_->manifest().total_bytes(), now - fetch_started_),
-          fetch_->chunks_asked_again() > 0 ? fmt::format(", {} chunk(s) asked for again", fetch_->chunks_asked_again())
-                                           : ""));
+      fmt::format("fetched the scene: {}{}",
+                  protocol::transfer_text(fetch_->manifest().total_bytes() - fetch_had_bytes_, now - fetch_started_),
+                  fetch_->chunks_asked_again() > 0
+                      ? fmt::format(", {} chunk(s) asked for again", fetch_->chunks_asked_again())
+                      : ""));
   fetch_.reset();
   job_->scene_path = gltf_path.value();
   configure(out);

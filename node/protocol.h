@@ -130,7 +130,8 @@ struct StoreSceneChunk {
 // Every chunk is stored: check the copy whole, put it in place and answer with
 // scene_copy_finished().
 struct FinishScene {};
-// The copy will not be finished (the connection went, the node stops): remove it.
+// The copy will not be finished (the node stops): remove it. A copy whose
+// connection went is kept, and goes on after the reconnect.
 struct AbandonScene {};
 
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, Configure, Render, PresentAt,
@@ -170,7 +171,8 @@ class NodeProtocol {
   [[nodiscard]] Actions configured(const Result<void>& result, const std::string& renderer_description);
   // Answers to PrepareScene, StoreSceneChunk and FinishScene.
   [[nodiscard]] Actions scene_found(const std::string& gltf_path);
-  [[nodiscard]] Actions scene_copy_started(const Result<void>& started, clock::Nanos now);
+  // `started`: which chunks the copy already holds (one going on after a lost connection).
+  [[nodiscard]] Actions scene_copy_started(const Result<protocol::SceneFetch::Present>& started, clock::Nanos now);
   [[nodiscard]] Actions scene_store_failed(const std::string& error);
   [[nodiscard]] Actions scene_copy_finished(const Result<std::string>& gltf_path, clock::Nanos now);
   [[nodiscard]] Actions rendered(std::uint64_t frame_id, clock::Nanos render_time, const Rendered& how = {});
@@ -232,7 +234,9 @@ class NodeProtocol {
   bool connection_open_ = false;
   std::optional<protocol::NodeJob> job_;
   std::optional<protocol::SceneFetch> fetch_;  // the scene's files coming from the master
+  bool copy_unfinished_ = false;               // a copy started and not yet put in place
   clock::Nanos fetch_started_ = 0;
+  std::uint64_t fetch_had_bytes_ = 0;  // here already when the fetch (re)started
   int fetch_quarters_logged_ = 0;
   scene::SceneState state_;
   // The lag hook's memory: the last lag_frames + 1 frames as they came.

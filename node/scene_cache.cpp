@@ -1,14 +1,17 @@
 #include "node/scene_cache.h"
 
-#include <signal.h>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <random>
-#include <vector>
+#include <utility>
 
 #include "util/sha256.h"
 
@@ -18,52 +21,108 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Room kept free on the disk beyond the scene itself.
-constexpr std::uintmax_t kSpareBytes = 64u << 20;
+constexpr char kPartial[] = ".partial-";
+constexpr char kLock[] = ".lock";
 
 std::string describe(const std::error_code& error) { return error.message(); }
 
-// Whether `path` holds `size` bytes whose SHA-256 is `sha256`; what differs.
-Result<void> check_file(const fs::path& path, const scene::SceneFile& file) {
-  std::error_code error;
-  const std::uintmax_t size = fs::file_size(path, error);
-  if (error) return Error{path.string() + ": " + describe(error)};
-  if (size != file.size) {
-    return Error{path.string() + " has " + std::to_string(size) + " bytes, not " + std::to_string(file.size)};
-  }
+enum class Check { whole, differs, unreadable };
+
+struct FileCheck {
+  Check outcome = Check::whole;
+  std::string problem;
+};
+
+// Reads `path` in 1 MiB pieces, handing each to `piece`; false on a read error.
+template <class Piece>
+bool read_pieces(const fs::path& path, std::uint64_t piece_bytes, Piece&& piece) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path.string() + ": cannot open: " + std::strerror(errno)};
-  util::Sha256 digest;
-  std::vector<char> buffer(1u << 20);
+  if (!in) return false;
+  std::vector<char> buffer(piece_bytes);
   while (in) {
     in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
-    digest.update(std::string_view(buffer.data(), static_cast<std::size_t>(in.gcount())));
+    const auto got = static_cast<std::size_t>(in.gcount());
+    if (got > 0) piece(std::string_view(buffer.data(), got));
   }
-  if (in.bad()) return Error{path.string() + ": read error"};
-  if (digest.finish() != file.sha256) return Error{path.string() + " does not match its SHA-256"};
+  return !in.bad();
+}
+
+// Whether `path` holds the file `file` describes: its size and SHA-256.
+FileCheck check_file(const fs::path& path, const scene::SceneFile& file) {
+  std::error_code error;
+  const std::uintmax_t size = fs::file_size(path, error);
+  if (error) {
+    return {error == std::errc::no_such_file_or_directory ? Check::differs : Check::unreadable,
+            path.string() + ": " + describe(error)};
+  }
+  if (size != file.size) {
+    return {Check::differs,
+            path.string() + " has " + std::to_string(size) + " bytes, not " + std::to_string(file.size)};
+  }
+  util::Sha256 digest;
+  if (!read_pieces(path, 1u << 20, [&](std::string_view piece) { digest.update(piece); })) {
+    return {Check::unreadable, path.string() + ": " + std::strerror(errno)};
+  }
+  if (digest.finish() != file.sha256) return {Check::differs, path.string() + " does not match its SHA-256"};
   return {};
 }
 
-Result<void> check_copy(const fs::path& copy, const scene::SceneManifest& manifest) {
+FileCheck check_copy(const fs::path& copy, const scene::SceneManifest& manifest) {
   for (const scene::SceneFile& file : manifest.files) {
-    if (auto checked = check_file(copy / file.path, file); !checked) return checked;
+    FileCheck checked = check_file(copy / file.path, file);
+    if (checked.outcome != Check::whole) return checked;
   }
   return {};
 }
 
-// The pid a partial copy's name ends with, if it is one of `sha256`'s.
-std::optional<pid_t> partial_owner(const std::string& name, const std::string& sha256) {
-  const std::string prefix = sha256 + ".partial-";
-  if (!name.starts_with(prefix)) return std::nullopt;
-  char* end = nullptr;
-  const long pid = std::strtol(name.c_str() + prefix.size(), &end, 10);
-  if (end == nullptr || (*end != '\0' && *end != '-') || pid <= 0) return std::nullopt;
-  return static_cast<pid_t>(pid);
+bool is_identity(const std::string& name) {
+  return name.size() == 64 && std::all_of(name.begin(), name.end(), [](char c) {
+           return std::isdigit(static_cast<unsigned char>(c)) || (c >= 'a' && c <= 'f');
+         });
+}
+
+// Partial copies whose node is gone: nobody holds their lock (or they have none).
+void remove_abandoned_partials(const fs::path& folder) {
+  std::error_code error;
+  std::vector<fs::path> partials;
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find(kPartial) != std::string::npos && !name.ends_with(kLock)) partials.push_back(entry.path());
+  }
+  for (const fs::path& partial : partials) {
+    const fs::path lock = partial.string() + kLock;
+    const int fd = open(lock.c_str(), O_RDWR | O_CLOEXEC);
+    const bool alive = fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) != 0;
+    if (!alive) {
+      fs::remove_all(partial, error);
+      fs::remove(lock, error);
+    }
+    if (fd >= 0) close(fd);
+  }
+}
+
+// Removes the copies used longest ago (never `keep`) until `needed` bytes are free.
+void make_room(const fs::path& folder, std::uintmax_t needed, const std::string& keep) {
+  std::error_code error;
+  std::vector<std::pair<fs::file_time_type, fs::path>> copies;
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (is_identity(name) && name != keep) copies.emplace_back(fs::last_write_time(entry.path(), error), entry.path());
+  }
+  std::sort(copies.begin(), copies.end());
+  for (const auto& [used, copy] : copies) {
+    const fs::space_info space = fs::space(folder, error);
+    if (error || space.available >= needed) return;
+    fs::remove_all(copy, error);
+  }
 }
 
 }  // namespace
 
-SceneCache::SceneCache(const fs::path& cache_dir) : folder_(cache_dir / "scenes") {}
+SceneCache::SceneCache(const fs::path& cache_dir, std::uintmax_t spare_bytes)
+    : folder_(cache_dir / "scenes"), spare_bytes_(spare_bytes) {}
+
+SceneCache::~SceneCache() { release_lock(); }
 
 fs::path SceneCache::default_cache_dir() {
   const auto variable = [](const char* name) -> std::string {
@@ -88,34 +147,54 @@ std::optional<std::string> SceneCache::find(const scene::SceneManifest& manifest
   std::error_code error;
   if (!fs::is_directory(copy, error)) return std::nullopt;
   if (verified_ != sha256) {
-    if (!check_copy(copy, manifest)) {
-      fs::remove_all(copy, error);
-      return std::nullopt;
-    }
+    const FileCheck checked = check_copy(copy, manifest);
+    if (checked.outcome == Check::differs) fs::remove_all(copy, error);
+    if (checked.outcome != Check::whole) return std::nullopt;
     verified_ = sha256;
   }
+  fs::last_write_time(copy, fs::file_time_type::clock::now(), error);  // used now: evicted last
   return (copy / manifest.files.front().path).string();
 }
 
-Result<void> SceneCache::begin(const scene::SceneManifest& manifest, const std::string& sha256) {
-  abandon();
+Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manifest, const std::string& sha256) {
+  Present present(manifest.files.size());
+  for (std::size_t f = 0; f < manifest.files.size(); ++f)
+    present[f].assign(manifest.files[f].chunks(manifest.chunk_bytes), false);
   std::error_code error;
+  if (manifest_ && sha256_ == sha256 && fs::is_directory(partial_, error)) {
+    // This process's unfinished copy: keep the chunks that check.
+    for (std::size_t f = 0; f < manifest.files.size(); ++f) {
+      std::uint64_t index = 0;
+      (void)read_pieces(partial_ / manifest.files[f].path, manifest.chunk_bytes, [&](std::string_view piece) {
+        if (index < present[f].size() && piece.size() == manifest.chunk_length(f, index) &&
+            util::sha256_raw(piece) == manifest.files[f].chunk_digest(index)) {
+          present[f][index] = true;
+        }
+        ++index;
+      });
+    }
+    return present;
+  }
+  abandon();
   fs::create_directories(folder_, error);
   if (error) return Error{"cannot make the scene cache " + folder_.string() + ": " + describe(error)};
-  // Partial copies of this scene whose node is gone.
-  for (const auto& entry : fs::directory_iterator(folder_, error)) {
-    const auto owner = partial_owner(entry.path().filename().string(), sha256);
-    if (owner && kill(*owner, 0) != 0 && errno == ESRCH) fs::remove_all(entry.path(), error);
-  }
+  remove_abandoned_partials(folder_);
+  const std::uintmax_t needed = manifest.total_bytes() + spare_bytes_;
+  make_room(folder_, needed, sha256);
   const fs::space_info space = fs::space(folder_, error);
-  if (!error && space.available < manifest.total_bytes() + kSpareBytes) {
+  if (!error && space.available < needed) {
     return Error{"the scene cache " + folder_.string() + " has " + std::to_string(space.available >> 20) +
-                 " MiB free, the scene needs " + std::to_string((manifest.total_bytes() + kSpareBytes) >> 20)};
+                 " MiB free, the scene needs " + std::to_string(needed >> 20)};
   }
-  // The process (for the clean-up above) and a random tag: two caches of one
-  // process (tests) never share a partial copy either.
-  partial_ = folder_ / (sha256 + ".partial-" + std::to_string(getpid()) + "-" + std::to_string(std::random_device{}()));
-  fs::remove_all(partial_, error);
+  // The lock first: a partial copy without one is taken for abandoned.
+  partial_ = folder_ / (sha256 + kPartial + std::to_string(std::random_device{}()) + "-" +
+                        std::to_string(std::random_device{}()));
+  lock_fd_ = open((partial_.string() + kLock).c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0 || flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    const std::string why = std::strerror(errno);
+    abandon();
+    return Error{"cannot write the scene cache " + folder_.string() + ": " + why};
+  }
   for (const scene::SceneFile& file : manifest.files) {
     const fs::path path = partial_ / file.path;
     fs::create_directories(path.parent_path(), error);
@@ -128,7 +207,7 @@ Result<void> SceneCache::begin(const scene::SceneManifest& manifest, const std::
   }
   manifest_ = manifest;
   sha256_ = sha256;
-  return {};
+  return present;
 }
 
 Result<void> SceneCache::write(std::uint32_t file, std::uint64_t offset, std::string_view data) {
@@ -145,21 +224,30 @@ Result<void> SceneCache::write(std::uint32_t file, std::uint64_t offset, std::st
 Result<std::string> SceneCache::commit() {
   if (!manifest_) return Error{"no scene is being written"};
   const scene::SceneManifest manifest = *manifest_;
-  if (auto checked = check_copy(partial_, manifest); !checked) {
-    abandon();
-    return Error{"the scene's copy is not whole: " + checked.error()};
+  // Each chunk was checked against the manifest as it came; what the disk did
+  // with them the loader sees (it checks the scene's identity again).
+  for (const scene::SceneFile& file : manifest.files) {
+    std::error_code error;
+    const std::uintmax_t size = fs::file_size(partial_ / file.path, error);
+    if (error || size != file.size) {
+      abandon();
+      return Error{"the scene's copy is not whole: " + (partial_ / file.path).string() + " has " +
+                   (error ? describe(error) : std::to_string(size) + " bytes, not " + std::to_string(file.size))};
+    }
   }
   const fs::path copy = folder_ / sha256_;
   std::error_code error;
   fs::rename(partial_, copy, error);
   if (error) {
-    // Another node of this machine put the same scene in place first: use it.
+    // Another node of this host put the same scene in place first: use it.
     abandon();
     if (auto found = find(manifest, sha256_)) return *found;
     return Error{"cannot put the scene in place at " + copy.string() + ": " + describe(error)};
   }
-  verified_ = sha256_;
+  release_lock();
+  partial_.clear();
   manifest_.reset();
+  fs::last_write_time(copy, fs::file_time_type::clock::now(), error);
   return (copy / manifest.files.front().path).string();
 }
 
@@ -167,9 +255,22 @@ void SceneCache::abandon() {
   if (!partial_.empty()) {
     std::error_code ignored;
     fs::remove_all(partial_, ignored);
+    fs::remove(partial_.string() + kLock, ignored);
   }
+  release_lock();
   partial_.clear();
   manifest_.reset();
+}
+
+void SceneCache::release_lock() {
+  if (lock_fd_ >= 0) {
+    if (!partial_.empty()) {
+      std::error_code ignored;
+      fs::remove(partial_.string() + kLock, ignored);
+    }
+    close(lock_fd_);
+  }
+  lock_fd_ = -1;
 }
 
 }  // namespace optique::node

@@ -1,17 +1,21 @@
 #pragma once
 // A node's copies of the master's glTF scenes on disk, each under its identity
 // (the SHA-256 of its manifest): <folder>/<sha256>/ holds the files by their
-// paths. A scene being fetched is written into <sha256>.partial-<pid>-<tag> beside it
-// and renamed into place once every file is whole, so a copy in place is complete
-// (it is checked again when used) and a node that restarts does not fetch it
-// again. Several nodes of one machine may share a folder: each writes its own
-// partial copy, and the first to finish puts it in place.
+// paths. A scene being fetched is written into <sha256>.partial-<tag> beside it,
+// whose owner holds a lock on <sha256>.partial-<tag>.lock, and renamed into
+// place once every chunk is in, so a copy in place is complete (the loader checks
+// its identity again) and a node that restarts does not fetch it again. Several
+// nodes of one host may share a folder (even from several containers: the locks,
+// not process ids, tell a partial copy whose node is gone): each writes its own
+// partial copy, and the first to finish puts it in place. When the disk runs
+// short, the copies used longest ago make room.
 
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "scene/manifest.h"
 #include "util/result.h"
@@ -20,8 +24,14 @@ namespace optique::node {
 
 class SceneCache {
  public:
+  // Room kept free on the disk beyond a scene being fetched.
+  static constexpr std::uintmax_t kSpareBytes = 64u << 20;
+
   // The copies go into `cache_dir`/scenes.
-  explicit SceneCache(const std::filesystem::path& cache_dir);
+  explicit SceneCache(const std::filesystem::path& cache_dir, std::uintmax_t spare_bytes = kSpareBytes);
+  ~SceneCache();
+  SceneCache(const SceneCache&) = delete;
+  SceneCache& operator=(const SceneCache&) = delete;
 
   // The node's cache folder (the scenes go into its "scenes"):
   // $CACHE_DIRECTORY (systemd's CacheDirectory=), else $XDG_CACHE_HOME/optique,
@@ -30,26 +40,35 @@ class SceneCache {
   [[nodiscard]] const std::filesystem::path& folder() const { return folder_; }
 
   // The glTF of scene `sha256` when the cache holds every file of `manifest`
-  // whole (sizes and SHA-256 checked); a copy that fails the check is removed,
-  // so that it is fetched again.
+  // whole (sizes and SHA-256 checked; once per process). A copy seen to differ
+  // is removed, so that it is fetched again; one that cannot be read is left.
   [[nodiscard]] std::optional<std::string> find(const scene::SceneManifest& manifest, const std::string& sha256);
-  // Starts a copy: its partial folder, every file made; fails, naming the folder,
-  // when it cannot be written or the disk has too little room for it. Partial
-  // copies left by nodes that are gone are removed.
-  [[nodiscard]] Result<void> begin(const scene::SceneManifest& manifest, const std::string& sha256);
+
+  // For each file of the manifest, which chunks are in the copy being written.
+  using Present = std::vector<std::vector<bool>>;
+  // Starts a copy, or goes on with this process's unfinished copy of the same
+  // scene (a connection lost midway): which chunks it already holds, each
+  // checked against the manifest. Removes partial copies whose node is gone,
+  // makes room by removing the copies used longest ago, and fails, naming the
+  // folder, when it cannot be written or the disk has no room for the scene.
+  [[nodiscard]] Result<Present> begin(const scene::SceneManifest& manifest, const std::string& sha256);
   [[nodiscard]] Result<void> write(std::uint32_t file, std::uint64_t offset, std::string_view data);
-  // Every file checked whole against the manifest, then the copy put in place;
-  // the path of its glTF.
+  // Every chunk is in (each was checked as it came): the copy put in place; the
+  // path of its glTF.
   [[nodiscard]] Result<std::string> commit();
-  // A fetch that will not finish: its partial copy is removed.
+  // A fetch that will not go on (the node stops): its partial copy is removed.
   void abandon();
 
  private:
+  void release_lock();
+
   std::filesystem::path folder_;
-  // The copy being written.
+  std::uintmax_t spare_bytes_;
+  // The copy being written, and the lock that says its node is alive.
   std::optional<scene::SceneManifest> manifest_;
   std::string sha256_;
   std::filesystem::path partial_;
+  int lock_fd_ = -1;
   // Checked whole in this process already: not read again on a rejoin.
   std::string verified_;
 };

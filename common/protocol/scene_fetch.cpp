@@ -14,11 +14,18 @@ std::string transfer_text(std::uint64_t bytes, clock::Nanos took) {
   return fmt::format("{:.1f} MiB in {:.2f} s ({:.1f} MiB/s)", mib, seconds, mib / seconds);
 }
 
-SceneFetch::SceneFetch(scene::SceneManifest manifest, std::string scene_sha256)
+SceneFetch::SceneFetch(scene::SceneManifest manifest, std::string scene_sha256, const Present& present)
     : manifest_(std::move(manifest)), scene_sha256_(std::move(scene_sha256)) {
   for (std::size_t f = 0; f < manifest_.files.size(); ++f) {
     const std::uint64_t chunks = manifest_.files[f].chunks(manifest_.chunk_bytes);
-    for (std::uint64_t c = 0; c < chunks; ++c) to_ask_.push_back({static_cast<std::uint32_t>(f), c});
+    for (std::uint64_t c = 0; c < chunks; ++c) {
+      if (f < present.size() && c < present[f].size() && present[f][c]) {
+        ++stored_;
+        bytes_stored_ += manifest_.chunk_length(f, c);
+      } else {
+        to_ask_.push_back({static_cast<std::uint32_t>(f), c});
+      }
+    }
     chunk_count_ += chunks;
   }
 }

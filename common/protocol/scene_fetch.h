@@ -46,8 +46,12 @@ class SceneFetch {
     std::string problem;       // ask_again, fail: what was wrong with it
   };
 
+  // For each file, which of its chunks are already here (a copy going on after a
+  // lost connection); missing entries: none.
+  using Present = std::vector<std::vector<bool>>;
+
   // `manifest` checked (scene::check_manifest); `scene_sha256`: its identity.
-  SceneFetch(scene::SceneManifest manifest, std::string scene_sha256);
+  SceneFetch(scene::SceneManifest manifest, std::string scene_sha256, const Present& present = {});
 
   // The requests to send now: enough to have kInFlight chunks asked for.
   [[nodiscard]] std::vector<wire::Envelope> requests();
@@ -62,9 +66,9 @@ class SceneFetch {
  private:
   scene::SceneManifest manifest_;
   std::string scene_sha256_;
-  std::deque<Chunk> to_ask_;           // in order; chunks that failed go first
-  std::map<Chunk, int> in_flight_;     // asked for, with how many times
-  std::map<Chunk, int> tries_;         // how many times each chunk that failed was asked for
+  std::deque<Chunk> to_ask_;        // in order; chunks that failed go first
+  std::map<Chunk, int> in_flight_;  // asked for, with how many times
+  std::map<Chunk, int> tries_;      // how many times each chunk that failed was asked for
   std::uint64_t chunk_count_ = 0;
   std::uint64_t stored_ = 0;
   std::uint64_t bytes_stored_ = 0;

@@ -18,7 +18,6 @@ schema::Installation job_of(const wire::Welcome& welcome) {
 }
 
 // Checked here for shape and identity; each node holds the size to its own limit.
-constexpr std::uint64_t kMostSceneBytes = std::uint64_t{1} << 40;
 
 Result<scene::SceneManifest> decode_scene_manifest(const wire::SceneManifest& wire, const std::string& sha256) {
   scene::SceneManifest manifest;
@@ -26,7 +25,7 @@ Result<scene::SceneManifest> decode_scene_manifest(const wire::SceneManifest& wi
   for (const wire::SceneFile& file : wire.files()) {
     manifest.files.push_back({file.path(), file.size(), file.sha256(), file.chunk_sha256()});
   }
-  if (auto checked = scene::check_manifest(manifest, {kMostSceneBytes, 1u << 16}); !checked) {
+  if (auto checked = scene::check_manifest(manifest, scene::kLargestScene); !checked) {
     return Error{checked.error()};
   }
   if (scene::manifest_sha256(manifest) != sha256) {

@@ -914,8 +914,8 @@ class Loader {
     const std::size_t vertex_count = out.positions.size() / 3;
     if (vertex_count > std::numeric_limits<std::uint32_t>::max()) fail(label + " has too many vertices");
     if (const auto normal = attribute(primitive, "NORMAL")) {
-      out.normals = per_vertex(read_floats(*normal, label + " NORMAL", TINYGLTF_TYPE_VEC3), 3, vertex_count, label,
-                               "NORMAL");
+      out.normals =
+          per_vertex(read_floats(*normal, label + " NORMAL", TINYGLTF_TYPE_VEC3), 3, vertex_count, label, "NORMAL");
     }
     if (const auto uv = attribute(primitive, "TEXCOORD_0")) {
       out.uvs = per_vertex(read_uvs(*uv, label), 2, vertex_count, label, "TEXCOORD_0");
@@ -938,13 +938,17 @@ class Loader {
   // A KHR_draco_mesh_compression primitive: the attributes the extension maps
   // come from the compressed data, any other from its accessor (the extension
   // allows both); the accessors' counts must agree with what was decoded.
-  Attributes read_draco(const tinygltf::Primitive& primitive, const std::string& label, int indices, int mode) const {
+  Attributes read_draco(const tinygltf::Primitive& primitive, const std::string& label, std::int64_t indices,
+                        int mode) const {
     const std::string what = label + ": " + kDracoExtension;
     if (mode != TINYGLTF_MODE_TRIANGLES) fail(what + " needs mode TRIANGLES");
-    const tinygltf::Value& extension = primitive.extensions.at(kDracoExtension);
-    if (!extension.IsObject() || !extension.Get("bufferView").IsInt() || !extension.Get("attributes").IsObject()) {
-      fail(what + " must have a bufferView and attributes");
+    if (indices < -1) fail(what + ": its indices are not an accessor's index");
+    const auto found = primitive.extensions.find(kDracoExtension);
+    if (found == primitive.extensions.end() || !found->second.IsObject() || !found->second.Get("bufferView").IsInt() ||
+        !found->second.Get("attributes").IsObject()) {
+      fail(what + " must be an object with a bufferView and attributes");
     }
+    const tinygltf::Value& extension = found->second;
     const int view_index = extension.Get("bufferView").GetNumberAsInt();
     if (view_index < 0 || static_cast<std::size_t>(view_index) >= model_.bufferViews.size()) {
       fail(what + ": buffer view " + std::to_string(view_index) + " is out of range");
@@ -985,19 +989,19 @@ class Loader {
       }
     };
     expect_count(*position, mesh.points, "POSITION");
-    if (indices >= 0) expect_count(indices, mesh.indices.size(), "indices");
+    if (indices >= 0) expect_count(static_cast<int>(indices), mesh.indices.size(), "indices");
     Attributes out;
     out.positions = std::move(mesh.positions);
     if (has_normal) {
-      out.normals = normal_id ? std::move(mesh.normals)
-                              : per_vertex(read_floats(*attribute(primitive, "NORMAL"), label + " NORMAL",
-                                                       TINYGLTF_TYPE_VEC3),
-                                           3, mesh.points, label, "NORMAL");
+      out.normals =
+          normal_id ? std::move(mesh.normals)
+                    : per_vertex(read_floats(*attribute(primitive, "NORMAL"), label + " NORMAL", TINYGLTF_TYPE_VEC3), 3,
+                                 mesh.points, label, "NORMAL");
     }
     if (has_uv) {
-      out.uvs = uv_id ? std::move(mesh.uvs)
-                      : per_vertex(read_uvs(*attribute(primitive, "TEXCOORD_0"), label), 2, mesh.points, label,
-                                   "TEXCOORD_0");
+      out.uvs =
+          uv_id ? std::move(mesh.uvs)
+                : per_vertex(read_uvs(*attribute(primitive, "TEXCOORD_0"), label), 2, mesh.points, label, "TEXCOORD_0");
     }
     out.order = std::move(mesh.indices);
     return out;
@@ -1026,8 +1030,8 @@ class Loader {
     if (!primitive.targets.empty()) fail(label + ": morph targets are not supported");
 
     Attributes read = source_.draco_indices.contains({mesh_index, p})
-                                ? read_draco(primitive, label, source_.draco_indices.at({mesh_index, p}), mode)
-                                : read_accessors(primitive, label);
+                          ? read_draco(primitive, label, source_.draco_indices.at({mesh_index, p}), mode)
+                          : read_accessors(primitive, label);
     const std::vector<double>& positions = read.positions;
     const std::vector<double>& normals = read.normals;
     const std::vector<double>& uvs = read.uvs;
@@ -1354,17 +1358,17 @@ Result<LoadedGltf> load(const std::string& path, const ImageDecoder& decode) {
 
   tinygltf::TinyGLTF reader;
   reader.SetImageLoader(&keep_encoded_image, nullptr);
-  reader.SetFsCallbacks({&fs_file_exists, &fs_expand_path, &fs_read_whole_file, &fs_write_whole_file,
-                         const_cast<GltfSource*>(&source)});
+  reader.SetFsCallbacks(
+      {&fs_file_exists, &fs_expand_path, &fs_read_whole_file, &fs_write_whole_file, const_cast<GltfSource*>(&source)});
   tinygltf::Model model;
   std::string load_error;
   std::string load_warning;
   const auto* bytes = reinterpret_cast<const unsigned char*>(source.document.data());
   const auto size = static_cast<unsigned int>(source.document.size());
   const bool loaded =
-      source.binary ? reader.LoadBinaryFromMemory(&model, &load_error, &load_warning, bytes, size, kSourceFolder)
-                    : reader.LoadASCIIFromString(&model, &load_error, &load_warning, source.document.data(), size,
-                                                 kSourceFolder);
+      source.binary
+          ? reader.LoadBinaryFromMemory(&model, &load_error, &load_warning, bytes, size, kSourceFolder)
+          : reader.LoadASCIIFromString(&model, &load_error, &load_warning, source.document.data(), size, kSourceFolder);
   if (!loaded) return Error{path + ": malformed glTF: " + one_line(load_error.empty() ? "unknown error" : load_error)};
 
   LoadedGltf loaded_gltf;
@@ -1372,6 +1376,10 @@ Result<LoadedGltf> load(const std::string& path, const ImageDecoder& decode) {
   Loader loader(source, model, decode, loaded_gltf.warnings);
   loaded_gltf.scene = loader.build();
   loaded_gltf.manifest = source.manifest();
+  // As every node will check it: a file name a node would refuse is refused here.
+  if (auto sendable = check_manifest(loaded_gltf.manifest, kLargestScene); !sendable) {
+    return Error{path + ": " + sendable.error()};
+  }
   loaded_gltf.content_sha256 = manifest_sha256(loaded_gltf.manifest);
   for (const auto& file : source.files) loaded_gltf.files.push_back(file.second);
   return loaded_gltf;

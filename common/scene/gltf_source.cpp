@@ -142,14 +142,19 @@ class SourceReader {
       found = static_cast<std::size_t>(known - source_.files.begin());
     } else {
       const fs::path file = folder_ / relative.value();
-      auto bytes = read_file(file);
-      if (!bytes) {
-        problems_.push_back(label + ": " + (bytes.error() == "no such file" ? "missing (no file " + file.string() + ")"
-                                                                            : file.string() + ": " + bytes.error()));
+      std::error_code error;
+      if (!fs::exists(file, error)) {
+        problems_.push_back(label + ": missing (no file " + file.string() + ")");
         return std::nullopt;
       }
+      // Before reading: a link out may lead to anything (a device, a huge file).
       if (!inside(folder_, file)) {
         problems_.push_back(label + ": " + file.string() + " is a link to a file outside the glTF's folder");
+        return std::nullopt;
+      }
+      auto bytes = read_file(file);
+      if (!bytes) {
+        problems_.push_back(label + ": " + file.string() + ": " + bytes.error());
         return std::nullopt;
       }
       source_.files.emplace_back(relative.value(), std::make_shared<const std::string>(std::move(bytes).value()));
@@ -297,9 +302,12 @@ Result<GltfSource> read_gltf_source(const std::string& path, const std::vector<s
         if (extensions == primitive.end() || !extensions->is_object() || !extensions->contains(kDracoExtension)) {
           continue;
         }
-        int indices = -1;
+        // -1: none; an index no accessor has is kept as one, for the loader to refuse.
+        std::int64_t indices = -1;
         if (const auto found = primitive.find("indices"); found != primitive.end()) {
-          if (found->is_number_integer()) indices = found->get<int>();
+          indices = found->is_number_integer()
+                        ? std::clamp<std::int64_t>(found->get<std::int64_t>(), -2, std::numeric_limits<int>::max())
+                        : -2;
           primitive.erase("indices");
           changed = true;
         }

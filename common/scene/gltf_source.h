@@ -15,6 +15,7 @@
 // the compressed data).
 
 #include <cstddef>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -38,8 +39,9 @@ struct GltfSource {
   bool binary = false;
   std::vector<std::optional<std::size_t>> buffer_file;  // per buffer: its file, if external
   std::vector<std::optional<std::size_t>> image_file;   // per image: its file, if external
-  // (mesh, primitive) → the indices accessor of a Draco-compressed primitive.
-  std::map<std::pair<std::size_t, std::size_t>, int> draco_indices;
+  // (mesh, primitive) → the indices accessor of a Draco-compressed primitive
+  // (-1: none; -2: not a valid index, refused when the primitive is read).
+  std::map<std::pair<std::size_t, std::size_t>, std::int64_t> draco_indices;
 
   [[nodiscard]] SceneManifest manifest(std::uint32_t chunk_bytes = kSceneChunkBytes) const;
 };

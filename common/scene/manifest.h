@@ -56,6 +56,10 @@ struct ManifestLimits {
   std::uint64_t most_bytes = 0;  // all files together
   std::size_t most_files = 4096;
 };
+// What any scene may be: the master refuses a larger one when it loads it, a
+// node a larger manifest when it decodes the welcome (and its own
+// --max-scene-mb after that).
+inline constexpr ManifestLimits kLargestScene{std::uint64_t{1} << 40, std::size_t{1} << 16};
 
 // A manifest from a peer, checked before anything is fetched or written: at
 // least one file, every path inside the folder (scene/relative_path.h) and

@@ -1,6 +1,7 @@
 #include "scene/relative_path.h"
 
 #include <cctype>
+#include <cstdint>
 
 namespace optique::scene {
 
@@ -25,6 +26,41 @@ std::size_t scheme_length(std::string_view uri) {
   return 0;
 }
 
+// Whether `text` is well-formed UTF-8 (no overlong forms, surrogates or code
+// points past U+10FFFF): file names travel in protobuf strings, which must be.
+bool is_utf8(std::string_view text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const auto byte = static_cast<unsigned char>(text[i]);
+    std::size_t length = 0;
+    std::uint32_t code = 0;
+    if (byte < 0x80) {
+      ++i;
+      continue;
+    } else if ((byte & 0xE0) == 0xC0) {
+      length = 2;
+      code = byte & 0x1F;
+    } else if ((byte & 0xF0) == 0xE0) {
+      length = 3;
+      code = byte & 0x0F;
+    } else if ((byte & 0xF8) == 0xF0) {
+      length = 4;
+      code = byte & 0x07;
+    } else {
+      return false;
+    }
+    if (i + length > text.size()) return false;
+    for (std::size_t k = 1; k < length; ++k) {
+      const auto next = static_cast<unsigned char>(text[i + k]);
+      if ((next & 0xC0) != 0x80) return false;
+      code = (code << 6) | (next & 0x3F);
+    }
+    const std::uint32_t least[] = {0, 0, 0x80, 0x800, 0x10000};
+    if (code < least[length] || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) return false;
+    i += length;
+  }
+  return true;
+}
+
 }  // namespace
 
 bool is_data_uri(std::string_view uri) {
@@ -35,6 +71,7 @@ Result<std::string> checked_relative_path(std::string_view path) {
   if (path.empty()) return Error{"is empty"};
   if (path.find('\0') != std::string_view::npos) return Error{"holds a NUL byte"};
   if (path.find('\\') != std::string_view::npos) return Error{"holds a backslash (use '/' between folders)"};
+  if (!is_utf8(path)) return Error{"is not UTF-8 (rename the file, or write its name in UTF-8)"};
   if (path.front() == '/') return Error{"is an absolute path: only files inside the scene's folder are read"};
   std::string out;
   std::size_t start = 0;

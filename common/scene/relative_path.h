@@ -14,7 +14,7 @@ namespace optique::scene {
 
 // A relative path inside a folder, '/'-separated, without '.', '..' or empty
 // segments ("textures/wood.png"), or an error saying why it is not one:
-// empty, absolute, with a '..' segment, a NUL or a backslash.
+// empty, absolute, with a '..' segment, a NUL or a backslash, or not UTF-8.
 [[nodiscard]] Result<std::string> checked_relative_path(std::string_view path);
 
 // A glTF URI that is not a data: URI, percent-decoded and checked as above; also

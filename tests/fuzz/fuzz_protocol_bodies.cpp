@@ -104,7 +104,8 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
             // A scene's files: fetched into a cache that takes everything.
             [&](node::PrepareScene& a) {
               outcome.scene_files = a.manifest;
-              broken = carry_out(node, node.scene_copy_started({}, 0), light_count, outcome);
+              broken =
+                  carry_out(node, node.scene_copy_started(protocol::SceneFetch::Present{}, 0), light_count, outcome);
             },
             [&](node::StoreSceneChunk& a) {
               if (a.file >= outcome.scene_files.files.size() ||

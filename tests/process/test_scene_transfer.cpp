@@ -86,13 +86,13 @@ struct ClusterOutcome {
 // connecting to `host`:the master's port, with the secret beside the config when
 // `secret`; `before_node` runs once the master is listening.
 ClusterOutcome run(const std::string& config, const std::string& cache, const std::string& host,
-        const std::vector<std::string>& prefix = {}, bool secret = false,
-        const std::function<void()>& before_node = {}) {
+                   const std::vector<std::string>& prefix = {}, bool secret = false,
+                   const std::function<void()>& before_node = {}) {
   const std::string dir = make_temp_dir("optique-transfer-run");
-  Process master({master_binary(), "--config", config, "--port-file", dir + "/port", "--frames",
-                  std::to_string(kFrames), "--capture-every", std::to_string(kCapturedFrame), "--no-status", "--out",
-                  dir + "/out"},
-                 dir + "/master.log");
+  Process master(
+      {master_binary(), "--config", config, "--port-file", dir + "/port", "--frames", std::to_string(kFrames),
+       "--capture-every", std::to_string(kCapturedFrame), "--no-status", "--out", dir + "/out"},
+      dir + "/master.log");
   ClusterOutcome out;
   if (!wait_for_file(dir + "/port", 10s)) {
     ADD_FAILURE() << "the master wrote no port:\n" << master.output();
@@ -102,8 +102,8 @@ ClusterOutcome run(const std::string& config, const std::string& cache, const st
   while (!port.empty() && port.back() == '\n') port.pop_back();
   if (before_node) before_node();
   std::vector<std::string> argv = prefix;
-  const std::vector<std::string> node{node_binary(), "--master",      host + ":" + port, "--id", "wall", "--cache-dir",
-                                      cache,         "--capture-dir", dir + "/captures"};
+  const std::vector<std::string> node{node_binary(), "--master", host + ":" + port, "--id",           "wall",
+                                      "--cache-dir", cache,      "--capture-dir",   dir + "/captures"};
   argv.insert(argv.end(), node.begin(), node.end());
   if (secret) {
     argv.push_back("--secret-file");
@@ -173,9 +173,13 @@ TEST(SceneTransfer, TheMasterSendsTheFilesAsItLoadedThemNotAsTheyAreLater) {
   const std::string config = torus_config(dir, gltf, "127.0.0.1", false);
   const std::string cache = dir + "/cache";
   const std::string png = read_bytes(kTorus + "torus.png");
-  // Once the master has loaded the scene, its texture changes on disk.
-  const ClusterOutcome fetched = run(config, cache, "127.0.0.1", {}, false,
-                          [&] { std::ofstream(fs::path(gltf).parent_path() / "torus.png", std::ios::app) << "x"; });
+  // Once the master has loaded the scene, a byte of its texture changes on disk
+  // (inside the file: a master that read it again would send other bytes).
+  const ClusterOutcome fetched = run(config, cache, "127.0.0.1", {}, false, [&] {
+    std::fstream file(fs::path(gltf).parent_path() / "torus.png", std::ios::binary | std::ios::in | std::ios::out);
+    file.seekp(500);
+    file.put('\x7f');
+  });
   EXPECT_EQ(fetched.master_status, 0) << fetched.master_log;
   EXPECT_EQ(fetched.node_status, 0) << fetched.node_log;
   int copies = 0;
@@ -202,17 +206,16 @@ TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
   // torus.bin (184 KiB), then big.bin's chunks of 1 MiB: 1.7 MiB in is the
   // middle of big.bin's second chunk, far from any message's framing.
   proxy.corrupt_from_target_at((17u << 20) / 10);
-  Process node({node_binary(), "--master", "127.0.0.1:" + std::to_string(proxy.port()), "--id", "wall", "--cache-dir",
-                cache},
-               dir + "/node.log");
+  Process node(
+      {node_binary(), "--master", "127.0.0.1:" + std::to_string(proxy.port()), "--id", "wall", "--cache-dir", cache},
+      dir + "/node.log");
   EXPECT_EQ(master.wait(scaled(60s)), 0) << master.output();
   EXPECT_EQ(node.wait(scaled(20s)), 0) << node.output();
   EXPECT_EQ(proxy.corruptions_done(), 1u);
   EXPECT_TRUE(contains(node.output(), "chunk 1 of file 2 ('big.bin') does not match its SHA-256; asking for it again"))
       << node.output();
   EXPECT_TRUE(contains(node.output(), "1 chunk(s) asked for again")) << node.output();
-  EXPECT_TRUE(contains(master.output(), "'wall' asked again for chunk 1 of 'big.bin' of the scene"))
-      << master.output();
+  EXPECT_TRUE(contains(master.output(), "'wall' asked again for chunk 1 of 'big.bin' of the scene")) << master.output();
   EXPECT_TRUE(contains(master.output(), "node 'wall' joined")) << master.output();
   int copies = 0;
   for (const auto& entry : fs::directory_iterator(cache + "/scenes")) {

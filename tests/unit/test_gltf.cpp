@@ -616,6 +616,27 @@ TEST(Gltf, DracoCompressedTorusDecodes) {
   EXPECT_NEAR(area(loaded.scene.meshes[0]), area(plain.scene.meshes[0]), 1e-3 * area(plain.scene.meshes[0]));
 }
 
+TEST(Gltf, ADracoExtensionThatIsNotAnObjectIsRefusedByName) {
+  TempDir dir;
+  fs::copy_file(kTorus + "torus.bin", dir.file("torus.bin"));
+  fs::copy_file(kTorus + "torus.png", dir.file("torus.png"));
+  json doc = read_json(kTorus + "torus.gltf");
+  doc["meshes"][0]["primitives"][0]["extensions"] = {{"KHR_draco_mesh_compression", nullptr}};
+  doc["meshes"][0]["primitives"][0]["indices"] = 4294967299.0;  // 2^32 + 3: no accessor's index
+  write_json(dir.file("torus.gltf"), doc);
+  expect_error(dir.file("torus.gltf"), {"mesh 0", "KHR_draco_mesh_compression"});
+}
+
+TEST(Gltf, AFileNameThatIsNotUtf8IsRefusedBeforeAnyNodeWouldBe) {
+  TempDir dir;
+  fs::copy_file(kTorus + "torus.bin", dir.file("torus.bin"));
+  fs::copy_file(kTorus + "torus.png", dir.file("caf\xe9.png"));
+  json doc = read_json(kTorus + "torus.gltf");
+  doc["images"][0]["uri"] = "caf%E9.png";
+  write_json(dir.file("torus.gltf"), doc);
+  expect_error(dir.file("torus.gltf"), {"image 0", "not UTF-8"});
+}
+
 TEST(Gltf, CorruptDracoDataIsRefusedNamingThePrimitive) {
   TempDir dir;
   std::string glb = read_bytes(kTorus + "torus-draco.glb");
@@ -703,8 +724,8 @@ TEST(Gltf, ATruncatedGlbIsRefused) {
 TEST(Gltf, UnsupportedRequiredExtensionsAreListedBeforeAnythingElse) {
   TempDir dir;
   const auto path = torus_variant(dir, [](json& doc) {
-    doc["extensionsRequired"] = json::array({"EXT_meshopt_compression", "KHR_draco_mesh_compression",
-                                             "KHR_texture_basisu"});
+    doc["extensionsRequired"] =
+        json::array({"EXT_meshopt_compression", "KHR_draco_mesh_compression", "KHR_texture_basisu"});
     doc["buffers"][0]["uri"] = "gone.bin";  // not looked at: the extensions decide first
     doc["accessors"][0]["bufferView"] = 99;
   });

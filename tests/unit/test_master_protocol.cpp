@@ -735,7 +735,8 @@ TEST_F(MasterTest, TheWelcomeNamesTheScenesFilesAndEachChunkAskedForIsSent) {
   ASSERT_EQ(chunks.size(), 1u);
   EXPECT_EQ(chunks.front().scene_chunk().data(), *run_.scene.files[1]);
   ASSERT_NE(first<SetDeadline>(a), nullptr);
-  EXPECT_EQ(first<SetDeadline>(a)->after, std::chrono::milliseconds(kConfigureTimeout));
+  // 30 s, and a second for the torus's first 64 MiB.
+  EXPECT_EQ(first<SetDeadline>(a)->after, std::chrono::milliseconds(kConfigureTimeout + std::chrono::seconds(1)));
   EXPECT_TRUE(logged(a, "sending the scene to 'wall', which has no copy: 3 file(s)"));
   (void)master_->message(1, scene_request(sha256, 0, 0), now_);
   a = master_->message(1, scene_request(sha256, 2, 0), now_ + 10 * kMs);

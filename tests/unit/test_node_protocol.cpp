@@ -676,7 +676,7 @@ TEST_F(SceneFetchTest, ACopyInTheCacheIsUsedWithoutAFetch) {
 TEST_F(SceneFetchTest, AMissingSceneIsFetchedChunkByChunkAndCheckedThenConfigured) {
   NodeProtocol node(settings());
   (void)welcome_with_files(node);
-  Actions a = node.scene_copy_started({}, now_);
+  Actions a = node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
   auto requests = sent(a, wire::Envelope::kSceneRequest);
   ASSERT_EQ(requests.size(), 3u);  // every chunk there is, up to four at once
   EXPECT_EQ(requests[0].scene_request().scene_sha256(), scene_.sha256);
@@ -716,12 +716,14 @@ TEST_F(SceneFetchTest, AChunkNotAskedForClosesAndAFailedCopyStopsTheNode) {
   {
     NodeProtocol node(settings());
     (void)welcome_with_files(node);
-    (void)node.scene_copy_started({}, now_);
+    (void)node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
     const Actions a = node.message(chunk(1, 9, "x"), now_);
     ASSERT_NE(first<Close>(a), nullptr);
     EXPECT_NE(first<Close>(a)->reason.find("not asked for"), std::string::npos);
-    // The connection goes: the partial copy with it.
-    EXPECT_NE(first<AbandonScene>(node.closed("gone", now_)), nullptr);
+    // The connection goes; the partial copy stays, for the fetch to go on from.
+    EXPECT_EQ(first<AbandonScene>(node.closed("gone", now_)), nullptr);
+    // Stopping while it reconnects removes it.
+    EXPECT_NE(first<AbandonScene>(node.interrupted("SIGTERM")), nullptr);
   }
   {
     NodeProtocol node(settings());
@@ -734,7 +736,7 @@ TEST_F(SceneFetchTest, AChunkNotAskedForClosesAndAFailedCopyStopsTheNode) {
   {
     NodeProtocol node(settings());
     (void)welcome_with_files(node);
-    (void)node.scene_copy_started({}, now_);
+    (void)node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
     const Actions a = node.scene_store_failed("disk full");
     ASSERT_NE(first<Stop>(a), nullptr);
     EXPECT_NE(first<AbandonScene>(a), nullptr);
@@ -743,12 +745,33 @@ TEST_F(SceneFetchTest, AChunkNotAskedForClosesAndAFailedCopyStopsTheNode) {
     // The same chunk spoilt on every try: the fetch gives the connection up.
     NodeProtocol node(settings());
     (void)welcome_with_files(node);
-    (void)node.scene_copy_started({}, now_);
+    (void)node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
     Actions a;
     for (int i = 0; i < protocol::SceneFetch::kMostTries; ++i) a = node.message(chunk(0, 0, "{}"), now_);
     ASSERT_NE(first<Close>(a), nullptr);
     EXPECT_NE(first<Close>(a)->reason.find("after 4 tries"), std::string::npos) << first<Close>(a)->reason;
   }
+}
+
+TEST_F(SceneFetchTest, AFetchCutShortGoesOnFromWhatIsHere) {
+  NodeProtocol node(settings());
+  (void)welcome_with_files(node);
+  // The glTF and the binary's first chunk came before the connection went.
+  const protocol::SceneFetch::Present present{{true}, {true, false}};
+  Actions a = node.scene_copy_started(present, now_);
+  EXPECT_TRUE(logged(a, "fetching the rest of the scene"));
+  const auto requests = sent(a, wire::Envelope::kSceneRequest);
+  ASSERT_EQ(requests.size(), 1u);
+  EXPECT_EQ(requests[0].scene_request().file(), 1u);
+  EXPECT_EQ(requests[0].scene_request().chunk(), 1u);
+  a = node.message(chunk(1, 1, scene_.bin.substr(4096)), now_);
+  EXPECT_NE(first<FinishScene>(a), nullptr);
+  // Everything here already: put in place at once.
+  NodeProtocol whole(settings());
+  (void)welcome_with_files(whole);
+  a = whole.scene_copy_started(protocol::SceneFetch::Present{{true}, {true, true}}, now_);
+  EXPECT_TRUE(sent(a, wire::Envelope::kSceneRequest).empty());
+  EXPECT_NE(first<FinishScene>(a), nullptr);
 }
 
 TEST_F(SceneFetchTest, ANodeWithoutARendererOrTooSmallALimitFetchesNothing) {

@@ -1,12 +1,18 @@
 // A node's copies of the master's scenes (node/scene_cache.h), on a real file
-// system under a temporary folder: a copy is written, checked whole and put in
-// place; a spoilt copy is not used; partial copies of nodes that are gone go.
+// system under a temporary folder: a copy is written and put in place; a spoilt
+// copy is not used; a copy cut short goes on from the chunks it holds; partial
+// copies whose node is gone (no one holds their lock) go; when the disk is short
+// (a small tmpfs, where this runs as root) the copies used longest ago make room.
 
 #include "node/scene_cache.h"
 
 #include <gtest/gtest.h>
+#include <sys/mount.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <chrono>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -30,18 +36,29 @@ class SceneCacheTest : public ::testing::Test {
     fs::remove_all(dir_, ignored);
   }
 
-  // Writes the whole scene through `cache` as a fetch would, chunk by chunk.
-  Result<std::string> fetch(SceneCache& cache) {
-    if (auto begun = cache.begin(files_, sha_); !begun) return Error{begun.error()};
+  // Writes chunks of the scene through `cache` as a fetch would; all of them
+  // unless `only` names one (file, chunk).
+  void write_chunks(SceneCache& cache, std::optional<std::pair<std::uint32_t, std::uint64_t>> only = {}) {
     const std::vector<const std::string*> contents{&gltf_, &bin_};
     for (std::uint32_t f = 0; f < 2; ++f) {
       for (std::uint64_t c = 0; c < files_.files[f].chunks(files_.chunk_bytes); ++c) {
-        const std::string data =
-            contents[f]->substr(files_.chunk_offset(c), files_.chunk_length(f, c));
-        if (auto written = cache.write(f, files_.chunk_offset(c), data); !written) return Error{written.error()};
+        if (only && *only != std::make_pair(f, c)) continue;
+        const std::string data = contents[f]->substr(files_.chunk_offset(c), files_.chunk_length(f, c));
+        ASSERT_TRUE(cache.write(f, files_.chunk_offset(c), data).ok());
       }
     }
+  }
+
+  Result<std::string> fetch(SceneCache& cache) {
+    if (auto begun = cache.begin(files_, sha_); !begun) return Error{begun.error()};
+    write_chunks(cache);
     return cache.commit();
+  }
+
+  int entries_in_scenes() const {
+    int entries = 0;
+    for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_ / "scenes")) ++entries;
+    return entries;
   }
 
   static std::string read(const fs::path& path) {
@@ -52,8 +69,8 @@ class SceneCacheTest : public ::testing::Test {
   fs::path dir_;
   std::string gltf_ = R"({"asset":{"version":"2.0"}})";
   std::string bin_ = std::string(10000, '\x61');
-  scene::SceneManifest files_{4096, {scene::describe_file("s.gltf", gltf_, 4096),
-                                     scene::describe_file("maps/s.bin", bin_, 4096)}};
+  scene::SceneManifest files_{
+      4096, {scene::describe_file("s.gltf", gltf_, 4096), scene::describe_file("maps/s.bin", bin_, 4096)}};
   std::string sha_ = scene::manifest_sha256(files_);
 };
 
@@ -65,10 +82,7 @@ TEST_F(SceneCacheTest, AFetchedCopyIsPutInPlaceAndFoundAgainAfterARestart) {
   ASSERT_TRUE(stored.ok()) << stored.error();
   EXPECT_EQ(stored.value(), (dir_ / "scenes" / sha_ / "s.gltf").string());
   EXPECT_EQ(read(dir_ / "scenes" / sha_ / "maps/s.bin"), bin_);
-  // No partial copy is left beside it.
-  int entries = 0;
-  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_ / "scenes")) ++entries;
-  EXPECT_EQ(entries, 1);
+  EXPECT_EQ(entries_in_scenes(), 1) << "no partial copy or lock is left beside it";
   SceneCache restarted(dir_);
   EXPECT_EQ(restarted.find(files_, sha_), stored.value());
 }
@@ -86,48 +100,100 @@ TEST_F(SceneCacheTest, ASpoiltCopyIsNotUsedButRemoved) {
   EXPECT_FALSE(fs::exists(dir_ / "scenes" / sha_));
 }
 
-TEST_F(SceneCacheTest, ACopyThatIsNotWholeIsNotPutInPlace) {
+TEST_F(SceneCacheTest, ACopyMissingChunksIsNotPutInPlace) {
   SceneCache cache(dir_);
   ASSERT_TRUE(cache.begin(files_, sha_).ok());
-  ASSERT_TRUE(cache.write(0, 0, gltf_).ok());
-  ASSERT_TRUE(cache.write(1, 0, std::string(4096, 'z')).ok());  // what no chunk check would let through
+  write_chunks(cache, std::make_pair(1u, std::uint64_t{0}));
   const auto committed = cache.commit();
   ASSERT_FALSE(committed.ok());
   EXPECT_NE(committed.error().find("not whole"), std::string::npos) << committed.error();
   EXPECT_FALSE(fs::exists(dir_ / "scenes" / sha_));
-  int entries = 0;
-  for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_ / "scenes")) ++entries;
-  EXPECT_EQ(entries, 0) << "the partial copy is removed";
+  EXPECT_EQ(entries_in_scenes(), 0) << "the partial copy and its lock are removed";
 }
 
-TEST_F(SceneCacheTest, TwoNodesOfOneMachineFetchingTogetherShareTheCopy) {
+TEST_F(SceneCacheTest, ACopyCutShortGoesOnFromTheChunksItHolds) {
+  SceneCache cache(dir_);
+  auto begun = cache.begin(files_, sha_);
+  ASSERT_TRUE(begun.ok());
+  EXPECT_EQ(begun.value(), (SceneCache::Present{{false}, {false, false, false}}));
+  write_chunks(cache, std::make_pair(0u, std::uint64_t{0}));
+  write_chunks(cache, std::make_pair(1u, std::uint64_t{1}));
+  // The connection went; the fetch starts again on the same copy.
+  begun = cache.begin(files_, sha_);
+  ASSERT_TRUE(begun.ok());
+  EXPECT_EQ(begun.value(), (SceneCache::Present{{true}, {false, true, false}}));
+  write_chunks(cache, std::make_pair(1u, std::uint64_t{0}));
+  write_chunks(cache, std::make_pair(1u, std::uint64_t{2}));
+  const auto committed = cache.commit();
+  ASSERT_TRUE(committed.ok()) << committed.error();
+  EXPECT_EQ(read(dir_ / "scenes" / sha_ / "maps/s.bin"), bin_);
+}
+
+TEST_F(SceneCacheTest, TwoNodesOfOneHostFetchingTogetherShareTheCopy) {
   SceneCache first(dir_);
   SceneCache second(dir_);
   ASSERT_TRUE(first.begin(files_, sha_).ok());
-  auto by_second = fetch(second);  // finishes first
+  auto by_second = fetch(second);  // finishes first; first's partial copy is left alone
   ASSERT_TRUE(by_second.ok()) << by_second.error();
-  ASSERT_TRUE(first.write(0, 0, gltf_).ok());
-  for (std::uint64_t c = 0; c < 3; ++c) {
-    ASSERT_TRUE(first.write(1, c * 4096, bin_.substr(c * 4096, files_.chunk_length(1, c))).ok());
-  }
+  write_chunks(first);
   const auto by_first = first.commit();
   ASSERT_TRUE(by_first.ok()) << by_first.error();
   EXPECT_EQ(by_first.value(), by_second.value());
+  EXPECT_EQ(entries_in_scenes(), 1);
 }
 
-TEST_F(SceneCacheTest, PartialCopiesOfNodesThatAreGoneAreRemoved) {
-  fs::create_directories(dir_ / "scenes" / (sha_ + ".partial-999999999"));  // no such process
-  fs::create_directories(dir_ / "scenes" / (sha_ + ".partial-1"));          // init: alive
+TEST_F(SceneCacheTest, PartialCopiesWhoseNodeIsGoneAreRemovedAndOthersKept) {
+  SceneCache alive(dir_);
+  const scene::SceneManifest other{4096, {scene::describe_file("o.gltf", "{}", 4096)}};
+  ASSERT_TRUE(alive.begin(other, scene::manifest_sha256(other)).ok());  // holds its lock
+  fs::create_directories(dir_ / "scenes" / (sha_ + ".partial-1-2"));    // no lock file: its node died early
+  fs::create_directories(dir_ / "scenes" / (sha_ + ".partial-3-4"));
+  std::ofstream(dir_ / "scenes" / (sha_ + ".partial-3-4.lock")) << "";  // a lock nobody holds
   SceneCache cache(dir_);
   ASSERT_TRUE(cache.begin(files_, sha_).ok());
-  EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-999999999")));
-  EXPECT_TRUE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-1")));
+  EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-1-2")));
+  EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-3-4")));
+  EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-3-4.lock")));
+  // alive's partial and lock, cache's partial and lock.
+  EXPECT_EQ(entries_in_scenes(), 4);
   cache.abandon();
-  int ours = 0;
-  for (const auto& entry : fs::directory_iterator(dir_ / "scenes")) {
-    ours += entry.path().filename().string().starts_with(sha_ + ".partial-" + std::to_string(getpid())) ? 1 : 0;
+  alive.abandon();
+  EXPECT_EQ(entries_in_scenes(), 0);
+}
+
+TEST_F(SceneCacheTest, WhenTheDiskIsShortTheCopiesUsedLongestAgoMakeRoom) {
+  const fs::path small = dir_ / "small";
+  fs::create_directories(small);
+  if (mount("tmpfs", small.c_str(), "tmpfs", 0, "size=1m") != 0) {
+    GTEST_SKIP() << "a small tmpfs needs root: " << std::strerror(errno);
   }
-  EXPECT_EQ(ours, 0) << "abandoned: removed";
+  struct Unmount {
+    const fs::path& at;
+    ~Unmount() { umount(at.c_str()); }
+  } unmount{small};
+  {
+    // Two copies of other scenes, 400 KiB each, the first used longer ago.
+    const std::string fake = std::string(64, 'a');
+    const std::string used = std::string(64, 'b');
+    for (const std::string& name : {fake, used}) {
+      fs::create_directories(small / "scenes" / name);
+      std::ofstream(small / "scenes" / name / "big.bin", std::ios::binary) << std::string(400 << 10, 'x');
+    }
+    const auto now = fs::file_time_type::clock::now();
+    fs::last_write_time(small / "scenes" / fake, now - std::chrono::hours(2));
+    fs::last_write_time(small / "scenes" / used, now - std::chrono::hours(1));
+    const scene::SceneManifest big{4096, {scene::describe_file("big.gltf", std::string(300 << 10, 'y'), 4096)}};
+    SceneCache cache(small, 0);
+    ASSERT_TRUE(cache.begin(big, scene::manifest_sha256(big)).ok());
+    EXPECT_FALSE(fs::exists(small / "scenes" / fake)) << "used longest ago: removed";
+    EXPECT_TRUE(fs::exists(small / "scenes" / used));
+    cache.abandon();
+    // More than the disk holds at all: refused, naming the folder.
+    const scene::SceneManifest huge{4096, {scene::describe_file("huge.gltf", std::string(2 << 20, 'z'), 4096)}};
+    const auto refused = cache.begin(huge, scene::manifest_sha256(huge));
+    ASSERT_FALSE(refused.ok());
+    EXPECT_NE(refused.error().find((small / "scenes").string()), std::string::npos) << refused.error();
+  }
 }
 
 TEST_F(SceneCacheTest, AFolderThatCannotBeWrittenSaysSo) {

@@ -32,6 +32,7 @@ TEST(RelativePath, PlainPathsAreKeptInTheirPlainForm) {
   EXPECT_EQ(checked_relative_path("./maps//wood.png").value(), "maps/wood.png");
   EXPECT_EQ(relative_file_of_uri("maps/the%20wood.png").value(), "maps/the wood.png");
   EXPECT_EQ(relative_file_of_uri("a+b.bin").value(), "a+b.bin");
+  EXPECT_EQ(relative_file_of_uri("caf%C3%A9.png").value(), "caf\xc3\xa9.png");  // UTF-8, escaped
 }
 
 TEST(RelativePath, WhatLeavesTheFolderIsRefusedSayingWhy) {
@@ -43,6 +44,10 @@ TEST(RelativePath, WhatLeavesTheFolderIsRefusedSayingWhy) {
       {"a\\..\\b", "backslash"},
       {std::string("a\0b", 3), "NUL"},
       {".", "names the folder itself"},
+      {"caf\xe9.png", "not UTF-8"},       // Latin-1
+      {"a\xc0\xaf.png", "not UTF-8"},     // an overlong '/'
+      {"\xed\xa0\x80.png", "not UTF-8"},  // a surrogate
+      {"x\xf0\x9f\x98", "not UTF-8"},     // cut short
   };
   for (const auto& [path, reason] : paths) {
     const auto checked = checked_relative_path(path);
@@ -56,6 +61,7 @@ TEST(RelativePath, WhatLeavesTheFolderIsRefusedSayingWhy) {
       {"a.bin#x", "query or a fragment"},
       {"a%zz.bin", "two hex digits"},
       {"a%2", "two hex digits"},
+      {"caf%E9.png", "not UTF-8"},
   };
   for (const auto& [uri, reason] : uris) {
     const auto checked = relative_file_of_uri(uri);
