@@ -122,7 +122,10 @@ void make_room(const fs::path& folder, std::uintmax_t needed, const std::string&
 SceneCache::SceneCache(const fs::path& cache_dir, std::uintmax_t spare_bytes)
     : folder_(cache_dir / "scenes"), spare_bytes_(spare_bytes) {}
 
-SceneCache::~SceneCache() { release_lock(); }
+SceneCache::~SceneCache() {
+  close_file();
+  release_lock();
+}
 
 fs::path SceneCache::default_cache_dir() {
   const auto variable = [](const char* name) -> std::string {
@@ -213,16 +216,30 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
 Result<void> SceneCache::write(std::uint32_t file, std::uint64_t offset, std::string_view data) {
   if (!manifest_ || file >= manifest_->files.size()) return Error{"no scene is being written"};
   const fs::path path = partial_ / manifest_->files[file].path;
-  std::fstream out(path, std::ios::binary | std::ios::in | std::ios::out);
-  out.seekp(static_cast<std::streamoff>(offset));
-  out.write(data.data(), static_cast<std::streamsize>(data.size()));
-  out.flush();
-  if (!out) return Error{"cannot write " + path.string() + ": " + std::strerror(errno)};
+  if (open_file_ != file) {
+    close_file();
+    file_fd_ = open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    if (file_fd_ < 0) return Error{"cannot write " + path.string() + ": " + std::strerror(errno)};
+    open_file_ = file;
+  }
+  for (std::size_t done = 0; done < data.size();) {
+    const ssize_t n = pwrite(file_fd_, data.data() + done, data.size() - done, static_cast<off_t>(offset + done));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return Error{"cannot write " + path.string() + ": " + std::strerror(errno)};
+    done += static_cast<std::size_t>(n);
+  }
   return {};
+}
+
+void SceneCache::close_file() {
+  if (file_fd_ >= 0) close(file_fd_);
+  file_fd_ = -1;
+  open_file_ = -1;
 }
 
 Result<std::string> SceneCache::commit() {
   if (!manifest_) return Error{"no scene is being written"};
+  close_file();
   const scene::SceneManifest manifest = *manifest_;
   // Each chunk was checked against the manifest as it came; what the disk did
   // with them the loader sees (it checks the scene's identity again).
@@ -252,6 +269,7 @@ Result<std::string> SceneCache::commit() {
 }
 
 void SceneCache::abandon() {
+  close_file();
   if (!partial_.empty()) {
     std::error_code ignored;
     fs::remove_all(partial_, ignored);

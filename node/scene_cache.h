@@ -61,6 +61,7 @@ class SceneCache {
 
  private:
   void release_lock();
+  void close_file();
 
   std::filesystem::path folder_;
   std::uintmax_t spare_bytes_;
@@ -69,6 +70,9 @@ class SceneCache {
   std::string sha256_;
   std::filesystem::path partial_;
   int lock_fd_ = -1;
+  // The file written last, kept open: chunks come file by file.
+  std::int64_t open_file_ = -1;
+  int file_fd_ = -1;
   // Checked whole in this process already: not read again on a rejoin.
   std::string verified_;
 };
