@@ -249,6 +249,12 @@ void NodeProtocol::configure(Actions& out) {
   out.push_back(Configure{*job_});
 }
 
+// The cache cannot hold the scene (no room, no permission): not something a
+// retry cures.
+void NodeProtocol::cache_failed(const std::string& error, Actions& out) {
+  stop(kExitRefused, "cannot keep the master's scene here: " + error, out);
+}
+
 Actions NodeProtocol::scene_found(const std::string& gltf_path) {
   Actions out;
   if (phase_ != Phase::preparing_scene) return out;
@@ -262,7 +268,7 @@ Actions NodeProtocol::scene_copy_started(const Result<protocol::SceneFetch::Pres
   Actions out;
   if (phase_ != Phase::preparing_scene) return out;
   if (!started) {
-    stop(kExitRefused, "cannot keep the master's scene here: " + started.error(), out);
+    cache_failed(started.error(), out);
     return out;
   }
   copy_unfinished_ = true;
@@ -317,7 +323,7 @@ void NodeProtocol::on_scene_chunk(const wire::SceneChunk& chunk, Actions& out) {
 Actions NodeProtocol::scene_store_failed(const std::string& error) {
   Actions out;
   if (phase_ != Phase::fetching_scene) return out;
-  stop(kExitRefused, "cannot keep the master's scene here: " + error, out);
+  cache_failed(error, out);
   return out;
 }
 
@@ -325,7 +331,7 @@ Actions NodeProtocol::scene_copy_finished(const Result<std::string>& gltf_path, 
   Actions out;
   if (phase_ != Phase::fetching_scene) return out;
   if (!gltf_path) {
-    stop(kExitRefused, "cannot keep the master's scene here: " + gltf_path.error(), out);
+    cache_failed(gltf_path.error(), out);
     return out;
   }
   copy_unfinished_ = false;

@@ -205,6 +205,7 @@ class NodeProtocol {
   void on_scene_chunk(const wire::SceneChunk& chunk, Actions& out);
   // The scene's files are here (or none are needed): set the renderer up.
   void configure(Actions& out);
+  void cache_failed(const std::string& error, Actions& out);
   void on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out);
   void on_frame_begin(const wire::FrameBegin& begin, clock::Nanos now, Actions& out);
   void on_swap(const wire::FrameSwap& swap, clock::Nanos now, Actions& out);
