@@ -1,18 +1,16 @@
 #include "scene/gltf.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <exception>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <map>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -523,19 +521,14 @@ class Loader {
     return model_.accessors[static_cast<std::size_t>(index)];
   }
 
-  // Where the elements of accessor `index` are, each `element_size` bytes, after
-  // checking that all of them lie inside their buffer view and buffer.
-  Located locate(int index, const std::string& what, std::size_t element_size) const {
-    const auto& acc = accessor(index, what);
-    const std::string label = accessor_label(index, what);
-    if (acc.sparse.isSparse) fail(label + ": sparse accessors are not supported");
-    if (acc.count == 0) return {};
-    if (acc.bufferView < 0) fail(label + ": accessors without a buffer view are not supported");
-    if (static_cast<std::size_t>(acc.bufferView) >= model_.bufferViews.size()) {
-      fail(label + ": buffer view " + std::to_string(acc.bufferView) + " is out of range");
+  // The bytes of buffer view `index` (for `label`), after checking that the view
+  // and its buffer exist and that the view lies inside the buffer.
+  std::span<const unsigned char> view_bytes(int index, const std::string& label) const {
+    const std::string view_label = "buffer view " + std::to_string(index);
+    if (index < 0 || static_cast<std::size_t>(index) >= model_.bufferViews.size()) {
+      fail(label + ": " + view_label + " is out of range");
     }
-    const auto& view = model_.bufferViews[static_cast<std::size_t>(acc.bufferView)];
-    const std::string view_label = "buffer view " + std::to_string(acc.bufferView);
+    const auto& view = model_.bufferViews[static_cast<std::size_t>(index)];
     if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model_.buffers.size()) {
       fail(label + ": " + view_label + " names buffer " + std::to_string(view.buffer) + ", which is out of range");
     }
@@ -545,6 +538,20 @@ class Loader {
            std::to_string(view.byteLength) + ") is out of range of buffer " + std::to_string(view.buffer) + " (" +
            std::to_string(buffer.data.size()) + " bytes)");
     }
+    return {buffer.data.data() + view.byteOffset, view.byteLength};
+  }
+
+  // Where the elements of accessor `index` are, each `element_size` bytes, after
+  // checking that all of them lie inside their buffer view and buffer.
+  Located locate(int index, const std::string& what, std::size_t element_size) const {
+    const auto& acc = accessor(index, what);
+    const std::string label = accessor_label(index, what);
+    if (acc.sparse.isSparse) fail(label + ": sparse accessors are not supported");
+    if (acc.count == 0) return {};
+    if (acc.bufferView < 0) fail(label + ": accessors without a buffer view are not supported");
+    const std::span<const unsigned char> bytes = view_bytes(acc.bufferView, label);
+    const auto& view = model_.bufferViews[static_cast<std::size_t>(acc.bufferView)];
+    const std::string view_label = "buffer view " + std::to_string(acc.bufferView);
     const std::size_t stride = view.byteStride != 0 ? view.byteStride : element_size;
     if (stride < element_size) {
       fail(label + ": byteStride " + std::to_string(stride) + " is smaller than an element (" +
@@ -555,7 +562,7 @@ class Loader {
       fail(label + ": " + std::to_string(acc.count) + " elements from byte " + std::to_string(acc.byteOffset) +
            " are out of range of " + view_label + " (" + std::to_string(view.byteLength) + " bytes)");
     }
-    return {buffer.data.data() + view.byteOffset + acc.byteOffset, stride, acc.count};
+    return {bytes.data() + acc.byteOffset, stride, acc.count};
   }
 
   // The components of accessor `index`, which must be of `type` and FLOAT (or,
@@ -949,18 +956,7 @@ class Loader {
       fail(what + " must be an object with a bufferView and attributes");
     }
     const tinygltf::Value& extension = found->second;
-    const int view_index = extension.Get("bufferView").GetNumberAsInt();
-    if (view_index < 0 || static_cast<std::size_t>(view_index) >= model_.bufferViews.size()) {
-      fail(what + ": buffer view " + std::to_string(view_index) + " is out of range");
-    }
-    const auto& view = model_.bufferViews[static_cast<std::size_t>(view_index)];
-    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model_.buffers.size()) {
-      fail(what + ": buffer view " + std::to_string(view_index) + " names a buffer out of range");
-    }
-    const auto& buffer = model_.buffers[static_cast<std::size_t>(view.buffer)];
-    if (view.byteOffset > buffer.data.size() || view.byteLength > buffer.data.size() - view.byteOffset) {
-      fail(what + ": buffer view " + std::to_string(view_index) + " is out of range of its buffer");
-    }
+    const std::span<const unsigned char> compressed = view_bytes(extension.Get("bufferView").GetNumberAsInt(), what);
     const tinygltf::Value& ids = extension.Get("attributes");
     const auto id_of = [&](const std::string& name) -> std::optional<int> {
       if (!ids.Has(name)) return std::nullopt;
@@ -976,8 +972,8 @@ class Loader {
     const std::optional<int> normal_id = has_normal ? id_of("NORMAL") : std::nullopt;
     const std::optional<int> uv_id = has_uv ? id_of("TEXCOORD_0") : std::nullopt;
     auto decoded = decode_draco_primitive(
-        std::string_view(reinterpret_cast<const char*>(buffer.data.data() + view.byteOffset), view.byteLength),
-        *position_id, normal_id, uv_id);
+        std::string_view(reinterpret_cast<const char*>(compressed.data()), compressed.size()), *position_id,
+        normal_id, uv_id);
     if (!decoded) fail(what + ": " + decoded.error());
     DracoPrimitive& mesh = decoded.value();
     if (mesh.points > std::numeric_limits<std::uint32_t>::max()) fail(label + " has too many vertices");
@@ -1227,24 +1223,16 @@ class Loader {
 
     const auto& image = model_.images[image_index];
     const std::string image_label = labelled("image", image_index, image.name.empty() ? image.uri : image.name);
-    std::vector<unsigned char> view_bytes;
-    const std::vector<unsigned char>* encoded = &image.image;
+    // Embedded (a data URI), in a buffer view, or a file beside the glTF.
+    std::span<const unsigned char> encoded(image.image);
     if (image.bufferView >= 0) {
-      const auto& view = model_.bufferViews[static_cast<std::size_t>(image.bufferView)];  // checked by tinygltf
-      const auto& buffer = model_.buffers[static_cast<std::size_t>(view.buffer)];
-      if (view.byteOffset > buffer.data.size() || view.byteLength > buffer.data.size() - view.byteOffset) {
-        fail(image_label + ": buffer view " + std::to_string(image.bufferView) + " is out of range of its buffer");
-      }
-      const auto begin = buffer.data.begin() + static_cast<std::ptrdiff_t>(view.byteOffset);
-      view_bytes.assign(begin, begin + static_cast<std::ptrdiff_t>(view.byteLength));
-      encoded = &view_bytes;
+      encoded = view_bytes(image.bufferView, image_label);
     } else if (image_index < source_.image_file.size() && source_.image_file[image_index]) {
       const std::string& bytes = *source_.files[*source_.image_file[image_index]].second;
-      view_bytes.assign(bytes.begin(), bytes.end());
-      encoded = &view_bytes;
+      encoded = {reinterpret_cast<const unsigned char*>(bytes.data()), bytes.size()};
     }
     if (!decode_) return std::nullopt;  // not drawn here: the image is not needed
-    auto decoded = decode_(std::span<const std::uint8_t>(encoded->data(), encoded->size()), image.mimeType);
+    auto decoded = decode_(encoded, image.mimeType);
     if (!decoded) {
       warn(what + ": " + image_label + " cannot be decoded (" + decoded.error() + "); ignored");
       return std::nullopt;
