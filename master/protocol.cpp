@@ -346,7 +346,7 @@ void MasterProtocol::on_scene_request(PeerId peer, Session& session, const wire:
   auto& chunk = *envelope.mutable_scene_chunk();
   chunk.set_file(request.file());
   chunk.set_chunk(request.chunk());
-  chunk.set_data(scene_.files[request.file()]->substr(offset, length));
+  chunk.set_data(scene_.files[request.file()]->data() + offset, length);
   out.push_back(Send{peer, std::move(envelope)});
   out.push_back(SetDeadline{peer, configure_timeout(),
                             "node did not finish configuring within " + std::to_string(configure_timeout().count()) +

@@ -17,8 +17,8 @@ schema::Installation job_of(const wire::Welcome& welcome) {
   return job;
 }
 
-// Checked here for shape and identity; each node holds the size to its own limit.
-
+// A welcome's manifest, checked for shape (any scene's limits: each node holds
+// the size to its own afterwards) and for the scene's identity.
 Result<scene::SceneManifest> decode_scene_manifest(const wire::SceneManifest& wire, const std::string& sha256) {
   scene::SceneManifest manifest;
   manifest.chunk_bytes = wire.chunk_bytes();

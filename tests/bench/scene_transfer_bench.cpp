@@ -157,9 +157,8 @@ double optique_fetch(const std::string& config, const fs::path& cache, const fs:
   testing::Process master({testing::master_binary(), "--config", config, "--port-file", (dir / "port").string(),
                            "--frames", "3", "--no-status", "--out", (dir / "out").string()},
                           (dir / "master.log").string());
-  if (!testing::wait_for_file((dir / "port").string(), 20s)) throw std::runtime_error("the master wrote no port");
-  std::string port = testing::read_file((dir / "port").string());
-  port.pop_back();
+  const std::string port = testing::wait_for_port((dir / "port").string(), 20s);
+  if (port.empty()) throw std::runtime_error("the master wrote no port");
   testing::Process node({testing::node_binary(), "--master", "127.0.0.1:" + port, "--id", "wall", "--cache-dir",
                          cache.string(), "--capture-dir", (dir / "captures").string()},
                         (dir / "node.log").string());

@@ -122,9 +122,8 @@ TEST(LightRepartition, LightsSwitchedAndANodeKilledAreSharedOutAnewAndTheScreenS
       {kMaster, "--config", config, "--listen", "127.0.0.1", "--port", "0", "--port-file", dir + "/port", "--out", out,
        "--frames", std::to_string(kFrames), "--capture-every", std::to_string(kCaptureEvery), "--no-status"},
       dir + "/master.log");
-  ASSERT_TRUE(wait_for_file(dir + "/port", 10s)) << master.output();
-  std::string port = read_file(dir + "/port");
-  while (!port.empty() && port.back() == '\n') port.pop_back();
+  const std::string port = wait_for_port(dir + "/port", 10s);
+  ASSERT_FALSE(port.empty()) << master.output();
   std::map<std::string, std::unique_ptr<Process>> nodes;
   for (const std::string& id : kNodes) {
     nodes[id] = std::make_unique<Process>(std::vector<std::string>{kNode, "--master", "127.0.0.1:" + port, "--id", id,

@@ -64,9 +64,8 @@ StackedRun run_cluster(const std::string& lagging_node, const std::string& shipp
       {kMaster, "--config", config, "--listen", "127.0.0.1", "--port", "0", "--port-file", dir + "/port", "--out",
        run.out, "--frames", std::to_string(frames), "--capture-every", std::to_string(capture_every), "--no-status"},
       dir + "/master.log");
-  EXPECT_TRUE(wait_for_file(dir + "/port", 10s)) << master.output();
-  std::string port = read_file(dir + "/port");
-  while (!port.empty() && port.back() == '\n') port.pop_back();
+  const std::string port = wait_for_port(dir + "/port", 10s);
+  EXPECT_FALSE(port.empty()) << master.output();
   std::vector<std::unique_ptr<Process>> nodes;
   auto loaded = config::load_installation(config);
   EXPECT_TRUE(loaded);

@@ -249,9 +249,8 @@ TEST(Cluster, InterruptStopsTheLocalClusterCleanly) {
   Process master({kMaster, "--config", kConfigs + "/powerwall-2x2.json", "--local", "--port-file", dir + "/port",
                   "--out", dir + "/out", "--no-status"},
                  dir + "/master.log");
-  ASSERT_TRUE(wait_for_file(dir + "/port", 10s));
-  std::string port = read_file(dir + "/port");
-  port.pop_back();
+  const std::string port = wait_for_port(dir + "/port", 10s);
+  ASSERT_FALSE(port.empty());
   ASSERT_TRUE(master.wait_for_output("starting frames", 15s)) << master.output();
   std::this_thread::sleep_for(500ms);
   master.signal(SIGINT);

@@ -538,9 +538,8 @@ TEST(Security, WithoutASecretOnlyLoopbackPeersAreAccepted) {
   Process master({master_binary(), "--config", config, "--listen", "0.0.0.0", "--port", "0", "--port-file",
                   dir + "/port", "--frames", "60", "--no-status"},
                  dir + "/master.log");
-  ASSERT_TRUE(wait_for_file(dir + "/port", 10s)) << master.output();
-  std::string port = read_file(dir + "/port");
-  while (!port.empty() && port.back() == '\n') port.pop_back();
+  const std::string port = wait_for_port(dir + "/port", 10s);
+  ASSERT_FALSE(port.empty()) << master.output();
   RawClient outsider(address, port);
   ASSERT_TRUE(outsider.connected());
   EXPECT_TRUE(outsider.closed_within(scaled(3s)));

@@ -94,12 +94,11 @@ ClusterOutcome run(const std::string& config, const std::string& cache, const st
        "--capture-every", std::to_string(kCapturedFrame), "--no-status", "--out", dir + "/out"},
       dir + "/master.log");
   ClusterOutcome out;
-  if (!wait_for_file(dir + "/port", 10s)) {
+  const std::string port = wait_for_port(dir + "/port", 10s);
+  if (port.empty()) {
     ADD_FAILURE() << "the master wrote no port:\n" << master.output();
     return out;
   }
-  std::string port = read_file(dir + "/port");
-  while (!port.empty() && port.back() == '\n') port.pop_back();
   if (before_node) before_node();
   std::vector<std::string> argv = prefix;
   const std::vector<std::string> node{node_binary(), "--master", host + ":" + port, "--id",           "wall",
@@ -198,9 +197,8 @@ TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
   Process master({master_binary(), "--config", config, "--port-file", dir + "/port", "--frames",
                   std::to_string(kFrames), "--no-status", "--out", dir + "/out"},
                  dir + "/master.log");
-  ASSERT_TRUE(wait_for_file(dir + "/port", 10s)) << master.output();
-  std::string port = read_file(dir + "/port");
-  port.pop_back();
+  const std::string port = wait_for_port(dir + "/port", 10s);
+  ASSERT_FALSE(port.empty()) << master.output();
   FaultProxy proxy(static_cast<std::uint16_t>(std::stoi(port)));
   // What the master sends: the challenge and the welcome (a few KiB), the glTF,
   // torus.bin (184 KiB), then big.bin's chunks of 1 MiB: 1.7 MiB in is the

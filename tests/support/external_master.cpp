@@ -34,10 +34,7 @@ ExternalMaster::ExternalMaster(const std::string& config, const std::vector<std:
                                 "--port-file",   dir + "/port", "--out", dir + "/out", "--no-status"};
   argv.insert(argv.end(), extra.begin(), extra.end());
   process = std::make_unique<Process>(argv, dir + "/master.log");
-  if (wait_for_file(dir + "/port", 10s)) {
-    port = read_file(dir + "/port");
-    while (!port.empty() && port.back() == '\n') port.pop_back();
-  }
+  port = wait_for_port(dir + "/port", 10s);
 }
 
 std::unique_ptr<Process> ExternalMaster::node(const std::string& id, const std::vector<std::string>& extra) const {

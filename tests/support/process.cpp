@@ -110,6 +110,13 @@ bool wait_for_file(const std::string& path, std::chrono::milliseconds timeout) {
       timeout);
 }
 
+std::string wait_for_port(const std::string& port_file, std::chrono::milliseconds timeout) {
+  if (!wait_for_file(port_file, timeout)) return {};
+  std::string port = read_file(port_file);
+  while (!port.empty() && (port.back() == '\n' || port.back() == '\r')) port.pop_back();
+  return port;
+}
+
 bool poll_until(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
   while (std::chrono::steady_clock::now() < deadline) {

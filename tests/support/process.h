@@ -43,6 +43,9 @@ class Process {
 [[nodiscard]] bool poll_until(const std::function<bool()>& done, std::chrono::milliseconds timeout);
 // Polls until `path` exists and is non-empty, or the timeout passes.
 [[nodiscard]] bool wait_for_file(const std::string& path, std::chrono::milliseconds timeout);
+// The port a master wrote to its --port-file once it listens (without the line
+// break); empty when it wrote none within the timeout.
+[[nodiscard]] std::string wait_for_port(const std::string& port_file, std::chrono::milliseconds timeout);
 // How many times slower than a plain build the processes under test run:
 // OPTIQUE_TEST_TIME_SCALE (scripts/sanitize.sh sets it), else 1. Bounds on how
 // late something may be are multiplied by it; bounds on what happened are not.
