@@ -391,10 +391,16 @@ void Master::update_status() {
   last_status_ = now;
   status_frame_ = frame;
   const std::string total = options_.run.frames ? std::to_string(options_.run.frames) : std::string("-");
-  char line[200];
-  std::snprintf(line, sizeof line, "frame %llu/%s  %.1f Hz  nodes %zu/%zu  skew %.0f us  missing %llu",
-                static_cast<unsigned long long>(frame), total.c_str(), rate, protocol_->nodes_up(),
-                protocol_->projectors(), recorder_->last_present_skew_us(),
+  const std::uint64_t finalized = recorder_->frames_finalized();
+  const double shown_by_all =
+      finalized == 0 ? 0.0
+                     : 100.0 * static_cast<double>(finalized - std::min(finalized, recorder_->frames_with_missing_node())) /
+                           static_cast<double>(finalized);
+  char line[240];
+  std::snprintf(line, sizeof line,
+                "frame %llu/%s  %.1f of %g Hz  nodes %zu/%zu  shown by all %.1f %%  skew %.0f us  missing %llu",
+                static_cast<unsigned long long>(frame), total.c_str(), rate, options_.config.installation.master.frame_rate,
+                protocol_->nodes_up(), protocol_->projectors(), shown_by_all, recorder_->last_present_skew_us(),
                 static_cast<unsigned long long>(recorder_->frames_with_missing_node()));
   status_.show(line);
 }

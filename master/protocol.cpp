@@ -6,6 +6,7 @@
 #include <csignal>
 
 #include "config/light_list.h"
+#include "master/run_verdict.h"
 #include "net/envelope.h"
 #include "protocol/focus.h"
 #include "protocol/scene_fetch.h"
@@ -26,13 +27,6 @@ wire::Envelope refusal(const std::string& reason, bool retriable) {
 using std::chrono::milliseconds;
 
 clock::Nanos nanos(std::chrono::nanoseconds d) { return d.count(); }
-
-// "median 140 µs p99 260 µs", or why there is no number: a median over no
-// samples is not 0.
-std::string median_p99(const report::Distribution& d, const char* why_none) {
-  if (d.count() == 0) return fmt::format("n/a ({})", why_none);
-  return fmt::format("median {:.0f} µs p99 {:.0f} µs", d.median(), d.p99());
-}
 
 }  // namespace
 
@@ -290,11 +284,22 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
                             "node silent for " + std::to_string(config_.liveness_timeout.count()) + " ms"});
   send_resync(peer, out);
   session.phase = Phase::joined;
+  session.drawing.reset();
+  session.pace = RenderPace{};
+  // The first frame pays what the warm-up paid (programs, textures): it is
+  // waited for as long as the warm-up took, twice over.
+  if (configured.warm_up_ns() > 0) session.pace.add(configured.warm_up_ns());
   recorder_.node_joined(*session.slot);
   rebalance_lights(true);
   out.push_back(
-      Log{spdlog::level::info, fmt::format("node '{}' joined from {} with {} ({}/{} up)", slot_id(*session.slot),
-                                           session.peer_text, configured.renderer(), nodes_up(), slots_.size())});
+      Log{spdlog::level::info,
+          fmt::format("node '{}' joined from {} with {}{} ({}/{} up)", slot_id(*session.slot), session.peer_text,
+                      configured.renderer(),
+                      configured.warm_up_ns() > 0
+                          ? fmt::format(", warm-up frame {:.0f} ms",
+                                        static_cast<double>(std::min(configured.warm_up_ns(), kLongestRender)) / 1e6)
+                          : "",
+                      nodes_up(), slots_.size())});
   if (state_ == RunState::starting && (nodes_up() == slots_.size() || (startup_passed_ && slots_configuring().empty())))
     start_frames(now, out);
 }
@@ -416,6 +421,11 @@ Actions MasterProtocol::closed(PeerId peer, const std::string& reason, clock::Na
       if (barrier_.complete()) swap(now, out);
     }
     present_owed(slot, now, out);  // nor waited for to show the last one (after its lights moved)
+    if (begin_when_answered_ && !all_behind()) {
+      begin_when_answered_ = false;
+      out.push_back(Disarm{Timer::next_frame});
+      begin_frame(now, out);
+    }
   }
   finish_if_all_gone(out);
   return out;
@@ -532,6 +542,20 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     drain("ran " + std::to_string(settings_.frames) + " frames", now, out);
     return;
   }
+  if (all_behind()) {
+    if (!begin_when_answered_) {
+      out.push_back(Log{spdlog::level::warn,
+                        fmt::format("frame {} waits: every node is still drawing an earlier frame", frame)});
+    }
+    begin_when_answered_ = true;
+    return;
+  }
+  if (begin_when_answered_) {
+    // The schedule starts again from now: no rush of frames to catch up.
+    begin_when_answered_ = false;
+    schedule_origin_ = now;
+    schedule_origin_frame_ = frame;
+  }
   scene::SceneState state = authority_.state_at_frame(frame);
   const clock::Nanos display =
       schedule_origin_ + static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_;
@@ -571,15 +595,26 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     if (!up(slots_[i])) continue;
     const PeerId peer = *slots_[i].peer;
     Session& session = sessions_.at(peer);
+    // Behind: it would draw this frame only after the one it is drawing, too
+    // late for either; it keeps up with the scene and draws the newest frame
+    // once it has answered.
+    const bool behind = session.phase == Phase::out_of_barrier && session.drawing.has_value();
+    if (session.phase == Phase::out_of_barrier && !behind) {
+      out.push_back(Log{spdlog::level::info,
+                        fmt::format("node '{}' is back in the barrier from frame {}", slot_id(i), frame)});
+      session.phase = Phase::in_barrier;
+    }
     if (session.phase == Phase::joined) session.phase = Phase::in_barrier;
+    if (!behind) session.drawing = frame;
     const LightShare* share = light_plan_.share(i);
     const bool new_share = share != nullptr && slots_[i].sent_share != *share;
     const config::UpConversion& up_conversion = installation_.projectors[i].up_conversion;
     const bool interpolates = up_conversion.frames_ahead() > 0;
-    if (!new_share && !interpolates) {
+    if (!new_share && !interpolates && !behind) {
       out.push_back(Send{peer, envelope});
     } else {
       wire::Envelope to_node = envelope;
+      to_node.mutable_frame_begin()->set_skip(behind);
       if (new_share) {
         // A new share applies from this frame on, on every node of the group at once.
         *to_node.mutable_frame_begin()->mutable_lights() = protocol::to_wire(*share);
@@ -603,24 +638,60 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
       }
       out.push_back(Send{peer, std::move(to_node)});
     }
+    if (behind) continue;
     sent.push_back(i);
     if (session.phase == Phase::in_barrier) waited.push_back(i);
   }
   recorder_.frame_begun(frame, begin_sent, sent);
   next_frame_ = frame + 1;
   ready_for_swap_.clear();
+  // Waited for as long as the slowest of them usually takes, at least the
+  // frame timeout.
+  barrier_allowance_ = nanos(config_.frame_timeout);
+  for (const std::size_t slot : waited) {
+    barrier_allowance_ = std::max(barrier_allowance_, session_of(slot)->pace.allowance(nanos(config_.frame_timeout)));
+  }
   barrier_.begin(frame, std::move(waited));
   if (barrier_.complete()) {
     swap(now, out);
     return;
   }
-  out.push_back(Arm{Timer::barrier, now + nanos(config_.frame_timeout)});
+  out.push_back(Arm{Timer::barrier, now + barrier_allowance_});
+}
+
+bool MasterProtocol::all_behind() const {
+  bool any_up = false;
+  for (const Slot& slot : slots_) {
+    if (!up(slot)) continue;
+    any_up = true;
+    const Session& session = sessions_.at(*slot.peer);
+    if (session.phase != Phase::out_of_barrier || !session.drawing) return false;
+  }
+  return any_up;
+}
+
+void MasterProtocol::say_if_slow(Session& session, Actions& out) {
+  const std::optional<clock::Nanos> usual = session.pace.typical();
+  if (session.said_slow || !usual || *usual <= frame_period_) return;
+  session.said_slow = true;
+  out.push_back(Log{spdlog::level::warn,
+                    fmt::format("node '{}' draws a frame in {:.1f} ms, longer than the {:.1f} ms frame period: frames "
+                                "come at the rate it can draw (about {:.1f} Hz), not at {} Hz",
+                                slot_id(*session.slot), static_cast<double>(*usual) / 1e6,
+                                static_cast<double>(frame_period_) / 1e6, 1e9 / static_cast<double>(*usual),
+                                config_.frame_rate)});
 }
 
 void MasterProtocol::on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now,
                               Actions& out) {
   const std::size_t slot = *session.slot;
   recorder_.ready(ready.frame_id(), slot, received, ready.render_ns(), ready.drawn_as());
+  const bool answers_drawing = session.drawing && ready.frame_id() >= *session.drawing;
+  if (answers_drawing) {
+    session.drawing.reset();
+    session.pace.add(ready.render_ns());
+    say_if_slow(session, out);
+  }
   if (ready.frame_id() + 1 == next_frame_ && ready.state_hash() != current_hash_) {
     recorder_.hash_mismatch(slot);
     out.push_back(Log{spdlog::level::warn,
@@ -631,12 +702,14 @@ void MasterProtocol::on_ready(Session& session, const wire::FrameReady& ready, c
   }
   const bool current = barrier_.active() && ready.frame_id() == barrier_.frame();
   if (session.phase == Phase::out_of_barrier) {
-    // It answers again: wait for it from the next frame on, and if this answer is
-    // for the frame being decided, it swaps with the others.
-    session.phase = Phase::joined;
-    out.push_back(Log{spdlog::level::info,
-                      fmt::format("node '{}' answers again (frame {}); back in the barrier from the next frame",
-                                  slot_id(slot), ready.frame_id())});
+    // It answers again: the next frame is drawn by it and waited for (begin_frame
+    // takes it back), and if this answer is for the frame being decided, it
+    // swaps with the others.
+    if (answers_drawing) {
+      out.push_back(Log{spdlog::level::info,
+                        fmt::format("node '{}' answers again (frame {}); back in the barrier from the next frame",
+                                    slot_id(slot), ready.frame_id())});
+    }
     if (current) ready_for_swap_.push_back(slot);
   } else if (current && barrier_.ready(slot)) {
     ready_for_swap_.push_back(slot);
@@ -646,6 +719,10 @@ void MasterProtocol::on_ready(Session& session, const wire::FrameReady& ready, c
         Log{spdlog::level::debug, fmt::format("late ready from '{}' for frame {}", slot_id(slot), ready.frame_id())});
   }
   if (barrier_.complete()) swap(now, out);
+  if (begin_when_answered_ && !all_behind()) {
+    out.push_back(Disarm{Timer::next_frame});
+    begin_frame(now, out);
+  }
 }
 
 void MasterProtocol::on_barrier_timeout(clock::Nanos now, Actions& out) {
@@ -656,7 +733,7 @@ void MasterProtocol::on_barrier_timeout(clock::Nanos now, Actions& out) {
     if (Session* session = session_of(slot)) session->phase = Phase::out_of_barrier;
     out.push_back(Log{spdlog::level::warn,
                       fmt::format("node '{}' was not ready for frame {} within {} ms: taken out of the barrier; {}",
-                                  slot_id(slot), barrier_.frame(), config_.frame_timeout.count(),
+                                  slot_id(slot), barrier_.frame(), barrier_allowance_ / clock::kNanosPerMilli,
                                   drop ? "the frame is dropped everywhere" : "the others show the frame")});
   }
   if (drop) {
@@ -776,12 +853,13 @@ void MasterProtocol::finish(Actions& out) {
   }
   recorder_.finalize_all();
   const report::RunReport summary = report();
-  const auto& sync = summary.sync();
-  out.push_back(Log{spdlog::level::info,
-                    fmt::format("{} frames; barrier round {}; present skew {}; {} frame(s) with a node missing",
-                                summary.frames(), median_p99(sync.barrier_round_us(), "no frame ran"),
-                                median_p99(sync.present_skew_us(), "no frame was presented by two nodes"),
-                                sync.frames_with_missing_node())});
+  out.push_back(Log{spdlog::level::info, summary_line(summary)});
+  if (exit_code_ == kExitOk) {
+    if (auto why = too_few_shown(summary, config_.min_presented)) {
+      out.push_back(Log{spdlog::level::err, "the run failed: " + *why});
+      exit_code_ = kExitTooFewShown;
+    }
+  }
   out.push_back(Finish{exit_code_});
 }
 

@@ -28,6 +28,7 @@
 #include "master/exit_codes.h"
 #include "master/focus_schedule.h"
 #include "master/live_status.h"
+#include "master/render_pace.h"
 #include "master/operator_api.h"
 #include "master/run_recorder.h"
 #include "master/scene_authority.h"
@@ -194,6 +195,12 @@ class MasterProtocol {
     std::vector<std::uint8_t> nonce;  // of its challenge
     bool refused = false;             // said so in the log already
     std::optional<SceneSending> scene;
+    // The frame it was last told to draw and has not answered yet: out of the
+    // barrier, it is told to skip frames until it answers, then draws the
+    // newest and is waited for again.
+    std::optional<std::uint64_t> drawing;
+    RenderPace pace;
+    bool said_slow = false;  // logged once that it draws slower than the period
   };
   struct Slot {
     std::optional<PeerId> peer;
@@ -205,6 +212,11 @@ class MasterProtocol {
   void on_scene_request(PeerId peer, Session& session, const wire::SceneRequest& request, clock::Nanos now,
                         Actions& out);
   void on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now, Actions& out);
+  // Whether every node that is up is behind (out of the barrier, still drawing
+  // an earlier frame): then a frame would be shown by nobody, and the next one
+  // waits for the first of them to answer.
+  [[nodiscard]] bool all_behind() const;
+  void say_if_slow(Session& session, Actions& out);
   void on_presented(Session& session, const wire::Presented& presented, clock::Nanos now, Actions& out);
   // `slot` showed the last swapped frame, or is gone: the next frame may begin
   // once no node is still to show it.
@@ -268,6 +280,8 @@ class MasterProtocol {
   std::uint64_t presents_owed_frame_ = 0;
   clock::Nanos presents_grace_end_ = 0;
   bool begin_when_presented_ = false;  // the next frame's time came while presents were owed
+  bool begin_when_answered_ = false;   // the next frame's time came while every node was behind
+  clock::Nanos barrier_allowance_ = 0;  // how long the frame in the barrier is waited for
 
   std::uint64_t next_frame_ = 0;
   clock::Nanos frame_period_ = 0;

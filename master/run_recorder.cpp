@@ -126,6 +126,7 @@ void RunRecorder::finalize(const FrameRecord& record) {
   recent_.push_back(std::move(recent));
   if (recent_.size() > kRecentFrames) recent_.pop_front();
   if (presented < record.nodes.size()) ++frames_missing_;
+  if (presented == 0) ++frames_shown_by_none_;
   if (incoherent) ++frames_incoherent_;
   ++frames_finalized_;
 }
@@ -183,6 +184,7 @@ report::RunReport RunRecorder::report() const {
   sync.set_frames_with_missing_node(frames_missing_);
   sync.set_frames_incoherent(frames_incoherent_);
   sync.set_frames_dropped(frames_dropped_);
+  sync.set_frames_shown_by_none(frames_shown_by_none_);
   if (frames_finalized_ > 1 && last_begin_ > first_begin_) {
     sync.set_achieved_frame_rate(static_cast<double>(frames_finalized_ - 1) * 1e9 /
                                  static_cast<double>(last_begin_ - first_begin_));

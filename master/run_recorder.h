@@ -83,6 +83,7 @@ class RunRecorder {
   [[nodiscard]] std::uint64_t frames_with_missing_node() const { return frames_missing_; }
   [[nodiscard]] std::uint64_t frames_incoherent() const { return frames_incoherent_; }
   [[nodiscard]] std::uint64_t frames_dropped() const { return frames_dropped_; }
+  [[nodiscard]] std::uint64_t frames_shown_by_none() const { return frames_shown_by_none_; }
   [[nodiscard]] const std::deque<RecentFrame>& recent() const { return recent_; }
   [[nodiscard]] const NodeCounts& node_counts(std::size_t node) const { return totals_.at(node).counts; }
   // Over every finalized frame that two or more nodes presented.
@@ -129,6 +130,7 @@ class RunRecorder {
   std::uint64_t frames_missing_ = 0;
   std::uint64_t frames_incoherent_ = 0;
   std::uint64_t frames_dropped_ = 0;
+  std::uint64_t frames_shown_by_none_ = 0;
   clock::Nanos first_begin_ = 0;
   clock::Nanos last_begin_ = 0;
   double last_skew_us_ = 0.0;

@@ -124,13 +124,14 @@ void Node::carry_out(Action& action) {
           },
           [&](Configure& a) {
             const Result<void> result = renderer_.configure(a.job);
-            carry_out(protocol_.configured(result, renderer_.description()));
+            carry_out(protocol_.configured(result, renderer_.description(), renderer_.warm_up_time()));
           },
           [&](Render& a) {
             const clock::Nanos started = clock::monotonic_now();
             const Rendered how = renderer_.render(a.frame);
             carry_out(protocol_.rendered(a.frame.frame_id, clock::monotonic_now() - started, how));
           },
+          [&](Skip& a) { renderer_.skip(a.frame); },
           [&](PresentAt& a) { wait_for_present(a.deadline); },
           [&](Present& a) {
             renderer_.present(a.image);

@@ -348,7 +348,8 @@ Actions NodeProtocol::scene_copy_finished(const Result<std::string>& gltf_path, 
   return out;
 }
 
-Actions NodeProtocol::configured(const Result<void>& result, const std::string& renderer_description) {
+Actions NodeProtocol::configured(const Result<void>& result, const std::string& renderer_description,
+                                 clock::Nanos warm_up) {
   Actions out;
   if (phase_ != Phase::configuring) return out;  // the connection went meanwhile
   if (!result) {
@@ -361,14 +362,16 @@ Actions NodeProtocol::configured(const Result<void>& result, const std::string& 
   liveness_timeout_ = job_->liveness_timeout;
   wire::Envelope envelope;
   envelope.mutable_configured()->set_renderer(renderer_description);
+  envelope.mutable_configured()->set_warm_up_ns(warm_up);
   out.push_back(Send{std::move(envelope)});
   phase_ = Phase::awaiting_state;
   out.push_back(SetDeadline{kHandshakeTimeout, "no state from the master within 5 s of being configured"});
   const config::Projector& p = job_->job.self();
   log(out, spdlog::level::info,
-      fmt::format("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}", p.id, p.width, p.height,
-                  job_->job.screen().id, config::to_string(p.eye), static_cast<double>(frame_period_) / 1e6,
-                  renderer_description));
+      fmt::format("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}{}", p.id, p.width,
+                  p.height, job_->job.screen().id, config::to_string(p.eye), static_cast<double>(frame_period_) / 1e6,
+                  renderer_description,
+                  warm_up > 0 ? fmt::format("; warm-up frame {:.1f} ms", static_cast<double>(warm_up) / 1e6) : ""));
   return out;
 }
 
@@ -407,7 +410,8 @@ void NodeProtocol::on_resync(const wire::Resync& resync, clock::Nanos now, Actio
 
 void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos now, Actions& out) {
   last_begin_ = now;
-  round_open_ = true;
+  // A frame to skip has no round: no swap comes for it.
+  round_open_ = !begin.skip();
   if (begin.frame_id() != next_frame_) {
     log(out, spdlog::level::warn,
         "frame ids jumped from " + std::to_string(next_frame_) + " to " + std::to_string(begin.frame_id()));
@@ -478,6 +482,24 @@ void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos no
     ahead_ = std::move(ahead).value();
     input.ahead = &*ahead_;
     input.ahead_frame = begin.ahead_frame();
+  }
+  if (begin.skip()) {
+    ++skipped_;
+    if (!skipping_) {
+      skipping_ = true;
+      log(out, spdlog::level::warn,
+          fmt::format("behind: skipping frames from frame {} (the master no longer waits for this node); drawing the "
+                      "newest once the frame being drawn is done",
+                      begin.frame_id()));
+    }
+    out.push_back(Skip{input});
+    return;
+  }
+  if (skipping_) {
+    skipping_ = false;
+    log(out, spdlog::level::info,
+        fmt::format("caught up: drawing frame {} after skipping {} frame(s)", begin.frame_id(), skipped_));
+    skipped_ = 0;
   }
   last_content_frame_ = shown->frame_id();
   rendering_ = input;

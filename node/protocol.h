@@ -86,6 +86,11 @@ struct Configure {
 struct Render {
   FrameInput frame;
 };
+// The master says this node is behind: keep what the frame carries, draw
+// nothing, answer nothing (Renderer::skip).
+struct Skip {
+  FrameInput frame;
+};
 // Wait, without holding up other events, until the monotonic time `deadline`;
 // then answer with present_due().
 struct PresentAt {
@@ -134,7 +139,7 @@ struct FinishScene {};
 // connection went is kept, and goes on after the reconnect.
 struct AbandonScene {};
 
-using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, Configure, Render, PresentAt,
+using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, Configure, Render, Skip, PresentAt,
                             Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log, PrepareScene,
                             StoreSceneChunk, FinishScene, AbandonScene>;
 using Actions = std::vector<Action>;
@@ -168,7 +173,9 @@ class NodeProtocol {
   [[nodiscard]] Actions connect_failed(const std::string& reason, clock::Nanos now);
   [[nodiscard]] Actions message(const wire::Envelope& message, clock::Nanos now);
   [[nodiscard]] Actions closed(const std::string& reason, clock::Nanos now);
-  [[nodiscard]] Actions configured(const Result<void>& result, const std::string& renderer_description);
+  // `warm_up`: how long the renderer's warm-up frame took (Renderer::warm_up_time).
+  [[nodiscard]] Actions configured(const Result<void>& result, const std::string& renderer_description,
+                                   clock::Nanos warm_up = 0);
   // Answers to PrepareScene, StoreSceneChunk and FinishScene.
   [[nodiscard]] Actions scene_found(const std::string& gltf_path);
   // `started`: which chunks the copy already holds (one going on after a lost connection).
@@ -250,6 +257,8 @@ class NodeProtocol {
   std::optional<scene::SceneState> ahead_;
   std::optional<protocol::LightShare> share_;  // a new share that the frame being rendered starts
   std::optional<FrameInput> rendering_;        // between Render and rendered()
+  bool skipping_ = false;                      // the master says this node is behind
+  std::uint64_t skipped_ = 0;                  // frames skipped since it did
   std::uint64_t last_content_frame_ = 0;
   std::uint64_t next_frame_ = 0;
   std::uint64_t last_rendered_ = 0;

@@ -47,9 +47,16 @@ class Renderer {
   [[nodiscard]] virtual Result<void> configure(const protocol::NodeJob& job) = 0;
   // What draws, for the master's log ("llvmpipe (...), headless").
   [[nodiscard]] virtual std::string description() const = 0;
+  // How long configure()'s warm-up frame took (every program and texture used
+  // once): the master waits that long for the first frame. 0: none was drawn.
+  [[nodiscard]] virtual clock::Nanos warm_up_time() const { return 0; }
   // Draws the frame into the back buffer; returns when it is ready to show,
   // with how it was drawn.
   virtual Rendered render(const FrameInput& frame) = 0;
+  // A frame this node is too far behind to draw: nothing is drawn, but what it
+  // carries for later frames (a new share of the lights, the focus, a scene
+  // sent ahead) is kept.
+  virtual void skip(const FrameInput& frame) { (void)frame; }
   // Shows image `image` of the last rendered frame (swap buffers): 0, or 1 for
   // a projector that shows two images per frame (a stereo one used as mono).
   virtual void present(int image) = 0;

@@ -169,6 +169,9 @@ struct MasterSettings {
   std::uint32_t max_pending_connections = defaults::kMaxPendingConnections;
   StragglerPolicy straggler_policy = StragglerPolicy::present;
   std::optional<StatusServer> status;
+  // The share of frames every projector must show for the run to succeed;
+  // none: at least one frame shown by any projector.
+  std::optional<double> min_presented;
 };
 
 // At `time`, these of the scene's point lights go dark and these come on again.

@@ -211,6 +211,7 @@ MasterSettings build_master(const schema::MasterSettings& m) {
   master.secret_file = m.secret_file();
   master.max_pending_connections = or_default(m.max_pending_connections(), defaults::kMaxPendingConnections);
   master.straggler_policy = m.straggler_policy() == "drop" ? StragglerPolicy::drop : StragglerPolicy::present;
+  if (m.has_min_presented()) master.min_presented = m.min_presented();
   if (m.has_status()) {
     const schema::StatusServer& st = m.status();
     StatusServer status;

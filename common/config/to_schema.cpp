@@ -168,6 +168,7 @@ schema::MasterSettings to_schema(const MasterSettings& m) {
   out.set_secret_file(m.secret_file);
   out.set_max_pending_connections(m.max_pending_connections);
   out.set_straggler_policy(std::string(to_string(m.straggler_policy)));
+  if (m.min_presented) out.set_min_presented(*m.min_presented);
   if (m.status) {
     schema::StatusServer& status = *out.mutable_status();
     status.set_listen(m.status->listen);

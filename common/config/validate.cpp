@@ -399,6 +399,11 @@ void check_master(Checker& check, const schema::MasterSettings& m) {
                                               "' (\"present\": the frame without the late node, or "
                                               "\"drop\": the frame everywhere)");
   }
+  if (m.has_min_presented() && check.finite("master.min_presented", m.min_presented()) &&
+      (m.min_presented() < 0.0 || m.min_presented() > 1.0)) {
+    check.fail("master.min_presented", "is a share of the frames, 0 to 1 (got " + number_text(m.min_presented()) +
+                                           "; 0.9 means 90 %)");
+  }
   if (m.max_message_bytes() != 0 && m.max_message_bytes() < 1024) {
     check.fail("master.max_message_bytes", "must be at least 1024 (got " + std::to_string(m.max_message_bytes()) + ")");
   }

@@ -12,8 +12,9 @@ namespace optique::net {
 
 // Bumped whenever a message changes meaning; master and node must agree exactly.
 // 5: the welcome says how many lights the scene has; 6: the scene's files travel
-// from the master to nodes that lack them.
-inline constexpr std::uint32_t kProtocolVersion = 6;
+// from the master to nodes that lack them; 7: a node that is behind is told to
+// skip frames, and says how long its warm-up frame took.
+inline constexpr std::uint32_t kProtocolVersion = 7;
 
 // Serializes `envelope` and appends it as one frame to `out`.
 void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envelope);

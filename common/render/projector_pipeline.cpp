@@ -355,21 +355,21 @@ Result<void> ProjectorPipeline::draw_fields_between(const scene::SceneState& sta
   return {};
 }
 
-void ProjectorPipeline::warm_up() {
+void ProjectorPipeline::warm_up(const scene::SceneState& state) {
   const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
   if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
-    renderer_->draw(scene::SceneState{}, 0.0, in_front, frustum.value());
+    renderer_->draw(state, 0.0, in_front, frustum.value());
     if (schedule_) {  // the motion fields, each resolve and the check
       const geometry::Frustum& f = frustum.value();
       for (int slot = 0; slot < schedule_->slots(); ++slot) {
-        renderer_->keep_key(slot, {scene::SceneState{}, 0.0, f.projection * f.view});
+        renderer_->keep_key(slot, {state, 0.0, f.projection * f.view});
       }
-      (void)renderer_->check_between(scene::SceneState{}, 0.0, in_front, f, {}, terms_);
+      (void)renderer_->check_between(state, 0.0, in_front, f, {}, terms_);
       up::BetweenFrame frame;
       frame.method = schedule_->settings().method;
       for (bool two : {false, true}) {
         frame.two_keys = two;
-        (void)renderer_->draw_between(scene::SceneState{}, 0.0, in_front, f, frame, terms_);
+        (void)renderer_->draw_between(state, 0.0, in_front, f, frame, terms_);
       }
     }
     if (color_fields_.up_converts()) {  // one field at the render's moment, one built from it
@@ -377,7 +377,7 @@ void ProjectorPipeline::warm_up() {
       FieldPass other = key;
       other.fraction = 0.5;
       other.green = other.blue = false;
-      (void)renderer_->draw_fields_up_converted(scene::SceneState{}, &key, {&other, 1});
+      (void)renderer_->draw_fields_up_converted(state, &key, {&other, 1});
     }
     if (color_fields_.needs_velocity()) {
       // The velocity program and the tile passes too (the field pass itself
@@ -388,7 +388,7 @@ void ProjectorPipeline::warm_up() {
       frame.view_projection_now = frustum.value().projection * frustum.value().view;
       frame.view_projection_next = frame.view_projection_now;
       frame.fields.push_back({true, true, true, 0.0});
-      (void)renderer_->draw_gathered(scene::SceneState{}, frame);
+      (void)renderer_->draw_gathered(state, frame);
     }
   }
 }

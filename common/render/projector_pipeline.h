@@ -109,9 +109,11 @@ class ProjectorPipeline {
   // threshold, found (zero without either): how fast the scene moved, and
   // whether the gather radius cut a motion short (over all its images).
   [[nodiscard]] const GatherReport& gather_report() const { return gather_report_; }
-  // One draw of an empty scene from a metre in front of the screen: drivers
-  // compile shaders lazily, and the first frame should not pay for it.
-  void warm_up();
+  // One draw of `state` (every animated object somewhere, so that their
+  // programs run too) from a metre in front of the screen, with every pass this
+  // projector uses: drivers compile shaders lazily, and the first frame should
+  // not pay for it.
+  void warm_up(const scene::SceneState& state = {});
 
   [[nodiscard]] SceneRenderer& renderer() { return *renderer_; }
   [[nodiscard]] const SceneRenderer& renderer() const { return *renderer_; }

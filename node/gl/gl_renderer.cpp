@@ -56,7 +56,17 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   if (node.lights) pipeline_->set_share(*node.lights);
   deep_signal_ = pipeline_->projector_model().bits() > 8;
   gathers_ = projector.color_fields.gathers();
-  pipeline_->warm_up();
+  // Every animated object where it starts: the warm-up runs the programs the
+  // first frame runs.
+  scene::SceneState start;
+  for (const scene::AnimatedObject& object : scene.definition.objects) {
+    const scene::Pose pose = object.pose_at(0.0);
+    start.objects.emplace(object.id, scene::ObjectState{pose, pose});
+  }
+  start.eye_now = start.eye_next = job.installation.viewer.eye_at(0.0);
+  const clock::Nanos warm_up_started = clock::monotonic_now();
+  pipeline_->warm_up(start);
+  warm_up_time_ = clock::monotonic_now() - warm_up_started;
   if (!captures_) captures_.emplace(capture_folder_, log_);
   configured_for_ = key;
   const render::ProjectorView& view = pipeline_->view();
@@ -76,10 +86,7 @@ std::string GlRenderer::description() const {
 
 Rendered GlRenderer::render(const FrameInput& frame) {
   read_back_shown_.reset();  // a captured frame that was never presented (stale) has no read-back
-  // A new share comes once, with the frame it starts at: taken even when this
-  // frame shows nothing, so it is not lost.
-  if (frame.lights != nullptr) pipeline_->set_share(*frame.lights);
-  if (frame.focus) pipeline_->set_focus(*frame.focus);
+  take_along(frame);
   // Each image captured as it is drawn (a stereo projector used as mono draws two).
   const auto capture = [&](int image) {
     if (!frame.capture) return;
@@ -88,10 +95,6 @@ Rendered GlRenderer::render(const FrameInput& frame) {
                       deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
                       deep_signal_ ? renderer.read_signal() : image::WordImage{});
   };
-  if (last_frame_ && frame.frame_id <= *last_frame_) ahead_.clear();
-  last_frame_ = frame.frame_id;
-  if (frame.ahead != nullptr) ahead_[frame.ahead_frame] = *frame.ahead;
-  while (!ahead_.empty() && ahead_.begin()->first < frame.frame_id) ahead_.erase(ahead_.begin());
   const render::DisplayFrame display{frame.frame_id, [this](std::uint64_t f) -> const scene::SceneState* {
                                        const auto found = ahead_.find(f);
                                        return found == ahead_.end() ? nullptr : &found->second;
@@ -129,6 +132,22 @@ Rendered GlRenderer::render(const FrameInput& frame) {
     logged_ratio_ = up.ratio;
   }
   return {up.kind, up.kind == up::FrameKind::between && up.drew_key_ahead};
+}
+
+// A new share comes once, with the frame it starts at: taken even when this
+// frame shows nothing or is skipped, so it is not lost; so is a scene sent ahead.
+void GlRenderer::take_along(const FrameInput& frame) {
+  if (frame.lights != nullptr) pipeline_->set_share(*frame.lights);
+  if (frame.focus) pipeline_->set_focus(*frame.focus);
+  if (last_frame_ && frame.frame_id <= *last_frame_) ahead_.clear();
+  last_frame_ = frame.frame_id;
+  if (frame.ahead != nullptr) ahead_[frame.ahead_frame] = *frame.ahead;
+  while (!ahead_.empty() && ahead_.begin()->first < frame.frame_id) ahead_.erase(ahead_.begin());
+}
+
+void GlRenderer::skip(const FrameInput& frame) {
+  read_back_shown_.reset();
+  take_along(frame);
 }
 
 void GlRenderer::present(int image) {

@@ -27,7 +27,9 @@ class GlRenderer final : public Renderer {
 
   [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
   [[nodiscard]] std::string description() const override;
+  [[nodiscard]] clock::Nanos warm_up_time() const override { return warm_up_time_; }
   Rendered render(const FrameInput& frame) override;
+  void skip(const FrameInput& frame) override;
   void present(int image) override;
   void show_black() override;
 
@@ -38,6 +40,10 @@ class GlRenderer final : public Renderer {
   std::unique_ptr<render::GlContext> context_;
   std::unique_ptr<render::ProjectorPipeline> pipeline_;
   std::optional<CaptureWriter> captures_;
+  // What a frame carries for later ones (lights, focus, the scene ahead).
+  void take_along(const FrameInput& frame);
+
+  clock::Nanos warm_up_time_ = 0;
   bool warned_gather_radius_ = false;
   bool gathers_ = false;      // method gather (else the clamp can only be per-field's blur)
   bool deep_signal_ = false;  // the projector takes more than 8 bits: captures are 16-bit PNGs

@@ -94,6 +94,7 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
                 broken = carry_out(node, node.rendered(a.frame.frame_id, 1000), light_count, outcome);
               }
             },
+            [&](node::Skip& a) { broken = check_frame(a.frame, light_count); },
             [&](node::PresentAt& a) { broken = carry_out(node, node.present_due(a.deadline), light_count, outcome); },
             [&](node::Present&) {
               ++outcome.frames_presented;

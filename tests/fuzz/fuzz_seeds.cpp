@@ -548,6 +548,14 @@ std::vector<Seed> node_seeds() {
     bad.set_frame_period_ns(0);
     seeds.push_back({"welcome_no_frame_period", node_seed(bad, {})});
   }
+  // Behind: frames to skip (a share of the lights with one of them), then one to draw.
+  seeds.push_back({"frames_skipped_while_behind",
+                   node_seed(welcome, {frame_and_swap(0), frame_and_swap(1, [](wire::FrameBegin& b) {
+                                         b.set_skip(true);
+                                         b.mutable_lights()->add_lights(1);
+                                       }),
+                                       frame_and_swap(2, [](wire::FrameBegin& b) { b.set_skip(true); }),
+                                       frame_and_swap(3)})});
   seeds.push_back(
       {"frame_light_out_of_range",
        node_seed(welcome, {frame_and_swap(0, [](wire::FrameBegin& b) { b.mutable_lights()->add_lights(9); })})});

@@ -14,6 +14,7 @@
 #include "config/load.h"
 #include "external_master.h"
 #include "process.h"
+#include "shipped_configs.h"
 
 namespace optique::testing {
 namespace {
@@ -72,20 +73,8 @@ TEST_P(ShippedConfig, RunsSixtyFramesInSyncWithLocalNodes) {
   }
 }
 
-std::vector<std::string> shipped_configs() {
-  std::vector<std::string> names;
-  for (const auto& entry : std::filesystem::directory_iterator(kConfigs)) {
-    if (entry.path().extension() == ".json") names.push_back(entry.path().filename().string());
-  }
-  std::sort(names.begin(), names.end());
-  return names;
-}
-
-INSTANTIATE_TEST_SUITE_P(Configs, ShippedConfig, ::testing::ValuesIn(shipped_configs()), [](const auto& param_info) {
-  std::string name = param_info.param.substr(0, param_info.param.size() - 5);
-  for (char& c : name) c = std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
-  return name;
-});
+INSTANTIATE_TEST_SUITE_P(Configs, ShippedConfig, ::testing::ValuesIn(shipped_configs(kConfigs)),
+                         [](const auto& param_info) { return config_test_name(param_info.param); });
 
 // ------------------------------------------------------------- failures
 

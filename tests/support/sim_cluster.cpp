@@ -281,6 +281,7 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
               n.last_rendered = a.frame.frame_id;
               node_actions(i, n.protocol.rendered(a.frame.frame_id, clock::kNanosPerMilli));
             },
+            [&](node::Skip&) {},
             [&](node::PresentAt& a) { n.present_at = a.deadline; },
             [&](node::Present&) {
               if (std::find(n.presented.begin(), n.presented.end(), n.last_rendered) != n.presented.end()) {

@@ -371,6 +371,17 @@ TEST(ParseInstallation, FrameRateAtTheLimitIsFine) {
   EXPECT_DOUBLE_EQ(parsed.value().master.frame_rate, 1000.0);
 }
 
+TEST(ParseInstallation, MinPresentedIsAShare) {
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "min_presented": 90)")), "master.min_presented",
+                 {"share of the frames, 0 to 1", "90"});
+  auto parsed = parse(with(R"("port": 7400)", R"("port": 7400, "min_presented": 0.9)"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().master.min_presented, 0.9);
+  parsed = parse(with(R"("port": 7400)", R"("port": 7400)"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_FALSE(parsed.value().master.min_presented) << "by default: any frame shown at all";
+}
+
 TEST(ParseInstallation, UnknownOutputKind) {
   expect_problem(parse(with(R"("screen": "front"})", R"("screen": "front", "output": {"kind": "hologram"}})")),
                  "projectors[0].output.kind", {"unknown value 'hologram'", "headless, window"});

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -399,23 +400,106 @@ TEST_F(MasterTest, AStragglerIsLeftOutAndComesBack) {
   EXPECT_TRUE(logged(a, "node 'top-right' was not ready for frame 0 within 500 ms"));
   for (PeerId p = 1; p <= 3; ++p) EXPECT_EQ(sent_to(a, p, wire::Envelope::kSwap).size(), 1u);
   EXPECT_TRUE(sent_to(a, 4, wire::Envelope::kSwap).empty()) << "never a late frame";
-  // Frame 1 does not wait for it: three readies swap it.
+  // Frame 1 does not wait for it: three readies swap it. It is still drawing
+  // frame 0, so it is told to skip frame 1 (drawn after frame 0, it would be
+  // late too).
   all_shown(0, {1, 2, 3});
   a = master_->timer(Timer::next_frame, now_);
   hash = hash_of(a, 1);
-  EXPECT_EQ(sent_to(a, 4, wire::Envelope::kFrameBegin).size(), 1u) << "it is still sent the frames";
+  const auto to_straggler = sent_to(a, 4, wire::Envelope::kFrameBegin);
+  ASSERT_EQ(to_straggler.size(), 1u) << "it is still sent the frames";
+  EXPECT_TRUE(to_straggler.front().frame_begin().skip());
+  EXPECT_FALSE(sent_to(a, 1, wire::Envelope::kFrameBegin).front().frame_begin().skip());
   for (PeerId p = 1; p <= 2; ++p) (void)ready(p, 1, hash);
   a = ready(3, 1, hash);
   EXPECT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u);
-  // It answers again: back in the barrier from the next frame.
-  a = ready(4, 1, hash);
-  EXPECT_TRUE(logged(a, "node 'top-right' answers again (frame 1)"));
-  all_shown(1, {1, 2, 3, 4});
+  // It answers frame 0 at last: it draws the next frame and is waited for.
+  a = ready(4, 0, hash);
+  EXPECT_TRUE(logged(a, "node 'top-right' answers again (frame 0)"));
+  EXPECT_TRUE(sent_to(a, 4, wire::Envelope::kSwap).empty()) << "frame 0 is over";
+  all_shown(1, {1, 2, 3});
   a = master_->timer(Timer::next_frame, now_);
-  hash = hash_of(a, 1);
+  EXPECT_TRUE(logged(a, "node 'top-right' is back in the barrier from frame 2"));
+  hash = hash_of(a, 4);
+  EXPECT_FALSE(sent_to(a, 4, wire::Envelope::kFrameBegin).front().frame_begin().skip());
   for (PeerId p = 1; p <= 3; ++p) EXPECT_TRUE(sent_to(ready(p, 2, hash), p, wire::Envelope::kSwap).empty());
   EXPECT_EQ(sent_to(ready(4, 2, hash), 4, wire::Envelope::kSwap).size(), 1u);
   EXPECT_EQ(recorder_->report().nodes(3).barrier_misses(), 1u);
+}
+
+// A node that draws slowly but steadily is waited for as long as it usually
+// takes (twice its median), the first frame as long as its warm-up took, and
+// the log says once that it is slower than the frame period.
+TEST_F(MasterTest, TheBarrierWaitsForASlowNodeAsLongAsItUsuallyTakes) {
+  load("single-wall.json");
+  const std::string id = run_.config.installation.projectors.front().id;
+  (void)hello(1, id);
+  wire::Envelope e = envelope();
+  e.mutable_configured()->set_renderer("test");
+  e.mutable_configured()->set_warm_up_ns(400 * kMs);
+  Actions a = master_->message(1, e, now_);
+  EXPECT_TRUE(logged(a, "warm-up frame 400 ms"));
+  const clock::Nanos* at = armed(a, Timer::barrier);
+  ASSERT_NE(at, nullptr);
+  EXPECT_EQ(*at - now_, 800 * kMs) << "the first frame: twice the warm-up";
+  std::uint64_t hash = hash_of(a, 1);
+  for (std::uint64_t frame = 0; frame < 4; ++frame) {
+    now_ += 300 * kMs;
+    wire::Envelope r = envelope();
+    r.mutable_frame_ready()->set_frame_id(frame);
+    r.mutable_frame_ready()->set_state_hash(hash);
+    r.mutable_frame_ready()->set_render_ns(300 * kMs);
+    a = master_->message(1, r, now_);
+    ASSERT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "frame " << frame;
+    EXPECT_EQ(logged(a, "draws a frame in 300.0 ms, longer than the 16.7 ms frame period"), frame == 0)
+        << "said once, at frame 0; frame " << frame;
+    (void)shown(1, frame);
+    a = master_->timer(Timer::next_frame, now_);
+    hash = hash_of(a, 1);
+  }
+  at = armed(a, Timer::barrier);
+  ASSERT_NE(at, nullptr);
+  EXPECT_EQ(*at - now_, 600 * kMs) << "twice its usual 300 ms, not the 500 ms frame timeout";
+  // A render time from the node is bounded: INT64_MAX does not wait forever.
+  wire::Envelope r = envelope();
+  r.mutable_frame_ready()->set_frame_id(4);
+  r.mutable_frame_ready()->set_state_hash(hash);
+  r.mutable_frame_ready()->set_render_ns(std::numeric_limits<std::int64_t>::max());
+  for (int i = 0; i < 8; ++i) {
+    (void)master_->message(1, r, now_);
+    (void)shown(1, 4 + i);
+    a = master_->timer(Timer::next_frame, now_);
+    hash = hash_of(a, 1);
+    r.mutable_frame_ready()->set_frame_id(5 + i);
+    r.mutable_frame_ready()->set_state_hash(hash);
+  }
+  at = armed(a, Timer::barrier);
+  ASSERT_NE(at, nullptr);
+  EXPECT_LE(*at - now_, 2 * kLongestRender);
+}
+
+// Every node behind (one projector, stopped for a while): a frame would be
+// shown by nobody, so the next waits for the node to answer, and is drawn by it.
+TEST_F(MasterTest, WhenEveryNodeIsBehindTheNextFrameWaitsForOne) {
+  load("single-wall.json");
+  const std::string id = run_.config.installation.projectors.front().id;
+  (void)hello(1, id);
+  Actions a = configured(1);
+  const std::uint64_t hash = hash_of(a, 1);
+  now_ += 500 * kMs;
+  a = master_->timer(Timer::barrier, now_);
+  EXPECT_TRUE(logged(a, "was not ready for frame 0"));
+  a = master_->timer(Timer::next_frame, now_);
+  EXPECT_TRUE(sent_to(a, 1, wire::Envelope::kFrameBegin).empty()) << "no frame nobody would draw";
+  EXPECT_TRUE(logged(a, "frame 1 waits: every node is still drawing an earlier frame"));
+  now_ += 700 * kMs;
+  a = ready(1, 0, hash);
+  const auto begins = sent_to(a, 1, wire::Envelope::kFrameBegin);
+  ASSERT_EQ(begins.size(), 1u) << "it answered: frame 1 begins at once";
+  EXPECT_EQ(begins.front().frame_begin().frame_id(), 1u);
+  EXPECT_FALSE(begins.front().frame_begin().skip());
+  EXPECT_GT(begins.front().frame_begin().present_time_ns(), now_) << "the schedule starts again from now";
+  EXPECT_NE(armed(a, Timer::barrier), nullptr) << "and it is waited for";
 }
 
 TEST_F(MasterTest, TheDropPolicyShowsALateFrameNowhere) {
@@ -566,12 +650,48 @@ TEST_F(MasterTest, AfterItsFramesItSaysGoodbyeAndFinishes) {
   for (PeerId p = 1; p <= 3; ++p) EXPECT_EQ(first<Finish>(master_->closed(p, "goodbye", now_)), nullptr);
   a = master_->closed(4, "goodbye", now_);
   ASSERT_NE(first<Finish>(a), nullptr);
-  EXPECT_EQ(first<Finish>(a)->exit_code, kExitOk);
-  EXPECT_TRUE(logged(a, "1 frames; barrier round median ")) << "one round was measured";
+  EXPECT_TRUE(logged(a, "1 frames at n/a of 60 Hz; 0.0 % shown by every projector; barrier round median "))
+      << "one round was measured";
   // No node reported a present: no skew, and the summary does not call that 0 µs.
   EXPECT_TRUE(logged(a, "present skew n/a (no frame was presented by two nodes)"));
+  // Nothing was shown at all: the run failed, and says so.
+  EXPECT_EQ(first<Finish>(a)->exit_code, kExitTooFewShown);
+  EXPECT_TRUE(logged(a, "the run failed: no projector showed any of the 1 frames"));
   EXPECT_EQ(master_->report().frames(), 1u);
   EXPECT_EQ(master_->report().stopped_because(), "ran 1 frames");
+}
+
+// What a run must show to succeed: by default any frame on any projector;
+// with master.min_presented, that share of frames on every projector.
+TEST_F(MasterTest, ARunSucceedsOnlyWhenEnoughWasShown) {
+  for (const std::optional<double> min_presented : {std::optional<double>{}, std::optional<double>{0.5}}) {
+    SCOPED_TRACE(min_presented ? "min_presented 0.5" : "by default");
+    RunSettings settings;
+    settings.frames = 2;
+    load("powerwall-2x2.json", [&](config::Installation& i) { i.master.min_presented = min_presented; }, settings);
+    Actions a = join_all();
+    std::uint64_t hash = hash_of(a, 1);
+    for (PeerId p = 1; p <= 4; ++p) (void)ready(p, 0, hash);
+    all_shown(0, {1, 2, 3});  // one projector does not show frame 0
+    now_ += 19 * kMs;         // a period after the deadline: it no longer would
+    a = master_->timer(Timer::next_frame, now_);
+    hash = hash_of(a, 1);
+    for (PeerId p = 1; p <= 4; ++p) (void)ready(p, 1, hash);
+    all_shown(1, {1, 2, 3});  // nor frame 1: no frame was shown by every projector
+    now_ += 19 * kMs;
+    (void)master_->timer(Timer::next_frame, now_);
+    (void)master_->timer(Timer::last_presents, now_ + 300 * kMs);
+    for (PeerId p = 1; p <= 3; ++p) (void)master_->closed(p, "goodbye", now_);
+    a = master_->closed(4, "goodbye", now_);
+    ASSERT_NE(first<Finish>(a), nullptr);
+    if (min_presented) {
+      EXPECT_EQ(first<Finish>(a)->exit_code, kExitTooFewShown);
+      EXPECT_TRUE(logged(a, "the run failed: 0.0 % of the 2 frames were shown by every projector, less than "
+                            "master.min_presented (50.0 %)"));
+    } else {
+      EXPECT_EQ(first<Finish>(a)->exit_code, kExitOk) << "frames were shown, by some";
+    }
+  }
 }
 
 TEST_F(MasterTest, NoNodeBeforeTheStartupTimeoutFails) {

@@ -819,3 +819,66 @@ TEST_F(SceneFetchTest, AWelcomeWhoseManifestDoesNotHashToTheSceneIsRefused) {
 
 }  // namespace
 }  // namespace optique::node
+
+namespace optique::node {
+namespace {
+
+// Behind (the master no longer waits for it): frames it is told to skip change
+// the state and pass on what they carry, but are neither drawn nor answered;
+// the first frame it is told to draw again is drawn.
+TEST_F(NodeTest, AFrameToSkipIsAppliedButNotDrawnOrAnswered) {
+  NodeProtocol node(settings());
+  join(node, 3);
+  const scene::SceneState before = state_;
+  state_.eye_now.x += 0.25;  // what the skipped frame changes
+  wire::Envelope e = envelope();
+  auto& b = *e.mutable_frame_begin();
+  b.set_frame_id(3);
+  *b.mutable_delta() = scene::make_delta(before, state_);
+  b.set_state_hash(scene::state_hash(state_));
+  b.set_skip(true);
+  Actions a = node.message(e, now_);
+  EXPECT_EQ(first<Render>(a), nullptr);
+  const Skip* skip = first<Skip>(a);
+  ASSERT_NE(skip, nullptr);
+  EXPECT_EQ(skip->frame.frame_id, 3u);
+  EXPECT_EQ(node.state(), state_) << "the skipped frame's change is applied";
+  EXPECT_TRUE(sent(a, wire::Envelope::kFrameReady).empty());
+  EXPECT_TRUE(logged(a, "behind: skipping frames from frame 3"));
+  // A ping falling due now is not held back for a round that never ends.
+  a = node.ping_due(now_);
+  EXPECT_EQ(sent(a, wire::Envelope::kPing).size(), 1u);
+
+  b.set_frame_id(4);
+  b.clear_delta();
+  a = node.message(e, now_);
+  EXPECT_NE(first<Skip>(a), nullptr);
+  EXPECT_FALSE(logged(a, "behind")) << "said once";
+
+  a = begin(node, 5);
+  const Render* render = first<Render>(a);
+  ASSERT_NE(render, nullptr);
+  EXPECT_EQ(render->frame.frame_id, 5u);
+  EXPECT_TRUE(logged(a, "caught up: drawing frame 5 after skipping 2 frame(s)"));
+  a = node.rendered(5, 3 * kMs);
+  EXPECT_EQ(sent(a, wire::Envelope::kFrameReady).size(), 1u);
+}
+
+TEST_F(NodeTest, ConfiguredSaysHowLongTheWarmUpFrameTook) {
+  NodeProtocol node(settings());
+  (void)node.connected(now_);
+  wire::Envelope challenge = envelope();
+  challenge.mutable_challenge()->set_nonce(std::string(32, 'n'));
+  (void)node.message(challenge, now_);
+  wire::Envelope welcome = envelope();
+  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr);
+  (void)node.message(welcome, now_);
+  const Actions a = node.configured({}, "test renderer", 420 * kMs);
+  const auto configured = sent(a, wire::Envelope::kConfigured);
+  ASSERT_EQ(configured.size(), 1u);
+  EXPECT_EQ(configured.front().configured().warm_up_ns(), 420 * kMs);
+  EXPECT_TRUE(logged(a, "warm-up frame 420.0 ms"));
+}
+
+}  // namespace
+}  // namespace optique::node

@@ -1,0 +1,29 @@
+#include "master/render_pace.h"
+
+#include <algorithm>
+#include <vector>
+
+namespace optique::master {
+
+void RenderPace::add(clock::Nanos render) {
+  times_[count_ % kKept] = std::clamp<clock::Nanos>(render, 0, kLongestRender);
+  ++count_;
+}
+
+std::optional<clock::Nanos> RenderPace::typical() const {
+  const std::size_t kept = std::min(count_, kKept);
+  if (kept == 0) return std::nullopt;
+  std::vector<clock::Nanos> sorted(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(kept));
+  // The lower median: a warm-up that took longer than the frames after it
+  // counts for no more than they do once there are two of them.
+  const auto middle = sorted.begin() + static_cast<std::ptrdiff_t>((kept - 1) / 2);
+  std::nth_element(sorted.begin(), middle, sorted.end());
+  return *middle;
+}
+
+clock::Nanos RenderPace::allowance(clock::Nanos frame_timeout) const {
+  const std::optional<clock::Nanos> usual = typical();
+  return usual ? std::max(frame_timeout, 2 * *usual) : frame_timeout;
+}
+
+}  // namespace optique::master

@@ -1,0 +1,35 @@
+#pragma once
+// How long a node takes to draw a frame, from what it reported: its warm-up
+// frame, then its last few frames. The barrier waits for a node that is slow
+// but steady as long as it usually takes, and takes out one that stalled.
+
+#include <array>
+#include <cstddef>
+#include <optional>
+
+#include "clock/clock.h"
+
+namespace optique::master {
+
+// A render time a node reports is peer input: beyond this it is taken as this.
+inline constexpr clock::Nanos kLongestRender = 60 * clock::kNanosPerSecond;
+
+class RenderPace {
+ public:
+  static constexpr std::size_t kKept = 8;
+
+  // A frame (or the warm-up) took `render` (clamped to 0 … kLongestRender).
+  void add(clock::Nanos render);
+  // The median of the times kept; none before the first.
+  [[nodiscard]] std::optional<clock::Nanos> typical() const;
+  // How long the barrier waits for this node: `frame_timeout`, or twice its
+  // typical render when that is longer (a node that takes 300 ms a frame is
+  // slow, not stalled; one that takes 1 s after 300 ms each is stalled).
+  [[nodiscard]] clock::Nanos allowance(clock::Nanos frame_timeout) const;
+
+ private:
+  std::array<clock::Nanos, kKept> times_{};
+  std::size_t count_ = 0;  // all added, of which the last kKept are kept
+};
+
+}  // namespace optique::master
