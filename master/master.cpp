@@ -319,6 +319,9 @@ void Master::carry_out(Action& action) {
                  [&](SetMaxPayload& a) {
                    if (net::Connection* c = connection(a.peer)) c->set_max_payload_bytes(a.bytes);
                  },
+                 [&](Protect& a) {
+                   if (net::Connection* c = connection(a.peer)) c->protect(a.keys.to_node, a.keys.to_master, false);
+                 },
                  [&](Arm& a) { arm(a.timer, a.at); },
                  [&](Disarm& a) {
                    ++timer_generations_[static_cast<std::size_t>(a.timer)];

@@ -230,12 +230,28 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
              "this master requires the installation's shared secret: start the node with --secret-file", false, out);
       return;
     }
-    if (!net::verify_hello_mac(*settings_.secret, session.nonce, hello.node_id(), message.protocol_version(),
+    const std::string& node_nonce = hello.node_nonce();
+    if (node_nonce.size() != net::kNonceBytes) {
+      refuse(peer, session, hello.node_id(),
+             fmt::format("the hello's node nonce has {} bytes, not {}", node_nonce.size(), net::kNonceBytes), false,
+             out);
+      return;
+    }
+    std::vector<std::uint8_t> both = session.nonce;
+    both.insert(both.end(), node_nonce.begin(), node_nonce.end());
+    if (!net::verify_hello_mac(*settings_.secret, both, hello.node_id(), message.protocol_version(),
                                std::span(reinterpret_cast<const std::uint8_t*>(mac.data()), mac.size()))) {
       refuse(peer, session, hello.node_id(), "authentication failed: the node's secret does not match the master's",
              false, out);
       return;
     }
+    // Everything from here on is sealed, refusals included: the node knows its
+    // master by the first message that opens.
+    out.push_back(Protect{peer, net::derive_session_keys(
+                                    *settings_.secret, session.nonce,
+                                    std::span(reinterpret_cast<const std::uint8_t*>(node_nonce.data()),
+                                              node_nonce.size()),
+                                    hello.node_id(), message.protocol_version())});
   }
   const std::optional<std::size_t> slot = installation_.find_projector(hello.node_id());
   if (!slot) {

@@ -34,6 +34,7 @@
 #include "master/scene_authority.h"
 #include "master/stacked_groups.h"
 #include "net/auth.h"
+#include "net/session_seal.h"
 #include "optique/report.pb.h"
 #include "optique/wire.pb.h"
 #include "scene/load_scene.h"
@@ -86,6 +87,12 @@ struct SetMaxPayload {
   PeerId peer = 0;
   std::uint32_t bytes = 0;
 };
+// The node proved it holds the secret: from now on everything to it is sealed
+// with keys.to_node, and everything from it must open with keys.to_master.
+struct Protect {
+  PeerId peer = 0;
+  net::SessionKeys keys;
+};
 struct Arm {
   Timer timer = Timer::startup;
   clock::Nanos at = 0;  // monotonic
@@ -106,7 +113,7 @@ struct Log {
   std::string text;
 };
 
-using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Arm, Disarm,
+using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Protect, Arm, Disarm,
                             StopAccepting, SignalLocalNodes, Finish, Log>;
 using Actions = std::vector<Action>;
 

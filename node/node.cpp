@@ -6,6 +6,7 @@
 #include <cstring>
 #include <thread>
 
+#include "net/auth.h"
 #include "util/overloaded.h"
 
 namespace optique::node {
@@ -79,7 +80,7 @@ void Node::connect() {
                   [this](const std::string& reason) { carry_out(protocol_.closed(reason, clock::monotonic_now())); },
               });
               log_.debug("connected to the master at {}", connection_->peer());
-              carry_out(protocol_.connected(clock::monotonic_now()));
+              carry_out(protocol_.connected(clock::monotonic_now(), net::random_nonce()));
             });
       });
 }
@@ -118,6 +119,9 @@ void Node::carry_out(Action& action) {
           },
           [&](CancelDeadline&) {
             if (connection_) connection_->cancel_deadline();
+          },
+          [&](Protect& a) {
+            if (connection_) connection_->protect(a.send, a.receive, true);
           },
           [&](SetLiveness& a) {
             if (connection_) connection_->set_liveness_timeout(a.timeout, a.reason);

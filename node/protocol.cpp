@@ -37,11 +37,12 @@ void NodeProtocol::stop(int exit_code, const std::string& reason, Actions& out) 
 
 // ---------------------------------------------------------------- connection
 
-Actions NodeProtocol::connected(clock::Nanos) {
+Actions NodeProtocol::connected(clock::Nanos, std::vector<std::uint8_t> nonce) {
   Actions out;
   if (phase_ == Phase::stopped) return out;
   phase_ = Phase::awaiting_challenge;
   connection_open_ = true;
+  nonce_ = std::move(nonce);
   out.push_back(SetDeadline{kHandshakeTimeout, "no welcome from the master within 5 s"});
   return out;
 }
@@ -204,18 +205,40 @@ void NodeProtocol::on_challenge(const wire::Envelope& message, Actions& out) {
          out);
     return;
   }
+  if (settings_.secret && !challenge.secret_required()) {
+    // A master without the secret could be anyone: it would be given this
+    // projector and its scene would be cached here.
+    stop(kExitRefused,
+         "the master at " + settings_.master +
+             " asked for no secret, but this node has one (--secret-file): it is not this installation's master, or "
+             "it runs without master.secret_file; not joining it",
+         out);
+    return;
+  }
+  if (settings_.secret && (challenge.nonce().size() != net::kNonceBytes || nonce_.size() != net::kNonceBytes)) {
+    stop(kExitRefused,
+         fmt::format("cannot authenticate: the master's challenge has {} random bytes and this node {}, not {}",
+                     challenge.nonce().size(), nonce_.size(), net::kNonceBytes),
+         out);
+    return;
+  }
   wire::Envelope hello;
   hello.set_protocol_version(settings_.protocol_version);
   hello.mutable_hello()->set_node_id(settings_.id);
   hello.mutable_hello()->add_capabilities("render");
+  std::optional<net::SessionKeys> keys;
   if (settings_.secret) {
-    const std::string& nonce = challenge.nonce();
-    const auto mac =
-        net::hello_mac(*settings_.secret, std::span(reinterpret_cast<const std::uint8_t*>(nonce.data()), nonce.size()),
-                       settings_.id, settings_.protocol_version);
+    const std::string& theirs = challenge.nonce();
+    std::vector<std::uint8_t> both(theirs.begin(), theirs.end());
+    both.insert(both.end(), nonce_.begin(), nonce_.end());
+    const auto mac = net::hello_mac(*settings_.secret, both, settings_.id, settings_.protocol_version);
     hello.mutable_hello()->set_nonce_mac(mac.data(), mac.size());
+    hello.mutable_hello()->set_node_nonce(nonce_.data(), nonce_.size());
+    keys = net::derive_session_keys(*settings_.secret, std::span(both).first(net::kNonceBytes), nonce_, settings_.id,
+                                    settings_.protocol_version);
   }
   out.push_back(Send{std::move(hello)});
+  if (keys) out.push_back(Protect{keys->to_master, keys->to_node});
   phase_ = Phase::awaiting_welcome;
 }
 

@@ -22,6 +22,7 @@
 #include "clock/offset_estimator.h"
 #include "net/auth.h"
 #include "net/envelope.h"
+#include "net/session_seal.h"
 #include "node/renderer.h"
 #include "optique/wire.pb.h"
 #include "protocol/scene_fetch.h"
@@ -72,6 +73,13 @@ struct SetDeadline {
   std::string reason;
 };
 struct CancelDeadline {};
+// The hello is sent: from now on everything to the master is sealed with `send`
+// and everything from it must open with `receive` (its first answer may be an
+// unsealed refusal: a master that could not check this node's secret).
+struct Protect {
+  net::SessionKey send{};
+  net::SessionKey receive{};
+};
 // The connection closes with `reason` when nothing arrives for `timeout`.
 struct SetLiveness {
   std::chrono::milliseconds timeout{0};
@@ -139,7 +147,7 @@ struct FinishScene {};
 // connection went is kept, and goes on after the reconnect.
 struct AbandonScene {};
 
-using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, Configure, Render, Skip, PresentAt,
+using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, Protect, SetLiveness, Configure, Render, Skip, PresentAt,
                             Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log, PrepareScene,
                             StoreSceneChunk, FinishScene, AbandonScene>;
 using Actions = std::vector<Action>;
@@ -169,7 +177,9 @@ class NodeProtocol {
   explicit NodeProtocol(NodeSettings settings);
 
   // Times are this machine's monotonic clock (clock::monotonic_now()).
-  [[nodiscard]] Actions connected(clock::Nanos now);
+  // `nonce`: fresh randomness for this connection's session keys
+  // (net::random_nonce()); needed when the node has a secret.
+  [[nodiscard]] Actions connected(clock::Nanos now, std::vector<std::uint8_t> nonce = {});
   [[nodiscard]] Actions connect_failed(const std::string& reason, clock::Nanos now);
   [[nodiscard]] Actions message(const wire::Envelope& message, clock::Nanos now);
   [[nodiscard]] Actions closed(const std::string& reason, clock::Nanos now);
@@ -240,6 +250,7 @@ class NodeProtocol {
   NodeSettings settings_;
   Phase phase_ = Phase::disconnected;
   bool connection_open_ = false;
+  std::vector<std::uint8_t> nonce_;  // this connection's, for the session keys
   std::optional<protocol::NodeJob> job_;
   std::optional<protocol::SceneFetch> fetch_;  // the scene's files coming from the master
   bool copy_unfinished_ = false;               // a copy started and not yet put in place

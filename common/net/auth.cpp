@@ -18,6 +18,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "net/openssl_error.h"
+
 namespace optique::net {
 namespace {
 
@@ -43,14 +45,6 @@ std::string quoted(const std::string& path) { return "secret file '" + path + "'
 std::string octal_mode(mode_t mode) {
   char text[16];
   std::snprintf(text, sizeof text, "%04o", static_cast<unsigned>(mode & 07777));
-  return text;
-}
-
-std::string openssl_error() {
-  const unsigned long code = ERR_get_error();
-  if (code == 0) return "no OpenSSL error recorded";
-  char text[256];
-  ERR_error_string_n(code, text, sizeof text);
   return text;
 }
 

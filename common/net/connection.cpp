@@ -38,7 +38,13 @@ void Connection::send(wire::Envelope& message) {
   if (!open_ || closing_) return;
   message.set_protocol_version(message.protocol_version() != 0 ? message.protocol_version() : kProtocolVersion);
   message.set_sequence(next_send_sequence_++);
-  append_envelope(outbox_, message);
+  if (sealer_) {
+    std::vector<std::uint8_t> plain(message.ByteSizeLong());
+    (void)message.SerializeWithCachedSizesToArray(plain.data());
+    append_frame(outbox_, sealer_->seal(plain));
+  } else {
+    append_envelope(outbox_, message);
+  }
   if (queued_bytes() > kMaxQueuedBytes) {
     // Closed from the event loop, not from inside send(): the caller may be
     // iterating over sessions, and on_closed may drop the last reference to one.
@@ -128,7 +134,28 @@ void Connection::handle_bytes(std::size_t count, clock::Nanos received) {
       close("bad frame: " + frame.error);
       return;
     }
-    auto message = parse_envelope(frame.payload);
+    std::span<const std::uint8_t> payload = frame.payload;
+    std::vector<std::uint8_t> opened;
+    if (opener_) {
+      auto open = opener_->open(payload);
+      const bool may_be_refusal = unsealed_refusal_allowed_;
+      unsealed_refusal_allowed_ = false;
+      if (!open) {
+        if (may_be_refusal) {
+          if (auto plain = parse_envelope(payload); plain && plain.value().has_refuse()) {
+            wire::Refuse& refuse = *plain.value().mutable_refuse();
+            refuse.set_reason(refuse.reason() + " (an unsealed answer: the master could not check this node's secret)");
+            if (handlers_.on_message) handlers_.on_message(plain.value(), received);
+            return;
+          }
+        }
+        close(open.error());
+        return;
+      }
+      opened = std::move(open).value();
+      payload = opened;
+    }
+    auto message = parse_envelope(payload);
     if (!message) {
       close("bad message: " + message.error());
       return;
@@ -141,6 +168,12 @@ void Connection::handle_bytes(std::size_t count, clock::Nanos received) {
     ++next_receive_sequence_;
     if (handlers_.on_message) handlers_.on_message(message.value(), received);
   }
+}
+
+void Connection::protect(const SessionKey& send, const SessionKey& receive, bool unsealed_refusal_first) {
+  sealer_.emplace(send);
+  opener_.emplace(receive);
+  unsealed_refusal_allowed_ = unsealed_refusal_first;
 }
 
 void Connection::close(const std::string& reason) { finish(reason); }

@@ -13,11 +13,13 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "clock/clock.h"
 #include "net/framing.h"
+#include "net/session_seal.h"
 #include "optique/wire.pb.h"
 
 namespace optique::net {
@@ -57,6 +59,12 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void cancel_deadline();
   // The largest frame accepted from now on (small before a peer has identified itself).
   void set_max_payload_bytes(std::uint32_t max_payload_bytes);
+  // From now on every message sent is sealed with `send` and every message
+  // received must open with `receive` (net/session_seal.h); one that does not
+  // closes the connection. `unsealed_refusal_first`: the first message may
+  // instead be a plain Refuse (a master that could not check this node's
+  // secret cannot seal its answer), handed on marked as unsealed.
+  void protect(const SessionKey& send, const SessionKey& receive, bool unsealed_refusal_first);
 
   [[nodiscard]] bool is_open() const { return open_; }
   [[nodiscard]] const std::string& peer() const { return peer_; }
@@ -86,6 +94,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::array<std::uint8_t, 64 * 1024> read_buffer_{};
   std::vector<std::uint8_t> outbox_;
   std::vector<std::uint8_t> in_flight_;
+  std::optional<Sealer> sealer_;
+  std::optional<Opener> opener_;
+  bool unsealed_refusal_allowed_ = false;  // the next message may be a plain Refuse
   std::uint64_t next_send_sequence_ = 1;
   std::uint64_t next_receive_sequence_ = 1;
   std::uint64_t deadline_generation_ = 0;

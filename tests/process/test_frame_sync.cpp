@@ -343,16 +343,22 @@ class RawClient {
 
 std::vector<std::uint8_t> bytes_of(const std::string& text) { return {text.begin(), text.end()}; }
 
+// The node's own nonce, the same in every hello here (a relay forwards a real
+// node's hello as it is).
+const std::string kNodeNonce(net::kNonceBytes, 'n');
+
 wire::Envelope hello(const std::string& id, const std::string& mac) {
   wire::Envelope envelope;
   envelope.set_protocol_version(net::kProtocolVersion);
   envelope.mutable_hello()->set_node_id(id);
   envelope.mutable_hello()->set_nonce_mac(mac);
+  envelope.mutable_hello()->set_node_nonce(kNodeNonce);
   return envelope;
 }
 
+// The mac a node holding `secret` answers the challenge `nonce` with.
 std::string mac_text(const net::Secret& secret, const std::string& nonce, const std::string& id) {
-  const auto mac = net::hello_mac(secret, bytes_of(nonce), id, net::kProtocolVersion);
+  const auto mac = net::hello_mac(secret, bytes_of(nonce + kNodeNonce), id, net::kProtocolVersion);
   return {mac.begin(), mac.end()};
 }
 
@@ -403,6 +409,40 @@ TEST(Security, OnlyNodesWithTheSecretJoin) {
   const std::string log = master.process->output();
   EXPECT_NE(log.find("refused node 'right' from 127.0.0.1:"), std::string::npos) << log;
   EXPECT_NE(log.find("authentication failed: the node's secret does not match"), std::string::npos) << log;
+}
+
+// A relay between a node and the real master passes the node's hello on (it
+// needs no secret for that), then speaks for the projector itself: after the
+// hello every message is sealed with keys from the secret and both nonces, so
+// what the relay says fails to open, the master drops the connection, and the
+// relay cannot read the welcome either.
+TEST(Security, ARelayThatPassesTheHelloOnCannotSpeakForTheNode) {
+  const SecretWall wall;
+  ExternalMaster master(wall.config, {"--frames", "60"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  RawClient relay("127.0.0.1", master.port);
+  const auto challenge = relay.receive();
+  ASSERT_TRUE(challenge && challenge->has_challenge());
+  relay.send(hello("left", mac_text(wall.secret, challenge->challenge().nonce(), "left")));  // the node's, passed on
+  EXPECT_FALSE(relay.receive().has_value()) << "the welcome is sealed: the relay cannot read it";
+  wire::Envelope forged;
+  forged.set_protocol_version(net::kProtocolVersion);
+  forged.mutable_configured()->set_renderer("the relay, as projector 'left'");
+  relay.send(forged);
+  EXPECT_TRUE(relay.closed_within(scaled(5s)));
+  EXPECT_TRUE(master.process->wait_for_output("failed authentication", scaled(5s))) << master.process->output();
+  EXPECT_EQ(master.process->output().find("joined"), std::string::npos) << "nobody joined as 'left'";
+}
+
+// A node with the installation's secret does not join a master that asks for
+// none (anyone could run one): it says why and exits 2, and caches nothing.
+TEST(Security, ANodeWithTheSecretDoesNotJoinAMasterWithout) {
+  const SecretWall wall;
+  ExternalMaster master(std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json", {"--frames", "30"});
+  ASSERT_FALSE(master.port.empty()) << master.process->output();
+  auto node = master.node("wall", {"--renderer", "null", "--secret-file", wall.secret_file});
+  EXPECT_EQ(node->wait(20s).value_or(-1), 2) << node->output();
+  EXPECT_NE(node->output().find("asked for no secret, but this node has one"), std::string::npos) << node->output();
 }
 
 TEST(Security, AWorldReadableSecretFileStopsTheMasterBeforeAnythingStarts) {

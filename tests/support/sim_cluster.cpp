@@ -228,6 +228,7 @@ void SimCluster::master_actions(master::Actions actions) {
                      }
                    },
                    [&](master::SetMaxPayload& a) { (void)peer_link(a.peer, "a payload limit"); },
+                   [&](master::Protect& a) { (void)peer_link(a.peer, "a session's keys"); },
                    [&](master::Arm& a) { master_timers_[a.timer] = a.at; },
                    [&](master::Disarm& a) { master_timers_.erase(a.timer); },
                    [&](master::StopAccepting&) { accepting_ = false; },
@@ -282,6 +283,7 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
               node_actions(i, n.protocol.rendered(a.frame.frame_id, clock::kNanosPerMilli));
             },
             [&](node::Skip&) {},
+            [&](node::Protect&) {},
             [&](node::PresentAt& a) { n.present_at = a.deadline; },
             [&](node::Present&) {
               if (std::find(n.presented.begin(), n.presented.end(), n.last_rendered) != n.presented.end()) {

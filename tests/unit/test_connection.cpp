@@ -152,3 +152,93 @@ TEST(Connection, BytesOutOfSequenceCloseTheConnectionWithTheReason) {
 
 }  // namespace
 }  // namespace optique::net
+
+namespace optique::net {
+namespace {
+
+// Frames `count` pings sealed with `sealer`, sequence numbers from `first`.
+std::vector<std::uint8_t> sealed_pings(Sealer& sealer, std::uint64_t first, int count) {
+  std::vector<std::uint8_t> bytes;
+  for (int i = 0; i < count; ++i) {
+    const std::vector<std::uint8_t> plain = Loopback::pings(first + static_cast<std::uint64_t>(i), 1);
+    const auto payload = std::span(plain).subspan(kFrameHeaderBytes);
+    append_frame(bytes, sealer.seal(payload));
+  }
+  return bytes;
+}
+
+const SessionKeys& test_keys() {
+  static const SessionKeys keys = derive_session_keys(Secret{std::vector<std::uint8_t>(32, 1)},
+                                                      std::vector<std::uint8_t>(32, 2),
+                                                      std::vector<std::uint8_t>(32, 3), "wall", kProtocolVersion);
+  return keys;
+}
+
+// After protect(): sealed frames in order are taken; a plain one, a replayed
+// one, or one sealed with another key closes the connection, and nothing of it
+// reaches the handler.
+TEST(Connection, AProtectedConnectionTakesOnlyItsSessionsFramesInOrder) {
+  for (const std::string attack : {"plain", "replayed", "other key", "reordered"}) {
+    SCOPED_TRACE(attack);
+    Loopback loop;
+    loop.server->protect(test_keys().to_node, test_keys().to_master, false);
+    Sealer node(test_keys().to_master);
+    const auto good = sealed_pings(node, 1, 2);
+    asio::write(loop.client, asio::buffer(good));
+    loop.run_until([&] { return loop.received.size() == 2; });
+    ASSERT_EQ(loop.received.size(), 2u);
+    std::vector<std::uint8_t> bad;
+    if (attack == "plain") {
+      bad = Loopback::pings(3, 1);
+    } else if (attack == "replayed") {
+      bad = good;
+    } else if (attack == "other key") {
+      Sealer forger(derive_session_keys(Secret{std::vector<std::uint8_t>(32, 9)}, std::vector<std::uint8_t>(32, 2),
+                                        std::vector<std::uint8_t>(32, 3), "wall", kProtocolVersion)
+                        .to_master);
+      (void)forger.seal(std::vector<std::uint8_t>{});
+      (void)forger.seal(std::vector<std::uint8_t>{});
+      bad = sealed_pings(forger, 3, 1);
+    } else {
+      (void)node.seal(std::vector<std::uint8_t>{});  // the third frame is skipped: the fourth comes first
+      bad = sealed_pings(node, 4, 1);
+    }
+    asio::write(loop.client, asio::buffer(bad));
+    loop.run_until([&] { return !loop.closed_reason.empty(); });
+    EXPECT_TRUE(loop.closed_reason.find("failed authentication") != std::string::npos ||
+                loop.closed_reason.find("no room for its tag") != std::string::npos)
+        << loop.closed_reason;
+    EXPECT_EQ(loop.received.size(), 2u) << "nothing of it handed on";
+  }
+}
+
+// What the server sends after protect() is sealed: the peer's opener opens it,
+// and the plain bytes are not on the wire.
+TEST(Connection, WhatAProtectedConnectionSendsIsSealed) {
+  Loopback loop;
+  loop.server->protect(test_keys().to_node, test_keys().to_master, false);
+  wire::Envelope message;
+  message.mutable_goodbye()->set_reason("a reason anyone could read");
+  loop.server->send(message);
+  std::vector<std::uint8_t> bytes;
+  loop.run_until([&] {
+    std::array<std::uint8_t, 4096> buffer{};
+    boost::system::error_code error;
+    loop.client.non_blocking(true);
+    const std::size_t got = loop.client.read_some(asio::buffer(buffer), error);
+    if (!error) bytes.insert(bytes.end(), buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(got));
+    return !bytes.empty();
+  });
+  const DecodedFrame frame = decode_frame(bytes, kDefaultMaxPayloadBytes);
+  ASSERT_EQ(frame.status, DecodeStatus::good);
+  EXPECT_EQ(std::string(frame.payload.begin(), frame.payload.end()).find("anyone could read"), std::string::npos);
+  Opener opener(test_keys().to_node);
+  const auto opened = opener.open(frame.payload);
+  ASSERT_TRUE(opened) << opened.error();
+  const auto parsed = parse_envelope(opened.value());
+  ASSERT_TRUE(parsed);
+  EXPECT_EQ(parsed.value().goodbye().reason(), "a reason anyone could read");
+}
+
+}  // namespace
+}  // namespace optique::net

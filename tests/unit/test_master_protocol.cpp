@@ -206,18 +206,47 @@ TEST_F(MasterTest, TheSharedSecretIsChecked) {
   no_mac.mutable_hello()->set_node_id("top-left");
   EXPECT_TRUE(logged(master_->message(1, no_mac, now_), "start the node with --secret-file"));
 
+  // The node's own nonce follows the master's in what the mac covers.
+  const std::vector<std::uint8_t> node_nonce(32, 5);
+  std::vector<std::uint8_t> both = nonce_;
+  both.insert(both.end(), node_nonce.begin(), node_nonce.end());
+  wire::Envelope with_nonce = no_mac;
+  with_nonce.mutable_hello()->set_node_nonce(node_nonce.data(), node_nonce.size());
+
   (void)master_->accepted(2, "10.0.0.8:5000", false, nonce_, now_);
-  wire::Envelope wrong = no_mac;
-  const auto bad =
-      net::hello_mac(net::Secret{std::vector<std::uint8_t>(32, 8)}, nonce_, "top-left", net::kProtocolVersion);
+  wire::Envelope wrong = with_nonce;
+  const auto bad = net::hello_mac(net::Secret{std::vector<std::uint8_t>(32, 8)}, both, "top-left", net::kProtocolVersion);
   wrong.mutable_hello()->set_nonce_mac(bad.data(), bad.size());
-  EXPECT_TRUE(logged(master_->message(2, wrong, now_), "authentication failed"));
+  Actions a = master_->message(2, wrong, now_);
+  EXPECT_TRUE(logged(a, "authentication failed"));
+  EXPECT_EQ(first<Protect>(a), nullptr) << "a refusal to a node that proved nothing goes unsealed";
+
+  (void)master_->accepted(4, "10.0.0.10:5000", false, nonce_, now_);
+  wire::Envelope only_master_nonce = no_mac;
+  const auto old_style = net::hello_mac(*settings.secret, nonce_, "top-left", net::kProtocolVersion);
+  only_master_nonce.mutable_hello()->set_nonce_mac(old_style.data(), old_style.size());
+  EXPECT_TRUE(logged(master_->message(4, only_master_nonce, now_), "node nonce has 0 bytes, not 32"));
 
   (void)master_->accepted(3, "10.0.0.9:5000", false, nonce_, now_);
-  wire::Envelope right = no_mac;
-  const auto good = net::hello_mac(*settings.secret, nonce_, "top-left", net::kProtocolVersion);
+  wire::Envelope right = with_nonce;
+  const auto good = net::hello_mac(*settings.secret, both, "top-left", net::kProtocolVersion);
   right.mutable_hello()->set_nonce_mac(good.data(), good.size());
-  EXPECT_EQ(sent_to(master_->message(3, right, now_), 3, wire::Envelope::kWelcome).size(), 1u);
+  a = master_->message(3, right, now_);
+  EXPECT_EQ(sent_to(a, 3, wire::Envelope::kWelcome).size(), 1u);
+  // Sealed from the welcome on, with keys from the secret and both nonces.
+  std::size_t protect_at = a.size();
+  std::size_t welcome_at = a.size();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (const auto* p = std::get_if<Protect>(&a[i])) {
+      protect_at = i;
+      const net::SessionKeys expected =
+          net::derive_session_keys(*settings.secret, nonce_, node_nonce, "top-left", net::kProtocolVersion);
+      EXPECT_EQ(p->keys.to_node, expected.to_node);
+      EXPECT_EQ(p->keys.to_master, expected.to_master);
+    }
+    if (const auto* s = std::get_if<Send>(&a[i]); s != nullptr && s->message.has_welcome()) welcome_at = i;
+  }
+  EXPECT_LT(protect_at, welcome_at) << "the welcome is the first sealed message";
 }
 
 TEST_F(MasterTest, AGoodHelloGetsItsJobAndTheStateOnceConfigured) {

@@ -129,20 +129,48 @@ TEST_F(NodeTest, HandshakeAnswersTheChallengeWithItsMacAndJoinsOnTheState) {
   NodeSettings s = settings();
   s.secret = net::Secret{std::vector<std::uint8_t>(32, 7)};
   NodeProtocol node(s);
-  (void)node.connected(now_);
+  const std::vector<std::uint8_t> own(32, 6);
+  (void)node.connected(now_, own);
   wire::Envelope challenge = envelope();
   const std::string nonce(32, 'x');
   challenge.mutable_challenge()->set_nonce(nonce);
   challenge.mutable_challenge()->set_secret_required(true);
-  const auto hello = sent(node.message(challenge, now_), wire::Envelope::kHello);
+  const Actions a = node.message(challenge, now_);
+  const auto hello = sent(a, wire::Envelope::kHello);
   ASSERT_EQ(hello.size(), 1u);
   EXPECT_EQ(hello.front().hello().node_id(), "bottom-left");
+  EXPECT_EQ(hello.front().hello().node_nonce(), std::string(own.begin(), own.end()));
   const std::string& mac = hello.front().hello().nonce_mac();
-  EXPECT_TRUE(net::verify_hello_mac(*s.secret, std::span(reinterpret_cast<const std::uint8_t*>(nonce.data()), 32),
-                                    "bottom-left", net::kProtocolVersion,
+  std::vector<std::uint8_t> both(nonce.begin(), nonce.end());
+  both.insert(both.end(), own.begin(), own.end());
+  EXPECT_TRUE(net::verify_hello_mac(*s.secret, both, "bottom-left", net::kProtocolVersion,
                                     std::span(reinterpret_cast<const std::uint8_t*>(mac.data()), mac.size())));
+  // Everything after the hello is sealed, each way with its own key.
+  const Protect* protect = first<Protect>(a);
+  ASSERT_NE(protect, nullptr);
+  const net::SessionKeys keys = net::derive_session_keys(
+      *s.secret, std::span(both).first(32), own, "bottom-left", net::kProtocolVersion);
+  EXPECT_EQ(protect->send, keys.to_master);
+  EXPECT_EQ(protect->receive, keys.to_node);
   // A second challenge is a broken master.
   EXPECT_NE(first<Close>(node.message(challenge, now_)), nullptr);
+}
+
+// A node with the installation's secret does not join a master that asks for
+// none: anyone could be that master (and would be sent this node's pictures'
+// scene requests, and cached).
+TEST_F(NodeTest, ANodeWithASecretRefusesAMasterWithout) {
+  NodeSettings s = settings();
+  s.secret = net::Secret{std::vector<std::uint8_t>(32, 7)};
+  NodeProtocol node(s);
+  (void)node.connected(now_, std::vector<std::uint8_t>(32, 6));
+  wire::Envelope challenge = envelope();
+  challenge.mutable_challenge()->set_nonce(std::string(32, 'x'));
+  const Actions a = node.message(challenge, now_);
+  EXPECT_TRUE(sent(a, wire::Envelope::kHello).empty());
+  ASSERT_NE(first<Stop>(a), nullptr);
+  EXPECT_EQ(first<Stop>(a)->exit_code, kExitRefused);
+  EXPECT_TRUE(logged(a, "asked for no secret, but this node has one"));
 }
 
 TEST_F(NodeTest, ASecretTheNodeLacksStopsIt) {
