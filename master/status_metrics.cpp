@@ -161,7 +161,8 @@ std::string status_metrics(const LiveStatus& s) {
   w.single("optique_status_connections", "gauge", "Open connections to this status server.", s.clients.open);
   w.single("optique_status_requests_total", "counter", "Requests this status server answered.", s.clients.requests);
   w.single("optique_status_refused_total", "counter",
-           "Connections this status server closed: busy, too slow, too large or not HTTP.", s.clients.refused);
+           "Connections this status server closed: busy, too many from one address, too slow, too large, not HTTP "
+           "or an event stream behind.", s.clients.refused);
   return w.take();
 }
 

@@ -73,7 +73,8 @@ void StatusService::publish(const LiveStatus& status) {
 LiveClients StatusService::clients() const {
   const http::ServerCounts counts = server_.counts();
   return {counts.open, counts.streams, counts.requests,
-          counts.refused_busy + counts.timed_out + counts.too_large + counts.bad_requests + counts.streams_behind};
+          counts.refused_busy + counts.refused_address + counts.timed_out + counts.too_large + counts.bad_requests +
+              counts.streams_behind};
 }
 
 }  // namespace optique::master
