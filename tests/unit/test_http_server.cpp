@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 #include <spdlog/sinks/null_sink.h>
 
+#include <memory>
 #include <thread>
+#include <vector>
 
 #include "http/connection_budget.h"
 #include "http/server.h"
@@ -40,6 +42,26 @@ class HttpServerTest : public ::testing::Test {
     ASSERT_TRUE(port.ok()) << port.error();
     port_ = port.value();
     thread_ = std::thread([this] { io_.run(); });
+  }
+  // Six connections, the last two kept for loopback, on every address (a client
+  // from this machine's address that is not loopback is not a loopback peer).
+  void start_for_remote_peers(std::size_t per_address) {
+    ServerLimits limits;
+    limits.max_connections = 6;
+    limits.loopback_reserved = 2;
+    limits.max_per_address = per_address;
+    start(limits, "0.0.0.0");
+  }
+  // `count` connections from `remote` that say nothing, as slow clients
+  // re-opened as they close, once the server holds them all.
+  std::vector<std::unique_ptr<RawClient>> hold(const testing::ClientOptions& remote, std::size_t count) {
+    std::vector<std::unique_ptr<RawClient>> held;
+    for (std::size_t i = 0; i < count; ++i) {
+      held.push_back(std::make_unique<RawClient>(port_, remote));
+      EXPECT_TRUE(held.back()->connected());
+    }
+    EXPECT_TRUE(testing::poll_until([&] { return server_->counts().open == count; }, 2s));
+    return held;
   }
   void TearDown() override {
     if (server_) server_->stop();
@@ -271,22 +293,11 @@ TEST_F(HttpServerTest, AStreamThatIsNeverReadIsClosedBeforeItHoldsMuch) {
 }
 
 TEST_F(HttpServerTest, APeerNotOnLoopbackIsHeldToItsShareAndLoopbackAlwaysGetsIn) {
-  const std::string address = testing::non_loopback_address();
-  if (address.empty()) GTEST_SKIP() << "this machine has no address but loopback";
-  ServerLimits limits;
-  limits.max_connections = 6;
-  limits.loopback_reserved = 2;
-  limits.max_per_address = 3;
-  start(limits, "0.0.0.0");
   testing::ClientOptions remote;
-  remote.address = address;
-  // Connections that say nothing, as slow clients re-opened as they close.
-  std::vector<std::unique_ptr<RawClient>> held;
-  for (int i = 0; i < 3; ++i) {
-    held.push_back(std::make_unique<RawClient>(port_, remote));
-    ASSERT_TRUE(held.back()->connected());
-  }
-  ASSERT_TRUE(testing::poll_until([&] { return server_->counts().open == 3; }, 2s));
+  remote.address = testing::non_loopback_address();
+  if (remote.address.empty()) GTEST_SKIP() << "this machine has no address but loopback";
+  start_for_remote_peers(3);
+  const auto held = hold(remote, 3);
   RawClient fourth(port_, remote);
   const testing::HttpReply crowded = testing::parse_reply(fourth.read_until_closed(2s));
   EXPECT_EQ(crowded.status, 503);
@@ -305,20 +316,11 @@ TEST_F(HttpServerTest, APeerNotOnLoopbackIsHeldToItsShareAndLoopbackAlwaysGetsIn
 }
 
 TEST_F(HttpServerTest, TheLastSlotsAreKeptForLoopback) {
-  const std::string address = testing::non_loopback_address();
-  if (address.empty()) GTEST_SKIP() << "this machine has no address but loopback";
-  ServerLimits limits;
-  limits.max_connections = 6;
-  limits.loopback_reserved = 2;
-  start(limits, "0.0.0.0");
   testing::ClientOptions remote;
-  remote.address = address;
-  std::vector<std::unique_ptr<RawClient>> held;
-  for (int i = 0; i < 4; ++i) {
-    held.push_back(std::make_unique<RawClient>(port_, remote));
-    ASSERT_TRUE(held.back()->connected());
-  }
-  ASSERT_TRUE(testing::poll_until([&] { return server_->counts().open == 4; }, 2s));
+  remote.address = testing::non_loopback_address();
+  if (remote.address.empty()) GTEST_SKIP() << "this machine has no address but loopback";
+  start_for_remote_peers(16);
+  auto held = hold(remote, 4);
   RawClient fifth(port_, remote);
   EXPECT_EQ(testing::parse_reply(fifth.read_until_closed(2s)).status, 503) << "the last two are loopback's";
   EXPECT_EQ(server_->counts().refused_busy, 1u);
