@@ -59,7 +59,7 @@ struct LiveClients {
   std::uint64_t open = 0;
   std::uint64_t streams = 0;
   std::uint64_t requests = 0;
-  std::uint64_t refused = 0;  // busy, too slow, too large, not HTTP
+  std::uint64_t refused = 0;  // busy, too many from one address, too slow, too large, not HTTP, behind
 };
 
 struct LiveStatus {

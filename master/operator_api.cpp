@@ -2,6 +2,7 @@
 
 #include <openssl/crypto.h>
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 
@@ -20,17 +21,33 @@ bool starts_with_ignoring_case(std::string_view text, std::string_view prefix) {
   return true;
 }
 
-// A Host that names this machine by number or as localhost. Reads open on
+bool all_digits(std::string_view text) {
+  return std::all_of(text.begin(), text.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
+// A Host that names this machine by number or as localhost, with a port or
+// none (RFC 9110: host [":" port], an IPv6 address in brackets). Reads open on
 // loopback answer only these: a web page whose name was rebound to 127.0.0.1
-// (DNS rebinding) sends its own name, and learns nothing.
-bool host_is_local(std::string host) {
+// (DNS rebinding) sends its own name, and learns nothing. Nothing may follow
+// the name but the port's digits.
+bool host_is_local(std::string_view host) {
   if (host.empty()) return true;  // HTTP/1.0
+  std::string_view name = host;
+  std::string_view port;
   if (host.front() == '[') {
     const auto end = host.find(']');
-    return end != std::string::npos && config::is_ip_address(host.substr(1, end - 1));
+    if (end == std::string_view::npos) return false;
+    name = host.substr(1, end - 1);
+    const std::string_view rest = host.substr(end + 1);
+    if (!rest.empty() && rest.front() != ':') return false;
+    if (!rest.empty()) port = rest.substr(1);
+    return all_digits(port) && config::is_ip_address(std::string(name));
   }
-  if (const auto colon = host.rfind(':'); colon != std::string::npos) host.resize(colon);
-  return host == "localhost" || config::is_ip_address(host);
+  if (const auto colon = host.rfind(':'); colon != std::string_view::npos) {
+    name = host.substr(0, colon);
+    port = host.substr(colon + 1);
+  }
+  return all_digits(port) && (name == "localhost" || config::is_ip_address(std::string(name)));
 }
 
 // "Bearer <token>" with the right token, compared in constant time.
@@ -123,7 +140,9 @@ Routed route(const http::Request& request, const OperatorAccess& access, const S
   // The page holds no data: it asks for it with the token it is given.
   if (request.path == "/" || request.path == "/index.html") {
     if (!read) return {method_not_allowed(request, "GET, HEAD"), std::nullopt};
-    return {serve(latest.page, "text/html; charset=utf-8"), std::nullopt};
+    http::Response page = serve(latest.page, "text/html; charset=utf-8");
+    if (latest.page_policy) page.headers.emplace_back("Content-Security-Policy", *latest.page_policy);
+    return {std::move(page), std::nullopt};
   }
   const bool data = request.path == "/status.json" || request.path == "/metrics" || request.path == "/events";
   if (!data) return {http::text_response(404, request.path + ": no such page (try /, /status.json or /metrics)"), {}};

@@ -21,10 +21,12 @@ namespace optique::master {
 enum class OperatorCommand { pause, resume, stop };
 [[nodiscard]] std::string_view to_string(OperatorCommand command);
 
-// What is served: the page (set once), and the latest status (null until the
-// first is published).
+// What is served: the page and its Content-Security-Policy (set once,
+// master/page_policy.h), and the latest status (null until the first is
+// published).
 struct StatusTexts {
   std::shared_ptr<const std::string> page;
+  std::shared_ptr<const std::string> page_policy;
   std::shared_ptr<const std::string> json;
   std::shared_ptr<const std::string> metrics;
 };

@@ -6,6 +6,18 @@
 #include "metrics/distribution.h"
 
 namespace optique::master {
+namespace {
+
+bool within(clock::Nanos value, clock::Nanos low, clock::Nanos high) { return value >= low && value <= high; }
+
+bool plausible(const report::ClockReport& clock, std::optional<clock::Nanos> true_error) {
+  return std::isfinite(clock.drift_ppm()) && std::abs(clock.drift_ppm()) <= kLargestDriftPpm &&
+         within(clock.offset_ns(), -kLargestClockOffset, kLargestClockOffset) &&
+         within(clock.round_trip_ns(), 0, kLongestRoundTrip) && within(clock.error_bound_ns(), 0, kLongestRoundTrip) &&
+         (!true_error || within(*true_error, -kLongestRoundTrip, kLongestRoundTrip));
+}
+
+}  // namespace
 
 RunRecorder::RunRecorder(std::vector<std::string> node_ids, std::ostream* csv)
     : ids_(std::move(node_ids)), csv_(csv), totals_(ids_.size()) {
@@ -37,13 +49,20 @@ void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos rece
   record->nodes[node].ready = received;
   NodeTotals& t = totals_[node];
   t.counts.rendered += 1;
-  const double us = static_cast<double>(render_time) / 1e3;
-  t.render_us.add(us);
-  t.counts.render_us_sum += us;
-  record->nodes[node].render_us = static_cast<float>(us);
+  std::optional<double> us;
+  if (within(render_time, 0, kLongestRender)) {
+    us = static_cast<double>(render_time) / 1e3;
+    t.render_us.add(*us);
+    t.counts.render_us_sum += *us;
+    t.counts.render_times += 1;
+    record->nodes[node].render_us = static_cast<float>(*us);
+  } else {
+    t.counts.out_of_range += 1;
+  }
   // A value this master does not know (a newer node) counts as a full frame.
   if (drawn_as == wire::DRAWN_FULL || !wire::DrawnAs_IsValid(drawn_as)) return;
-  t.render_us_drawn_as[drawn_as].add(us);
+  metrics::Reservoir& drawn_as_us = t.render_us_drawn_as[drawn_as];  // there even without a time: it up-converts
+  if (us) drawn_as_us.add(*us);
   if (drawn_as == wire::DRAWN_KEY || drawn_as == wire::DRAWN_KEY_SHOWN) {
     t.key_frames_total += 1;
     if (t.key_frames.size() < kMostKeyFramesListed) t.key_frames.push_back(frame);
@@ -63,6 +82,11 @@ void RunRecorder::swapped(std::uint64_t frame, clock::Nanos sent, const std::vec
 void RunRecorder::presented(std::uint64_t frame, std::size_t node, clock::Nanos at, std::uint64_t content_frame) {
   FrameRecord* record = find(frame);
   if (record == nullptr || !record->nodes[node].swapped || record->nodes[node].presented != 0) return;
+  // Compared so that nothing overflows: `at` may be any 64-bit number.
+  if (at < record->swap_sent - kFarthestPresent || at > record->swap_sent + kFarthestPresent) {
+    totals_[node].counts.out_of_range += 1;
+    return;
+  }
   record->nodes[node].presented = at;
   record->nodes[node].content_frame = content_frame;
   totals_[node].counts.presented += 1;
@@ -73,6 +97,10 @@ void RunRecorder::clock_estimated(std::uint64_t frame, std::size_t node, const r
   // The first two seconds are the estimator's to settle in (the bar is set after them).
   constexpr clock::Nanos kSettling = 2 * clock::kNanosPerSecond;
   NodeTotals& t = totals_[node];
+  if (!plausible(latest, true_error)) {
+    t.counts.out_of_range += 1;
+    return;
+  }
   t.counts.clock = latest;
   const FrameRecord* record = find(frame);
   if (true_error && record != nullptr && record->begin_sent - first_begin_ >= kSettling) {
@@ -174,6 +202,7 @@ report::RunReport RunRecorder::report() const {
     node.set_barrier_misses(t.counts.barrier_misses);
     node.set_hash_mismatches(t.counts.hash_mismatches);
     node.set_joins(t.counts.joins);
+    node.set_out_of_range(t.counts.out_of_range);
     *node.mutable_clock() = t.counts.clock;
     if (t.clock_true_error_us.count() > 0)
       *node.mutable_clock()->mutable_true_error_us() = t.clock_true_error_us.summary();

@@ -25,6 +25,19 @@ inline constexpr std::size_t kMostKeyFramesListed = 100000;
 // The last frames finalized, for the live status: ten seconds at 60 Hz.
 inline constexpr std::size_t kRecentFrames = 600;
 
+// What a node reports is bounded here, at the recorder's door, whatever sent it
+// (an authenticated node may still be broken, or hostile): a value beyond these
+// enters neither run.json nor the live status, and is counted in its node's
+// `out_of_range`.
+inline constexpr clock::Nanos kLongestRender = 60 * clock::kNanosPerSecond;
+// From the frame's Swap, either way.
+inline constexpr clock::Nanos kFarthestPresent = 60 * clock::kNanosPerSecond;
+inline constexpr double kLargestDriftPpm = 1e4;
+// Monotonic clocks count from boot: two machines' differ by at most an uptime.
+inline constexpr clock::Nanos kLargestClockOffset = 10LL * 365 * 24 * 3600 * clock::kNanosPerSecond;
+// A round trip, its half (the error bound), and an estimate's true error.
+inline constexpr clock::Nanos kLongestRoundTrip = 60 * clock::kNanosPerSecond;
+
 struct RecentFrame {
   std::uint64_t id = 0;
   clock::Nanos begin_sent = 0;
@@ -40,7 +53,9 @@ struct NodeCounts {
   std::uint64_t hash_mismatches = 0;
   std::uint64_t joins = 0;
   double render_us_sum = 0.0;
-  report::ClockReport clock;  // the latest estimate
+  std::uint64_t render_times = 0;  // rendered with a render time in bounds: render_us_sum's count
+  std::uint64_t out_of_range = 0;  // values reported beyond the bounds above, not recorded
+  report::ClockReport clock;       // the latest estimate in bounds
 };
 
 class RunRecorder {
@@ -50,15 +65,19 @@ class RunRecorder {
   RunRecorder(std::vector<std::string> node_ids, std::ostream* csv);
 
   void frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
-  // `drawn_as`: how a node that up-converts drew it (key frame, between…).
+  // `drawn_as`: how a node that up-converts drew it (key frame, between…). A
+  // render time beyond kLongestRender (or negative) is counted, not recorded.
   void ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time,
              wire::DrawnAs drawn_as = wire::DRAWN_FULL);
   void swapped(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
   // `content_frame`: the frame whose content the node showed (a node out of step
-  // shows an older one: the frame is then incoherent).
+  // shows an older one: the frame is then incoherent). A time farther than
+  // kFarthestPresent from the frame's Swap is counted, not recorded.
   void presented(std::uint64_t frame, std::size_t node, clock::Nanos at, std::uint64_t content_frame);
 
-  // The node's clock estimate at its present of `frame`.
+  // The node's clock estimate at its present of `frame`; one with any field out
+  // of bounds (a drift not finite or over kLargestDriftPpm…) is counted and the
+  // previous one kept.
   void clock_estimated(std::uint64_t frame, std::size_t node, const report::ClockReport& latest,
                        std::optional<clock::Nanos> true_error);
 

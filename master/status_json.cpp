@@ -34,6 +34,7 @@ json node_json(const LiveNode& node) {
           {"barrier_misses", node.counts.barrier_misses},
           {"hash_mismatches", node.counts.hash_mismatches},
           {"joins", node.counts.joins},
+          {"out_of_range", node.counts.out_of_range},
           {"render_ms", {{"median", maybe(node.render_ms_median)}, {"p99", maybe(node.render_ms_p99)}}},
           {"clock",
            {{"offset_us", static_cast<double>(clock.offset_ns()) / 1e3},

@@ -125,11 +125,14 @@ std::string status_metrics(const LiveStatus& s) {
            [](const LiveNode& n) { return n.counts.hash_mismatches; });
   per_node("optique_node_joins_total", "counter", "Times the node joined the frame loop.",
            [](const LiveNode& n) { return n.counts.joins; });
+  per_node("optique_node_out_of_range_total", "counter",
+           "Values the node reported beyond any plausible bound (render, present or clock), not recorded.",
+           [](const LiveNode& n) { return n.counts.out_of_range; });
   w.family("optique_node_render_seconds", "summary",
            "The node's render time of a frame; quantiles over the recent frames.");
   for (const LiveNode& node : s.nodes) {
     w.summary("optique_node_render_seconds", {{"projector", node.id}}, in_seconds(node.render_ms_median, 1e3),
-              in_seconds(node.render_ms_p99, 1e3), node.counts.render_us_sum / 1e6, node.counts.rendered);
+              in_seconds(node.render_ms_p99, 1e3), node.counts.render_us_sum / 1e6, node.counts.render_times);
   }
   per_node("optique_node_clock_offset_seconds", "gauge", "The node's latest estimate of master minus node clock.",
            [](const LiveNode& n) { return static_cast<double>(n.counts.clock.offset_ns()) / 1e9; });
@@ -158,7 +161,8 @@ std::string status_metrics(const LiveStatus& s) {
   w.single("optique_status_connections", "gauge", "Open connections to this status server.", s.clients.open);
   w.single("optique_status_requests_total", "counter", "Requests this status server answered.", s.clients.requests);
   w.single("optique_status_refused_total", "counter",
-           "Connections this status server closed: busy, too slow, too large or not HTTP.", s.clients.refused);
+           "Connections this status server closed: busy, too many from one address, too slow, too large, not HTTP "
+           "or an event stream behind.", s.clients.refused);
   return w.take();
 }
 

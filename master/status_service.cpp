@@ -1,5 +1,6 @@
 #include "master/status_service.h"
 
+#include "master/page_policy.h"
 #include "master/status_json.h"
 #include "master/status_metrics.h"
 #include "operator_page.h"
@@ -45,7 +46,8 @@ StatusService::StatusService(const config::StatusServer& settings, OperatorAcces
             return std::move(routed.response);
           },
           log) {
-  board_.set({std::make_shared<const std::string>(pages::operator_page_html), nullptr, nullptr});
+  board_.set({std::make_shared<const std::string>(pages::operator_page_html),
+              std::make_shared<const std::string>(page_security_policy(pages::operator_page_html)), nullptr, nullptr});
 }
 
 StatusService::~StatusService() {
@@ -73,7 +75,8 @@ void StatusService::publish(const LiveStatus& status) {
 LiveClients StatusService::clients() const {
   const http::ServerCounts counts = server_.counts();
   return {counts.open, counts.streams, counts.requests,
-          counts.refused_busy + counts.timed_out + counts.too_large + counts.bad_requests + counts.streams_behind};
+          counts.refused_busy + counts.refused_address + counts.timed_out + counts.too_large + counts.bad_requests +
+              counts.streams_behind};
 }
 
 }  // namespace optique::master

@@ -30,7 +30,7 @@ Node::Node(asio::io_context& io, NodeOptions options, Renderer& renderer, spdlog
       connect_timer_(io),
       present_timer_(io),
       signals_(io, SIGINT, SIGTERM),
-      scene_cache_(options_.cache_dir) {}
+      scene_cache_(options_.cache_dir, log) {}
 
 void Node::start() {
   signals_.async_wait([this](const boost::system::error_code& error, int signal) {

@@ -4,6 +4,8 @@
 #include <sys/file.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -11,6 +13,7 @@
 #include <cstring>
 #include <fstream>
 #include <random>
+#include <tuple>
 #include <utility>
 
 #include "util/sha256.h"
@@ -101,26 +104,53 @@ void remove_abandoned_partials(const fs::path& folder) {
   }
 }
 
-// Removes the copies used longest ago (never `keep`) until `needed` bytes are free.
-void make_room(const fs::path& folder, std::uintmax_t needed, const std::string& keep) {
+struct CachedCopy {
+  fs::file_time_type used;
+  fs::path path;
+  std::uintmax_t bytes = 0;  // its files' sizes: about what removing it frees
+};
+
+std::uintmax_t bytes_under(const fs::path& folder) {
+  std::uintmax_t bytes = 0;
   std::error_code error;
-  std::vector<std::pair<fs::file_time_type, fs::path>> copies;
+  for (fs::recursive_directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    std::error_code ignored;
+    if (it->is_regular_file(ignored)) {
+      const std::uintmax_t size = it->file_size(ignored);
+      if (!ignored) bytes += size;
+    }
+  }
+  return bytes;
+}
+
+// The copies in place but `keep`, used longest ago first.
+std::vector<CachedCopy> copies_by_age(const fs::path& folder, const std::string& keep) {
+  std::error_code error;
+  std::vector<CachedCopy> copies;
   for (const auto& entry : fs::directory_iterator(folder, error)) {
     const std::string name = entry.path().filename().string();
-    if (is_identity(name) && name != keep) copies.emplace_back(fs::last_write_time(entry.path(), error), entry.path());
+    if (is_identity(name) && name != keep) {
+      copies.push_back({fs::last_write_time(entry.path(), error), entry.path(), bytes_under(entry.path())});
+    }
   }
-  std::sort(copies.begin(), copies.end());
-  for (const auto& [used, copy] : copies) {
-    const fs::space_info space = fs::space(folder, error);
-    if (error || space.available >= needed) return;
-    fs::remove_all(copy, error);
-  }
+  std::sort(copies.begin(), copies.end(),
+            [](const CachedCopy& a, const CachedCopy& b) { return std::tie(a.used, a.path) < std::tie(b.used, b.path); });
+  return copies;
 }
+
+std::string mib(std::uintmax_t bytes) { return fmt::format("{:.1f} MiB", static_cast<double>(bytes) / (1 << 20)); }
 
 }  // namespace
 
-SceneCache::SceneCache(const fs::path& cache_dir, std::uintmax_t spare_bytes)
-    : folder_(cache_dir / "scenes"), spare_bytes_(spare_bytes) {}
+SceneCache::SceneCache(const fs::path& cache_dir, spdlog::logger& log, std::uintmax_t spare_bytes, FreeSpace free_space)
+    : folder_(cache_dir / "scenes"), log_(log), spare_bytes_(spare_bytes), free_space_(std::move(free_space)) {}
+
+Result<std::uintmax_t> SceneCache::disk_free_space(const fs::path& folder) {
+  std::error_code error;
+  const fs::space_info space = fs::space(folder, error);
+  if (error) return Error{"cannot tell the free space of " + folder.string() + ": " + describe(error)};
+  return space.available;
+}
 
 SceneCache::~SceneCache() {
   close_file();
@@ -151,7 +181,14 @@ std::optional<std::string> SceneCache::find(const scene::SceneManifest& manifest
   if (!fs::is_directory(copy, error)) return std::nullopt;
   if (verified_ != sha256) {
     const FileCheck checked = check_copy(copy, manifest);
-    if (checked.outcome == Check::differs) fs::remove_all(copy, error);
+    if (checked.outcome == Check::differs) {
+      log_.warn("the cached copy of the scene {}… is spoilt ({}): removed, it is fetched again", sha256.substr(0, 12),
+                checked.problem);
+      fs::remove_all(copy, error);
+    } else if (checked.outcome == Check::unreadable) {
+      log_.warn("the cached copy of the scene {}… cannot be read ({}): left as it is, the scene is fetched",
+                sha256.substr(0, 12), checked.problem);
+    }
     if (checked.outcome != Check::whole) return std::nullopt;
     verified_ = sha256;
   }
@@ -182,13 +219,7 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
   fs::create_directories(folder_, error);
   if (error) return Error{"cannot make the scene cache " + folder_.string() + ": " + describe(error)};
   remove_abandoned_partials(folder_);
-  const std::uintmax_t needed = manifest.total_bytes() + spare_bytes_;
-  make_room(folder_, needed, sha256);
-  const fs::space_info space = fs::space(folder_, error);
-  if (!error && space.available < needed) {
-    return Error{"the scene cache " + folder_.string() + " has " + std::to_string(space.available >> 20) +
-                 " MiB free, the scene needs " + std::to_string(needed >> 20)};
-  }
+  if (auto room = make_room(manifest.total_bytes(), sha256); !room) return Error{room.error()};
   // The lock first: a partial copy without one is taken for abandoned.
   partial_ = folder_ / (sha256 + kPartial + std::to_string(std::random_device{}()) + "-" +
                         std::to_string(std::random_device{}()));
@@ -266,6 +297,33 @@ Result<std::string> SceneCache::commit() {
   manifest_.reset();
   fs::last_write_time(copy, fs::file_time_type::clock::now(), error);
   return (copy / manifest.files.front().path).string();
+}
+
+// Decided before anything is removed: a scene that would not fit even with every
+// other copy gone costs the node none of them.
+Result<void> SceneCache::make_room(std::uintmax_t scene_bytes, const std::string& keep) {
+  const std::uintmax_t needed = scene_bytes + spare_bytes_;
+  const Result<std::uintmax_t> free = free_space_(folder_);
+  if (!free || free.value() >= needed) return {};  // unknown: nothing removed on a guess
+  const std::vector<CachedCopy> copies = copies_by_age(folder_, keep);
+  std::uintmax_t freed = 0;
+  std::size_t removing = 0;
+  while (removing < copies.size() && free.value() + freed < needed) freed += copies[removing++].bytes;
+  const std::string wants = "the scene needs " + mib(needed) + " (" + mib(scene_bytes) + " and " + mib(spare_bytes_) +
+                            " kept free)";
+  if (free.value() + freed < needed) {
+    return Error{"the scene cache " + folder_.string() + " has " + mib(free.value()) + " free, and removing every other copy (" +
+                 std::to_string(copies.size()) + ") would free " + mib(freed) + " more; " + wants +
+                 ": none was removed"};
+  }
+  std::error_code error;
+  for (std::size_t i = 0; i < removing; ++i) fs::remove_all(copies[i].path, error);
+  const Result<std::uintmax_t> after = free_space_(folder_);
+  if (after && after.value() < needed) {
+    return Error{"the scene cache " + folder_.string() + " has " + mib(after.value()) + " free after removing the " +
+                 std::to_string(removing) + " copies used longest ago; " + wants};
+  }
+  return {};
 }
 
 void SceneCache::abandon() {

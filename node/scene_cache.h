@@ -8,10 +8,14 @@
 // nodes of one host may share a folder (even from several containers: the locks,
 // not process ids, tell a partial copy whose node is gone): each writes its own
 // partial copy, and the first to finish puts it in place. When the disk runs
-// short, the copies used longest ago make room.
+// short, the copies used longest ago make room, if removing them would; if not,
+// none is removed and the scene is refused.
+
+#include <spdlog/logger.h>
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -27,8 +31,15 @@ class SceneCache {
   // Room kept free on the disk beyond a scene being fetched.
   static constexpr std::uintmax_t kSpareBytes = 64u << 20;
 
-  // The copies go into `cache_dir`/scenes.
-  explicit SceneCache(const std::filesystem::path& cache_dir, std::uintmax_t spare_bytes = kSpareBytes);
+  // Bytes free for this process on the file system that holds a folder.
+  using FreeSpace = std::function<Result<std::uintmax_t>(const std::filesystem::path&)>;
+  // statvfs(), through std::filesystem::space.
+  [[nodiscard]] static Result<std::uintmax_t> disk_free_space(const std::filesystem::path& folder);
+
+  // The copies go into `cache_dir`/scenes; `log` hears of copies found spoilt.
+  // `free_space` is the disk's, or a test's.
+  SceneCache(const std::filesystem::path& cache_dir, spdlog::logger& log, std::uintmax_t spare_bytes = kSpareBytes,
+             FreeSpace free_space = disk_free_space);
   ~SceneCache();
   SceneCache(const SceneCache&) = delete;
   SceneCache& operator=(const SceneCache&) = delete;
@@ -41,7 +52,8 @@ class SceneCache {
 
   // The glTF of scene `sha256` when the cache holds every file of `manifest`
   // whole (sizes and SHA-256 checked; once per process). A copy seen to differ
-  // is removed, so that it is fetched again; one that cannot be read is left.
+  // is removed, so that it is fetched again; one that cannot be read is left;
+  // either is logged, naming the file and what was wrong with it.
   [[nodiscard]] std::optional<std::string> find(const scene::SceneManifest& manifest, const std::string& sha256);
 
   // For each file of the manifest, which chunks are in the copy being written.
@@ -50,7 +62,9 @@ class SceneCache {
   // scene (a connection lost midway): which chunks it already holds, each
   // checked against the manifest. Removes partial copies whose node is gone,
   // makes room by removing the copies used longest ago, and fails, naming the
-  // folder, when it cannot be written or the disk has no room for the scene.
+  // folder, when it cannot be written or the disk has no room for the scene;
+  // when removing every other copy would not make room either, it removes none
+  // and says how much the scene needs and how much there is.
   [[nodiscard]] Result<Present> begin(const scene::SceneManifest& manifest, const std::string& sha256);
   [[nodiscard]] Result<void> write(std::uint32_t file, std::uint64_t offset, std::string_view data);
   // Every chunk is in (each was checked as it came): the copy put in place; the
@@ -63,8 +77,12 @@ class SceneCache {
   void release_lock();
   void close_file();
 
+  [[nodiscard]] Result<void> make_room(std::uintmax_t needed, const std::string& keep);
+
   std::filesystem::path folder_;
+  spdlog::logger& log_;
   std::uintmax_t spare_bytes_;
+  FreeSpace free_space_;
   // The copy being written, and the lock that says its node is alive.
   std::optional<scene::SceneManifest> manifest_;
   std::string sha256_;

@@ -6,6 +6,7 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/http/span_body.hpp>
 
+#include <algorithm>
 #include <array>
 #include <deque>
 #include <optional>
@@ -47,10 +48,9 @@ class Server::Session : public std::enable_shared_from_this<Session> {
 
   void start() { read_request(); }
 
-  // Over the connection limit: told so, and closed.
-  void refuse_busy() {
-    counters_->refused_busy += 1;
-    Response busy = text_response(503, "too many connections to this status server; try again shortly");
+  // Over a connection limit: told so, and closed.
+  void refuse(std::string why) {
+    Response busy = text_response(503, std::move(why));
     busy.headers.emplace_back("Retry-After", "1");
     refusing_ = true;  // closed once written: lingering is for the clients let in
     write_response(std::move(busy), 11, false);
@@ -61,11 +61,19 @@ class Server::Session : public std::enable_shared_from_this<Session> {
     if (events_.size() >= server_.limits_.max_queued_events) {
       counters_->streams_behind += 1;
       server_.log_.debug("status: closing the event stream to {}: {} events behind", peer_, events_.size());
-      close();
+      reset();
       return;
     }
     events_.push_back(event);
     if (!writing_) write_next_event();
+  }
+
+  // Closed without a goodbye: what the kernel still holds for the client is
+  // dropped now, not kept (for minutes) for a client that does not read.
+  void reset() {
+    beast::error_code ignored;
+    stream_.socket().set_option(asio::socket_base::linger(true, 0), ignored);
+    close();
   }
 
   void close() {
@@ -82,9 +90,54 @@ class Server::Session : public std::enable_shared_from_this<Session> {
     parser_.emplace();
     parser_->header_limit(server_.limits_.max_header_bytes);
     parser_->body_limit(server_.limits_.max_body_bytes);
+    header_bytes_ = 0;
     stream_.expires_after(server_.limits_.request_timeout);
-    bhttp::async_read(stream_, buffer_, *parser_,
-                      [self = shared_from_this()](beast::error_code error, std::size_t) { self->on_request(error); });
+    read_header();
+  }
+
+  // Beast's header_limit bounds what is buffered past the part it has parsed,
+  // not the header: a header of many small fields passed an 8 KiB limit twice
+  // over. So the header is fed to the parser here, never read past the limit,
+  // and counted from the request line to the blank line; Beast reads the body.
+  void read_header() {
+    const std::size_t limit = server_.limits_.max_header_bytes;
+    if (buffer_.size() > 0) {
+      beast::error_code error;
+      const std::size_t used = parser_->put(buffer_.data(), error);
+      buffer_.consume(used);
+      header_bytes_ += used;
+      if (parser_->is_header_done()) {
+        if (header_bytes_ > limit) {
+          on_request(bhttp::error::header_limit);
+          return;
+        }
+        bhttp::async_read(stream_, buffer_, *parser_,
+                          [self = shared_from_this()](beast::error_code e, std::size_t) { self->on_request(e); });
+        return;
+      }
+      if (error && error != bhttp::error::need_more) {
+        on_request(error);
+        return;
+      }
+    }
+    if (header_bytes_ + buffer_.size() >= limit) {
+      on_request(bhttp::error::header_limit);
+      return;
+    }
+    const std::size_t room = limit - header_bytes_ - buffer_.size();
+    stream_.async_read_some(buffer_.prepare(std::min<std::size_t>(room, 4096)),
+                            [self = shared_from_this()](beast::error_code error, std::size_t n) {
+                              self->buffer_.commit(n);
+                              if (error == asio::error::eof) {
+                                const bool nothing = self->header_bytes_ + self->buffer_.size() == 0;
+                                error = nothing ? bhttp::error::end_of_stream : bhttp::error::partial_message;
+                              }
+                              if (error) {
+                                self->on_request(error);
+                                return;
+                              }
+                              self->read_header();
+                            });
   }
 
   void on_request(beast::error_code error) {
@@ -150,6 +203,8 @@ class Server::Session : public std::enable_shared_from_this<Session> {
     response_->set(bhttp::field::server, "optique");
     response_->set(bhttp::field::content_type, response.content_type);
     response_->set(bhttp::field::cache_control, "no-store");
+    response_->set("X-Content-Type-Options", "nosniff");
+    response_->set("X-Frame-Options", "DENY");
     for (const auto& [name, value] : response.headers) response_->set(name, value);
     response_->body() = boost::beast::span<const char>(body_->data(), body_->size());
     response_->prepare_payload();
@@ -201,9 +256,11 @@ class Server::Session : public std::enable_shared_from_this<Session> {
     streaming_ = true;
     counters_->streams += 1;
     server_.streams_[id_] = shared_from_this();  // between events nothing else holds it
+    beast::error_code ignored;
+    stream_.socket().set_option(asio::socket_base::send_buffer_size(server_.limits_.stream_send_buffer), ignored);
     events_.push_back(std::make_shared<const std::string>(
         "HTTP/1.1 200 OK\r\nServer: optique\r\nContent-Type: text/event-stream\r\nCache-Control: no-store\r\n"
-        "Connection: close\r\n\r\n"));
+        "X-Content-Type-Options: nosniff\r\nX-Frame-Options: DENY\r\nConnection: close\r\n\r\n"));
     write_next_event();
   }
 
@@ -220,7 +277,7 @@ class Server::Session : public std::enable_shared_from_this<Session> {
                         if (self->closed_) return;
                         if (error) {
                           if (error == beast::error::timeout) self->counters_->timed_out += 1;
-                          self->close();
+                          self->reset();
                           return;
                         }
                         self->events_.pop_front();
@@ -233,6 +290,7 @@ class Server::Session : public std::enable_shared_from_this<Session> {
   std::uint64_t id_;
   beast::tcp_stream stream_;
   beast::flat_buffer buffer_;
+  std::size_t header_bytes_ = 0;  // of the request being read, parsed so far
   std::string peer_;
   std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
   std::optional<bhttp::response<bhttp::span_body<const char>>> response_;
@@ -246,7 +304,13 @@ class Server::Session : public std::enable_shared_from_this<Session> {
 };
 
 Server::Server(asio::io_context& io, ServerLimits limits, Handler handler, spdlog::logger& log)
-    : io_(io), limits_(limits), handler_(std::move(handler)), log_(log), acceptor_(io), accept_retry_(io) {}
+    : io_(io),
+      limits_(limits),
+      handler_(std::move(handler)),
+      log_(log),
+      acceptor_(io),
+      accept_retry_(io),
+      budget_(limits.max_connections, limits.max_per_address, limits.loopback_reserved) {}
 
 Server::~Server() = default;
 
@@ -272,12 +336,24 @@ void Server::accept_next() {
       accept_failing_ = false;
       counters_->accepted += 1;
       const std::uint64_t id = next_id_++;
+      boost::system::error_code ec;
+      const asio::ip::address peer = socket.remote_endpoint(ec).address();
       auto session = std::make_shared<Session>(*this, id, std::move(socket));
-      if (sessions_.size() >= limits_.max_connections) {
-        session->refuse_busy();  // not counted among the sessions: it only says so
-      } else {
-        sessions_[id] = session;
-        session->start();
+      // One refused is not counted among the sessions: it only says so.
+      switch (ec ? Admission::busy : budget_.admit(peer)) {
+        case Admission::admitted:
+          sessions_[id] = {session, peer};
+          session->start();
+          break;
+        case Admission::busy:
+          counters_->refused_busy += 1;
+          session->refuse("too many connections to this status server; try again shortly");
+          break;
+        case Admission::too_many_from_address:
+          counters_->refused_address += 1;
+          session->refuse("too many connections to this status server from your address (" +
+                          std::to_string(limits_.max_per_address) + "); try again shortly");
+          break;
       }
     } else {
       // Out of file descriptors and the like: again in a moment, not in a spin.
@@ -294,7 +370,10 @@ void Server::accept_next() {
 }
 
 void Server::on_closed(std::uint64_t id) {
-  sessions_.erase(id);
+  if (const auto found = sessions_.find(id); found != sessions_.end()) {
+    budget_.release(found->second.peer);
+    sessions_.erase(found);
+  }
   streams_.erase(id);  // may be the last hold on the session: its caller holds another
 }
 
@@ -303,7 +382,7 @@ void Server::publish(std::shared_ptr<const std::string> data) {
     if (stopped_) return;
     const auto event = std::make_shared<const std::string>("data: " + *data + "\n\n");
     for (auto it = sessions_.begin(); it != sessions_.end();) {
-      const auto session = it->second.lock();
+      const auto session = it->second.session.lock();
       ++it;  // push() may close the session, which erases it
       if (session) session->push(event);
     }
@@ -318,8 +397,8 @@ void Server::stop() {
     acceptor_.close(ignored);
     accept_retry_.cancel();
     std::vector<std::shared_ptr<Session>> open;
-    for (auto& [id, weak] : sessions_) {
-      if (auto session = weak.lock()) open.push_back(std::move(session));
+    for (auto& [id, entry] : sessions_) {
+      if (auto session = entry.session.lock()) open.push_back(std::move(session));
     }
     for (auto& session : open) session->close();
     sessions_.clear();
@@ -332,6 +411,7 @@ ServerCounts Server::counts() const {
   c.accepted = counters_->accepted;
   c.requests = counters_->requests;
   c.refused_busy = counters_->refused_busy;
+  c.refused_address = counters_->refused_address;
   c.timed_out = counters_->timed_out;
   c.too_large = counters_->too_large;
   c.bad_requests = counters_->bad_requests;

@@ -17,6 +17,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 #include <CLI/CLI.hpp>
+#include <spdlog/sinks/null_sink.h>
 
 #include <algorithm>
 #include <chrono>
@@ -214,7 +215,8 @@ int run(const std::string& out, std::size_t mib, int runs) {
     rows.push_back({"optique fetch", optique_fetch(config, cache, dir)});
     {
       sync();
-      node::SceneCache restarted(cache);
+      spdlog::logger quiet("bench", std::make_shared<spdlog::sinks::null_sink_mt>());
+      node::SceneCache restarted(cache, quiet);
       const auto start = Clock::now();
       if (!restarted.find(manifest, identity)) throw std::runtime_error("the fetched copy is not in the cache");
       rows.push_back({"cached copy checked", seconds_since(start)});

@@ -20,10 +20,22 @@ struct HttpReply {
 // or up to the end); `error` set when it is not one.
 [[nodiscard]] HttpReply parse_reply(const std::string& raw);
 
-// A connection to 127.0.0.1:`port`.
+// How a RawClient connects: to which IPv4 address of this machine (another
+// than loopback makes the server see a peer that is not on loopback), and with
+// which receive buffer (SO_RCVBUF; 0: the kernel's, which grows as it likes).
+struct ClientOptions {
+  std::string address = "127.0.0.1";
+  int receive_buffer = 0;
+};
+
+// An IPv4 address of this machine's that is not loopback (an interface that is
+// up); empty when it has none.
+[[nodiscard]] std::string non_loopback_address();
+
+// A connection to `options.address`:`port`.
 class RawClient {
  public:
-  explicit RawClient(int port);
+  explicit RawClient(int port, const ClientOptions& options = {});
   ~RawClient();
   RawClient(const RawClient&) = delete;
   RawClient& operator=(const RawClient&) = delete;

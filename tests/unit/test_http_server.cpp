@@ -1,12 +1,17 @@
-// The status server's shell on real loopback sockets, with small limits so
-// that each takes milliseconds: answers, keep-alive, HEAD, and every limit a
-// client can run into (size, time, connections, a stream left unread).
+// The status server's shell on real sockets, with small limits so that each
+// takes milliseconds: answers, keep-alive, HEAD, and every limit a client can run
+// into (size, time, connections, per address and those kept for loopback, a
+// stream left unread, the kernel's buffer included); and who may connect
+// (http/connection_budget.h), decided without sockets.
 
 #include <gtest/gtest.h>
 #include <spdlog/sinks/null_sink.h>
 
+#include <memory>
 #include <thread>
+#include <vector>
 
+#include "http/connection_budget.h"
 #include "http/server.h"
 #include "http_client.h"
 #include "process.h"
@@ -19,7 +24,7 @@ using testing::RawClient;
 
 class HttpServerTest : public ::testing::Test {
  protected:
-  void start(ServerLimits limits) {
+  void start(ServerLimits limits, const std::string& address = "127.0.0.1") {
     server_.emplace(
         io_, limits,
         [this](const Request& request) {
@@ -33,10 +38,30 @@ class HttpServerTest : public ::testing::Test {
               200, request.method_text + " " + request.path + " " + request.query + " [" + request.authorization + "]");
         },
         log_);
-    auto port = server_->listen("127.0.0.1", 0);
+    auto port = server_->listen(address, 0);
     ASSERT_TRUE(port.ok()) << port.error();
     port_ = port.value();
     thread_ = std::thread([this] { io_.run(); });
+  }
+  // Six connections, the last two kept for loopback, on every address (a client
+  // from this machine's address that is not loopback is not a loopback peer).
+  void start_for_remote_peers(std::size_t per_address) {
+    ServerLimits limits;
+    limits.max_connections = 6;
+    limits.loopback_reserved = 2;
+    limits.max_per_address = per_address;
+    start(limits, "0.0.0.0");
+  }
+  // `count` connections from `remote` that say nothing, as slow clients
+  // re-opened as they close, once the server holds them all.
+  std::vector<std::unique_ptr<RawClient>> hold(const testing::ClientOptions& remote, std::size_t count) {
+    std::vector<std::unique_ptr<RawClient>> held;
+    for (std::size_t i = 0; i < count; ++i) {
+      held.push_back(std::make_unique<RawClient>(port_, remote));
+      EXPECT_TRUE(held.back()->connected());
+    }
+    EXPECT_TRUE(testing::poll_until([&] { return server_->counts().open == count; }, 2s));
+    return held;
   }
   void TearDown() override {
     if (server_) server_->stop();
@@ -161,8 +186,9 @@ TEST_F(HttpServerTest, EventStreamsGetEveryPublishAndAreClosedWhenTheyFallBehind
   std::thread keep_up([&] {
     while (!done && reader_open) reader_open = reader.discard_for(20ms);
   });
-  const auto big = std::make_shared<const std::string>(std::string(1 << 20, 'x'));
-  for (int i = 0; i < 64 && server_->counts().streams_behind == 0; ++i) {
+  // 64 KiB a time: a status is some KiB; the stream's send buffer is 64 KiB.
+  const auto big = std::make_shared<const std::string>(std::string(64 << 10, 'x'));
+  for (int i = 0; i < 200 && server_->counts().streams_behind == 0; ++i) {
     server_->publish(big);
     std::this_thread::sleep_for(10ms);
   }
@@ -171,6 +197,183 @@ TEST_F(HttpServerTest, EventStreamsGetEveryPublishAndAreClosedWhenTheyFallBehind
   done = true;
   keep_up.join();
   EXPECT_TRUE(reader_open);
+}
+
+TEST_F(HttpServerTest, TheHeaderLimitCountsTheWholeHeader) {
+  ServerLimits limits;
+  limits.max_header_bytes = 1024;
+  start(limits);
+  // Many small fields, sent in pieces as they would trickle in: Beast alone
+  // bounded only what it had not parsed yet, and let twice the limit through.
+  const std::string start_line = "GET /small HTTP/1.1\r\nHost: x\r\n";
+  std::string fields;
+  for (int i = 0; fields.size() < 2000; ++i) fields += "X-" + std::to_string(i) + ": y\r\n";
+  RawClient trickled(port_);
+  ASSERT_TRUE(trickled.send(start_line));
+  for (std::size_t at = 0; at < fields.size(); at += 100) {
+    ASSERT_TRUE(trickled.send(fields.substr(at, 100)));
+    std::this_thread::sleep_for(2ms);
+  }
+  (void)trickled.send("\r\n");
+  const testing::HttpReply refused = testing::parse_reply(trickled.read_until_closed(2s));
+  EXPECT_EQ(refused.status, 431) << refused.body;
+  EXPECT_NE(refused.body.find("the limit is 1024 bytes"), std::string::npos) << refused.body;
+  // Exactly the limit, from the request line to the blank line: taken; a byte more: not.
+  const auto header_of = [&](std::size_t bytes) {
+    std::string header = "GET /exact HTTP/1.1\r\nHost: x\r\nX-Pad: ";
+    header += std::string(bytes - header.size() - 4, 'p');
+    return header + "\r\n\r\n";
+  };
+  ASSERT_EQ(header_of(1024).size(), 1024u);
+  RawClient exact(port_);
+  ASSERT_TRUE(exact.send(header_of(1024)));
+  EXPECT_EQ(exact.read_reply(2s).status, 200);
+  RawClient over(port_);
+  ASSERT_TRUE(over.send(header_of(1025)));
+  EXPECT_EQ(testing::parse_reply(over.read_until_closed(2s)).status, 431);
+  // Requests kept alive and pipelined are each counted on their own.
+  RawClient pipelined(port_);
+  ASSERT_TRUE(pipelined.send(header_of(1000) + header_of(1000)));
+  EXPECT_EQ(pipelined.read_reply(2s).status, 200);
+  EXPECT_EQ(pipelined.read_reply(2s).status, 200);
+  EXPECT_EQ(server_->counts().too_large, 2u);
+}
+
+TEST_F(HttpServerTest, EveryAnswerForbidsFramingAndSniffing) {
+  ServerLimits limits;
+  limits.max_connections = 1;
+  start(limits);
+  RawClient kept(port_);
+  ASSERT_TRUE(kept.send("GET / HTTP/1.1\r\nHost: x\r\n\r\n"));
+  const testing::HttpReply answered = kept.read_reply(2s);
+  EXPECT_EQ(answered.status, 200);
+  RawClient refused_client(port_);
+  const testing::HttpReply refused = testing::parse_reply(refused_client.read_until_closed(2s));
+  EXPECT_EQ(refused.status, 503);
+  for (const auto& reply : {answered, refused}) {
+    EXPECT_EQ(reply.headers.count("x-frame-options") ? reply.headers.at("x-frame-options") : "", "DENY");
+    EXPECT_EQ(reply.headers.count("x-content-type-options") ? reply.headers.at("x-content-type-options") : "",
+              "nosniff");
+  }
+  ASSERT_TRUE(kept.send("GET /events HTTP/1.1\r\nHost: x\r\n\r\n"));
+  ASSERT_TRUE(kept.read_until("\r\n\r\n", 2s));
+  const std::string stream_head = kept.received();
+  EXPECT_NE(stream_head.find("X-Frame-Options: DENY\r\n"), std::string::npos) << stream_head;
+  EXPECT_NE(stream_head.find("X-Content-Type-Options: nosniff\r\n"), std::string::npos) << stream_head;
+}
+
+// A stream whose client never reads holds little: its socket's send buffer is
+// kept small, the queue behind it is bounded, and closing it drops what the
+// kernel held. Before, the kernel took up to 4 MiB for it first, minutes of
+// updates, before the queue even began to grow.
+TEST_F(HttpServerTest, AStreamThatIsNeverReadIsClosedBeforeItHoldsMuch) {
+  ServerLimits limits;
+  limits.max_queued_events = 8;
+  limits.write_timeout = 10s;  // the queue, not the time, closes it here
+  start(limits);
+  testing::ClientOptions small;
+  small.receive_buffer = 4096;
+  RawClient stuck(port_, small);
+  ASSERT_TRUE(stuck.send("GET /events HTTP/1.1\r\nHost: x\r\n\r\n"));
+  ASSERT_TRUE(testing::poll_until([&] { return server_->counts().streams == 1; }, 2s));
+  const auto event = std::make_shared<const std::string>(std::string(1024, 'e'));
+  std::size_t published = 0;
+  const auto deadline = std::chrono::steady_clock::now() + 8s;
+  while (server_->counts().streams_behind == 0 && std::chrono::steady_clock::now() < deadline) {
+    // In bursts the size of the queue, each given time to reach the socket.
+    for (int i = 0; i < 8; ++i) server_->publish(event);
+    published += 8;
+    std::this_thread::sleep_for(5ms);
+  }
+  ASSERT_EQ(server_->counts().streams_behind, 1u) << published << " events of 1 KiB published";
+  // 64 KiB of send buffer (32 KiB doubled), the client's few KiB, the queue,
+  // and a burst in flight: well under 512 KiB. It was about 4 MiB.
+  EXPECT_LT(published * 1030, 512u << 10) << published << " events of 1 KiB published before it was closed";
+  EXPECT_TRUE(stuck.closed_within(2s));
+}
+
+TEST_F(HttpServerTest, APeerNotOnLoopbackIsHeldToItsShareAndLoopbackAlwaysGetsIn) {
+  testing::ClientOptions remote;
+  remote.address = testing::non_loopback_address();
+  if (remote.address.empty()) GTEST_SKIP() << "this machine has no address but loopback";
+  start_for_remote_peers(3);
+  const auto held = hold(remote, 3);
+  RawClient fourth(port_, remote);
+  const testing::HttpReply crowded = testing::parse_reply(fourth.read_until_closed(2s));
+  EXPECT_EQ(crowded.status, 503);
+  EXPECT_NE(crowded.body.find("from your address (3)"), std::string::npos) << crowded.body;
+  EXPECT_EQ(server_->counts().refused_address, 1u);
+  // Loopback is not held to the share: it fills the rest, the kept slots too.
+  std::vector<std::unique_ptr<RawClient>> local;
+  for (int i = 0; i < 3; ++i) {
+    local.push_back(std::make_unique<RawClient>(port_));
+    ASSERT_TRUE(local.back()->send("GET / HTTP/1.1\r\nHost: x\r\n\r\n"));
+    EXPECT_EQ(local.back()->read_reply(2s).status, 200) << i;
+  }
+  RawClient over(port_);
+  EXPECT_EQ(testing::parse_reply(over.read_until_closed(2s)).status, 503) << "six are open";
+  EXPECT_EQ(server_->counts().refused_busy, 1u);
+}
+
+TEST_F(HttpServerTest, TheLastSlotsAreKeptForLoopback) {
+  testing::ClientOptions remote;
+  remote.address = testing::non_loopback_address();
+  if (remote.address.empty()) GTEST_SKIP() << "this machine has no address but loopback";
+  start_for_remote_peers(16);
+  auto held = hold(remote, 4);
+  RawClient fifth(port_, remote);
+  EXPECT_EQ(testing::parse_reply(fifth.read_until_closed(2s)).status, 503) << "the last two are loopback's";
+  EXPECT_EQ(server_->counts().refused_busy, 1u);
+  // The operator on the master's machine still gets in, twice.
+  EXPECT_EQ(testing::http_request(port_, "GET", "/").status, 200);
+  RawClient a(port_);
+  RawClient b(port_);
+  ASSERT_TRUE(a.send("GET / HTTP/1.1\r\nHost: x\r\n\r\n"));
+  ASSERT_TRUE(b.send("GET / HTTP/1.1\r\nHost: x\r\n\r\n"));
+  EXPECT_EQ(a.read_reply(2s).status, 200);
+  EXPECT_EQ(b.read_reply(2s).status, 200);
+  // A remote slot freed is a remote slot again.
+  held.pop_back();
+  ASSERT_TRUE(testing::poll_until([&] { return server_->counts().open == 5; }, 2s));
+  RawClient again(port_, remote);
+  ASSERT_TRUE(again.send("GET / HTTP/1.1\r\nHost: x\r\n\r\n"));
+  EXPECT_EQ(again.read_reply(2s).status, 200);
+}
+
+TEST(ConnectionBudget, OneAddressGetsItsShareAndAnIpv6Slash64CountsAsOne) {
+  namespace ip = boost::asio::ip;
+  ConnectionBudget budget(100, 2, 8);
+  const auto a = ip::make_address("192.0.2.7");
+  EXPECT_EQ(budget.admit(a), Admission::admitted);
+  EXPECT_EQ(budget.admit(ip::make_address("::ffff:192.0.2.7")), Admission::admitted) << "the same, mapped";
+  EXPECT_EQ(budget.admit(a), Admission::too_many_from_address);
+  EXPECT_EQ(budget.admit(ip::make_address("192.0.2.8")), Admission::admitted);
+  budget.release(a);
+  EXPECT_EQ(budget.admit(a), Admission::admitted) << "released: room again";
+  EXPECT_EQ(budget.admit(ip::make_address("2001:db8:1:2::1")), Admission::admitted);
+  EXPECT_EQ(budget.admit(ip::make_address("2001:db8:1:2:ffff::9")), Admission::admitted);
+  EXPECT_EQ(budget.admit(ip::make_address("2001:db8:1:2::3")), Admission::too_many_from_address) << "one /64";
+  EXPECT_EQ(budget.admit(ip::make_address("2001:db8:1:3::1")), Admission::admitted) << "another /64";
+  for (int i = 0; i < 20; ++i) {
+    EXPECT_EQ(budget.admit(ip::make_address(i % 2 == 0 ? "127.0.0.1" : "::1")), Admission::admitted);
+  }
+  EXPECT_EQ(budget.admit(ip::make_address("::ffff:127.0.0.5")), Admission::admitted) << "loopback, mapped";
+  EXPECT_EQ(budget.open(), 27u);
+}
+
+TEST(ConnectionBudget, TheLastSlotsAreLoopbacksAndAtMostHalf) {
+  namespace ip = boost::asio::ip;
+  ConnectionBudget budget(10, 100, 3);
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_EQ(budget.admit(ip::make_address("198.51.100." + std::to_string(i))), Admission::admitted);
+  }
+  EXPECT_EQ(budget.admit(ip::make_address("198.51.100.99")), Admission::busy);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(budget.admit(ip::make_address("127.0.0.1")), Admission::admitted);
+  EXPECT_EQ(budget.admit(ip::make_address("127.0.0.1")), Admission::busy) << "all ten taken";
+  ConnectionBudget small(2, 100, 8);
+  EXPECT_EQ(small.admit(ip::make_address("198.51.100.1")), Admission::admitted) << "one of two kept, not both";
+  EXPECT_EQ(small.admit(ip::make_address("198.51.100.2")), Admission::busy);
+  EXPECT_EQ(small.admit(ip::make_address("127.0.0.1")), Admission::admitted);
 }
 
 }  // namespace

@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+#include <functional>
+#include <limits>
 #include <regex>
 #include <sstream>
 
@@ -129,6 +132,92 @@ TEST(LiveStatus, MetricsAreWellFormedPrometheusText) {
   EXPECT_NE(text.find("optique_state{state=\"running\"} 1\n"), std::string::npos);
   EXPECT_NE(text.find("optique_tracker_state{state=\"tracking\"} 1\n"), std::string::npos);
   EXPECT_NE(text.find("optique_present_skew_seconds{quantile=\"0.5\"} 4e-05\n"), std::string::npos) << text;
+}
+
+// A node that reports absurd numbers (an authenticated one, broken or hostile):
+// nothing of its in /metrics or /status.json is infinite, huge or NaN (but a
+// quantile with no sample, which Prometheus writes so).
+TEST(LiveStatus, AbsurdReportsReachNeitherTheMetricsNorTheJson) {
+  constexpr clock::Nanos kHuge = std::numeric_limits<clock::Nanos>::max();
+  RunRecorder recorder({"left", "right"}, nullptr);
+  recorder.frame_begun(1, 1000 * kMs, {0, 1});
+  recorder.ready(1, 0, 1001 * kMs, kHuge);
+  recorder.ready(1, 1, 1001 * kMs, 2 * kMs);
+  recorder.swapped(1, 1002 * kMs, {0, 1});
+  recorder.presented(1, 0, -kHuge, 1);
+  recorder.presented(1, 1, 1010 * kMs, 1);
+  report::ClockReport clock;
+  clock.set_drift_ppm(std::numeric_limits<double>::quiet_NaN());
+  clock.set_offset_ns(kHuge);
+  clock.set_round_trip_ns(kHuge);
+  clock.set_error_bound_ns(kHuge);
+  recorder.clock_estimated(1, 0, clock, std::nullopt);
+  clock.set_drift_ppm(std::numeric_limits<double>::infinity());
+  recorder.clock_estimated(1, 1, clock, std::nullopt);
+  recorder.finalize_all();
+
+  LiveStatus s = two_nodes();
+  for (std::size_t n = 0; n < 2; ++n) s.nodes[n].counts = recorder.node_counts(n);
+  summarize_recent(recorder.recent(), 1100 * kMs, s);
+
+  const std::string text = status_metrics(s);
+  std::istringstream lines(text);
+  std::size_t node_samples = 0;
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("optique_node_", 0) != 0) continue;
+    ++node_samples;
+    const std::string value = line.substr(line.rfind(' ') + 1);
+    if (value == "NaN") {
+      EXPECT_NE(line.find("quantile="), std::string::npos) << "only a quantile with no sample: " << line;
+      continue;
+    }
+    const double number = std::stod(value);
+    EXPECT_TRUE(std::isfinite(number)) << line;
+    EXPECT_LT(std::abs(number), 1e6) << line;
+  }
+  EXPECT_GT(node_samples, 20u);
+  EXPECT_NE(text.find("optique_node_out_of_range_total{projector=\"left\"} 3\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("optique_node_out_of_range_total{projector=\"right \\\"quoted\\\"\"} 1\n"),
+            std::string::npos)
+      << text;
+  EXPECT_NE(text.find("optique_node_render_seconds_count{projector=\"left\"} 0\n"), std::string::npos) << text;
+
+  // JSON has no NaN (nlohmann writes it null) and no infinity: look for huge numbers.
+  const auto doc = nlohmann::json::parse(status_json(s));
+  std::function<void(const nlohmann::json&, const std::string&)> walk = [&](const nlohmann::json& j,
+                                                                            const std::string& at) {
+    if (j.is_structured()) {
+      for (auto it = j.begin(); it != j.end(); ++it) walk(*it, at + "/" + (j.is_object() ? it.key() : "[]"));
+    } else if (j.is_number()) {
+      EXPECT_TRUE(std::isfinite(j.get<double>())) << at;
+      EXPECT_LT(std::abs(j.get<double>()), 1e7) << at;
+    }
+  };
+  walk(doc, "");
+  EXPECT_TRUE(doc["nodes"][0]["clock"]["drift_ppm"].is_number()) << doc["nodes"][0]["clock"];
+  EXPECT_EQ(doc["nodes"][0]["out_of_range"], 3);
+}
+
+// Text from peers (a warning the log repeats, whose peer-given parts the logger
+// has escaped already) and odd ids cannot break the JSON's one line or the
+// metrics' lines.
+TEST(LiveStatus, OddTextStaysInsideItsJsonStringAndItsMetricsLabel) {
+  LiveStatus s = two_nodes();
+  s.nodes[0].id = "new\nline \\ back";
+  s.warnings.push_back({"12:00:00", "</script><script>alert(1)</script>\n\x1b[31m\xc3"});
+  const std::string json_text = status_json(s);
+  EXPECT_EQ(json_text.find('\n'), std::string::npos);
+  EXPECT_EQ(json_text.find('\x1b'), std::string::npos);
+  const auto doc = nlohmann::json::parse(json_text);
+  EXPECT_EQ(doc["nodes"][0]["id"], "new\nline \\ back");
+  EXPECT_EQ(doc["warnings"][0]["text"].get<std::string>().rfind("</script><script>alert(1)</script>\n\x1b[31m", 0),
+            0u);
+  const std::string text = status_metrics(s);
+  EXPECT_NE(text.find("optique_node_up{projector=\"new\\nline \\\\ back\"} 1\n"), std::string::npos) << text;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    EXPECT_TRUE(line.rfind("optique_", 0) == 0 || line.rfind("# ", 0) == 0) << "a line of its own: " << line;
+  }
 }
 
 }  // namespace

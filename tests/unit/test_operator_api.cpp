@@ -1,9 +1,13 @@
 // The status server's answers, decided without a network: which path gives
-// what, which method is allowed, and who may read or control.
+// what, which method is allowed, and who may read or control; and the page's
+// Content-Security-Policy (master/page_policy.h).
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "master/operator_api.h"
+#include "master/page_policy.h"
 #include "master/status_metrics.h"
 
 namespace optique::master {
@@ -22,7 +26,8 @@ http::Request request(http::Method method, const std::string& path, const std::s
 }
 
 StatusTexts published() {
-  return {std::make_shared<const std::string>("<html>page</html>"), std::make_shared<const std::string>("{\"a\":1}"),
+  return {std::make_shared<const std::string>("<html>page</html>"),
+          std::make_shared<const std::string>("default-src 'none'"), std::make_shared<const std::string>("{\"a\":1}"),
           std::make_shared<const std::string>("optique_up 1\n")};
 }
 
@@ -70,6 +75,14 @@ TEST(OperatorApi, OpenReadsRefuseAForeignHost) {
   EXPECT_NE(r.response.body->find("Host 'attacker.example:7480'"), std::string::npos);
   rebound.authorization = "Bearer " + kToken;
   EXPECT_EQ(route(rebound, kBeyondLoopback, texts).response.status, 200u) << "with the token, any name";
+  // Names that begin or end like this machine's are not it.
+  for (const char* host : {"localhost.attacker.example", "localhost.attacker.example:7480", "127.0.0.1.attacker.example",
+                           "attacker.localhost.example", "localhostx", "[::1].attacker.example", "[::1]x:7480",
+                           "attacker.example:localhost", "localhost:7480@attacker.example"}) {
+    http::Request foreign = request(http::Method::get, "/status.json");
+    foreign.host = host;
+    EXPECT_EQ(route(foreign, kLoopback, texts).response.status, 403u) << host;
+  }
 }
 
 TEST(OperatorApi, BeyondLoopbackDataNeedsTheToken) {
@@ -90,11 +103,56 @@ TEST(OperatorApi, BeyondLoopbackDataNeedsTheToken) {
         << path << ": a token one character short";
     EXPECT_EQ(route(request(http::Method::get, path, "Basic " + kToken), kBeyondLoopback, texts).response.status, 401u)
         << path << ": another scheme";
+    for (const std::string& longer : {kToken + "a", kToken + "0", kToken + " " + kToken, kToken + "\t", kToken + ",x",
+                                      kToken + std::string(1, '\0')}) {
+      EXPECT_EQ(route(request(http::Method::get, path, "Bearer " + longer), kBeyondLoopback, texts).response.status,
+                401u)
+          << path << ": the token with more after it (" << longer.size() << " characters)";
+    }
     r = route(request(http::Method::get, path, "bearer  " + kToken + " "), kBeyondLoopback, texts);
     EXPECT_TRUE(r.response.status == 200u || r.response.event_stream) << path << ": the scheme in any case";
   }
   // The page holds no data: it is served to anyone, and asks for the token.
   EXPECT_EQ(route(request(http::Method::get, "/"), kBeyondLoopback, texts).response.status, 200u);
+}
+
+TEST(OperatorApi, ControlsRefuseATokenWithMoreAfterIt) {
+  const StatusTexts texts = published();
+  const Routed r = route(request(http::Method::post, "/control/stop", "Bearer " + kToken + "x"), kLoopback, texts);
+  EXPECT_EQ(r.response.status, 401u);
+  EXPECT_FALSE(r.command);
+}
+
+TEST(OperatorApi, ThePageIsServedWithItsSecurityPolicy) {
+  const StatusTexts texts = published();
+  const Routed r = route(request(http::Method::get, "/"), kBeyondLoopback, texts);
+  ASSERT_EQ(r.response.status, 200u);
+  const auto policy = std::find_if(r.response.headers.begin(), r.response.headers.end(),
+                                   [](const auto& header) { return header.first == "Content-Security-Policy"; });
+  ASSERT_NE(policy, r.response.headers.end());
+  EXPECT_EQ(policy->second, *texts.page_policy);
+}
+
+// The hashes, worked out apart (python3: base64 of hashlib.sha256(text)), of
+// exactly what stands between the tags.
+TEST(PagePolicy, AllowsThePagesOwnScriptAndStyleByHashAndNothingElse) {
+  const std::string policy =
+      page_security_policy("<!doctype html><style> p { color: red; } </style><p>x</p><script>alert(1)</script>");
+  EXPECT_NE(policy.find("script-src 'sha256-bhHHL3z2vDgxUt0W3dWQOrprscmda2Y5pLsLg4GF+pI=';"), std::string::npos)
+      << policy;
+  EXPECT_NE(policy.find("style-src 'sha256-u/blH8m0r/Q1cgkpEic0SpNGAC4pqGOrjgBEon2/AYo=';"), std::string::npos)
+      << policy;
+  EXPECT_EQ(policy.rfind("default-src 'none';", 0), 0u) << policy;
+  EXPECT_NE(policy.find("connect-src 'self'"), std::string::npos) << policy;
+  EXPECT_NE(policy.find("frame-ancestors 'none'"), std::string::npos) << policy;
+  EXPECT_EQ(policy.find("unsafe"), std::string::npos) << policy;
+  const std::string none = page_security_policy("<p>no script</p>");
+  EXPECT_NE(none.find("script-src 'none';"), std::string::npos) << none;
+  EXPECT_NE(none.find("style-src 'none';"), std::string::npos) << none;
+  const std::string two = page_security_policy("<script>a</script><script type=\"module\">b</script>");
+  std::size_t hashes = 0;
+  for (std::size_t at = two.find("'sha256-"); at != std::string::npos; at = two.find("'sha256-", at + 1)) ++hashes;
+  EXPECT_EQ(hashes, 2u) << "each script, attributes or not: " << two;
 }
 
 TEST(OperatorApi, ControlsAlwaysNeedTheToken) {

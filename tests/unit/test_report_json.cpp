@@ -9,6 +9,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "master/run_recorder.h"
+
 namespace optique::master {
 namespace {
 
@@ -57,6 +63,40 @@ TEST(ReportJson, ReadsBackIntoTheSameReport) {
   report::RunReport read;
   ASSERT_TRUE(google::protobuf::util::JsonStringToMessage(report_json(written), &read).ok());
   EXPECT_TRUE(google::protobuf::util::MessageDifferencer::Equals(written, read)) << read.DebugString();
+}
+
+// A node that reports absurd numbers: run.json holds no NaN, infinity or number
+// near 2^63 from it (Protobuf would print "NaN" and 9223372036854775807), only
+// the count of what was left out.
+TEST(ReportJson, AbsurdReportsDoNotReachRunJson) {
+  constexpr std::int64_t kHuge = std::numeric_limits<std::int64_t>::max();
+  RunRecorder recorder({"a", "b"}, nullptr);
+  recorder.frame_begun(1, 1'000'000'000, {0, 1});
+  recorder.ready(1, 0, 1'000'100'000, kHuge);
+  recorder.ready(1, 1, 1'000'100'000, 300'000);
+  recorder.swapped(1, 1'000'200'000, {0, 1});
+  recorder.presented(1, 0, -kHuge - 1, 1);
+  recorder.presented(1, 1, 1'002'000'000, 1);
+  report::ClockReport clock;
+  clock.set_drift_ppm(std::numeric_limits<double>::quiet_NaN());
+  clock.set_offset_ns(kHuge);
+  recorder.clock_estimated(1, 0, clock, kHuge);
+  recorder.finalize_all();
+  const std::string text = report_json(recorder.report());
+  EXPECT_EQ(text.find("NaN"), std::string::npos) << text;
+  EXPECT_EQ(text.find("Infinity"), std::string::npos) << text;
+  const nlohmann::json json = nlohmann::json::parse(text);
+  std::function<void(const nlohmann::json&, const std::string&)> walk = [&](const nlohmann::json& j,
+                                                                            const std::string& at) {
+    if (j.is_structured()) {
+      for (auto it = j.begin(); it != j.end(); ++it) walk(*it, at + "/" + (j.is_object() ? it.key() : "[]"));
+    } else if (j.is_number()) {
+      EXPECT_LT(std::abs(j.get<double>()), 1e12) << at << " in " << text;
+    }
+  };
+  walk(json, "");
+  EXPECT_EQ(json["nodes"][0]["out_of_range"].get<std::uint64_t>(), 3u);
+  EXPECT_EQ(json["nodes"][1]["out_of_range"].get<std::uint64_t>(), 0u);
 }
 
 }  // namespace

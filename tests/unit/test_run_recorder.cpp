@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -216,6 +218,103 @@ TEST(RunRecorder, DuplicateAndUnknownEventsAreIgnored) {
   EXPECT_EQ(rep.nodes(0).hash_mismatches(), 2u);
   EXPECT_EQ(rep.sync().present_skew_us().count(), 0u) << "one node has no skew";
   EXPECT_EQ(rep.sync().frames_with_missing_node(), 0u);
+}
+
+// --- what a node reports is bounded at the recorder's door
+
+constexpr clock::Nanos kHuge = std::numeric_limits<clock::Nanos>::max();
+constexpr clock::Nanos kHugeNegative = std::numeric_limits<clock::Nanos>::min();
+
+TEST(RunRecorder, AbsurdRenderTimesAreCountedNotRecorded) {
+  RunRecorder r({"a", "b", "c"}, nullptr);
+  r.frame_begun(1, 1'000'000'000, {0, 1, 2});
+  r.ready(1, 0, 1'000'100'000, kHuge, wire::DRAWN_KEY);
+  r.ready(1, 1, 1'000'100'000, -5);
+  r.ready(1, 2, 1'000'100'000, kLongestRender);  // a minute: slow, not absurd
+  r.finalize_all();
+  const report::RunReport rep = r.report();
+  for (int n = 0; n < 2; ++n) {
+    EXPECT_EQ(rep.nodes(n).frames_rendered(), 1u) << "it did say it was ready";
+    EXPECT_EQ(rep.nodes(n).render_us().count(), 0u);
+    EXPECT_EQ(rep.nodes(n).out_of_range(), 1u);
+    EXPECT_EQ(r.node_counts(static_cast<std::size_t>(n)).render_us_sum, 0.0);
+    EXPECT_EQ(r.node_counts(static_cast<std::size_t>(n)).render_times, 0u);
+    EXPECT_LT(r.recent().back().render_us[static_cast<std::size_t>(n)], 0.0F) << "charted as not rendered";
+  }
+  EXPECT_EQ(rep.nodes(0).up_conversion().key_frames_total(), 1u) << "still a key frame";
+  EXPECT_EQ(rep.nodes(0).up_conversion().key_render_us().count(), 0u);
+  EXPECT_EQ(rep.nodes(2).out_of_range(), 0u);
+  EXPECT_NEAR(rep.nodes(2).render_us().max(), 60e6, kTolUs);
+  EXPECT_EQ(r.node_counts(2).render_times, 1u);
+}
+
+TEST(RunRecorder, PresentTimesFarFromTheSwapAreCountedNotRecorded) {
+  std::ostringstream csv;
+  RunRecorder r({"a", "b", "c", "d"}, &csv);
+  const clock::Nanos swap = 2'000'000'000;
+  r.frame_begun(3, 1'990'000'000, {0, 1, 2, 3});
+  r.swapped(3, swap, {0, 1, 2, 3});
+  r.presented(3, 0, kHuge, 3);
+  r.presented(3, 1, kHugeNegative, 3);
+  r.presented(3, 2, swap + kFarthestPresent + 1, 3);
+  r.presented(3, 3, swap - kFarthestPresent, 3);  // at the bound: recorded
+  r.presented(3, 2, swap + 1'000'000, 3);         // then a plausible one: taken
+  r.finalize_all();
+  const report::RunReport rep = r.report();
+  EXPECT_EQ(rep.nodes(0).frames_presented(), 0u);
+  EXPECT_EQ(rep.nodes(0).out_of_range(), 1u);
+  EXPECT_EQ(rep.nodes(1).out_of_range(), 1u);
+  EXPECT_EQ(rep.nodes(2).out_of_range(), 1u);
+  EXPECT_EQ(rep.nodes(2).frames_presented(), 1u);
+  EXPECT_EQ(rep.nodes(3).out_of_range(), 0u);
+  // Skew between the two in bounds only: 61 s, not 2^64 ns.
+  EXPECT_NEAR(rep.sync().present_skew_us().max(), 60e6 + 1e3, kTolUs);
+  EXPECT_EQ(rep.sync().frames_incoherent(), 1u) << "a and b were told to swap and said nothing usable";
+  const auto lines = lines_of(csv.str());
+  ASSERT_EQ(lines.size(), 5u);
+  EXPECT_EQ(lines[1], "3,a,1990000000,,2000000000,");
+  EXPECT_EQ(lines[2], "3,b,1990000000,,2000000000,");
+}
+
+TEST(RunRecorder, ImplausibleClockEstimatesAreCountedAndThePreviousKept) {
+  RunRecorder r({"a"}, nullptr);
+  report::ClockReport good;
+  good.set_offset_ns(-50'000'000);
+  good.set_drift_ppm(12.5);
+  good.set_round_trip_ns(8'000);
+  good.set_error_bound_ns(4'000);
+  r.clock_estimated(1, 0, good, std::nullopt);
+  std::vector<std::pair<const char*, report::ClockReport>> bad;
+  for (const double drift : {std::nan(""), std::numeric_limits<double>::infinity(),
+                             -std::numeric_limits<double>::infinity(), 2e4, -1e4 - 1}) {
+    bad.emplace_back("drift", good);
+    bad.back().second.set_drift_ppm(drift);
+  }
+  bad.emplace_back("offset", good);
+  bad.back().second.set_offset_ns(kHuge);
+  bad.emplace_back("offset", good);
+  bad.back().second.set_offset_ns(kHugeNegative);
+  bad.emplace_back("round trip", good);
+  bad.back().second.set_round_trip_ns(-1);
+  bad.emplace_back("round trip", good);
+  bad.back().second.set_round_trip_ns(kHuge);
+  bad.emplace_back("error bound", good);
+  bad.back().second.set_error_bound_ns(kHuge);
+  for (const auto& [what, clock] : bad) {
+    r.clock_estimated(1, 0, clock, std::nullopt);
+    EXPECT_EQ(r.node_counts(0).clock.drift_ppm(), 12.5) << what;
+    EXPECT_EQ(r.node_counts(0).clock.offset_ns(), -50'000'000) << what;
+    EXPECT_EQ(r.node_counts(0).clock.round_trip_ns(), 8'000) << what;
+    EXPECT_EQ(r.node_counts(0).clock.error_bound_ns(), 4'000) << what;
+  }
+  r.clock_estimated(1, 0, good, kHugeNegative);  // the test hook's true error, too
+  EXPECT_EQ(r.node_counts(0).out_of_range, bad.size() + 1);
+  report::ClockReport next = good;
+  next.set_drift_ppm(-kLargestDriftPpm);
+  next.set_offset_ns(kLargestClockOffset);
+  r.clock_estimated(1, 0, next, std::nullopt);
+  EXPECT_EQ(r.node_counts(0).clock.drift_ppm(), -kLargestDriftPpm) << "at the bounds: taken";
+  EXPECT_EQ(r.report().nodes(0).out_of_range(), bad.size() + 1);
 }
 
 TEST(RunRecorder, EmptyRunReport) {

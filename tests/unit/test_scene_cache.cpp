@@ -2,11 +2,15 @@
 // system under a temporary folder: a copy is written and put in place; a spoilt
 // copy is not used; a copy cut short goes on from the chunks it holds; partial
 // copies whose node is gone (no one holds their lock) go; when the disk is short
-// (a small tmpfs, where this runs as root) the copies used longest ago make room.
+// (a small tmpfs, where this runs as root, or a disk of a given size the test
+// hands in) the copies used longest ago make room, and none goes when that
+// would not make room anyway.
 
 #include "node/scene_cache.h"
 
 #include <gtest/gtest.h>
+#include <spdlog/sinks/null_sink.h>
+#include <spdlog/sinks/ostream_sink.h>
 #include <sys/mount.h>
 #include <unistd.h>
 
@@ -16,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include "scene/manifest.h"
 
@@ -66,6 +71,33 @@ class SceneCacheTest : public ::testing::Test {
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   }
 
+  // Copies of other scenes, `bytes` each, in `folder`/scenes: the first used
+  // longest ago.
+  static std::vector<fs::path> other_copies(const fs::path& folder, std::size_t count, std::size_t bytes) {
+    std::vector<fs::path> copies;
+    const auto now = fs::file_time_type::clock::now();
+    for (std::size_t i = 0; i < count; ++i) {
+      copies.push_back(folder / "scenes" / std::string(64, static_cast<char>('a' + i)));
+      fs::create_directories(copies.back() / "maps");
+      std::ofstream(copies.back() / "maps" / "big.bin", std::ios::binary) << std::string(bytes, 'x');
+      fs::last_write_time(copies.back(), now - std::chrono::hours(10 - static_cast<int>(i)));
+    }
+    return copies;
+  }
+
+  // A disk of `capacity` bytes that holds what is under dir_ and nothing else.
+  SceneCache::FreeSpace disk_of(std::uintmax_t capacity) const {
+    return [this, capacity](const fs::path&) -> Result<std::uintmax_t> {
+      std::uintmax_t used = 0;
+      for (const auto& entry : fs::recursive_directory_iterator(dir_)) {
+        if (entry.is_regular_file()) used += entry.file_size();
+      }
+      return used >= capacity ? 0 : capacity - used;
+    };
+  }
+
+  std::ostringstream log_text_;
+  spdlog::logger log_{"node", std::make_shared<spdlog::sinks::ostream_sink_st>(log_text_)};
   fs::path dir_;
   std::string gltf_ = R"({"asset":{"version":"2.0"}})";
   std::string bin_ = std::string(10000, '\x61');
@@ -75,7 +107,7 @@ class SceneCacheTest : public ::testing::Test {
 };
 
 TEST_F(SceneCacheTest, AFetchedCopyIsPutInPlaceAndFoundAgainAfterARestart) {
-  SceneCache cache(dir_);
+  SceneCache cache(dir_, log_);
   EXPECT_EQ(cache.folder(), dir_ / "scenes");
   EXPECT_FALSE(cache.find(files_, sha_).has_value());
   auto stored = fetch(cache);
@@ -83,25 +115,43 @@ TEST_F(SceneCacheTest, AFetchedCopyIsPutInPlaceAndFoundAgainAfterARestart) {
   EXPECT_EQ(stored.value(), (dir_ / "scenes" / sha_ / "s.gltf").string());
   EXPECT_EQ(read(dir_ / "scenes" / sha_ / "maps/s.bin"), bin_);
   EXPECT_EQ(entries_in_scenes(), 1) << "no partial copy or lock is left beside it";
-  SceneCache restarted(dir_);
+  SceneCache restarted(dir_, log_);
   EXPECT_EQ(restarted.find(files_, sha_), stored.value());
 }
 
 TEST_F(SceneCacheTest, ASpoiltCopyIsNotUsedButRemoved) {
-  SceneCache cache(dir_);
+  SceneCache cache(dir_, log_);
   ASSERT_TRUE(fetch(cache).ok());
   {
     std::fstream file(dir_ / "scenes" / sha_ / "maps/s.bin", std::ios::binary | std::ios::in | std::ios::out);
     file.seekp(5000);
     file.put('b');
   }
-  SceneCache restarted(dir_);
+  SceneCache restarted(dir_, log_);
   EXPECT_FALSE(restarted.find(files_, sha_).has_value());
   EXPECT_FALSE(fs::exists(dir_ / "scenes" / sha_));
+  // The log says which file and what was wrong, not only that there is no copy.
+  const std::string logged = log_text_.str();
+  EXPECT_NE(logged.find("is spoilt ("), std::string::npos) << logged;
+  EXPECT_NE(logged.find((dir_ / "scenes" / sha_ / "maps/s.bin").string() + " does not match its SHA-256"),
+            std::string::npos)
+      << logged;
+  EXPECT_NE(logged.find(sha_.substr(0, 12)), std::string::npos) << logged;
+}
+
+TEST_F(SceneCacheTest, ACopyWithAFileMissingSaysWhich) {
+  SceneCache cache(dir_, log_);
+  ASSERT_TRUE(fetch(cache).ok());
+  fs::remove(dir_ / "scenes" / sha_ / "s.gltf");
+  SceneCache restarted(dir_, log_);
+  EXPECT_FALSE(restarted.find(files_, sha_).has_value());
+  const std::string logged = log_text_.str();
+  EXPECT_NE(logged.find((dir_ / "scenes" / sha_ / "s.gltf").string() + ": No such file"), std::string::npos)
+      << logged;
 }
 
 TEST_F(SceneCacheTest, ACopyMissingChunksIsNotPutInPlace) {
-  SceneCache cache(dir_);
+  SceneCache cache(dir_, log_);
   ASSERT_TRUE(cache.begin(files_, sha_).ok());
   write_chunks(cache, std::make_pair(1u, std::uint64_t{0}));
   const auto committed = cache.commit();
@@ -112,7 +162,7 @@ TEST_F(SceneCacheTest, ACopyMissingChunksIsNotPutInPlace) {
 }
 
 TEST_F(SceneCacheTest, ACopyCutShortGoesOnFromTheChunksItHolds) {
-  SceneCache cache(dir_);
+  SceneCache cache(dir_, log_);
   auto begun = cache.begin(files_, sha_);
   ASSERT_TRUE(begun.ok());
   EXPECT_EQ(begun.value(), (SceneCache::Present{{false}, {false, false, false}}));
@@ -130,8 +180,8 @@ TEST_F(SceneCacheTest, ACopyCutShortGoesOnFromTheChunksItHolds) {
 }
 
 TEST_F(SceneCacheTest, TwoNodesOfOneHostFetchingTogetherShareTheCopy) {
-  SceneCache first(dir_);
-  SceneCache second(dir_);
+  SceneCache first(dir_, log_);
+  SceneCache second(dir_, log_);
   ASSERT_TRUE(first.begin(files_, sha_).ok());
   auto by_second = fetch(second);  // finishes first; first's partial copy is left alone
   ASSERT_TRUE(by_second.ok()) << by_second.error();
@@ -143,13 +193,13 @@ TEST_F(SceneCacheTest, TwoNodesOfOneHostFetchingTogetherShareTheCopy) {
 }
 
 TEST_F(SceneCacheTest, PartialCopiesWhoseNodeIsGoneAreRemovedAndOthersKept) {
-  SceneCache alive(dir_);
+  SceneCache alive(dir_, log_);
   const scene::SceneManifest other{4096, {scene::describe_file("o.gltf", "{}", 4096)}};
   ASSERT_TRUE(alive.begin(other, scene::manifest_sha256(other)).ok());  // holds its lock
   fs::create_directories(dir_ / "scenes" / (sha_ + ".partial-1-2"));    // no lock file: its node died early
   fs::create_directories(dir_ / "scenes" / (sha_ + ".partial-3-4"));
   std::ofstream(dir_ / "scenes" / (sha_ + ".partial-3-4.lock")) << "";  // a lock nobody holds
-  SceneCache cache(dir_);
+  SceneCache cache(dir_, log_);
   ASSERT_TRUE(cache.begin(files_, sha_).ok());
   EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-1-2")));
   EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-3-4")));
@@ -183,7 +233,7 @@ TEST_F(SceneCacheTest, WhenTheDiskIsShortTheCopiesUsedLongestAgoMakeRoom) {
     fs::last_write_time(small / "scenes" / fake, now - std::chrono::hours(2));
     fs::last_write_time(small / "scenes" / used, now - std::chrono::hours(1));
     const scene::SceneManifest big{4096, {scene::describe_file("big.gltf", std::string(300 << 10, 'y'), 4096)}};
-    SceneCache cache(small, 0);
+    SceneCache cache(small, log_, 0);
     ASSERT_TRUE(cache.begin(big, scene::manifest_sha256(big)).ok());
     EXPECT_FALSE(fs::exists(small / "scenes" / fake)) << "used longest ago: removed";
     EXPECT_TRUE(fs::exists(small / "scenes" / used));
@@ -196,9 +246,41 @@ TEST_F(SceneCacheTest, WhenTheDiskIsShortTheCopiesUsedLongestAgoMakeRoom) {
   }
 }
 
+TEST_F(SceneCacheTest, OnAShortDiskOnlyTheCopiesUsedLongestAgoThatMakeRoomGo) {
+  // 1 MiB; three copies of 256 KiB: 256 KiB free. A scene of 600 KiB and 64 KiB
+  // spare needs 664: the two used longest ago go, the third stays.
+  const auto copies = other_copies(dir_, 3, 256 << 10);
+  SceneCache cache(dir_, log_, 64 << 10, disk_of(1 << 20));
+  const scene::SceneManifest big{4096, {scene::describe_file("big.gltf", std::string(600 << 10, 'y'), 4096)}};
+  const auto begun = cache.begin(big, scene::manifest_sha256(big));
+  ASSERT_TRUE(begun.ok()) << begun.error();
+  EXPECT_FALSE(fs::exists(copies[0]));
+  EXPECT_FALSE(fs::exists(copies[1]));
+  EXPECT_TRUE(fs::exists(copies[2])) << "not needed gone";
+}
+
+TEST_F(SceneCacheTest, ASceneThatWouldNotFitEvenWithEveryCopyGoneCostsNone) {
+  // 1 MiB; two copies of 256 KiB: 512 KiB free, 1 MiB with both gone. A scene of
+  // 2 MiB (well within --max-scene-mb) cannot fit: both copies stay.
+  const auto copies = other_copies(dir_, 2, 256 << 10);
+  SceneCache cache(dir_, log_, 64 << 10, disk_of(1 << 20));
+  const scene::SceneManifest huge{4096, {scene::describe_file("huge.gltf", std::string(2 << 20, 'z'), 4096)}};
+  const auto refused = cache.begin(huge, scene::manifest_sha256(huge));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_TRUE(fs::exists(copies[0]));
+  EXPECT_TRUE(fs::exists(copies[1]));
+  const std::string& why = refused.error();
+  EXPECT_NE(why.find((dir_ / "scenes").string()), std::string::npos) << why;
+  EXPECT_NE(why.find("has 0.5 MiB free"), std::string::npos) << why;
+  EXPECT_NE(why.find("removing every other copy (2) would free 0.5 MiB more"), std::string::npos) << why;
+  EXPECT_NE(why.find("the scene needs 2.1 MiB (2.0 MiB and 0.1 MiB kept free)"), std::string::npos) << why;
+  EXPECT_NE(why.find("none was removed"), std::string::npos) << why;
+  EXPECT_EQ(entries_in_scenes(), 2) << "no partial copy or lock either";
+}
+
 TEST_F(SceneCacheTest, AFolderThatCannotBeWrittenSaysSo) {
   std::ofstream(dir_ / "file") << "not a folder";
-  SceneCache cache(dir_ / "file");
+  SceneCache cache(dir_ / "file", log_);
   const auto begun = cache.begin(files_, sha_);
   ASSERT_FALSE(begun.ok());
   EXPECT_NE(begun.error().find((dir_ / "file").string()), std::string::npos) << begun.error();
