@@ -10,7 +10,6 @@
 #include "config/address.h"
 #include "master/report_json.h"
 #include "net/stamped_receive.h"
-#include "tracking/dtrack.h"
 #include "util/overloaded.h"
 
 namespace optique::master {
@@ -42,7 +41,7 @@ Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
 
 Master::~Master() = default;
 
-Result<void> Master::listen_to_tracker(const config::Tracking& tracking) {
+Result<void> Master::listen_to_tracker(const config::Tracking& tracking, double frame_rate) {
   boost::system::error_code ec;
   const auto address = asio::ip::make_address(tracking.listen, ec);
   if (ec) return Error{"viewer.tracking.listen: '" + tracking.listen + "' is not an address"};
@@ -55,41 +54,21 @@ Result<void> Master::listen_to_tracker(const config::Tracking& tracking) {
   }
   log_.info("tracking: DTrack's ASCII output on {}:{} (UDP), body {}, predicted {}", tracking.listen,
             tracker_socket_.local_endpoint().port(), tracking.body, config::to_string(tracking.prediction));
-  tracker_buffer_.resize(tracking::kMaxDTrackDatagram + 1);
-  // Each sample is stamped when the kernel received it, not when this thread got to it.
+  // Each sample is stamped when the kernel received it, not when a thread got to it.
   if (!net::enable_receive_stamps(tracker_socket_.native_handle())) {
     log_.warn("tracking: the kernel does not stamp datagrams here; samples are stamped when read");
   }
   tracker_socket_.non_blocking(true, ec);
-  receive_tracker();
+  // The read budget is per frame.
+  const auto period = static_cast<clock::Nanos>(1e9 / std::max(frame_rate, 1.0));
+  tracker_receiver_ = std::make_unique<TrackerReceiver>(
+      tracker_socket_.native_handle(), tracking::DTrackReader(tracking, period),
+      [this] { asio::post(io_, [this] { take_tracker_input(); }); });
   return {};
 }
 
-// Once readable, what has come is read at once, up to a bound: a flood then
-// costs a read each and never holds up the frame loop for long.
-void Master::receive_tracker() {
-  tracker_socket_.async_wait(asio::socket_base::wait_read, [this](const boost::system::error_code& error) {
-    if (error == asio::error::operation_aborted || finished_) return;
-    constexpr int kMostPerWake = 256;
-    for (int i = 0; i < kMostPerWake && !error && !finished_; ++i) {
-      const net::StampedDatagram got = net::read_datagram_stamped(
-          tracker_socket_.native_handle(),
-          std::span(reinterpret_cast<std::uint8_t*>(tracker_buffer_.data()), tracker_buffer_.size()));
-      if (got.read.status == net::StampedRead::Status::would_block) break;
-      if (got.read.status != net::StampedRead::Status::data) {
-        if (!tracker_error_said_) log_.warn("tracking: receiving failed: {} (going on)", std::strerror(got.read.error));
-        tracker_error_said_ = true;
-        break;
-      }
-      carry_out(protocol_->tracker_datagram(std::string_view(tracker_buffer_.data(), got.read.count), got.sender,
-                                            got.read.received));
-    }
-    if (error && !tracker_error_said_) {
-      log_.warn("tracking: waiting for datagrams failed: {} (going on)", error.message());
-      tracker_error_said_ = true;
-    }
-    if (!finished_) receive_tracker();
-  });
+void Master::take_tracker_input() {
+  if (!finished_ && tracker_receiver_) carry_out(protocol_->tracker_input(tracker_receiver_->take()));
 }
 
 Result<void> Master::start() {
@@ -146,7 +125,7 @@ Result<void> Master::start() {
   for (const auto& id : ids) id_list += (id_list.empty() ? "" : ", ") + id;
   log_.info("listening on {}:{}; waiting for {} node(s): {}", settings.listen, port_, ids.size(), id_list);
   if (tracking && tracking->source == config::TrackingSource::dtrack) {
-    if (auto listening = listen_to_tracker(*tracking); !listening) return listening;
+    if (auto listening = listen_to_tracker(*tracking, settings.frame_rate); !listening) return listening;
   } else if (tracking) {
     log_.info("tracking: replaying {} ({} samples), predicted {}", tracking->file, replay_samples,
               config::to_string(tracking->prediction));
@@ -421,6 +400,10 @@ void Master::finish(int exit_code) {
   signals_.cancel();
   boost::system::error_code ignored;
   acceptor_.close(ignored);
+  if (tracker_receiver_) {
+    tracker_receiver_->stop();
+    carry_out(protocol_->tracker_input(tracker_receiver_->take()));  // the last counts, for run.json
+  }
   tracker_socket_.close(ignored);
   if (launcher_) {
     for (const ChildExit& exit : launcher_->reap()) {

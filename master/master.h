@@ -27,6 +27,7 @@
 #include "master/run_recorder.h"
 #include "master/status_line.h"
 #include "master/status_service.h"
+#include "master/tracker_receiver.h"
 #include "net/auth.h"
 #include "net/connection.h"
 #include "scene/load_scene.h"
@@ -67,9 +68,10 @@ class Master {
 
  private:
   void accept_next();
-  // The head tracker's datagrams (viewer.tracking, source dtrack).
-  [[nodiscard]] Result<void> listen_to_tracker(const config::Tracking& tracking);
-  void receive_tracker();
+  // The head tracker's datagrams (viewer.tracking, source dtrack), read on
+  // their own thread; what they brought taken on this one.
+  [[nodiscard]] Result<void> listen_to_tracker(const config::Tracking& tracking, double frame_rate);
+  void take_tracker_input();
   void on_accepted(asio::ip::tcp::socket socket);
   void carry_out(Actions actions);
   void carry_out(Action& action);
@@ -96,8 +98,7 @@ class Master {
 
   asio::ip::tcp::acceptor acceptor_;
   asio::ip::udp::socket tracker_socket_;
-  std::vector<char> tracker_buffer_;
-  bool tracker_error_said_ = false;
+  std::unique_ptr<TrackerReceiver> tracker_receiver_;  // reads tracker_socket_: stopped before it closes
   asio::steady_timer accept_retry_timer_;
   bool accept_failing_ = false;
   asio::signal_set signals_;

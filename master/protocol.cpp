@@ -1016,10 +1016,12 @@ Actions MasterProtocol::operator_command(OperatorCommand command, const std::str
 
 // ---------------------------------------------------------------- the head
 
-Actions MasterProtocol::tracker_datagram(std::string_view bytes, const std::string& sender, clock::Nanos now) {
+Actions MasterProtocol::tracker_input(tracking::TrackerInput input) {
   Actions out;
   if (!head_tracker_) return out;
-  if (auto said = head_tracker_->datagram(bytes, now, sender)) out.push_back(Log{spdlog::level::warn, *said});
+  std::vector<std::string> said;
+  head_tracker_->input(std::move(input), said);
+  for (std::string& text : said) out.push_back(Log{spdlog::level::warn, std::move(text)});
   return out;
 }
 

@@ -170,9 +170,9 @@ class MasterProtocol {
   // SIGINT or SIGTERM: the first finishes the frame and shuts down in order, a
   // second stops at once.
   [[nodiscard]] Actions interrupted(const std::string& signal_name, clock::Nanos now);
-  // A UDP datagram from the head tracker (viewer.tracking with source dtrack).
-  // `sender`: its address.
-  [[nodiscard]] Actions tracker_datagram(std::string_view bytes, const std::string& sender, clock::Nanos now);
+  // What the head tracker's datagrams brought (viewer.tracking with source
+  // dtrack), read and parsed off the frame loop (master/tracker_receiver.h).
+  [[nodiscard]] Actions tracker_input(tracking::TrackerInput input);
   // The operator's page asked (`from`: who, for the log). Pause: no frame
   // begins after the one under way, whose picture stays on every projector;
   // the scene waits too. Resume: frames go on from where they stopped. Stop:

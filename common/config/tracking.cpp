@@ -104,6 +104,12 @@ Tracking parse_tracking(const schema::Tracking& t, const std::string& path, std:
       out.from = canonical_address(t.from());  // as senders are written (net::read_datagram_stamped)
     }
   }
+  // Anyone who reaches the port can steer the head: beyond this machine, only the tracker may.
+  if (out.source == TrackingSource::dtrack && t.from().empty() && !is_loopback_address(out.listen)) {
+    problems.push_back({path + ".from", "is required when listen is " + out.listen +
+                                            " (not loopback): the tracker's address, so that no other host on the "
+                                            "network can steer the head"});
+  }
   if (t.port() > 65535) {
     problems.push_back({path + ".port", "must be 1..65535, or 0 for " + std::to_string(kDefaultTrackingPort) +
                                             " (got " + std::to_string(t.port()) + ")"});

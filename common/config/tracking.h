@@ -34,7 +34,7 @@ inline constexpr double kMostTrackingLatencyMs = 500.0;
 
 struct Tracking {
   TrackingSource source = TrackingSource::dtrack;
-  std::string listen = "0.0.0.0";  // dtrack
+  std::string listen = "127.0.0.1";  // dtrack; another address only with `from`
   std::string from;                // dtrack: the tracker's address, datagrams from others ignored; empty: any
   std::uint16_t port = kDefaultTrackingPort;
   std::string file;        // replay: resolved against the config file's folder when parsed
@@ -61,7 +61,8 @@ struct Tracking {
 // or prediction, a replay without its file (or a file for dtrack), an address
 // that is not one, tracker axes that are not unit, at right angles and right-
 // handed, an eye offset of a metre or more, a smoothing outside (0, 1), a
-// latency beyond kMostTrackingLatencyMs.
+// latency beyond kMostTrackingLatencyMs, a dtrack source that listens beyond
+// loopback without `from`.
 [[nodiscard]] Tracking parse_tracking(const schema::Tracking& tracking, const std::string& path,
                                       std::vector<Problem>& problems);
 

@@ -94,8 +94,7 @@ Result<std::vector<DTrackBody>> parse_6d(Cursor& c) {
       return Error{which + ": quality " + std::to_string(body.quality) + " is outside -1…1"};
     }
     if (!is_rotation(body.rotation)) return Error{which + ": the rotation matrix is not a rotation"};
-    if (std::abs(body.position.x) > kMostDTrackPosition || std::abs(body.position.y) > kMostDTrackPosition ||
-        std::abs(body.position.z) > kMostDTrackPosition) {
+    if (!(glm::length(body.position) <= kMostDTrackPosition)) {
       return Error{which + ": a position more than " + std::to_string(static_cast<int>(kMostDTrackPosition / 1000)) +
                    " m from the tracker's origin"};
     }

@@ -28,8 +28,8 @@ namespace optique::tracking {
 // kind of output is a few kilobytes).
 inline constexpr std::size_t kMaxDTrackDatagram = 65507;
 inline constexpr std::uint32_t kMaxDTrackBodies = 256;
-// Farther than this from the tracker's origin (mm) is no room's tracking; a
-// latency beyond this (s) no tracker's.
+// Farther than this from the tracker's origin (mm, the distance, not per axis) is
+// no room's tracking; a latency beyond this (s) no tracker's.
 inline constexpr double kMostDTrackPosition = 100'000.0;
 inline constexpr double kMostDTrackLatency = 1.0;
 

@@ -11,11 +11,8 @@
 namespace optique::tracking {
 namespace {
 
-// A frame counter this far back, or a timestamp this many seconds, is a
-// tracker that started again, not an old datagram.
-constexpr std::uint64_t kRestartFrames = 1000;
-constexpr double kRestartSeconds = 10.0;
-constexpr int kRestartAfter = 30;  // frames back in a row: half a second at 60 Hz
+// The reader's period in datagram(): a 60 Hz frame.
+constexpr Nanos kDefaultReadPeriod = clock::kNanosPerSecond / 60;
 
 Nanos seconds_to_nanos(double seconds) {
   return static_cast<Nanos>(std::llround(seconds * static_cast<double>(clock::kNanosPerSecond)));
@@ -50,83 +47,52 @@ std::string_view to_string(TrackerState state) {
 }
 
 HeadTracker::HeadTracker(const config::Tracking& settings, const glm::dquat& rest_turn)
-    : settings_(settings), rest_turn_(rest_turn), predictor_(settings.prediction, settings.smoothing) {}
+    : settings_(settings),
+      rest_turn_(rest_turn),
+      predictor_(settings.prediction, settings.smoothing),
+      reader_(settings, kDefaultReadPeriod),
+      sequence_(nanos(settings.lost_after)) {}
 
 std::optional<std::string> HeadTracker::datagram(std::string_view bytes, Nanos arrival, std::string_view sender) {
-  ++counts_.datagrams;
-  const auto once = [](bool& said, std::string text) -> std::optional<std::string> {
-    if (said) return std::nullopt;
-    said = true;
-    return text + " (further ones are only counted)";
-  };
-  if (!settings_.from.empty() && sender != settings_.from) {
-    ++counts_.other_sender;
-    return once(said_other_sender_, "tracker: ignored datagrams from " + std::string(sender) +
-                                        ": viewer.tracking.from is " + settings_.from);
-  }
-  auto last = last_read_.find(sender);
-  if (last != last_read_.end() && arrival - last->second < kFloodInterval) {
-    ++counts_.flood;
-    return once(said_flood_, "tracker: datagrams from " +
-                                 (sender.empty() ? std::string("one sender") : std::string(sender)) +
-                                 " come faster than " + std::to_string(clock::kNanosPerSecond / kFloodInterval) +
-                                 " a second; the extra ones are dropped unread");
-  }
-  if (last == last_read_.end()) {
-    if (last_read_.size() >= kMostSenders) {
-      last_read_.erase(std::min_element(last_read_.begin(), last_read_.end(),
-                                        [](const auto& a, const auto& b) { return a.second < b.second; }));
-    }
-    last = last_read_.emplace(std::string(sender), arrival).first;
-  }
-  last->second = arrival;
-  auto frame = parse_dtrack(bytes);
-  if (!frame) {
-    ++counts_.malformed;
-    return once(said_malformed_, "tracker: ignored a datagram that is not DTrack's ASCII output: " + frame.error());
-  }
-  const DTrackFrame& f = frame.value();
-  const auto body =
-      std::find_if(f.bodies.begin(), f.bodies.end(), [&](const DTrackBody& b) { return b.id == settings_.body; });
-  if (body == f.bodies.end()) {
-    ++counts_.without_body;
-    std::string seen;
-    for (const DTrackBody& b : f.bodies) seen += (seen.empty() ? "" : ", ") + std::to_string(b.id);
-    return once(said_without_body_, "tracker: a frame without body " + std::to_string(settings_.body) +
-                                        (seen.empty() ? " (no body tracked)" : " (bodies " + seen + ")"));
-  }
-  // Order: by the frame counter, else the timestamp. Far back, or back frame
-  // after frame for kRestartAfter frames, is a tracker that started again.
-  bool restarted = false;
-  bool older = false;
-  if (f.frame && last_frame_) {
-    older = *f.frame <= *last_frame_;
-    restarted = older && *last_frame_ - *f.frame > kRestartFrames;
-  } else if (f.timestamp && last_timestamp_) {
-    older = *f.timestamp <= *last_timestamp_;
-    restarted = older && *last_timestamp_ - *f.timestamp > kRestartSeconds;
-  }
-  backwards_in_a_row_ = older ? backwards_in_a_row_ + 1 : 0;
-  restarted = restarted || backwards_in_a_row_ >= kRestartAfter;
-  const Nanos shows = arrival - seconds_to_nanos(f.latency.value_or(0.0)) - nanos(settings_.latency);
-  if (!restarted && (older || (!predictor_.empty() && shows <= predictor_.newest_time()))) {
+  TrackerInput read;
+  reader_.read(bytes, arrival, sender, read);
+  std::vector<std::string> said;
+  input(std::move(read), said);
+  if (said.empty()) return std::nullopt;
+  std::string joined;
+  for (const std::string& text : said) joined += (joined.empty() ? "" : "; ") + text;
+  return joined;
+}
+
+void HeadTracker::input(TrackerInput input, std::vector<std::string>& said) {
+  counts_ += input.counted;
+  for (std::string& text : input.said) said.push_back(std::move(text));
+  for (const DTrackSample& sample : input.samples) take_dtrack(sample, said);
+}
+
+void HeadTracker::take_dtrack(const DTrackSample& sample, std::vector<std::string>& said) {
+  const Order order = sequence_.order(sample);
+  const Nanos shows = sample.arrival - seconds_to_nanos(sample.latency) - nanos(settings_.latency);
+  const bool restarted = order == Order::restart;
+  if (order == Order::outside || (!restarted && !predictor_.empty() && shows <= predictor_.newest_time())) {
     ++counts_.backwards;
-    return once(said_backwards_, "tracker: ignored a frame older than the last one taken");
+    say_once(said_backwards_, "tracker: ignored a frame out of the tracker's sequence (older than the last one taken, "
+                              "or further ahead than the time since could bring)",
+             said);
+    return;
   }
   if (!restarted && !predictor_.empty() && shows - predictor_.newest_time() < kLeastSampleInterval) {
     ++counts_.flood;
-    return once(said_flood_, "tracker: a frame less than 1 ms after the last one taken; dropped");
+    say_once(said_flood_, "tracker: a frame less than 1 ms after the last one taken; dropped", said);
+    return;
   }
   if (restarted) {
-    predictor_.reset();
-    backwards_in_a_row_ = 0;
+    predictor_.reset();  // what it knew was of the sequence before
+    said.push_back("tracker: its frame counter (or clock) started again, " + std::to_string(kRestartDatagrams) +
+                   " frames in a row; following it");
   }
-  last_frame_ = f.frame;
-  last_timestamp_ = f.timestamp;
-  const glm::dquat orientation = glm::quat_cast(body->rotation);
-  take(shows, arrival, body->position * 0.001, orientation);
-  if (restarted) return "tracker: its frame counter (or clock) started again; following it";
-  return std::nullopt;
+  sequence_.taken(sample);
+  take(shows, sample.arrival, sample.position * 0.001, glm::quat_cast(sample.rotation));
 }
 
 void HeadTracker::sample(Nanos time, const glm::dvec3& position, const glm::dquat& orientation) {
@@ -157,10 +123,28 @@ void HeadTracker::take(Nanos time, Nanos arrival, const glm::dvec3& position, co
   ++counts_.samples;
 }
 
+void HeadTracker::notice_start(Nanos now, std::vector<std::string>& said) {
+  if (settings_.source != config::TrackingSource::dtrack) return;
+  if (!first_now_) first_now_ = now;
+  if (!last_arrival_ && !said_quiet_start_ && now - *first_now_ >= kQuietStart) {
+    said_quiet_start_ = true;
+    said.push_back("tracker: no sample in " + std::to_string(kQuietStart / clock::kNanosPerSecond) +
+                   " s; listening for DTrack's output (body " + std::to_string(settings_.body) + ") on " +
+                   settings_.listen + " port " + std::to_string(settings_.port) + " (UDP)" +
+                   (settings_.from.empty() ? "" : " from " + settings_.from) + "; the eyes rest where the config puts them");
+  }
+  if (last_arrival_ && said_quiet_start_ && !said_first_sample_) {
+    said_first_sample_ = true;
+    said.push_back("tracker: the first sample came " + std::to_string((*last_arrival_ - *first_now_) / clock::kNanosPerMilli) +
+                   " ms after the first frame; tracking");
+  }
+}
+
 void HeadTracker::notice(Nanos now, std::vector<std::string>& said) {
   const Nanos lost_after = nanos(settings_.lost_after);
   const std::optional<Nanos> before = last_now_;
   last_now_ = now;
+  notice_start(now, said);
   if (!last_arrival_) return;
   const bool lost = now - *last_arrival_ > lost_after;
   // The time lost, counted from the moment the tracker was lost to now.

@@ -1,55 +1,43 @@
 #pragma once
-// The master's tracked head, without IO: samples in (DTrack datagrams as they
-// arrive, or a replay's samples at their times), each stamped on the master's
+// The master's tracked head, without IO: samples in (DTrack's, as the reader
+// hands them over, or a replay's at their times), each stamped on the master's
 // clock as the moment it shows (arrival − the tracker's own latency − the
 // configured latency), carried from tracker space to the world and to the eyes'
 // centre; out, the head predicted at a frame's display time.
 //
-// What it ignores, and counts: datagrams that do not parse (garbage, NaN, a
-// matrix that is not a rotation), frames without the configured body, frames
-// older than the last one (a frame counter or timestamp that goes backwards;
-// far backwards, or backwards for half a second, is a tracker that restarted,
-// and is followed), and datagrams that come sooner than kFloodInterval after
-// the last one read, or samples less than kLeastSampleInterval after the last
-// one taken (a flood is dropped unread: it costs the io thread a receive each).
+// What it ignores, and counts, besides what the reader dropped
+// (tracking/dtrack_reader.h): frames out of the tracker's sequence
+// (tracking/sequence.h: older than the newest taken, or further ahead than the
+// time since could bring; a new sequence that goes on is a tracker that
+// restarted, and is followed), and samples that show the head no later than, or
+// less than kLeastSampleInterval after, the last one taken.
 //
 // Lost (no sample for `lost_after`): the pose shown as it went quiet is held for
 // `hold`, then eased (smoothstep) over `ease` to where the viewer rests (its eye
 // or path, its eyes along the world's x); back on the first sample. Each loss and each
-// return is said once.
+// return is said once; so is a DTrack that has sent nothing kQuietStart after the
+// first frame (where the master listens), and its first sample after that.
 
 #include <cstdint>
-#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "config/tracking.h"
+#include "tracking/counts.h"
+#include "tracking/dtrack_reader.h"
 #include "tracking/predictor.h"
 #include "tracking/replay.h"
+#include "tracking/sequence.h"
 
 namespace optique::tracking {
 
-inline constexpr Nanos kFloodInterval = 500'000;  // 2 kHz: DTrack sends at most 300 frames a second
-// The senders whose last datagram is remembered for the flood rule; beyond
-// these, the one heard from longest ago is forgotten.
-inline constexpr std::size_t kMostSenders = 64;
+// No sample this long after the first frame: said, with where the master listens.
+inline constexpr Nanos kQuietStart = 2'000'000'000;
 
 enum class TrackerState { waiting, tracking, holding, easing, resting };
 [[nodiscard]] std::string_view to_string(TrackerState state);
-
-struct TrackingCounts {
-  std::uint64_t datagrams = 0;     // received (flood included)
-  std::uint64_t samples = 0;       // taken
-  std::uint64_t malformed = 0;     // did not parse: garbage, NaN, not a rotation
-  std::uint64_t without_body = 0;  // parsed, but the configured body was not in it
-  std::uint64_t backwards = 0;     // older than the last sample taken
-  std::uint64_t flood = 0;         // dropped unread, too soon after the sender's last
-  std::uint64_t other_sender = 0;  // dropped unread, not from viewer.tracking.from
-  std::uint64_t losses = 0;        // times the tracker was lost
-  Nanos lost_ns = 0;               // time spent lost, up to the last frame
-};
 
 struct HeadAt {
   HeadPose pose;
@@ -63,10 +51,13 @@ class HeadTracker {
   // turned to the world's right (the master's: rotation(head_right, x)).
   explicit HeadTracker(const config::Tracking& settings, const glm::dquat& rest_turn = {1.0, 0.0, 0.0, 0.0});
 
+  // What the reader handed over: its samples taken or refused, its counts
+  // added; what is worth a log line (the first of each kind of refusal, a
+  // restart) into `said`.
+  void input(TrackerInput input, std::vector<std::string>& said);
   // A DTrack datagram that arrived at `arrival` (master clock) from `sender`
-  // (its address). What is worth a log line (the first of each kind of refusal;
-  // further ones are counted). The flood rule is each sender's: a host that
-  // floods the port does not starve the tracker.
+  // (its address), read here and taken at once: the reader and the tracker on
+  // one thread (tests, the bench, the fuzzer). What is worth a log line, joined.
   [[nodiscard]] std::optional<std::string> datagram(std::string_view bytes, Nanos arrival,
                                                     std::string_view sender = {});
   // A sample in tracker space (metres) that shows the head at `time` and
@@ -85,26 +76,27 @@ class HeadTracker {
 
  private:
   void take(Nanos time, Nanos arrival, const glm::dvec3& position, const glm::dquat& orientation);
+  void take_dtrack(const DTrackSample& sample, std::vector<std::string>& said);
+  // Whether DTrack has been quiet since the first frame, or has just begun (said).
+  void notice_start(Nanos now, std::vector<std::string>& said);
 
   config::Tracking settings_;
   glm::dquat rest_turn_;
   HeadPredictor predictor_;
   HeadPose held_;       // where the eyes were shown as the tracker went quiet
   double eased_ = 0.0;  // how far from held_ to the rest, as of the last notice (smoothstep)
-  int backwards_in_a_row_ = 0;
+  DTrackReader reader_;  // for datagram() only
+  FrameSequence sequence_;
   TrackingCounts counts_;
   TrackerState state_ = TrackerState::waiting;
-  std::map<std::string, Nanos, std::less<>> last_read_;  // each sender's last datagram parsed (flood)
-  std::optional<Nanos> last_arrival_;                    // the last sample taken
-  std::optional<std::uint64_t> last_frame_;
-  std::optional<double> last_timestamp_;
+  std::optional<Nanos> last_arrival_;  // the last sample taken
   std::optional<Nanos> lost_since_;
   std::optional<Nanos> last_now_;
-  bool said_malformed_ = false;
-  bool said_without_body_ = false;
+  std::optional<Nanos> first_now_;  // the first notice: frames began
+  bool said_quiet_start_ = false;
+  bool said_first_sample_ = false;
   bool said_backwards_ = false;
   bool said_flood_ = false;
-  bool said_other_sender_ = false;
 };
 
 // The turn that carries `head_right` (a unit vector in the tracked body's

@@ -319,6 +319,34 @@ TEST(ParseInstallation, ViewerWithBothEyeAndPath) {
                  "viewer", {"not both"});
 }
 
+// A tracker's port is reached by whoever can send to it: by default only this
+// machine; listening beyond it, only the tracker's address (`from`) is heard, and
+// a config without one is refused, its problem listed with the others.
+TEST(ParseInstallation, ATrackerListensOnLoopbackUnlessItsAddressIsGiven) {
+  const std::string viewer = R"("viewer": {"eye": [0.0, 1.6, 2.0]})";
+  const auto tracked = [&](const std::string& tracking) {
+    return parse(with(viewer, R"("viewer": {"eye": [0.0, 1.6, 2.0], "tracking": {"source": "dtrack")" + tracking + "}}"));
+  };
+  const auto by_default = tracked("");
+  ASSERT_TRUE(by_default) << by_default.error();
+  EXPECT_EQ(by_default.value().viewer.tracking->listen, "127.0.0.1");
+  for (const char* loopback : {"127.0.0.1", "::1", "127.0.0.9"}) {
+    const auto ok = tracked(std::string(R"(, "listen": ")") + loopback + "\"");
+    EXPECT_TRUE(ok) << loopback << ": " << (ok ? "" : ok.error());
+  }
+  const auto with_from = tracked(R"(, "listen": "0.0.0.0", "from": "10.0.0.20")");
+  ASSERT_TRUE(with_from) << with_from.error();
+  EXPECT_EQ(with_from.value().viewer.tracking->from, "10.0.0.20");
+  for (const char* open : {"0.0.0.0", "10.0.0.5", "::"}) {
+    const auto refused = tracked(std::string(R"(, "listen": ")") + open + R"(", "smoothing": 2)");
+    expect_problem(refused, "viewer.tracking.from", {"is required when listen is", open, "not loopback"});
+    expect_problem(refused, "viewer.tracking.smoothing", {"must be in (0, 1)"});
+  }
+  // A replay listens nowhere.
+  EXPECT_TRUE(parse(with(viewer, R"("viewer": {"eye": [0.0, 1.6, 2.0], "tracking": {"source": "replay", )"
+                                 R"("file": "head.csv", "listen": "0.0.0.0"}})")));
+}
+
 TEST(ParseInstallation, ViewerPathTimesMustIncrease) {
   const std::string path = R"("viewer": {"path": [
       {"time": 0.0, "position": [0, 1.6, 2]},

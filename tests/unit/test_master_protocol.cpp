@@ -344,9 +344,14 @@ TEST_F(MasterTest, EachFrameCarriesTheTrackedHead) {
   ASSERT_EQ(first.size(), 1u);
   EXPECT_FALSE(first.front().frame_begin().delta().has_viewer()) << "resting where the config's eye is";
   // Turned a quarter about the tracker's z, 0.5 m to the right of the rest.
-  EXPECT_TRUE(
-      master_->tracker_datagram("fr 1\n6d 1 [2 1.0][500 1600 2000][0 1 0 -1 0 0 0 0 1]\n", "10.0.0.9", now_).empty());
-  const auto garbage = master_->tracker_datagram("not dtrack", "10.0.0.9", now_ + 5 * kMs);
+  tracking::DTrackReader reader(*run_.config.installation.viewer.tracking, 16'666'666);
+  const auto read = [&](std::string_view bytes, clock::Nanos at) {
+    tracking::TrackerInput input;
+    reader.read(bytes, at, "10.0.0.9", input);
+    return master_->tracker_input(std::move(input));
+  };
+  EXPECT_TRUE(read("fr 1\n6d 1 [2 1.0][500 1600 2000][0 1 0 -1 0 0 0 0 1]\n", now_).empty());
+  const auto garbage = read("not dtrack", now_ + 5 * kMs);
   ASSERT_EQ(garbage.size(), 1u);
   ASSERT_TRUE(std::holds_alternative<Log>(garbage.front()));
   EXPECT_NE(std::get<Log>(garbage.front()).text.find("not DTrack's ASCII output"), std::string::npos);

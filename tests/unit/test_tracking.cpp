@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <map>
+#include <optional>
 #include <string>
 
 #include <glm/gtc/quaternion.hpp>
@@ -12,6 +14,7 @@
 #include "config/address.h"
 #include "config/tracking.h"
 #include "tracking/dtrack.h"
+#include "tracking/dtrack_reader.h"
 #include "tracking/head_tracker.h"
 #include "tracking/predictor.h"
 #include "tracking/replay.h"
@@ -157,7 +160,9 @@ TEST(HeadTracker, BadInputIsIgnoredAndCounted) {
   EXPECT_NE(old->find("older than the last one"), std::string::npos);
   // A flood: 100 datagrams 10 µs apart; one is read every kFloodInterval.
   const Nanos flood_start = next();
-  for (int i = 0; i < 100; ++i) (void)tracker.datagram(datagram(2000 + i, 4, {0, 1000, 0}), flood_start + i * 10'000);
+  for (int i = 0; i < 100; ++i) {
+    (void)tracker.datagram(datagram(12 + i / 50, 4, {0, 1000, 0}), flood_start + i * 10'000);
+  }
   const TrackingCounts& counts = tracker.counts();
   EXPECT_EQ(counts.samples, 2u);
   EXPECT_EQ(counts.malformed, 2u);
@@ -165,12 +170,16 @@ TEST(HeadTracker, BadInputIsIgnoredAndCounted) {
   EXPECT_EQ(counts.backwards, 1u);
   EXPECT_EQ(counts.flood, 99u);  // 98 unread, one read but under 1 ms after the last sample
   EXPECT_EQ(counts.datagrams, 105u);
-  // A tracker that started again (its counter far back) is followed.
-  const auto restarted = tracker.datagram(datagram(3, 4, {0, 1500, 0}), flood_start + 20 * kMs);
+  // A tracker that started again (its counter far back, going on from there) is followed.
+  std::optional<std::string> restarted;
+  for (int i = 0; i < kRestartDatagrams; ++i) {
+    restarted = tracker.datagram(datagram(3 + i, 4, {0, 1500, 0}), flood_start + (20 + 16 * i) * kMs);
+  }
   ASSERT_TRUE(restarted);
   EXPECT_NE(restarted->find("started again"), std::string::npos);
+  const Nanos now = flood_start + (20 + 16 * (kRestartDatagrams - 1)) * kMs;
   std::vector<std::string> said;
-  EXPECT_NEAR(at(tracker, flood_start + 20 * kMs, flood_start + 20 * kMs, {}, said).pose.position.y, 1.5, 1e-12);
+  EXPECT_NEAR(at(tracker, now, now, {}, said).pose.position.y, 1.5, 1e-12);
 }
 
 // The flood rule is each sender's: a host that floods the port at 100 kHz does
@@ -201,11 +210,13 @@ TEST(HeadTracker, AFloodingHostDoesNotStarveTheTracker) {
   // still holds for those remembered.
   HeadTracker crowded(settings());
   const auto sender = [](int i) { return "10.1." + std::to_string(i / 256) + "." + std::to_string(i % 256); };
-  for (int i = 0; i < 1000; ++i) (void)crowded.datagram("junk", 10 * kMs + i, sender(i));
+  // (One sender a frame, so that the read budget is never what drops them.)
+  const auto heard = [](int i) { return 10 * kMs + i * 17 * kMs; };
+  for (int i = 0; i < 1000; ++i) (void)crowded.datagram("junk", heard(i), sender(i));
   EXPECT_EQ(crowded.counts().malformed, 1000u) << "each sender's first datagram is read";
-  (void)crowded.datagram("junk", 10 * kMs + 1000, sender(999));
+  (void)crowded.datagram("junk", heard(999) + 1000, sender(999));
   EXPECT_EQ(crowded.counts().flood, 1u) << "a remembered sender, again within 0.5 ms";
-  (void)crowded.datagram("junk", 10 * kMs + 1001, sender(0));
+  (void)crowded.datagram("junk", heard(999) + 1001, sender(0));
   EXPECT_EQ(crowded.counts().malformed, 1001u) << "a forgotten sender is read again";
   // Spelled otherwise, the tracker's address is still the tracker's.
   config::Tracking mapped = settings();
@@ -253,19 +264,56 @@ TEST(HeadTracker, StampsTooCloseAndFarPositionsCannotThrowTheHead) {
   EXPECT_FALSE(parse_dtrack("ts2 0 0 5000000\n"));
 }
 
-// A tracker started again within 1000 frames is followed after half a second.
-TEST(HeadTracker, ATrackerThatStartsAgainIsFollowed) {
+// A tracker that really restarts, its counter low and going on, is followed
+// within a few frames (kRestartDatagrams, over kRestartSpan).
+TEST(HeadTracker, ATrackerThatStartsAgainIsFollowedWithinAFewFrames) {
   HeadTracker tracker(settings());
-  EXPECT_FALSE(tracker.datagram(datagram(500, 4, {0, 1000, 0}), 10 * kMs));
+  for (int i = 0; i < 60; ++i) EXPECT_FALSE(tracker.datagram(datagram(5000 + i, 4, {0, 1000, 0}), i * 16 * kMs));
   int followed_at = -1;
   for (int i = 0; i < 40 && followed_at < 0; ++i) {
-    const auto said = tracker.datagram(datagram(1 + i, 4, {0, 1500, 0}), (30 + 16 * i) * kMs);
+    const auto said = tracker.datagram(datagram(1 + i, 4, {0, 1500, 0}), (60 + i) * 16 * kMs);
     if (said && said->find("started again") != std::string::npos) followed_at = i;
   }
-  // The first is said as backwards; the 30th in a row is taken as a restart.
-  EXPECT_EQ(followed_at, 29);
+  EXPECT_EQ(followed_at, 3) << "the first three are out of sequence; the fourth, 50 ms on, is believed";
   std::vector<std::string> said;
-  EXPECT_NEAR(at(tracker, 600 * kMs, 600 * kMs, {}, said).pose.position.y, 1.5, 1e-12);
+  EXPECT_NEAR(at(tracker, 64 * 16 * kMs, 64 * 16 * kMs, {}, said).pose.position.y, 1.5, 1e-12);
+  EXPECT_EQ(tracker.counts().backwards, 3u);
+}
+
+// One forged datagram every 30 frames (0.5 s at 60 Hz), its counter 900 ahead of
+// the tracker's and going on as the tracker's does, the head 9 m away: the head
+// stays with the tracker, every frame, and is never lost; so from the tracker's
+// own address, and a forger that sends a few in a row between two of the
+// tracker's frames does not get through either.
+TEST(HeadTracker, ForgedFramesFarAheadNeverTakeTheHead) {
+  for (const char* forger : {"10.0.0.66", "10.0.0.2"}) {
+    for (int burst : {1, 8}) {
+      config::Tracking t = settings();
+      t.lost_after = std::chrono::milliseconds(100);
+      HeadTracker tracker(t);
+      std::vector<std::string> said;
+      double worst = 0.0;
+      std::uint64_t forged = 0;
+      for (int i = 0; i < 600; ++i) {
+        const Nanos now = static_cast<Nanos>(i) * 16'666'667;
+        const glm::dvec3 real{1000.0 * 0.001 * i, 1600.0, 0.0};  // 1 mm a frame
+        (void)tracker.datagram(datagram(7000 + i, 4, real), now, "10.0.0.2");
+        if (i % 30 == 15) {
+          for (int k = 0; k < burst; ++k, ++forged) {
+            (void)tracker.datagram(datagram(7900 + i + k, 4, real + glm::dvec3(9000, 0, 3000)), now + (2 + k) * kMs,
+                                   forger);
+          }
+        }
+        const HeadAt head = at(tracker, now + 8 * kMs, now + 8 * kMs, {}, said);
+        EXPECT_EQ(head.state, TrackerState::tracking) << forger << " frame " << i;
+        worst = std::max(worst, glm::distance(head.pose.position, real * 0.001));
+      }
+      EXPECT_LT(worst, 1e-9) << forger << ", bursts of " << burst << ": the head went where the forger put it";
+      EXPECT_EQ(tracker.counts().samples, 600u) << forger;
+      EXPECT_EQ(tracker.counts().backwards, forged) << forger;
+      EXPECT_EQ(tracker.counts().losses, 0u) << forger;
+    }
+  }
 }
 
 // Lost, the eyes stay where they were shown as the tracker went quiet (the
@@ -350,6 +398,178 @@ TEST(HeadTracker, ALostTrackerIsHeldThenEasedToRest) {
   EXPECT_NE(said[1].find("tracker: back after 800 ms"), std::string::npos) << said[1];
   EXPECT_EQ(tracker.counts().losses, 1u);
   EXPECT_EQ(tracker.counts().lost_ns, 800 * kMs);
+}
+
+// 100 m is a distance from the tracker's origin, not a bound on each axis: a
+// body 173 m away is refused, one 98.7 m away taken.
+TEST(DTrack, APositionMoreThan100MetresAwayIsRefused) {
+  const auto far = parse_dtrack("6d 1 [0 1][100000 100000 100000][1 0 0 0 1 0 0 0 1]");
+  ASSERT_FALSE(far);
+  EXPECT_NE(far.error().find("more than 100 m from the tracker's origin"), std::string::npos) << far.error();
+  EXPECT_TRUE(parse_dtrack("6d 1 [0 1][57000 -57000 57000][1 0 0 0 1 0 0 0 1]"));
+  EXPECT_TRUE(parse_dtrack("6d 1 [0 1][0 0 -100000][1 0 0 0 1 0 0 0 1]"));
+}
+
+// A valid DTrack frame of about `bytes` bytes: body 4 and as many others as fit.
+std::string large_frame(std::uint64_t frame, std::size_t bytes) {
+  std::string bodies;
+  int count = 1;
+  bodies += " [4 1.000][100.000 1600.000 0.000][1.000000 0.000000 0.000000 0.000000 1.000000 0.000000 0.000000 "
+            "0.000000 1.000000]";
+  while (bodies.size() + 200 < bytes && count < static_cast<int>(kMaxDTrackBodies)) {
+    bodies += " [" + std::to_string(10 + count) +
+              " 1.000][-1234.567 2345.678 -3456.789][0.000000 1.000000 0.000000 -1.000000 0.000000 0.000000 "
+              "0.000000 0.000000 1.000000]";
+    ++count;
+  }
+  return "fr " + std::to_string(frame) + "\n6d " + std::to_string(count) + bodies + "\n";
+}
+
+// Sixteen hosts each sending valid 36 KB frames as fast as the flood rule lets
+// them read (2 kHz), the tracker's 2 KB frames at 60 Hz among them: no more than
+// the budget is parsed in any frame, and every frame of the tracker is read.
+TEST(DTrackReader, TheReadBudgetBoundsParsingAcrossSendersAndTheTrackerIsRead) {
+  const std::string flood = large_frame(1, 36'000);
+  ASSERT_GT(flood.size(), 30'000u);
+  ASSERT_TRUE(parse_dtrack(flood));
+  for (int hosts : {16, 2}) {
+    constexpr Nanos kPeriod = 16'666'667;
+    DTrackReader reader(settings(), kPeriod);
+    std::map<std::uint64_t, std::size_t> parsed_in;  // bytes, by period
+    std::uint64_t tracker_samples = 0;
+    std::uint64_t tracker_frame = 100;
+    for (Nanos t = 0; t < 2'000 * kMs; t += kFloodInterval) {
+      for (int h = 0; h < hosts; ++h) {
+        TrackerInput in;
+        reader.read(flood, t + h * 1'000, "127.0.0." + std::to_string(2 + h), in);
+        if (in.counted.flood == 0) parsed_in[static_cast<std::uint64_t>(t / kPeriod)] += flood.size();
+      }
+      if (t % kPeriod < kFloodInterval) {
+        TrackerInput in;
+        reader.read(datagram(tracker_frame++, 4, {0, 1600, 0}), t + 200'000, "127.0.0.1", in);
+        tracker_samples += in.samples.size();
+        if (in.samples.size() == 1) {
+          EXPECT_EQ(in.samples[0].sender, "127.0.0.1");
+        }
+      }
+    }
+    std::size_t most = 0;
+    for (const auto& [period, bytes] : parsed_in) most = std::max(most, bytes);
+    EXPECT_LE(most, kReadBudgetBytes) << hosts << " hosts: parsed in one frame";
+    EXPECT_EQ(tracker_samples, tracker_frame - 100) << hosts << " hosts: every frame of the tracker read";
+    if (hosts == 2) {
+      EXPECT_GT(most, 0u) << "two hosts' large frames fit their shares";
+    }
+  }
+}
+
+// DTrack quiet since frames began: said once after kQuietStart, with where the
+// master listens; and once more when the first sample comes.
+TEST(HeadTracker, ATrackerThatNeverSendsIsSaidWithWhereTheMasterListens) {
+  config::Tracking t = settings();
+  t.listen = "127.0.0.1";
+  t.port = 5017;
+  HeadTracker tracker(t);
+  std::vector<std::string> said;
+  for (Nanos now = 0; now < kQuietStart; now += 100 * kMs) tracker.notice(now, said);
+  EXPECT_TRUE(said.empty());
+  for (Nanos now = kQuietStart; now < 2 * kQuietStart; now += 100 * kMs) tracker.notice(now, said);
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_NE(said[0].find("no sample in 2 s"), std::string::npos) << said[0];
+  EXPECT_NE(said[0].find("127.0.0.1 port 5017 (UDP)"), std::string::npos) << said[0];
+  EXPECT_NE(said[0].find("body 4"), std::string::npos) << said[0];
+  EXPECT_FALSE(tracker.datagram(datagram(1, 4, {0, 1600, 0}), 2 * kQuietStart));
+  tracker.notice(2 * kQuietStart + 10 * kMs, said);
+  tracker.notice(2 * kQuietStart + 20 * kMs, said);
+  ASSERT_EQ(said.size(), 2u);
+  EXPECT_NE(said[1].find("the first sample came 4000 ms after the first frame"), std::string::npos) << said[1];
+  // A tracker that sends from the start is never said to be quiet.
+  HeadTracker prompt(t);
+  std::vector<std::string> quiet;
+  for (Nanos now = 0; now < 2 * kQuietStart; now += 100 * kMs) {
+    (void)prompt.datagram(datagram(static_cast<std::uint64_t>(1 + now / (100 * kMs)), 4, {0, 1600, 0}), now);
+    prompt.notice(now, quiet);
+  }
+  EXPECT_TRUE(quiet.empty()) << quiet.front();
+}
+
+// A head turning at a constant rate about a tilted axis, from a tilted start:
+// constant velocity carries the turn on, exactly; the rate and its direction
+// both matter.
+TEST(HeadPredictor, ConstantVelocityCarriesTheTurnOnExactly) {
+  const glm::dvec3 axis = glm::normalize(glm::dvec3(0.3, 1.0, -0.2));
+  const glm::dquat tilt = glm::angleAxis(0.4, glm::normalize(glm::dvec3(1.0, 0.0, 0.5)));
+  const double spin = 2.0;  // rad/s
+  const auto head = [&](Nanos t) { return glm::angleAxis(spin * static_cast<double>(t) / 1e9, axis) * tilt; };
+  HeadPredictor predictor(config::HeadPrediction::constant_velocity, 0.5);
+  Nanos t = 0;
+  for (int i = 0; i < 10; ++i) {
+    t = i * 10 * kMs;
+    predictor.add(t, {{}, head(t)});
+  }
+  for (Nanos ahead : {10 * kMs, 50 * kMs, 150 * kMs}) {
+    const glm::dquat p = predictor.predict(t + ahead).orientation;
+    EXPECT_LT(glm::angle(p * glm::inverse(head(t + ahead))), 1e-9) << ahead / kMs << " ms ahead";
+  }
+}
+
+// q and −q are the same turn. A head turning steadily through half a turn (where
+// a rotation matrix's quaternion changes sign), and samples given with their
+// signs alternating: the prediction turns on smoothly, never the long way round.
+TEST(HeadTracker, APredictionAcrossAQuaternionsSignDoesNotSpin) {
+  for (auto prediction : {config::HeadPrediction::constant_velocity, config::HeadPrediction::double_exponential}) {
+    HeadTracker tracker(settings(prediction));
+    std::vector<std::string> said;
+    double worst = 0.0;
+    // 90° a second about the tracker's z, from 150° to 210° (through 180°).
+    for (int i = 0; i < 60; ++i) {
+      const Nanos now = i * 10 * kMs;
+      const double degrees = 150.0 + 0.9 * i;
+      EXPECT_FALSE(tracker.datagram(datagram(1 + i, 4, {0, 1600, 0}, degrees), now));
+      if (i < 20) continue;  // double exponential smoothing settles
+      const glm::dquat shown = at(tracker, now + 20 * kMs, now, {}, said).pose.orientation;
+      const glm::dquat truth = glm::angleAxis(glm::radians(degrees + 1.8), glm::dvec3(0, 0, 1));
+      worst = std::max(worst, glm::degrees(glm::angle(glm::dquat(shown * glm::inverse(truth)))));
+    }
+    EXPECT_LT(worst, 0.5) << config::to_string(prediction);
+    // The same turns, every other one given as −q, straight to the predictor.
+    HeadPredictor predictor(prediction, 0.7);
+    const auto head = [](Nanos t) { return glm::angleAxis(1.5 * static_cast<double>(t) / 1e9, glm::dvec3(0, 1, 0)); };
+    Nanos t = 0;
+    for (int i = 0; i < 40; ++i) {
+      t = i * 10 * kMs;
+      predictor.add(t, {{}, i % 2 == 0 ? head(t) : -head(t)});
+    }
+    const glm::dquat p = predictor.predict(t + 30 * kMs).orientation;
+    EXPECT_LT(glm::degrees(glm::angle(glm::dquat(p * glm::inverse(head(t + 30 * kMs))))), 0.5)
+        << config::to_string(prediction) << ", signs alternating";
+  }
+}
+
+// Lost and back: what the predictor knew before the loss is stale. Moving at
+// 1 m/s and turning before; back 2 m away, still: the prediction is where the
+// head is now, not moved on by a velocity from before (or across) the loss.
+TEST(HeadTracker, ThePredictorStartsAgainAfterTheTrackerWasLost) {
+  for (auto prediction : {config::HeadPrediction::constant_velocity, config::HeadPrediction::double_exponential}) {
+    config::Tracking t = settings(prediction);
+    t.lost_after = std::chrono::milliseconds(100);
+    HeadTracker tracker(t);
+    std::vector<std::string> said;
+    std::uint64_t frame = 1;
+    for (int i = 0; i < 30; ++i) {
+      EXPECT_FALSE(tracker.datagram(datagram(frame++, 4, {10.0 * i, 1600, 0}, 2.0 * i), i * 10 * kMs));
+    }
+    EXPECT_EQ(at(tracker, 500 * kMs, 500 * kMs, {}, said).state, TrackerState::holding);
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_FALSE(tracker.datagram(datagram(frame++, 4, {2000, 1600, 0}, 90.0), (600 + 10 * i) * kMs));
+    }
+    const HeadAt back = at(tracker, 670 * kMs, 620 * kMs, {}, said);
+    EXPECT_EQ(back.state, TrackerState::tracking);
+    EXPECT_LT(glm::distance(back.pose.position, glm::dvec3(2.0, 1.6, 0.0)), 1e-9) << config::to_string(prediction);
+    const glm::dquat still = glm::angleAxis(glm::radians(90.0), glm::dvec3(0, 0, 1));
+    EXPECT_LT(glm::angle(glm::dquat(back.pose.orientation * glm::inverse(still))), 1e-6)
+        << config::to_string(prediction);
+  }
 }
 
 TEST(Replay, ParsesRowsAfterAHeaderAndRefusesBadOnes) {
