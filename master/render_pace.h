@@ -8,17 +8,16 @@
 #include <optional>
 
 #include "clock/clock.h"
+#include "master/run_recorder.h"
 
 namespace optique::master {
-
-// A render time a node reports is peer input: beyond this it is taken as this.
-inline constexpr clock::Nanos kLongestRender = 60 * clock::kNanosPerSecond;
 
 class RenderPace {
  public:
   static constexpr std::size_t kKept = 8;
 
-  // A frame (or the warm-up) took `render` (clamped to 0 … kLongestRender).
+  // A frame (or the warm-up) took `render`, peer input: clamped to 0 …
+  // kLongestRender (run_recorder.h), as a report bounds it.
   void add(clock::Nanos render);
   // The median of the times kept; none before the first.
   [[nodiscard]] std::optional<clock::Nanos> typical() const;
