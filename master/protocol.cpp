@@ -661,11 +661,13 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   recorder_.frame_begun(frame, begin_sent, sent);
   next_frame_ = frame + 1;
   ready_for_swap_.clear();
-  // Waited for as long as the slowest of them usually takes, at least the
-  // frame timeout.
+  // Waited for as long as the slowest of them may take (render_pace.h), at
+  // least the frame timeout.
   barrier_allowance_ = nanos(config_.frame_timeout);
   for (const std::size_t slot : waited) {
-    barrier_allowance_ = std::max(barrier_allowance_, session_of(slot)->pace.allowance(nanos(config_.frame_timeout)));
+    // At most the liveness timeout: a node drawing longer than that is gone anyway.
+    barrier_allowance_ = std::max(barrier_allowance_, session_of(slot)->pace.allowance(
+                                                          nanos(config_.frame_timeout), nanos(config_.liveness_timeout)));
   }
   barrier_.begin(frame, std::move(waited));
   if (barrier_.complete()) {

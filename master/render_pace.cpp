@@ -21,9 +21,11 @@ std::optional<clock::Nanos> RenderPace::typical() const {
   return *middle;
 }
 
-clock::Nanos RenderPace::allowance(clock::Nanos frame_timeout) const {
-  const std::optional<clock::Nanos> usual = typical();
-  return usual ? std::max(frame_timeout, 2 * *usual) : frame_timeout;
+clock::Nanos RenderPace::allowance(clock::Nanos frame_timeout, clock::Nanos longest) const {
+  const std::size_t kept = std::min(count_, kKept);
+  if (kept == 0) return frame_timeout;
+  const clock::Nanos slowest = *std::max_element(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(kept));
+  return std::max(frame_timeout, std::min(2 * slowest, longest));
 }
 
 }  // namespace optique::master

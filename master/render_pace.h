@@ -21,10 +21,12 @@ class RenderPace {
   void add(clock::Nanos render);
   // The median of the times kept; none before the first.
   [[nodiscard]] std::optional<clock::Nanos> typical() const;
-  // How long the barrier waits for this node: `frame_timeout`, or twice its
-  // typical render when that is longer (a node that takes 300 ms a frame is
-  // slow, not stalled; one that takes 1 s after 300 ms each is stalled).
-  [[nodiscard]] clock::Nanos allowance(clock::Nanos frame_timeout) const;
+  // How long the barrier waits for this node: `frame_timeout`, or twice the
+  // slowest of the times kept when that is longer (a node that takes 300 ms a
+  // frame, or a key frame every fourth, is slow, not stalled; one that takes
+  // 1 s after 300 ms each is stalled), but never more than `longest` (a node
+  // reporting absurd times does not hold the others up for long).
+  [[nodiscard]] clock::Nanos allowance(clock::Nanos frame_timeout, clock::Nanos longest) const;
 
  private:
   std::array<clock::Nanos, kKept> times_{};

@@ -1,9 +1,12 @@
 // Barrier benchmark: optique's frame barrier (null renderer, real master and node
 // processes on loopback) for 1 … 64 nodes, side by side in one run with a plain
 // ready/go barrier at the same pacing. Writes a Markdown table, a CSV and a plot
-// (barrier.png: barrier round and present skew against the node count).
+// (barrier.png: barrier round and present skew against the node count). Then
+// what sealing every message costs: runs with and without the shared secret,
+// alternating, for a few node counts (barrier-secret.md, barrier-secret.csv).
 //
 //   optique-bench-barrier [--out DIR] [--frames N] [--rate HZ] [--repeats R] [--nodes 1,2,4]
+//                         [--secret-nodes 1,8]
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -23,7 +26,9 @@ namespace {
 
 using namespace optique;
 
-std::string installation_json(std::size_t nodes, double rate) {
+// `sealed`: with master.secret_file "secret" (beside the config), so every
+// message after the hello is sealed.
+std::string installation_json(std::size_t nodes, double rate, bool sealed = false) {
   // One wall cut into vertical strips, one small projector each.
   std::ostringstream json;
   const double width = 4.0;
@@ -41,7 +46,8 @@ std::string installation_json(std::size_t nodes, double rate) {
   // not late joins.
   json << R"(], "viewer": {"eye": [0, 1.6, 2]}, "master": {"frame_rate": )" << rate
        << R"(, "max_pending_connections": )" << std::max<std::size_t>(16, nodes + 1)
-       << R"(, "startup_timeout_ms": 120000}, "scene": {"builtin": "cubes"}})";
+       << R"(, "startup_timeout_ms": 120000)" << (sealed ? R"(, "secret_file": "secret")" : "")
+       << R"(}, "scene": {"builtin": "cubes"}})";
   return json.str();
 }
 
@@ -63,9 +69,9 @@ double presented_by_all(const testing::ClusterRun& run, std::size_t nodes, std::
 }
 
 Sample run_once(const std::string& master_bin, const std::string& work, std::size_t nodes, std::size_t frames,
-                double rate) {
+                double rate, bool sealed = false) {
   const std::string config = work + "/bench-" + std::to_string(nodes) + ".json";
-  std::ofstream(config) << installation_json(nodes, rate);
+  std::ofstream(config) << installation_json(nodes, rate, sealed);
   const std::string out = work + "/run-" + std::to_string(nodes);
   std::filesystem::remove_all(out);
   testing::Process master({master_bin, "--config", config, "--local", "--frames", std::to_string(frames), "--out", out,
@@ -105,6 +111,9 @@ int main(int argc, char** argv) {
   app.add_option("--rate", rate, "frame rate in Hz (both barriers are paced at it)");
   app.add_option("--repeats", repeats, "runs per node count; the table shows the median and the min–max");
   app.add_option("--nodes", node_counts, "node counts")->delimiter(',');
+  std::vector<std::size_t> secret_nodes{1, 8};
+  app.add_option("--secret-nodes", secret_nodes, "node counts run with and without the shared secret (none: skip)")
+      ->delimiter(',');
   app.add_option("--master", master_bin, "optique-master binary");
   app.get_option("--frames")->check(CLI::PositiveNumber);
   app.get_option("--repeats")->check(CLI::PositiveNumber);
@@ -153,6 +162,51 @@ int main(int argc, char** argv) {
           << cell(skew_median, 0) << " | " << cell(skew_p99, 0) << " | " << cell(spread(gm), 0) << " | "
           << cell(spread(gp), 0) << " | " << cell(spread(ratio), 2) << " | " << cell(spread(all), 1) << " |\n";
   }
+
+  // Sealed sessions against plain ones, alternating so that both see the same
+  // machine.
+  std::ofstream secret_csv(out + "/barrier-secret.csv");
+  secret_csv << "nodes,repeat,sealed,barrier_median_us,barrier_p99_us,present_skew_median_us,present_skew_p99_us\n";
+  std::ostringstream secret_table;
+  secret_table << "| nodes | plain: barrier median µs | p99 µs | sealed: barrier median µs | p99 µs | sealed / plain "
+                  "(median) | plain: skew median µs | sealed: skew median µs |\n"
+               << "|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+  {
+    const std::string secret = work + "/secret";
+    std::ofstream(secret) << "a secret for the barrier bench, 32 bytes or so\n";
+    std::filesystem::permissions(secret, std::filesystem::perms::owner_read | std::filesystem::perms::owner_write);
+  }
+  for (std::size_t nodes : secret_nodes) {
+    std::vector<double> pm, pp, qm, qp, ratio, ps, qs;
+    for (std::size_t r = 0; r < repeats; ++r) {
+      for (const bool sealed : {false, true}) {
+        const Sample s = run_once(master_bin, work, nodes, frames, rate, sealed);
+        secret_csv << nodes << ',' << r << ',' << sealed << ',' << s.barrier_median << ',' << s.barrier_p99 << ','
+                   << s.skew_median << ',' << s.skew_p99 << '\n'
+                   << std::flush;
+        (sealed ? qm : pm).push_back(s.barrier_median);
+        (sealed ? qp : pp).push_back(s.barrier_p99);
+        (sealed ? qs : ps).push_back(s.skew_median);
+        std::cerr << "nodes " << nodes << " repeat " << r << (sealed ? " sealed" : " plain") << ": barrier "
+                  << s.barrier_median << " µs, skew " << s.skew_median << " µs\n";
+      }
+      ratio.push_back(qm.back() / pm.back());
+    }
+    using bench::cell;
+    using bench::spread;
+    secret_table << "| " << nodes << " | " << cell(spread(pm), 0) << " | " << cell(spread(pp), 0) << " | "
+                 << cell(spread(qm), 0) << " | " << cell(spread(qp), 0) << " | " << cell(spread(ratio), 2) << " | "
+                 << cell(spread(ps), 0) << " | " << cell(spread(qs), 0) << " |\n";
+  }
+  std::ofstream secret_md(out + "/barrier-secret.md");
+  secret_md << "What sealing every message costs (master.secret_file: AES-256-GCM per message after the hello): "
+            << frames << " frames at " << rate << " Hz, " << repeats
+            << " pairs of runs per row, plain and sealed alternating; each cell is the median over runs with the "
+               "min–max in brackets. Null-render nodes, all on this machine.\n\n"
+            << secret_table.str();
+  secret_md.close();
+  secret_csv.close();
+  std::cout << secret_table.str();
 
   std::ofstream md(out + "/barrier.md");
   md << "Barrier benchmark: " << frames << " frames at " << rate << " Hz, " << repeats
