@@ -18,7 +18,6 @@ constexpr std::string_view kSessionLabel = "optique session v1";
 constexpr std::size_t kIvBytes = 12;
 
 struct ContextFree {
-  void operator()(EVP_CIPHER_CTX* c) const { EVP_CIPHER_CTX_free(c); }
   void operator()(EVP_PKEY_CTX* c) const { EVP_PKEY_CTX_free(c); }
 };
 
@@ -66,18 +65,44 @@ SessionKeys derive_session_keys(const Secret& secret, std::span<const std::uint8
   return keys;
 }
 
+// The OpenSSL context behind the opaque name the header uses.
+struct CipherContext {
+  EVP_CIPHER_CTX* context = nullptr;
+};
+
+void CipherContextFree::operator()(CipherContext* c) const {
+  if (c != nullptr) EVP_CIPHER_CTX_free(c->context);
+  delete c;
+}
+
+namespace {
+
+CipherContextPtr keyed_context(const SessionKey& key, bool encrypt) {
+  CipherContextPtr c(new CipherContext{EVP_CIPHER_CTX_new()});
+  const int done = encrypt ? EVP_EncryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr)
+                           : EVP_DecryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr);
+  if (c->context == nullptr || done != 1) throw std::runtime_error("AES-256-GCM set-up failed: " + openssl_error());
+  return c;
+}
+
+}  // namespace
+
+Sealer::Sealer(const SessionKey& key) : context_(keyed_context(key, true)) {}
+
+Opener::Opener(const SessionKey& key) : context_(keyed_context(key, false)) {}
+
 std::vector<std::uint8_t> Sealer::seal(std::span<const std::uint8_t> payload) {
   if (payload.size() > INT_MAX) throw std::invalid_argument("Sealer::seal: payload too long");
   const auto iv = iv_for(count_);
-  std::unique_ptr<EVP_CIPHER_CTX, ContextFree> context(EVP_CIPHER_CTX_new());
+  EVP_CIPHER_CTX* context = context_->context;
   std::vector<std::uint8_t> sealed(payload.size() + kSealTagBytes);
   int written = 0;
   int final_written = 0;
-  if (!context || EVP_EncryptInit_ex(context.get(), EVP_aes_256_gcm(), nullptr, key_.data(), iv.data()) != 1 ||
-      EVP_EncryptUpdate(context.get(), sealed.data(), &written, payload.data(), static_cast<int>(payload.size())) != 1 ||
-      EVP_EncryptFinal_ex(context.get(), sealed.data() + written, &final_written) != 1 ||
+  if (EVP_EncryptInit_ex(context, nullptr, nullptr, nullptr, iv.data()) != 1 ||
+      EVP_EncryptUpdate(context, sealed.data(), &written, payload.data(), static_cast<int>(payload.size())) != 1 ||
+      EVP_EncryptFinal_ex(context, sealed.data() + written, &final_written) != 1 ||
       static_cast<std::size_t>(written + final_written) != payload.size() ||
-      EVP_CIPHER_CTX_ctrl(context.get(), EVP_CTRL_GCM_GET_TAG, static_cast<int>(kSealTagBytes),
+      EVP_CIPHER_CTX_ctrl(context, EVP_CTRL_GCM_GET_TAG, static_cast<int>(kSealTagBytes),
                           sealed.data() + payload.size()) != 1) {
     throw std::runtime_error("AES-256-GCM failed: " + openssl_error());
   }
@@ -92,19 +117,19 @@ Result<std::vector<std::uint8_t>> Opener::open(std::span<const std::uint8_t> sea
   if (sealed.size() > INT_MAX) return Error{"a sealed message too long to open"};
   const std::size_t length = sealed.size() - kSealTagBytes;
   const auto iv = iv_for(count_);
-  std::unique_ptr<EVP_CIPHER_CTX, ContextFree> context(EVP_CIPHER_CTX_new());
+  EVP_CIPHER_CTX* context = context_->context;
   std::vector<std::uint8_t> payload(length);
   int written = 0;
   int final_written = 0;
   // The tag is only read by the library; its API takes a non-const pointer.
   std::array<std::uint8_t, kSealTagBytes> tag{};
   std::copy(sealed.begin() + static_cast<std::ptrdiff_t>(length), sealed.end(), tag.begin());
-  if (!context || EVP_DecryptInit_ex(context.get(), EVP_aes_256_gcm(), nullptr, key_.data(), iv.data()) != 1 ||
-      EVP_DecryptUpdate(context.get(), payload.data(), &written, sealed.data(), static_cast<int>(length)) != 1 ||
-      EVP_CIPHER_CTX_ctrl(context.get(), EVP_CTRL_GCM_SET_TAG, static_cast<int>(kSealTagBytes), tag.data()) != 1) {
+  if (EVP_DecryptInit_ex(context, nullptr, nullptr, nullptr, iv.data()) != 1 ||
+      EVP_DecryptUpdate(context, payload.data(), &written, sealed.data(), static_cast<int>(length)) != 1 ||
+      EVP_CIPHER_CTX_ctrl(context, EVP_CTRL_GCM_SET_TAG, static_cast<int>(kSealTagBytes), tag.data()) != 1) {
     return Error{"cannot open a sealed message: " + openssl_error()};
   }
-  if (EVP_DecryptFinal_ex(context.get(), payload.data() + written, &final_written) != 1) {
+  if (EVP_DecryptFinal_ex(context, payload.data() + written, &final_written) != 1) {
     ERR_clear_error();
     return Error{"message " + std::to_string(count_) +
                  " of the session failed authentication (forged, changed, replayed, reordered, or sealed with "
