@@ -210,6 +210,15 @@ void MasterProtocol::refuse(PeerId peer, Session& session, const std::string& no
 
 void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelope& message, clock::Nanos now,
                               Actions& out) {
+  if (message.body_case() == wire::Envelope::kGoodbye) {
+    // A node that cannot answer the challenge (it has no secret) says why.
+    out.push_back(Log{spdlog::level::warn, "a node at " + session.peer_text +
+                                               " left before its hello: " + message.goodbye().reason()});
+    session.refused = true;
+    ++refused_connections_;
+    out.push_back(Close{peer, "left before its hello"});
+    return;
+  }
   if (message.body_case() != wire::Envelope::kHello) {
     refuse(peer, session, "?", std::string("expected hello, got ") + net::body_name(message), false, out);
     return;

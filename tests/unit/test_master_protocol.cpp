@@ -206,6 +206,14 @@ TEST_F(MasterTest, TheSharedSecretIsChecked) {
   no_mac.mutable_hello()->set_node_id("top-left");
   EXPECT_TRUE(logged(master_->message(1, no_mac, now_), "start the node with --secret-file"));
 
+  // A node without the secret leaves at the challenge, saying why: the log says that, not "expected hello".
+  (void)master_->accepted(5, "10.0.0.11:5000", false, nonce_, now_);
+  wire::Envelope goodbye = envelope();
+  goodbye.mutable_goodbye()->set_reason("the master requires the installation's shared secret");
+  const Actions left = master_->message(5, goodbye, now_);
+  EXPECT_TRUE(logged(left, "a node at 10.0.0.11:5000 left before its hello: the master requires"));
+  EXPECT_FALSE(logged(left, "expected hello"));
+
   // The node's own nonce follows the master's in what the mac covers.
   const std::vector<std::uint8_t> node_nonce(32, 5);
   std::vector<std::uint8_t> both = nonce_;
