@@ -172,6 +172,7 @@ int run_cli(int argc, char** argv) {
   // What the scene file asked for that is left out or assumed (default lights):
   // the operator reads it here, not in each node's log.
   for (const std::string& warning : options.scene.warnings) logger->warn("scene: {}", warning);
+  for (const std::string& note : options.scene.notes) logger->info("scene: {}", note);
 
   boost::asio::io_context io;
   Master master(io, std::move(options), *logger);

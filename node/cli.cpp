@@ -19,6 +19,8 @@ namespace optique::node {
 
 int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
   CLI::App app{"optique-node: renders one projector's share of the picture in sync with the master"};
+  // --help shows each option's default (the value it starts with below).
+  app.option_defaults()->always_capture_default();
   NodeOptions options;
   std::string master = "127.0.0.1:7400";
   std::string log_level = "info";

@@ -134,8 +134,12 @@ std::string summarize(const config::LoadedConfig& config) {
       << "), present lead " << m.present_lead.count() << " µs\n";
   if (m.status) {
     const std::string& listen = m.status->listen;
-    out << "  status: http://" << (listen.find(':') != std::string::npos ? "[" + listen + "]" : listen) << ":"
-        << m.status->port << "/ (page, /status.json, /metrics); "
+    const std::string host = listen.find(':') != std::string::npos ? "[" + listen + "]" : listen;
+    // Port 0 is no address to open: the master takes a free one and logs it.
+    out << "  status: "
+        << (m.status->port == 0 ? "on " + host + ", an ephemeral port the master logs when it starts"
+                                : "http://" + host + ":" + std::to_string(m.status->port) + "/")
+        << " (page, /status.json, /metrics); "
         << (config::is_loopback_address(listen) ? "reads open on loopback" : "reads need the token") << ", "
         << (m.secret_file.empty() ? "controls off (they need a token, and there is no master.secret_file)"
                                   : "controls need the token")

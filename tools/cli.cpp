@@ -51,6 +51,7 @@ int check_config(const std::vector<std::string>& files) {
                 << "…: sent to every node that has no copy\n";
     }
     for (const auto& warning : scene.warnings) std::cout << "  scene warning: " << warning << "\n";
+    for (const auto& note : scene.notes) std::cout << "  scene: " << note << "\n";
   }
   return status;
 }

@@ -110,8 +110,15 @@ class Checker {
     }
   }
 
-  void integer(const Json& value, const std::string& path, double lowest, double highest) {
-    if (value.is_string()) return;  // Protobuf reads quoted integers; its parser judges them
+  // `quoted_ok`: 64-bit fields, which Protobuf's own JSON writes in quotes (its
+  // parser judges those); a 32-bit one in quotes ("640") is a slip worth a word.
+  void integer(const Json& value, const std::string& path, double lowest, double highest, bool quoted_ok) {
+    if (value.is_string()) {
+      if (!quoted_ok) {
+        fail(path, "expected a whole number, not text (got " + shown(value) + "; write it without quotes)");
+      }
+      return;
+    }
     if (!value.is_number()) {
       fail(path, "expected a whole number (got " + kind_of(value) + ")");
       return;
@@ -132,22 +139,30 @@ class Checker {
   void one_value(const FieldDescriptor& field, const Json& value, const std::string& path) {
     switch (field.cpp_type()) {
       case FieldDescriptor::CPPTYPE_INT32:
-        integer(value, path, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max());
+        integer(value, path, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max(),
+                false);
         break;
       case FieldDescriptor::CPPTYPE_UINT32:
-        integer(value, path, 0.0, std::numeric_limits<std::uint32_t>::max());
+        integer(value, path, 0.0, std::numeric_limits<std::uint32_t>::max(), false);
         break;
       case FieldDescriptor::CPPTYPE_INT64:
-        integer(value, path, -9.007199254740992e15, 9.007199254740992e15);
+        integer(value, path, -9.007199254740992e15, 9.007199254740992e15, true);
         break;
       case FieldDescriptor::CPPTYPE_UINT64:
-        integer(value, path, 0.0, 9.007199254740992e15);
+        integer(value, path, 0.0, 9.007199254740992e15, true);
         break;
       case FieldDescriptor::CPPTYPE_DOUBLE:
       case FieldDescriptor::CPPTYPE_FLOAT:
         // Protobuf also reads "NaN" and "Infinity" as text: the validation
         // after it refuses those where they make no sense, by name.
-        if (!value.is_number() && !value.is_string()) fail(path, "expected a number (got " + kind_of(value) + ")");
+        if (value.is_string()) {
+          const std::string text = value.get<std::string>();
+          if (text != "NaN" && text != "Infinity" && text != "-Infinity") {
+            fail(path, "expected a number, not text (got " + shown(value) + "; write it without quotes)");
+          }
+        } else if (!value.is_number()) {
+          fail(path, "expected a number (got " + kind_of(value) + ")");
+        }
         break;
       case FieldDescriptor::CPPTYPE_BOOL:
         if (!value.is_boolean()) fail(path, "expected true or false (got " + kind_of(value) + ")");

@@ -1,5 +1,7 @@
 #include "scene/load_scene.h"
 
+#include <fmt/format.h>
+
 #include <filesystem>
 
 #include "scene/builtin.h"
@@ -32,8 +34,13 @@ Result<LoadedScene> load_scene(const std::string& builtin, const std::string& pa
   loaded.files = std::move(gltf.value().files);
   loaded.warnings = std::move(gltf.value().warnings);
   loaded.source = path;
+  // Either way the log says how the scene is lit (an export without lights is
+  // the usual case, not a fault).
   if (loaded.definition.lights.empty()) {
-    loaded.warnings.push_back(path + ": " + add_default_lights(loaded.definition, viewer));
+    loaded.notes.push_back(path + ": " + add_default_lights(loaded.definition, viewer));
+  } else {
+    loaded.notes.push_back(fmt::format("{}: lit by the file's {} point light(s)", path,
+                                       loaded.definition.lights.size()));
   }
   return loaded;
 }

@@ -23,7 +23,8 @@ struct LoadedScene {
   std::string content_sha256;  // the glTF's identity (its manifest's SHA-256); empty for built-in scenes
   SceneManifest manifest;      // the glTF's files; none for built-in scenes
   std::vector<std::shared_ptr<const std::string>> files;  // their bytes, as manifest.files
-  std::vector<std::string> warnings;
+  std::vector<std::string> warnings;  // what the file asked for that is left out or changed
+  std::vector<std::string> notes;     // what was done that is no fault: how a glTF is lit
 };
 
 // A glTF path relative to `config_dir` becomes absolute, so nodes started

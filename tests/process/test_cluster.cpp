@@ -160,6 +160,16 @@ TEST(Cluster, AStoppedNodeAloneComesBackAfterSigcont) {
   EXPECT_GE(wall->frames_presented(), 150u);
 }
 
+// A user reads the defaults in --help, not in the source.
+TEST(Cluster, NodeHelpShowsTheDefaults) {
+  const std::string dir = make_temp_dir("optique-help");
+  Process help({kNode, "--help"}, dir + "/help.log");
+  ASSERT_EQ(help.wait(10s), 0) << help.output();
+  const std::string said = help.output();
+  EXPECT_NE(said.find("--give-up-after-ms INT:INT in [0 - 86400000]=10000"), std::string::npos) << said;
+  EXPECT_NE(said.find("--max-scene-mb UINT:UINT in [1 - 16777216]=8192"), std::string::npos) << said;
+}
+
 TEST(Cluster, UnknownNodeIdIsRefusedOnBothSides) {
   ExternalMaster master(kConfigs + "/single-wall.json", {});
   ASSERT_FALSE(master.port.empty()) << master.process->output();

@@ -53,3 +53,21 @@ TEST(CheckConfig, SaysThatAnUpConvertingDlpProjectorBuildsEveryField) {
 
 }  // namespace
 }  // namespace optique::tools
+
+namespace optique::tools {
+namespace {
+
+// Port 0 is not an address anyone can open: check-config says the master picks one.
+TEST(CheckConfig, AnEphemeralStatusPortIsNotGivenAsAnAddress) {
+  config::LoadedConfig config = pinball();
+  config.installation.master.status = config::StatusServer{};
+  config.installation.master.status->port = 0;
+  const std::string said = summarize(config);
+  EXPECT_EQ(said.find("127.0.0.1:0/"), std::string::npos) << said;
+  EXPECT_NE(said.find("an ephemeral port the master logs when it starts"), std::string::npos) << said;
+  config.installation.master.status->port = 7480;
+  EXPECT_NE(summarize(config).find("http://127.0.0.1:7480/"), std::string::npos) << summarize(config);
+}
+
+}  // namespace
+}  // namespace optique::tools

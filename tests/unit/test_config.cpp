@@ -214,6 +214,7 @@ TEST(ParseInstallation, ValuesOfTheWrongKindAreAllListedWithTheirPaths) {
                                           "test.json: projectors[0].width: must be 0 or more (got -640)",
                                           "test.json: projectors[1].height: expected a whole number (got 1.5)",
                                           "test.json: viewer.eye: expected a list [ … ] (got the number 3)",
+                                          "test.json: master.port: expected a whole number, not text (got \"x\"; write it without quotes)",
                                           "test.json: master.secret_file: expected text in quotes (got true)",
                                       }))
       << parsed.error();
@@ -397,6 +398,15 @@ TEST(ParseInstallation, FrameRateAtTheLimitIsFine) {
   auto parsed = parse(with(R"("port": 7400)", R"("port": 7400, "frame_rate": 1000)"));
   ASSERT_TRUE(parsed.ok()) << parsed.error();
   EXPECT_DOUBLE_EQ(parsed.value().master.frame_rate, 1000.0);
+}
+
+// "640" in quotes is text, though Protobuf's JSON reader would take it: said,
+// with the field's path, for whole numbers and decimals alike.
+TEST(ParseInstallation, ANumberInQuotesIsSaid) {
+  expect_problem(parse(with(R"("port": 7400)", R"("port": "7400")")), "master.port",
+                 {"expected a whole number, not text", "\"7400\""});
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "frame_rate": "60")")), "master.frame_rate",
+                 {"expected a number, not text", "\"60\""});
 }
 
 TEST(ParseInstallation, MinPresentedIsAShare) {

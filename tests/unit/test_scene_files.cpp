@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/default_lights.h"
+#include "scene/load_scene.h"
 #include "scene/manifest.h"
 #include "scene/meshes.h"
 #include "scene/relative_path.h"
@@ -213,6 +214,28 @@ TEST(ShippedAssets, EveryGltfAssetPassedTheKhronosValidatorAsItIsNow) {
           << uri << " changed since it was validated: run scripts/make-gltf-assets.sh";
     }
   }
+}
+
+}  // namespace
+}  // namespace optique::scene
+
+namespace optique::scene {
+namespace {
+
+// How a glTF is lit is said either way, and as a note, not a warning: an
+// export without lights is the usual case, not a fault.
+TEST(DefaultLights, HowAFileIsLitIsANoteEitherWay) {
+  const glm::dvec3 viewer(0.0, 1.6, 3.0);
+  auto unlit = load_scene("", OPTIQUE_SOURCE_DIR "/configs/assets/torus/torus.gltf", {}, viewer);
+  ASSERT_TRUE(unlit) << unlit.error();
+  ASSERT_EQ(unlit.value().notes.size(), 1u);
+  EXPECT_NE(unlit.value().notes.front().find("a key, a fill and a rim light"), std::string::npos);
+  for (const std::string& w : unlit.value().warnings) EXPECT_EQ(w.find("key, a fill"), std::string::npos) << w;
+  auto lit = load_scene("", OPTIQUE_SOURCE_DIR "/configs/assets/animated-cubes.gltf", {}, viewer);
+  ASSERT_TRUE(lit) << lit.error();
+  ASSERT_EQ(lit.value().notes.size(), 1u);
+  EXPECT_NE(lit.value().notes.front().find("lit by the file's 2 point light(s)"), std::string::npos)
+      << lit.value().notes.front();
 }
 
 }  // namespace
