@@ -96,11 +96,14 @@ TEST(Manifest, TheIdentityFollowsEveryPathSizeDigestAndTheChunkSize) {
   const std::string identity = manifest_sha256(base);
   EXPECT_EQ(identity.size(), 64u);
   EXPECT_EQ(manifest_sha256(base), identity);
-  std::vector<SceneManifest> changed(4, base);
+  std::vector<SceneManifest> changed(5, base);
   changed[0].files[1].path = "b.bin";
   changed[1].files[1] = describe_file("a.bin", "abd", 4096);
   changed[2].chunk_bytes = 8192;
   std::swap(changed[3].files[0], changed[3].files[1]);
+  // A chunk's digest alone: nodes check each chunk against it, so a manifest
+  // whose identity did not cover it could send them spoilt chunks as good.
+  changed[4].files[1].chunk_sha256[0] = static_cast<char>(changed[4].files[1].chunk_sha256[0] ^ 1);
   for (const auto& manifest : changed) EXPECT_NE(manifest_sha256(manifest), identity);
 }
 
@@ -128,6 +131,12 @@ TEST(Manifest, APeersManifestIsCheckedBeforeAnythingIsFetched) {
   m = good;
   m.files[1].size = 5000;  // two chunks, one digest
   refused(m, "larger than the 1000 bytes", limits);
+  {
+    // Every file within the limit, all of them together not.
+    SceneManifest two{4096, {describe_file("s.gltf", std::string(600, '{'), 4096),
+                             describe_file("a.bin", std::string(600, 'a'), 4096)}};
+    refused(two, "larger than the 1000 bytes", limits);
+  }
   refused(m, "1 chunk digests for 2 chunks", {100000, 10});
   m = good;
   m.chunk_bytes = 16;
