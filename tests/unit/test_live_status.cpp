@@ -222,3 +222,38 @@ TEST(LiveStatus, OddTextStaysInsideItsJsonStringAndItsMetricsLabel) {
 
 }  // namespace
 }  // namespace optique::master
+
+namespace optique::master {
+namespace {
+
+// Frames unevenly apart (10, 20, 30 … ms): the chart's frame time k is the time
+// from frame k to frame k + 1, not a neighbour's; and /metrics gives a node's
+// render time in seconds (51 ms → 0.051), its sum too.
+TEST(LiveStatus, TheChartAndTheMetricsCarryEachFramesOwnTimes) {
+  std::deque<RecentFrame> recent = frames(6);
+  clock::Nanos at = 1000 * kMs;
+  for (std::size_t i = 0; i < recent.size(); ++i) {
+    recent[i].begin_sent = at;
+    at += static_cast<clock::Nanos>(10 * (i + 1)) * kMs;
+  }
+  LiveStatus s = two_nodes();
+  summarize_recent(recent, 1200 * kMs, s);
+  ASSERT_EQ(s.history.size(), 6u);
+  for (std::size_t i = 0; i + 1 < s.history.size(); ++i) {
+    ASSERT_TRUE(s.history[i].frame_ms) << i;
+    EXPECT_DOUBLE_EQ(*s.history[i].frame_ms, 10.0 * static_cast<double>(i + 1)) << "frame " << i;
+  }
+
+  LiveStatus many = two_nodes();
+  summarize_recent(frames(101), 3000 * kMs, many);
+  many.nodes[0].counts.render_us_sum = 2'500'000.0;
+  many.nodes[0].counts.render_times = 50;
+  const std::string text = status_metrics(many);
+  EXPECT_NE(text.find("optique_node_render_seconds{projector=\"left\",quantile=\"0.5\"} 0.051\n"), std::string::npos)
+      << text;
+  EXPECT_NE(text.find("optique_node_render_seconds_sum{projector=\"left\"} 2.5\n"), std::string::npos) << text;
+  EXPECT_NE(text.find("optique_node_render_seconds_count{projector=\"left\"} 50\n"), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace optique::master
