@@ -721,6 +721,37 @@ TEST(Gltf, ATruncatedGlbIsRefused) {
   expect_error(dir.file("cut.glb"), {"malformed GLB", "truncated"});
 }
 
+// The GLB's chunks checked one by one, past a header that is whole: a BIN
+// chunk that says it runs 4 bytes past the file, and one that is whole but
+// shorter than the buffer's byteLength.
+TEST(Gltf, AGlbChunkPastTheEndOrShorterThanItsBufferIsRefused) {
+  TempDir dir;
+  const std::string glb = read_bytes(kTorus + "torus.glb");
+  const auto u32 = [](const std::string& bytes, std::size_t at) {
+    return static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at])) |
+           static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 1])) << 8 |
+           static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 2])) << 16 |
+           static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 3])) << 24;
+  };
+  const auto put = [](std::string& bytes, std::size_t at, std::uint32_t value) {
+    for (int i = 0; i < 4; ++i) bytes[at + static_cast<std::size_t>(i)] = static_cast<char>(value >> (8 * i));
+  };
+  const std::size_t bin = 12 + 8 + u32(glb, 12);  // the BIN chunk's header
+  ASSERT_LT(bin + 8, glb.size());
+  ASSERT_EQ(u32(glb, 8), glb.size());
+
+  std::string over = glb;
+  put(over, bin, u32(glb, bin) + 4);
+  write_bytes(dir.file("over.glb"), over);
+  expect_error(dir.file("over.glb"), {"malformed GLB", "a chunk at byte " + std::to_string(bin) + " runs past the end"});
+
+  std::string shorter = glb.substr(0, glb.size() - 8);
+  put(shorter, 8, static_cast<std::uint32_t>(shorter.size()));
+  put(shorter, bin, u32(glb, bin) - 8);
+  write_bytes(dir.file("short.glb"), shorter);
+  expect_error(dir.file("short.glb"), {"buffer 0 (the GLB's binary chunk) is truncated"});
+}
+
 TEST(Gltf, UnsupportedRequiredExtensionsAreListedBeforeAnythingElse) {
   TempDir dir;
   const auto path = torus_variant(dir, [](json& doc) {
