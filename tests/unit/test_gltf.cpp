@@ -714,6 +714,17 @@ TEST(Gltf, ATruncatedBufferIsRefused) {
   expect_error(path, {"buffer 0 'torus.bin' is truncated: 1000 bytes where its byteLength says 184352"});
 }
 
+// A buffer view that runs past its buffer (the buffer itself whole): refused
+// where the view is read, naming it, never read beyond the buffer.
+TEST(Gltf, ABufferViewPastItsBufferIsRefused) {
+  TempDir dir;
+  const auto path = torus_variant(dir, [](json& doc) {
+    auto& view = doc["bufferViews"][0];
+    view["byteOffset"] = view.value("byteOffset", 0) + 184352 - 8;  // 8 bytes before the end of the buffer
+  });
+  expect_error(path, {"buffer view 0", "is out of range of buffer 0 (184352 bytes)"});
+}
+
 TEST(Gltf, ATruncatedGlbIsRefused) {
   TempDir dir;
   const std::string glb = read_bytes(kTorus + "torus.glb");
