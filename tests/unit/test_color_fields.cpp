@@ -128,6 +128,16 @@ TEST(ColorFields, AWindowOutsideTheFrame) {
   EXPECT_TRUE(problems_at(parsed, ".fields[1].offset").empty()) << parsed.error();
 }
 
+// The window's end, not its centre, must stay in the frame: a field centred
+// inside whose end is past it.
+TEST(ColorFields, AWindowCentredInsideButEndingPastTheFrame) {
+  const auto parsed = parse(R"({"fields": [
+      {"channel": "red", "offset": -0.3, "duration": 0.2},
+      {"channel": "green", "offset": 0.0, "duration": 0.2},
+      {"channel": "blue", "offset": 0.45, "duration": 0.2}]})");
+  expect_one(parsed, ".fields[2].offset", "its window [0.35, 0.55] leaves the frame");
+}
+
 TEST(ColorFields, DurationsOfMoreThanAFrame) {
   const auto parsed = parse(R"({"fields": [
       {"channel": "red", "offset": -0.3, "duration": 0.4},
