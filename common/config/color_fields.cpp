@@ -20,6 +20,7 @@ struct Preset {
   std::string name;
   int images = 1;
   std::vector<ColorField> fields;
+  double frame_rate = 60.0;  // what its shares of a frame are of
 };
 
 const std::vector<Preset>& presets() {
@@ -27,12 +28,12 @@ const std::vector<Preset>& presets() {
     // Lancelle et al. read a 120 Hz projector's offsets off a photo taken while
     // turning the camera: B −0.2, R 0.0, G +0.32 of the frame. They give no
     // durations; 0.2 each keeps the three windows apart.
-    Preset brg{"dlp-brg-120hz", 1, {}};
+    Preset brg{"dlp-brg-120hz", 1, {}, 120.0};
     brg.fields = {{Channel::blue, 0, -0.2, 0.2}, {Channel::red, 0, 0.0, 0.2}, {Channel::green, 0, 0.32, 0.2}};
     // A 2×60 Hz stereo projector used as mono 120 Hz: per 60 Hz frame, B R G of
     // the left image, then of the right, at ∓5/6, ∓3/6, ∓1/6 of 1/120 s, each a
     // sixth of the frame.
-    Preset stereo{"dlp-stereo-as-mono", 2, {}};
+    Preset stereo{"dlp-stereo-as-mono", 2, {}, 60.0};
     const std::array<Channel, 3> order{Channel::blue, Channel::red, Channel::green};
     for (int i = 0; i < 6; ++i) {
       stereo.fields.push_back({order[static_cast<std::size_t>(i % 3)], i / 3, (2 * i - 5) / 12.0, 1.0 / 6.0});
@@ -93,6 +94,13 @@ std::string_view to_string(FieldMethod method) {
       return "off";
   }
   return "?";
+}
+
+std::optional<double> preset_frame_rate(const std::string& name) {
+  for (const Preset& p : presets()) {
+    if (p.name == name) return p.frame_rate;
+  }
+  return std::nullopt;
 }
 
 const std::vector<std::string>& color_field_presets() {

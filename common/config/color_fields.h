@@ -5,6 +5,7 @@
 // "Fast Motion Rendering for Single-Chip Stereo DLP Projectors").
 // Times are in frame periods from the frame's display time.
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -66,6 +67,9 @@ struct ColorFields {
 
 // The presets' names, for messages and docs.
 [[nodiscard]] const std::vector<std::string>& color_field_presets();
+// The frame rate preset `name`'s field times are for (its offsets and
+// durations are shares of that frame); none for an unknown name.
+[[nodiscard]] std::optional<double> preset_frame_rate(const std::string& name);
 
 // Checks `fields` (a projector's `color_fields`, at `path` in the file) and types
 // it, the preset expanded. Every problem goes to `problems`, each with its own

@@ -93,7 +93,8 @@ schema::Projector to_schema(const Projector& p, const std::vector<Screen>& scree
     up.set_ratio(static_cast<std::uint32_t>(p.up_conversion.ratio));
     up.set_method(std::string(to_string(p.up_conversion.method)));
     up.set_mode(std::string(to_string(p.up_conversion.mode)));
-    up.set_min_psnr(p.up_conversion.min_psnr);
+    // Method average keeps its ratio fixed: a floor there is refused, not ignored.
+    if (p.up_conversion.method == UpMethod::motion) up.set_min_psnr(p.up_conversion.min_psnr);
     up.set_spread(p.up_conversion.spread);
   }
   return out;

@@ -41,6 +41,11 @@ UpConversion parse_up_conversion(const schema::UpConversion& up, const std::stri
                           "must be 10…100 dB of PSNR_Y, or 0 for a fixed ratio (got " + std::to_string(floor) + ")"});
     }
   }
+  if (up.has_min_psnr() && up.min_psnr() > 0.0 && out.method == UpMethod::average) {
+    problems.push_back({path + ".min_psnr",
+                        "the adaptive ratio weighs frames that motion builds; method average (the paper's baseline) "
+                        "keeps its ratio fixed and would ignore it: leave min_psnr out"});
+  }
   out.spread = up.spread();
   if (mode_known && out.method == UpMethod::average && out.mode == UpMode::extrapolate) {
     problems.push_back({path + ".method", "average blends the key frames before and after: it needs mode interpolate"});

@@ -343,6 +343,27 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
     if (check.problems().size() == problems_before) {  // each well formed: together?
       if (auto problem = up_conversion_with_fields(up, fields)) check.fail(at + "." + problem->path, problem->message);
     }
+    // A preset's field times are shares of its projector's frame: at another
+    // frame rate every field would last longer or shorter than the projector's.
+    const double rate = inst.master().frame_rate() > 0.0 ? inst.master().frame_rate() : defaults::kFrameRate;
+    if (p.has_color_fields() && !p.color_fields().preset().empty() && fields.method != FieldMethod::off) {
+      if (const auto preset_rate = preset_frame_rate(p.color_fields().preset());
+          preset_rate && std::abs(*preset_rate - rate) > 0.01) {
+        check.fail(at + ".color_fields.preset",
+                   "'" + p.color_fields().preset() + "' is the field timing of a " + number_text(*preset_rate) +
+                       " Hz projector, but master.frame_rate is " + number_text(rate) +
+                       " Hz: each field would last " + number_text(*preset_rate / rate) +
+                       " times as long (set master.frame_rate, or give the fields)");
+      }
+    }
+    // Interpolation draws key frames from the scene sent ahead; a live tracked
+    // head cannot be sent ahead, only predicted that far.
+    if (p.has_up_conversion() && up.enabled() && up.mode == UpMode::interpolate && inst.viewer().has_tracking() &&
+        inst.viewer().tracking().source() != "replay") {
+      check.fail(at + ".up_conversion.mode",
+                 "interpolate draws key frames from the scene ratio − 1 frames ahead, but the head is tracked live "
+                 "(viewer.tracking): it cannot be known ahead; use extrapolate");
+    }
   }
   if (scope == Scope::installation) check_stacked_pairs(check, inst);
 }

@@ -26,8 +26,8 @@ std::string installation_with(const std::string& fields, double frame_rate = 120
 })json";
 }
 
-Result<Installation> parse(const std::string& fields) {
-  return parse_installation(installation_with(fields), "test.json", ::testing::TempDir());
+Result<Installation> parse(const std::string& fields, double frame_rate = 120.0) {
+  return parse_installation(installation_with(fields, frame_rate), "test.json", ::testing::TempDir());
 }
 
 // Every line of the error that starts with "test.json: <path>: ".
@@ -71,7 +71,7 @@ TEST(ColorFields, ThePapersProjectorAsAPreset) {
 }
 
 TEST(ColorFields, TheStereoProjectorAsMonoHasSixFieldsInTwoImages) {
-  const auto parsed = parse(R"({"preset": "dlp-stereo-as-mono"})");
+  const auto parsed = parse(R"({"preset": "dlp-stereo-as-mono"})", 60.0);  // a 2×60 Hz projector
   ASSERT_TRUE(parsed) << parsed.error();
   const ColorFields& c = parsed.value().projectors[0].color_fields;
   EXPECT_EQ(c.images, 2);
@@ -219,7 +219,8 @@ TEST(ColorFields, PresetAndFieldsTogether) {
 
 TEST(ColorFields, AWelcomeCarriesTheFieldsAndTheirSettings) {
   const auto parsed =
-      parse(R"({"preset": "dlp-stereo-as-mono", "method": "gather", "velocity_threshold": 24, "gather_samples": 4})");
+      parse(R"({"preset": "dlp-stereo-as-mono", "method": "gather", "velocity_threshold": 24, "gather_samples": 4})",
+            60.0);
   ASSERT_TRUE(parsed) << parsed.error();
   const auto again = parse_installation(to_schema(parsed.value()), ::testing::TempDir(), "welcome");
   ASSERT_TRUE(again) << again.error();

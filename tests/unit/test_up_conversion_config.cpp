@@ -72,12 +72,13 @@ TEST(UpConversion, WithColourFieldsTheFieldsAreBuiltBetweenKeyFrames) {
   const auto fields = [](const std::string& colour_fields) {
     return with(R"({"ratio": 4}, "color_fields": )" + colour_fields);
   };
-  const auto built = fields(R"({"preset": "dlp-brg-120hz", "method": "up-conversion"})");
+  // (dlp-stereo-as-mono: its fields are for the 60 Hz these tests run at)
+  const auto built = fields(R"({"preset": "dlp-stereo-as-mono", "method": "up-conversion"})");
   ASSERT_TRUE(built) << built.error();
   EXPECT_TRUE(built.value().projectors[0].up_conversion.enabled());
   EXPECT_TRUE(built.value().projectors[0].color_fields.up_converts());
   for (const char* method : {"per-field", "gather"}) {
-    const auto refused = fields(std::string(R"({"preset": "dlp-brg-120hz", "method": ")") + method + R"("})");
+    const auto refused = fields(std::string(R"({"preset": "dlp-stereo-as-mono", "method": ")") + method + R"("})");
     EXPECT_TRUE(says(refused, std::string("projectors[0].color_fields.method: must be \"up-conversion\" with "
                                           "up_conversion (got \"") +
                                   method + "\")"))
@@ -112,13 +113,67 @@ TEST(UpConversion, HowFarAheadTheSceneIsSent) {
 
 TEST(UpConversion, AWelcomeCarriesIt) {
   const auto parsed =
-      with(R"({"ratio": 3, "method": "average", "mode": "interpolate", "min_psnr": 42, "spread": true})");
+      with(R"({"ratio": 3, "method": "motion", "mode": "interpolate", "min_psnr": 42, "spread": true})");
+  const auto average = with(R"({"ratio": 3, "method": "average", "mode": "interpolate", "spread": true})");
+  ASSERT_TRUE(average) << average.error();
+  const auto average_again = parse_installation(to_schema(average.value()), ::testing::TempDir(), "welcome");
+  ASSERT_TRUE(average_again) << average_again.error();
+  EXPECT_EQ(average_again.value().projectors[0].up_conversion, average.value().projectors[0].up_conversion);
   ASSERT_TRUE(parsed) << parsed.error();
   EXPECT_EQ(parsed.value().projectors[0].up_conversion.min_psnr, 42.0);
   EXPECT_TRUE(parsed.value().projectors[0].up_conversion.spread);
   const auto again = parse_installation(to_schema(parsed.value()), ::testing::TempDir(), "welcome");
   ASSERT_TRUE(again) << again.error();
   EXPECT_EQ(again.value().projectors[0].up_conversion, parsed.value().projectors[0].up_conversion);
+}
+
+}  // namespace
+}  // namespace optique::config
+
+namespace optique::config {
+namespace {
+
+// What used to pass without a word: min_psnr that method average ignores, and
+// interpolation from a head tracked live (it cannot be sent ahead).
+TEST(UpConversion, WhatWouldBeIgnoredOrCannotWorkIsSaid) {
+  EXPECT_TRUE(says(with(R"({"ratio": 4, "mode": "interpolate", "method": "average", "min_psnr": 30})"),
+                   "projectors[0].up_conversion.min_psnr: the adaptive ratio weighs frames that motion builds"));
+  EXPECT_TRUE(with(R"({"ratio": 4, "mode": "interpolate", "method": "average"})")) << "without min_psnr: fine";
+  const auto tracked = [](const std::string& source, const std::string& mode) {
+    const std::string json =
+        R"({"screens": [{"id": "front", "origin": [-2, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0],
+        "width": 4, "height": 2.25}],
+        "projectors": [{"id": "wall", "width": 640, "height": 360, "screen": "front",
+                        "up_conversion": {"ratio": 4, "mode": ")" +
+        mode + R"("}}],
+        "viewer": {"eye": [0, 1.2, 2], "tracking": {"source": ")" +
+        source + R"(", "body": 1)" + (source == "replay" ? R"(, "file": "walk.csv")" : "") +
+        R"(}}, "scene": {"builtin": "moving-square"}})";
+    return parse_installation(json, "test.json", ::testing::TempDir());
+  };
+  EXPECT_TRUE(says(tracked("dtrack", "interpolate"),
+                   "projectors[0].up_conversion.mode: interpolate draws key frames from the scene ratio − 1 frames "
+                   "ahead, but the head is tracked live"));
+  const auto extrapolated = tracked("dtrack", "extrapolate");
+  EXPECT_TRUE(extrapolated) << extrapolated.error();
+}
+
+// A preset's field times are shares of its projector's frame rate.
+TEST(UpConversion, APresetAtAnotherFrameRateIsSaid) {
+  const auto dlp = [](const std::string& rate) {
+    const std::string json =
+        R"({"screens": [{"id": "front", "origin": [-2, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0],
+        "width": 4, "height": 2.25}],
+        "projectors": [{"id": "dlp", "width": 640, "height": 360, "screen": "front",
+                        "color_fields": {"preset": "dlp-brg-120hz"}}],
+        "viewer": {"eye": [0, 1.2, 2]}, "master": {"frame_rate": )" +
+        rate + R"(}, "scene": {"builtin": "moving-square"}})";
+    return parse_installation(json, "test.json", ::testing::TempDir());
+  };
+  EXPECT_TRUE(says(dlp("60"), "projectors[0].color_fields.preset: 'dlp-brg-120hz' is the field timing of a 120 Hz "
+                              "projector, but master.frame_rate is 60 Hz: each field would last 2 times as long"));
+  const auto right = dlp("120");
+  EXPECT_TRUE(right) << right.error();
 }
 
 }  // namespace
