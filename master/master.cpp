@@ -9,6 +9,7 @@
 
 #include "config/address.h"
 #include "master/report_json.h"
+#include "master/run_verdict.h"
 #include "net/stamped_receive.h"
 #include "util/overloaded.h"
 
@@ -373,11 +374,8 @@ void Master::update_status() {
   last_status_ = now;
   status_frame_ = frame;
   const std::string total = options_.run.frames ? std::to_string(options_.run.frames) : std::string("-");
-  const std::uint64_t finalized = recorder_->frames_finalized();
   const double shown_by_all =
-      finalized == 0 ? 0.0
-                     : 100.0 * static_cast<double>(finalized - std::min(finalized, recorder_->frames_with_missing_node())) /
-                           static_cast<double>(finalized);
+      100.0 * shown_by_all_share(recorder_->frames_finalized(), recorder_->frames_with_missing_node());
   char line[240];
   std::snprintf(line, sizeof line,
                 "frame %llu/%s  %.1f of %g Hz  nodes %zu/%zu  shown by all %.1f %%  skew %.0f us  missing %llu",

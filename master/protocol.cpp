@@ -446,11 +446,7 @@ Actions MasterProtocol::closed(PeerId peer, const std::string& reason, clock::Na
       if (barrier_.complete()) swap(now, out);
     }
     present_owed(slot, now, out);  // nor waited for to show the last one (after its lights moved)
-    if (begin_when_answered_ && !all_behind()) {
-      begin_when_answered_ = false;
-      out.push_back(Disarm{Timer::next_frame});
-      begin_frame(now, out);
-    }
+    begin_if_held_frame_may(now, out);
   }
   finish_if_all_gone(out);
   return out;
@@ -686,6 +682,14 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   out.push_back(Arm{Timer::barrier, now + barrier_allowance_});
 }
 
+// A frame held while every node was behind begins once one is not (it
+// answered, or the behind ones left); begin_frame starts the schedule anew.
+void MasterProtocol::begin_if_held_frame_may(clock::Nanos now, Actions& out) {
+  if (!begin_when_answered_ || all_behind()) return;
+  out.push_back(Disarm{Timer::next_frame});
+  begin_frame(now, out);
+}
+
 bool MasterProtocol::all_behind() const {
   bool any_up = false;
   for (const Slot& slot : slots_) {
@@ -698,8 +702,9 @@ bool MasterProtocol::all_behind() const {
 }
 
 void MasterProtocol::say_if_slow(Session& session, Actions& out) {
+  if (session.said_slow) return;  // once: the median is not worked out on every ready after that
   const std::optional<clock::Nanos> usual = session.pace.typical();
-  if (session.said_slow || !usual || *usual <= frame_period_) return;
+  if (!usual || *usual <= frame_period_) return;
   session.said_slow = true;
   out.push_back(Log{spdlog::level::warn,
                     fmt::format("node '{}' draws a frame in {:.1f} ms, longer than the {:.1f} ms frame period: frames "
@@ -746,10 +751,7 @@ void MasterProtocol::on_ready(Session& session, const wire::FrameReady& ready, c
         Log{spdlog::level::debug, fmt::format("late ready from '{}' for frame {}", slot_id(slot), ready.frame_id())});
   }
   if (barrier_.complete()) swap(now, out);
-  if (begin_when_answered_ && !all_behind()) {
-    out.push_back(Disarm{Timer::next_frame});
-    begin_frame(now, out);
-  }
+  begin_if_held_frame_may(now, out);
 }
 
 void MasterProtocol::on_barrier_timeout(clock::Nanos now, Actions& out) {

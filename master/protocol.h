@@ -223,6 +223,7 @@ class MasterProtocol {
   // an earlier frame): then a frame would be shown by nobody, and the next one
   // waits for the first of them to answer.
   [[nodiscard]] bool all_behind() const;
+  void begin_if_held_frame_may(clock::Nanos now, Actions& out);
   void say_if_slow(Session& session, Actions& out);
   void on_presented(Session& session, const wire::Presented& presented, clock::Nanos now, Actions& out);
   // `slot` showed the last swapped frame, or is gone: the next frame may begin

@@ -16,10 +16,13 @@ std::string percent(double share) { return fmt::format("{:.1f} %", 100.0 * share
 
 }  // namespace
 
+double shown_by_all_share(std::uint64_t frames, std::uint64_t with_missing_node) {
+  if (frames == 0) return 0.0;
+  return static_cast<double>(frames - std::min(with_missing_node, frames)) / static_cast<double>(frames);
+}
+
 double shown_by_all_share(const report::RunReport& report) {
-  if (report.frames() == 0) return 0.0;
-  const std::uint64_t missing = std::min(report.sync().frames_with_missing_node(), report.frames());
-  return static_cast<double>(report.frames() - missing) / static_cast<double>(report.frames());
+  return shown_by_all_share(report.frames(), report.sync().frames_with_missing_node());
 }
 
 std::optional<std::string> too_few_shown(const report::RunReport& report, std::optional<double> min_presented) {

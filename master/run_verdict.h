@@ -10,7 +10,9 @@
 
 namespace optique::master {
 
-// The share of the run's frames that every projector showed (0 with no frames).
+// The share of the run's frames that every projector showed (0 with no frames):
+// of `frames`, all but `with_missing_node`; or of a report's.
+[[nodiscard]] double shown_by_all_share(std::uint64_t frames, std::uint64_t with_missing_node);
 [[nodiscard]] double shown_by_all_share(const report::RunReport& report);
 
 // Why the run failed for what it showed, or nothing: with `min_presented`,
