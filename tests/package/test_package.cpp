@@ -46,6 +46,26 @@ TEST(Package, CmakeInstallPutsTheProgramsConfigsAndDocsUnderThePrefix) {
   EXPECT_NE(read_file(log).find("tracking: replay of"), std::string::npos) << read_file(log);
 }
 
+// The units run /usr/bin/optique-*: the service component refuses another
+// prefix (it would write to /usr and /etc anyway, units starting nothing), and
+// stages under DESTDIR with prefix /usr.
+TEST(Package, TheServiceComponentInstallsWithPrefixUsrOnly) {
+  const std::string dir = make_temp_dir("optique-service");
+  const std::string log = dir + "/refused.log";
+  EXPECT_NE(run({"/usr/bin/cmake", "--install", kBuild, "--prefix", dir + "/local", "--component", "service"}, log), 0);
+  EXPECT_NE(read_file(log).find("installs with --prefix /usr"), std::string::npos) << read_file(log);
+  EXPECT_FALSE(fs::exists(dir + "/local"));
+  const std::string staged = dir + "/stage";
+  ASSERT_EQ(run({"/usr/bin/env", "DESTDIR=" + staged, "/usr/bin/cmake", "--install", kBuild, "--prefix", "/usr",
+                 "--component", "service"},
+                dir + "/staged.log"),
+            0)
+      << read_file(dir + "/staged.log");
+  EXPECT_TRUE(fs::exists(staged + "/usr/lib/systemd/system/optique-master.service"));
+  EXPECT_TRUE(fs::exists(staged + "/usr/lib/systemd/system/optique-node@.service"));
+  EXPECT_TRUE(fs::exists(staged + "/etc/optique/node.env"));
+}
+
 TEST(Package, TheDebianPackageHoldsEverythingAndRunsFromAnExtractedCopy) {
   const std::string dir = make_temp_dir("optique-deb");
   ASSERT_EQ(run({"/usr/bin/cpack", "--config", kBuild + "/CPackConfig.cmake", "-G", "DEB", "-B", dir + "/out"},
