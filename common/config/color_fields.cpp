@@ -5,6 +5,8 @@
 #include <cmath>
 #include <optional>
 
+#include <fmt/format.h>
+
 #include "util/number_text.h"
 
 namespace optique::config {
@@ -74,6 +76,28 @@ std::string_view to_string(Channel channel) {
       return "blue";
   }
   return "?";
+}
+
+std::string describe(const ColorFields& fields) {
+  if (fields.fields.empty()) return "";
+  std::string text = fmt::format("{} colour fields per frame", fields.fields.size());
+  if (fields.images > 1) text += fmt::format(" over {} images", fields.images);
+  switch (fields.method) {
+    case FieldMethod::per_field:
+      text += ", each drawn at its own time";
+      break;
+    case FieldMethod::gather:
+      text += fmt::format(", gathered from one render ({} samples)", fields.gather_samples);
+      break;
+    case FieldMethod::up_conversion:
+      text += ", built from one render by up-conversion";
+      break;
+    case FieldMethod::off:
+      text += ", all drawn at the display time (method off)";
+      break;
+  }
+  if (fields.blurs()) text += fmt::format(", blurred above {:.1f} px per frame", fields.velocity_threshold);
+  return text;
 }
 
 double ColorFields::on_share(Channel channel) const {

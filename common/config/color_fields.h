@@ -65,6 +65,11 @@ struct ColorFields {
   friend bool operator==(const ColorFields&, const ColorFields&) = default;
 };
 
+// What the fields are, for a node's log ("6 colour fields per frame, gathered
+// from one render, blurred above 2.0 px per frame"); empty when the projector
+// shows all colours at once.
+[[nodiscard]] std::string describe(const ColorFields& fields);
+
 // The presets' names, for messages and docs.
 [[nodiscard]] const std::vector<std::string>& color_field_presets();
 // The frame rate preset `name`'s field times are for (its offsets and

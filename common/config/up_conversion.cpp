@@ -1,10 +1,20 @@
 #include "config/up_conversion.h"
 
+#include <fmt/format.h>
+
 namespace optique::config {
 
 std::string_view to_string(UpMethod method) { return method == UpMethod::motion ? "motion" : "average"; }
 
 std::string_view to_string(UpMode mode) { return mode == UpMode::extrapolate ? "extrapolate" : "interpolate"; }
+
+std::string describe(const UpConversion& up) {
+  if (!up.enabled()) return "";
+  std::string text = fmt::format("a key frame every {} frames, the frames between by {} ({}{})", up.ratio,
+                                 to_string(up.method), to_string(up.mode), up.spread ? ", key frames spread" : "");
+  if (up.adaptive()) text += fmt::format("; the ratio adapts to keep {:.1f} dB PSNR_Y", up.min_psnr);
+  return text;
+}
 
 UpConversion parse_up_conversion(const schema::UpConversion& up, const std::string& path,
                                  std::vector<Problem>& problems) {

@@ -89,6 +89,20 @@ TEST(ColorFields, TheStereoProjectorAsMonoHasSixFieldsInTwoImages) {
   EXPECT_NEAR(c.fields.back().end(), 0.5, 1e-15);
 }
 
+// What a node's log says of its fields: how many, over how many images, how
+// each is drawn; nothing for a projector that shows all colours at once.
+TEST(ColorFields, DescribedForTheNodesLog) {
+  const auto gathered = parse(R"({"preset": "dlp-brg-120hz", "method": "gather", "velocity_threshold": 24})");
+  ASSERT_TRUE(gathered) << gathered.error();
+  EXPECT_EQ(describe(gathered.value().projectors[0].color_fields),
+            "3 colour fields per frame, gathered from one render (8 samples), blurred above 24.0 px per frame");
+  const auto stereo = parse(R"({"preset": "dlp-stereo-as-mono"})", 60.0);
+  ASSERT_TRUE(stereo) << stereo.error();
+  EXPECT_EQ(describe(stereo.value().projectors[0].color_fields),
+            "6 colour fields per frame over 2 images, each drawn at its own time");
+  EXPECT_EQ(describe(ColorFields{}), "");
+}
+
 TEST(ColorFields, FieldsGivenOneByOne) {
   const auto parsed = parse(R"({"fields": [
       {"channel": "red", "offset": -0.3, "duration": 0.3},

@@ -31,6 +31,20 @@ bool says(const Result<Installation>& parsed, const std::string& fragment) {
   return !parsed && parsed.error().find(fragment) != std::string::npos;
 }
 
+// What a node's log says of its up-conversion; nothing when every frame is drawn.
+TEST(UpConversion, DescribedForTheNodesLog) {
+  const auto adaptive = with(R"({"ratio": 4, "mode": "interpolate", "spread": true})");
+  ASSERT_TRUE(adaptive) << adaptive.error();
+  EXPECT_EQ(describe(adaptive.value().projectors[0].up_conversion),
+            "a key frame every 4 frames, the frames between by motion (interpolate, key frames spread); the ratio "
+            "adapts to keep 30.0 dB PSNR_Y");
+  const auto fixed = with(R"({"ratio": 2, "method": "average", "mode": "interpolate"})");
+  ASSERT_TRUE(fixed) << fixed.error();
+  EXPECT_EQ(describe(fixed.value().projectors[0].up_conversion),
+            "a key frame every 2 frames, the frames between by average (interpolate)");
+  EXPECT_EQ(describe(UpConversion{}), "");
+}
+
 TEST(UpConversion, DefaultsToMotionExtrapolatedAndAbsentIsOff) {
   const auto parsed = with(R"({"ratio": 4})");
   ASSERT_TRUE(parsed) << parsed.error();
