@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -104,6 +105,36 @@ void remove_abandoned_partials(const fs::path& folder) {
   }
 }
 
+// A partial copy of scene `sha256` whose node stopped midway (nobody holds its
+// lock), with its lock now held: the chunks it holds need not come again.
+// One without a lock file is left to remove_abandoned_partials (its node died
+// before it began, or while it removed the copy).
+struct Adopted {
+  fs::path partial;
+  int lock_fd = -1;
+};
+std::optional<Adopted> adopt_abandoned(const fs::path& folder, const std::string& sha256) {
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!name.starts_with(sha256 + kPartial) || name.ends_with(kLock) || !entry.is_directory(error)) continue;
+    const fs::path lock = entry.path().string() + kLock;
+    const int fd = open(lock.c_str(), O_RDWR | O_CLOEXEC);
+    if (fd < 0) continue;
+    // Held: its node is alive. Taken: the lock must still be the file at its
+    // path (a node clearing abandoned copies may have removed both meanwhile).
+    struct stat held {};
+    struct stat named {};
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0 || fstat(fd, &held) != 0 || stat(lock.c_str(), &named) != 0 ||
+        held.st_ino != named.st_ino || held.st_dev != named.st_dev || !fs::is_directory(entry.path(), error)) {
+      close(fd);
+      continue;
+    }
+    return Adopted{entry.path(), fd};
+  }
+  return std::nullopt;
+}
+
 struct CachedCopy {
   fs::file_time_type used;
   fs::path path;
@@ -152,9 +183,11 @@ Result<std::uintmax_t> SceneCache::disk_free_space(const fs::path& folder) {
   return space.available;
 }
 
+// The partial copy and its lock file stay (the lock released): the next node
+// to fetch this scene goes on from the chunks in it.
 SceneCache::~SceneCache() {
   close_file();
-  release_lock();
+  if (lock_fd_ >= 0) close(lock_fd_);
 }
 
 fs::path SceneCache::default_cache_dir() {
@@ -200,9 +233,8 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
   Present present(manifest.files.size());
   for (std::size_t f = 0; f < manifest.files.size(); ++f)
     present[f].assign(manifest.files[f].chunks(manifest.chunk_bytes), false);
-  std::error_code error;
-  if (manifest_ && sha256_ == sha256 && fs::is_directory(partial_, error)) {
-    // This process's unfinished copy: keep the chunks that check.
+  // The chunks of an unfinished copy that check against the manifest.
+  const auto mark_present = [&] {
     for (std::size_t f = 0; f < manifest.files.size(); ++f) {
       std::uint64_t index = 0;
       (void)read_pieces(partial_ / manifest.files[f].path, manifest.chunk_bytes, [&](std::string_view piece) {
@@ -213,11 +245,49 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
         ++index;
       });
     }
+  };
+  std::error_code error;
+  if (manifest_ && sha256_ == sha256 && fs::is_directory(partial_, error)) {
+    mark_present();  // this process's unfinished copy (its connection went)
     return present;
   }
   abandon();
   fs::create_directories(folder_, error);
   if (error) return Error{"cannot make the scene cache " + folder_.string() + ": " + describe(error)};
+  if (std::optional<Adopted> adopted = adopt_abandoned(folder_, sha256)) {
+    // A node killed midway (this one, restarted, or another of this host):
+    // what it fetched is kept; every file is there to be written into.
+    partial_ = adopted->partial;
+    lock_fd_ = adopted->lock_fd;
+    for (const scene::SceneFile& file : manifest.files) {
+      const fs::path path = partial_ / file.path;
+      fs::create_directories(path.parent_path(), error);
+      const int fd = open(path.c_str(), O_CREAT | O_WRONLY | O_CLOEXEC, 0644);
+      if (fd < 0) {
+        const std::string why = std::strerror(errno);
+        abandon();
+        return Error{"cannot write the scene cache " + folder_.string() + ": " + path.string() + ": " + why};
+      }
+      close(fd);
+    }
+    mark_present();
+    manifest_ = manifest;
+    sha256_ = sha256;
+    std::size_t held = 0;
+    std::size_t chunks = 0;
+    for (const std::vector<bool>& file : present) {
+      held += static_cast<std::size_t>(std::count(file.begin(), file.end(), true));
+      chunks += file.size();
+    }
+    log_.info("going on with the copy of the scene {}… that a stopped node left: {} of its {} chunks are in",
+              sha256.substr(0, 12), held, chunks);
+    remove_abandoned_partials(folder_);
+    if (auto room = make_room(manifest.total_bytes(), sha256); !room) {
+      abandon();
+      return Error{room.error()};
+    }
+    return present;
+  }
   remove_abandoned_partials(folder_);
   if (auto room = make_room(manifest.total_bytes(), sha256); !room) return Error{room.error()};
   // The lock first: a partial copy without one is taken for abandoned.
@@ -278,9 +348,11 @@ Result<std::string> SceneCache::commit() {
     std::error_code error;
     const std::uintmax_t size = fs::file_size(partial_ / file.path, error);
     if (error || size != file.size) {
-      abandon();
-      return Error{"the scene's copy is not whole: " + (partial_ / file.path).string() + " has " +
-                   (error ? describe(error) : std::to_string(size) + " bytes, not " + std::to_string(file.size))};
+      const std::string problem =
+          "the scene's copy is not whole: " + (partial_ / file.path).string() + " has " +
+          (error ? describe(error) : std::to_string(size) + " bytes, not " + std::to_string(file.size));
+      abandon();  // clears partial_: the message first
+      return Error{problem};
     }
   }
   const fs::path copy = folder_ / sha256_;

@@ -7,7 +7,9 @@
 // its identity again) and a node that restarts does not fetch it again. Several
 // nodes of one host may share a folder (even from several containers: the locks,
 // not process ids, tell a partial copy whose node is gone): each writes its own
-// partial copy, and the first to finish puts it in place. When the disk runs
+// partial copy, and the first to finish puts it in place. A partial copy whose
+// node stopped midway (killed, or its master gone) is taken over by the next
+// node that fetches the scene, with the chunks it holds. When the disk runs
 // short, the copies used longest ago make room, if removing them would; if not,
 // none is removed and the scene is refused.
 
@@ -58,9 +60,10 @@ class SceneCache {
 
   // For each file of the manifest, which chunks are in the copy being written.
   using Present = std::vector<std::vector<bool>>;
-  // Starts a copy, or goes on with this process's unfinished copy of the same
-  // scene (a connection lost midway): which chunks it already holds, each
-  // checked against the manifest. Removes partial copies whose node is gone,
+  // Starts a copy, or goes on with an unfinished copy of the same scene (this
+  // process's, its connection lost midway, or one a stopped node left): which
+  // chunks it already holds, each checked against the manifest. Removes the
+  // other partial copies whose node is gone,
   // makes room by removing the copies used longest ago, and fails, naming the
   // folder, when it cannot be written or the disk has no room for the scene;
   // when removing every other copy would not make room either, it removes none

@@ -156,7 +156,8 @@ TEST_F(SceneCacheTest, ACopyMissingChunksIsNotPutInPlace) {
   write_chunks(cache, std::make_pair(1u, std::uint64_t{0}));
   const auto committed = cache.commit();
   ASSERT_FALSE(committed.ok());
-  EXPECT_NE(committed.error().find("not whole"), std::string::npos) << committed.error();
+  EXPECT_NE(committed.error().find("not whole: " + (dir_ / "scenes").string()), std::string::npos)
+      << "names the file where it is: " << committed.error();
   EXPECT_FALSE(fs::exists(dir_ / "scenes" / sha_));
   EXPECT_EQ(entries_in_scenes(), 0) << "the partial copy and its lock are removed";
 }
@@ -192,18 +193,47 @@ TEST_F(SceneCacheTest, TwoNodesOfOneHostFetchingTogetherShareTheCopy) {
   EXPECT_EQ(entries_in_scenes(), 1);
 }
 
+// A node killed midway leaves its partial copy and its lock file; the next
+// node to fetch the scene (the same one restarted, or another of this host)
+// takes it over with the chunks it holds, and one still held is left alone.
+TEST_F(SceneCacheTest, ACopyLeftByAStoppedNodeIsTakenOverWithItsChunks) {
+  SceneCache held(dir_, log_);  // a node of this host fetching it too
+  {
+    SceneCache stopped(dir_, log_);
+    ASSERT_TRUE(stopped.begin(files_, sha_).ok());
+    write_chunks(stopped, std::make_pair(0u, std::uint64_t{0}));
+    write_chunks(stopped, std::make_pair(1u, std::uint64_t{2}));
+    ASSERT_TRUE(held.begin(files_, sha_).ok());
+  }  // its process ends without abandoning the copy: the lock is let go
+  SceneCache restarted(dir_, log_);
+  auto begun = restarted.begin(files_, sha_);
+  ASSERT_TRUE(begun.ok()) << begun.error();
+  EXPECT_EQ(begun.value(), (SceneCache::Present{{true}, {false, false, true}}));
+  EXPECT_NE(log_text_.str().find("that a stopped node left: 2 of its 4 chunks are in"), std::string::npos)
+      << log_text_.str();
+  write_chunks(restarted, std::make_pair(1u, std::uint64_t{0}));
+  write_chunks(restarted, std::make_pair(1u, std::uint64_t{1}));
+  const auto committed = restarted.commit();
+  ASSERT_TRUE(committed.ok()) << committed.error();
+  EXPECT_EQ(read(dir_ / "scenes" / sha_ / "maps/s.bin"), bin_);
+  EXPECT_EQ(read(dir_ / "scenes" / sha_ / "s.gltf"), gltf_);
+  held.abandon();
+  EXPECT_EQ(entries_in_scenes(), 1) << "the copy in place; no partial copy, no lock";
+}
+
 TEST_F(SceneCacheTest, PartialCopiesWhoseNodeIsGoneAreRemovedAndOthersKept) {
   SceneCache alive(dir_, log_);
   const scene::SceneManifest other{4096, {scene::describe_file("o.gltf", "{}", 4096)}};
   ASSERT_TRUE(alive.begin(other, scene::manifest_sha256(other)).ok());  // holds its lock
+  const std::string gone = std::string(64, 'e');                        // another scene's
   fs::create_directories(dir_ / "scenes" / (sha_ + ".partial-1-2"));    // no lock file: its node died early
-  fs::create_directories(dir_ / "scenes" / (sha_ + ".partial-3-4"));
-  std::ofstream(dir_ / "scenes" / (sha_ + ".partial-3-4.lock")) << "";  // a lock nobody holds
+  fs::create_directories(dir_ / "scenes" / (gone + ".partial-3-4"));
+  std::ofstream(dir_ / "scenes" / (gone + ".partial-3-4.lock")) << "";  // a lock nobody holds
   SceneCache cache(dir_, log_);
   ASSERT_TRUE(cache.begin(files_, sha_).ok());
   EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-1-2")));
-  EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-3-4")));
-  EXPECT_FALSE(fs::exists(dir_ / "scenes" / (sha_ + ".partial-3-4.lock")));
+  EXPECT_FALSE(fs::exists(dir_ / "scenes" / (gone + ".partial-3-4")));
+  EXPECT_FALSE(fs::exists(dir_ / "scenes" / (gone + ".partial-3-4.lock")));
   // alive's partial and lock, cache's partial and lock.
   EXPECT_EQ(entries_in_scenes(), 4);
   cache.abandon();
