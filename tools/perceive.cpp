@@ -87,7 +87,11 @@ Result<void> parse_track(const std::string& text, PerceiveOptions& options) {
     options.velocity = glm::dvec2(x, y);
     return {};
   } catch (const std::exception&) {
-    return Error{"--track: '" + text + "' is neither an object's name nor vx,vy (two numbers)"};
+    // Not two numbers: an object's name with a comma in it (glTF names may
+    // have one); perceive() says so if the scene has no such object.
+    options.object = text;
+    options.velocity.reset();
+    return {};
   }
 }
 
@@ -107,7 +111,10 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
       std::string names;
       for (const auto& o : scene.objects) names += (names.empty() ? "" : ", ") + o.name;
       return Error{"--track: the scene has no object '" + options.object +
-                   "' (its moving objects: " + (names.empty() ? "none" : names) + ")"};
+                   "' (its moving objects: " + (names.empty() ? "none" : names) + ")" +
+                   (options.object.find(',') != std::string::npos
+                        ? ", and it is not vx,vy either (two numbers, screen pixels per frame)"
+                        : "")};
     }
     tracked = &*found;
   }
@@ -157,6 +164,10 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
       }
     }
     const optics::Exposure exposure{centre, options.exposure, result.velocity};
+    // It takes a while on a software rasterizer: each step is said as it starts.
+    log.info("screen '{}': drawing frames {}…{} of its {} projector(s), the eye following {:.2f}, {:.2f} px per frame",
+             result.folder, std::max<std::int64_t>(first, 0), last, screen_image.projectors.size(),
+             result.velocity.x * period, result.velocity.y * period);
 
     // What the projectors put on the screen, frame by frame, field by field.
     std::deque<image::FloatImage> lights;  // the emissions point into it
@@ -208,6 +219,7 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
     // moment, at `ideal_moments` moments of the exposure — as bright as the
     // projectors can be (a highlight beyond their white is clipped there too, and
     // is no error of the fields).
+    log.info("screen '{}': the ideal, {} moments of the exposure", result.folder, options.ideal_moments);
     auto view = ReferenceView::make(installation, scene, screen_image, kIdealSupersample);
     if (!view) return Error{"screen '" + result.folder + "': " + view.error()};
     std::vector<image::FloatImage> moments;

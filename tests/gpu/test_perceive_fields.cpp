@@ -182,7 +182,13 @@ TEST(PerceiveFields, AnUnknownObjectIsNamedWithTheOnesThereAre) {
   const auto seen = tools::perceive(loaded.value().config, loaded.value().scene, options, "/nonexistent", *logger);
   ASSERT_FALSE(seen);
   EXPECT_NE(seen.error().find("no object 'ball' (its moving objects: square)"), std::string::npos) << seen.error();
-  EXPECT_FALSE(tools::parse_track("3,x", options));
+  // Not two numbers: a name with a comma, said to be neither when there is no such object.
+  ASSERT_TRUE(tools::parse_track("3,x", options));
+  const auto neither = tools::perceive(loaded.value().config, loaded.value().scene, options, "/nonexistent", *logger);
+  ASSERT_FALSE(neither);
+  EXPECT_NE(neither.error().find("no object '3,x' (its moving objects: square), and it is not vx,vy either"),
+            std::string::npos)
+      << neither.error();
   EXPECT_TRUE(tools::parse_track("-2.5,1", options));
   ASSERT_TRUE(options.velocity);
   EXPECT_EQ(*options.velocity, glm::dvec2(-2.5, 1.0));
