@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Configures and builds optique into build/ (or $OPTIQUE_BUILD_DIR).
+# Configures and builds optique into build/ (or $OPTIQUE_BUILD_DIR): everything,
+# or only the targets $OPTIQUE_BUILD_TARGETS names (space-separated).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir="${OPTIQUE_BUILD_DIR:-build}"
@@ -8,4 +9,9 @@ if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 if [ ! -f "$build_dir/CMakeCache.txt" ]; then
   cmake -S . -B "$build_dir" "${generator[@]}" -DCMAKE_BUILD_TYPE="${OPTIQUE_BUILD_TYPE:-RelWithDebInfo}" "$@"
 fi
-cmake --build "$build_dir" --parallel "$(nproc)"
+targets=()
+if [ -n "${OPTIQUE_BUILD_TARGETS:-}" ]; then
+  read -ra names <<<"$OPTIQUE_BUILD_TARGETS"
+  targets=(--target "${names[@]}")
+fi
+cmake --build "$build_dir" --parallel "$(nproc)" "${targets[@]}"

@@ -1,11 +1,15 @@
 #!/usr/bin/env bash
-# Installs everything optique needs to build and test, from Debian 12 packages
-# (with --fuzz, clang for the libFuzzer targets too).
+# Installs everything optique needs to build and test, from Debian 12 packages.
+#   scripts/install-deps.sh          build and test
+#   scripts/install-deps.sh --fuzz   also clang for the libFuzzer targets (CI)
+#   scripts/install-deps.sh --run    only what building and running the programs
+#                                    needs (scripts/run-local.sh): no browser,
+#                                    Prometheus, virtual display or plotting
 # Idempotent: when every package is already installed it changes nothing and
 # does not touch the network.
 set -euo pipefail
 
-packages=(
+run_packages=(
   build-essential cmake ninja-build pkg-config git
   libboost-dev                       # Asio (header-only)
   libprotobuf-dev protobuf-compiler  # wire format and config schema
@@ -18,22 +22,27 @@ packages=(
   libopenimageio-dev openimageio-tools  # image files and operations; oiiotool to inspect them
   libepoxy-dev libegl-dev            # GL/EGL function loading, headless contexts
   libegl-mesa0 libgl1-mesa-dri       # Mesa's EGL and llvmpipe: GL without a GPU
-  libgtest-dev libgmock-dev          # tests
+  libgtest-dev libgmock-dev          # tests (configured with the programs)
+  libssl-dev                         # SHA-256, HKDF, AES-GCM (libcrypto)
+)
+test_packages=(
   xvfb xauth                         # a virtual display for the window tests
-  libssl-dev                         # SHA-256 of configs, HMAC (libcrypto)
   python3                            # helper scripts, bench plot series
   gnuplot-nox                        # bench plots (scripts/plot-bench.sh)
   chromium fonts-dejavu-core         # the operator's page in a real browser (headless), with a font
   prometheus                         # promtool checks /metrics as a site's Prometheus reads it
   systemd                            # systemd-analyze verifies the service units
 )
-# scripts/install-deps.sh --fuzz: also what scripts/fuzz.sh needs (CI runs it).
-if [ "${1:-}" = --fuzz ]; then
-  packages+=(clang libclang-rt-14-dev llvm)  # libFuzzer and its sanitizer runtimes, llvm-symbolizer for stacks
-elif [ -n "${1:-}" ]; then
-  echo "install-deps: unknown argument '$1' (the only one is --fuzz)" >&2
-  exit 2
-fi
+packages=("${run_packages[@]}" "${test_packages[@]}")
+case "${1:-}" in
+  "") ;;
+  --fuzz) packages+=(clang libclang-rt-14-dev llvm) ;;  # libFuzzer and its sanitizer runtimes, llvm-symbolizer for stacks
+  --run) packages=("${run_packages[@]}") ;;
+  *)
+    echo "install-deps: unknown argument '$1' (--fuzz or --run)" >&2
+    exit 2
+    ;;
+esac
 
 missing=()
 for p in "${packages[@]}"; do

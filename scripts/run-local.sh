@@ -12,8 +12,10 @@ if ! [[ "$frames" =~ ^[0-9]+$ ]] || [ "$frames" -lt 1 ]; then
   echo "run-local: FRAMES must be a whole number of at least 1, not '$frames'" >&2
   exit 2
 fi
-bash scripts/install-deps.sh
-bash scripts/build.sh
+# Only what the run needs: the programs (not the tests and benches, nor the
+# browser and Prometheus that only tests use).
+bash scripts/install-deps.sh --run
+OPTIQUE_BUILD_TARGETS="optique-master optique-node optique-node-gl optique-tools" bash scripts/build.sh
 build_dir="${OPTIQUE_BUILD_DIR:-build}"
 every=60
 "$build_dir/bin/optique-master" --config "$config" --local --frames "$frames" --capture-every "$every" --out "$out"
