@@ -7,6 +7,7 @@
 #include <fstream>
 #include <limits>
 
+#include <fmt/format.h>
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
@@ -275,11 +276,20 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
                             {"eye_velocity_px_per_frame", {per_frame.x, per_frame.y}},
                             {"measured", result.measured}};
     if (result.measured) {
+      // Which pixels the numbers are over: a velocity names no object, so the
+      // whole screen, still background and all (PSNR_Y far higher than around
+      // a moving object at the same speed).
+      const std::string over =
+          options.velocity ? fmt::format("the whole screen, {}×{} px", result.box[2] - result.box[0],
+                                         result.box[3] - result.box[1])
+                           : fmt::format("'{}' and its motion, {}×{} px", options.object,
+                                         result.box[2] - result.box[0], result.box[3] - result.box[1]);
       log.info(
           "screen '{}': the eye at ({:.1f}, {:.1f}) px/frame over {:.4f} s: colour fringes {:.2f} px (ideal "
-          "{:.2f}), PSNR_Y {:.2f} dB against the ideal → {}",
+          "{:.2f}), PSNR_Y {:.2f} dB against the ideal, over {} → {}",
           result.folder, per_frame.x, per_frame.y, options.exposure, result.fringe_px, result.ideal_fringe_px,
-          result.psnr_y_db, png);
+          result.psnr_y_db, over, png);
+      entry["measured_over"] = options.velocity ? "screen" : "object";
       entry["box"] = {result.box[0], result.box[1], result.box[2], result.box[3]};
       entry["fringe_px"] = result.fringe_px;
       entry["ideal_fringe_px"] = result.ideal_fringe_px;

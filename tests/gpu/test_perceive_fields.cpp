@@ -79,6 +79,10 @@ TEST(PerceiveFields, PerFieldRemovesTheFringesThatOneMomentPerFrameShows) {
                                  "/perceived/front.ideal/frame-000060.png", "/perceived/frame-000060.json"}) {
     EXPECT_TRUE(fs::exists(fields.out + file)) << file;
   }
+  // It says what the numbers are over: the tracked object's neighbourhood.
+  std::stringstream report;
+  report << std::ifstream(fields.out + "/perceived/frame-000060.json").rdbuf();
+  EXPECT_NE(report.str().find(R"("measured_over": "object")"), std::string::npos) << report.str();
   fs::remove_all(dir);
 }
 
