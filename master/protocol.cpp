@@ -314,6 +314,7 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
   // The first frame pays what the warm-up paid (programs, textures): it is
   // waited for as long as the warm-up took, twice over.
   if (configured.warm_up_ns() > 0) session.pace.add(configured.warm_up_ns());
+  session.pace.set_capture(configured.capture_ns());
   recorder_.node_joined(*session.slot);
   rebalance_lights(true);
   out.push_back(
@@ -591,7 +592,8 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   current_hash_ = scene::state_hash(current_state_);
   if (lights_switched) log_light_switches(frame, begin.delta(), out);
   begin.set_state_hash(current_hash_);
-  begin.set_capture(settings_.capture_every != 0 && frame % settings_.capture_every == 0);
+  const bool captured = settings_.capture_every != 0 && frame % settings_.capture_every == 0;
+  begin.set_capture(captured);
   begin.set_present_time_ns(display);
   if (focus_) {
     *begin.mutable_focus() = protocol::to_wire(focus_->at(static_cast<double>(begin.simulation_time_ns()) / 1e9,
@@ -671,8 +673,9 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   barrier_allowance_ = nanos(config_.frame_timeout);
   for (const std::size_t slot : waited) {
     // At most the liveness timeout: a node drawing longer than that is gone anyway.
-    barrier_allowance_ = std::max(barrier_allowance_, session_of(slot)->pace.allowance(
-                                                          nanos(config_.frame_timeout), nanos(config_.liveness_timeout)));
+    barrier_allowance_ =
+        std::max(barrier_allowance_, session_of(slot)->pace.allowance(nanos(config_.frame_timeout),
+                                                                      nanos(config_.liveness_timeout), captured));
   }
   barrier_.begin(frame, std::move(waited));
   if (barrier_.complete()) {

@@ -10,6 +10,8 @@ void RenderPace::add(clock::Nanos render) {
   ++count_;
 }
 
+void RenderPace::set_capture(clock::Nanos capture) { capture_ = std::clamp<clock::Nanos>(capture, 0, kLongestRender); }
+
 std::optional<clock::Nanos> RenderPace::typical() const {
   const std::size_t kept = std::min(count_, kKept);
   if (kept == 0) return std::nullopt;
@@ -21,11 +23,11 @@ std::optional<clock::Nanos> RenderPace::typical() const {
   return *middle;
 }
 
-clock::Nanos RenderPace::allowance(clock::Nanos frame_timeout, clock::Nanos longest) const {
+clock::Nanos RenderPace::allowance(clock::Nanos frame_timeout, clock::Nanos longest, bool captured) const {
   const std::size_t kept = std::min(count_, kKept);
-  if (kept == 0) return frame_timeout;
-  const clock::Nanos slowest = *std::max_element(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(kept));
-  return std::max(frame_timeout, std::min(2 * slowest, longest));
+  const clock::Nanos slowest =
+      kept == 0 ? 0 : *std::max_element(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(kept));
+  return std::max(frame_timeout, std::min(2 * (slowest + (captured ? capture_ : 0)), longest));
 }
 
 }  // namespace optique::master

@@ -128,7 +128,7 @@ void Node::carry_out(Action& action) {
           },
           [&](Configure& a) {
             const Result<void> result = renderer_.configure(a.job);
-            carry_out(protocol_.configured(result, renderer_.description(), renderer_.warm_up_time()));
+            carry_out(protocol_.configured(result, renderer_.description(), renderer_.warm_up()));
           },
           [&](Render& a) {
             const clock::Nanos started = clock::monotonic_now();

@@ -372,7 +372,7 @@ Actions NodeProtocol::scene_copy_finished(const Result<std::string>& gltf_path, 
 }
 
 Actions NodeProtocol::configured(const Result<void>& result, const std::string& renderer_description,
-                                 clock::Nanos warm_up) {
+                                 WarmUp warm_up) {
   Actions out;
   if (phase_ != Phase::configuring) return out;  // the connection went meanwhile
   if (!result) {
@@ -385,16 +385,28 @@ Actions NodeProtocol::configured(const Result<void>& result, const std::string& 
   liveness_timeout_ = job_->liveness_timeout;
   wire::Envelope envelope;
   envelope.mutable_configured()->set_renderer(renderer_description);
-  envelope.mutable_configured()->set_warm_up_ns(warm_up);
+  envelope.mutable_configured()->set_warm_up_ns(warm_up.frame);
+  envelope.mutable_configured()->set_capture_ns(warm_up.capture);
   out.push_back(Send{std::move(envelope)});
   phase_ = Phase::awaiting_state;
   out.push_back(SetDeadline{kHandshakeTimeout, "no state from the master within 5 s of being configured"});
   const config::Projector& p = job_->job.self();
+  // What it draws besides a frame per frame period, said where an operator looks first.
+  std::string drawing;
+  for (const std::string& part : {config::describe(p.color_fields), config::describe(p.up_conversion)}) {
+    if (!part.empty()) drawing += "; " + part;
+  }
   log(out, spdlog::level::info,
-      fmt::format("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}{}", p.id, p.width,
+      fmt::format("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}{}{}", p.id, p.width,
                   p.height, job_->job.screen().id, config::to_string(p.eye), static_cast<double>(frame_period_) / 1e6,
                   renderer_description,
-                  warm_up > 0 ? fmt::format("; warm-up frame {:.1f} ms", static_cast<double>(warm_up) / 1e6) : ""));
+                  warm_up.frame > 0 ? fmt::format("; warm-up frame {:.1f} ms{}", static_cast<double>(warm_up.frame) / 1e6,
+                                                  warm_up.capture > 0
+                                                      ? fmt::format(", {:.1f} ms more when captured",
+                                                                    static_cast<double>(warm_up.capture) / 1e6)
+                                                      : "")
+                                    : "",
+                  drawing));
   return out;
 }
 

@@ -183,9 +183,9 @@ class NodeProtocol {
   [[nodiscard]] Actions connect_failed(const std::string& reason, clock::Nanos now);
   [[nodiscard]] Actions message(const wire::Envelope& message, clock::Nanos now);
   [[nodiscard]] Actions closed(const std::string& reason, clock::Nanos now);
-  // `warm_up`: how long the renderer's warm-up frame took (Renderer::warm_up_time).
+  // `warm_up`: how long the renderer's warm-up frame took (Renderer::warm_up).
   [[nodiscard]] Actions configured(const Result<void>& result, const std::string& renderer_description,
-                                   clock::Nanos warm_up = 0);
+                                   WarmUp warm_up = {});
   // Answers to PrepareScene, StoreSceneChunk and FinishScene.
   [[nodiscard]] Actions scene_found(const std::string& gltf_path);
   // `started`: which chunks the copy already holds (one going on after a lost connection).

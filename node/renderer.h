@@ -35,6 +35,14 @@ struct FrameInput {
 // How a frame was drawn: in full, or (a node that up-converts) as a key frame,
 // between key frames (and a later key frame drawn ahead with it), or as a key
 // frame drawn ahead.
+// What configure()'s warm-up frame took: drawing it (every program and texture
+// used once), and reading it back as a captured frame is read. The master
+// waits that long for the first frame, and a captured frame that much longer.
+struct WarmUp {
+  clock::Nanos frame = 0;    // 0: none was drawn
+  clock::Nanos capture = 0;  // 0: not measured
+};
+
 struct Rendered {
   up::FrameKind kind = up::FrameKind::full;
   bool key_ahead = false;
@@ -47,9 +55,8 @@ class Renderer {
   [[nodiscard]] virtual Result<void> configure(const protocol::NodeJob& job) = 0;
   // What draws, for the master's log ("llvmpipe (...), headless").
   [[nodiscard]] virtual std::string description() const = 0;
-  // How long configure()'s warm-up frame took (every program and texture used
-  // once): the master waits that long for the first frame. 0: none was drawn.
-  [[nodiscard]] virtual clock::Nanos warm_up_time() const { return 0; }
+  // How long configure()'s warm-up frame took.
+  [[nodiscard]] virtual WarmUp warm_up() const { return {}; }
   // Draws the frame into the back buffer; returns when it is ready to show,
   // with how it was drawn.
   virtual Rendered render(const FrameInput& frame) = 0;

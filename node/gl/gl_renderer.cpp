@@ -66,7 +66,10 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   start.eye_now = start.eye_next = job.installation.viewer.eye_at(0.0);
   const clock::Nanos warm_up_started = clock::monotonic_now();
   pipeline_->warm_up(start);
-  warm_up_time_ = clock::monotonic_now() - warm_up_started;
+  const clock::Nanos drawn = clock::monotonic_now();
+  // A captured frame is read back before it is ready, so it is that much later.
+  (void)read_back();
+  warm_up_ = {drawn - warm_up_started, clock::monotonic_now() - drawn};
   if (!captures_) captures_.emplace(capture_folder_, log_);
   configured_for_ = key;
   const render::ProjectorView& view = pipeline_->view();
@@ -77,6 +80,12 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
                       " px, then warped)"
                 : "single pass");
   return {};
+}
+
+GlRenderer::ReadBack GlRenderer::read_back() const {
+  const render::SceneRenderer& renderer = pipeline_->renderer();
+  return {renderer.read_linear(), deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
+          deep_signal_ ? renderer.read_signal() : image::WordImage{}};
 }
 
 std::string GlRenderer::description() const {
@@ -90,10 +99,8 @@ Rendered GlRenderer::render(const FrameInput& frame) {
   // Each image captured as it is drawn (a stereo projector used as mono draws two).
   const auto capture = [&](int image) {
     if (!frame.capture) return;
-    const render::SceneRenderer& renderer = pipeline_->renderer();
-    captures_->submit(frame.frame_id, image, renderer.read_linear(),
-                      deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
-                      deep_signal_ ? renderer.read_signal() : image::WordImage{});
+    ReadBack read = read_back();
+    captures_->submit(frame.frame_id, image, std::move(read.linear), std::move(read.encoded), std::move(read.signal));
   };
   const render::DisplayFrame display{frame.frame_id, [this](std::uint64_t f) -> const scene::SceneState* {
                                        const auto found = ahead_.find(f);

@@ -27,7 +27,7 @@ class GlRenderer final : public Renderer {
 
   [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
   [[nodiscard]] std::string description() const override;
-  [[nodiscard]] clock::Nanos warm_up_time() const override { return warm_up_time_; }
+  [[nodiscard]] WarmUp warm_up() const override { return warm_up_; }
   Rendered render(const FrameInput& frame) override;
   void skip(const FrameInput& frame) override;
   void present(int image) override;
@@ -40,10 +40,17 @@ class GlRenderer final : public Renderer {
   std::unique_ptr<render::GlContext> context_;
   std::unique_ptr<render::ProjectorPipeline> pipeline_;
   std::optional<CaptureWriter> captures_;
+  // The drawn image as a capture takes it.
+  struct ReadBack {
+    image::FloatImage linear;
+    image::ByteImage encoded;  // none when the signal is deeper than 8 bits
+    image::WordImage signal;   // only then
+  };
+  [[nodiscard]] ReadBack read_back() const;
   // What a frame carries for later ones (lights, focus, the scene ahead).
   void take_along(const FrameInput& frame);
 
-  clock::Nanos warm_up_time_ = 0;
+  WarmUp warm_up_;
   bool warned_gather_radius_ = false;
   bool gathers_ = false;      // method gather (else the clamp can only be per-field's blur)
   bool deep_signal_ = false;  // the projector takes more than 8 bits: captures are 16-bit PNGs

@@ -520,6 +520,44 @@ TEST_F(MasterTest, TheBarrierWaitsForASlowNodeAsLongAsItUsuallyTakes) {
   EXPECT_EQ(*at - now_, 3000 * kMs) << "the liveness timeout";
 }
 
+// Reading a captured frame back costs a node what it measured on its warm-up
+// frame (a 2560×1440 read-back on llvmpipe: several times the drawing): a
+// captured frame is waited for twice its drawing and that, the others not.
+TEST_F(MasterTest, ACapturedFrameIsWaitedForAsLongAsItsReadBackTakesBesides) {
+  RunSettings settings;
+  settings.capture_every = 2;
+  load("single-wall.json", {}, settings);
+  const std::string id = run_.config.installation.projectors.front().id;
+  (void)hello(1, id);
+  wire::Envelope e = envelope();
+  e.mutable_configured()->set_renderer("test");
+  e.mutable_configured()->set_warm_up_ns(100 * kMs);
+  e.mutable_configured()->set_capture_ns(250 * kMs);
+  Actions a = master_->message(1, e, now_);
+  const clock::Nanos* at = armed(a, Timer::barrier);
+  ASSERT_NE(at, nullptr);
+  EXPECT_EQ(*at - now_, 700 * kMs) << "frame 0 is captured: twice the warm-up's 100 ms drawing and 250 ms read-back";
+  wire::Envelope r = envelope();
+  r.mutable_frame_ready()->set_frame_id(0);
+  r.mutable_frame_ready()->set_state_hash(hash_of(a, 1));
+  r.mutable_frame_ready()->set_render_ns(350 * kMs);
+  now_ += 350 * kMs;
+  (void)master_->message(1, r, now_);
+  (void)shown(1, 0);
+  a = master_->timer(Timer::next_frame, now_);
+  at = armed(a, Timer::barrier);
+  ASSERT_NE(at, nullptr);
+  EXPECT_EQ(*at - now_, 700 * kMs) << "frame 1 is not captured: twice the slowest (350 ms, a captured frame)";
+  // A read-back time from the node is bounded like a render time.
+  RenderPace pace;
+  pace.add(100 * kMs);
+  pace.set_capture(std::numeric_limits<std::int64_t>::max());
+  EXPECT_EQ(pace.allowance(500 * kMs, 3000 * kMs, true), 3000 * kMs);
+  EXPECT_EQ(pace.allowance(500 * kMs, 3000 * kMs, false), 500 * kMs);
+  pace.set_capture(-5);
+  EXPECT_EQ(pace.allowance(100 * kMs, 3000 * kMs, true), 200 * kMs);
+}
+
 // Every node behind (one projector, stopped for a while): a frame would be
 // shown by nobody, so the next waits for the node to answer, and is drawn by it.
 TEST_F(MasterTest, WhenEveryNodeIsBehindTheNextFrameWaitsForOne) {

@@ -901,11 +901,12 @@ TEST_F(NodeTest, ConfiguredSaysHowLongTheWarmUpFrameTook) {
   wire::Envelope welcome = envelope();
   *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr);
   (void)node.message(welcome, now_);
-  const Actions a = node.configured({}, "test renderer", 420 * kMs);
+  const Actions a = node.configured({}, "test renderer", {420 * kMs, 130 * kMs});
   const auto configured = sent(a, wire::Envelope::kConfigured);
   ASSERT_EQ(configured.size(), 1u);
   EXPECT_EQ(configured.front().configured().warm_up_ns(), 420 * kMs);
-  EXPECT_TRUE(logged(a, "warm-up frame 420.0 ms"));
+  EXPECT_EQ(configured.front().configured().capture_ns(), 130 * kMs);
+  EXPECT_TRUE(logged(a, "warm-up frame 420.0 ms, 130.0 ms more when captured"));
 }
 
 }  // namespace
