@@ -103,6 +103,27 @@ TEST(ColorFields, DescribedForTheNodesLog) {
   EXPECT_EQ(describe(ColorFields{}), "");
 }
 
+// Each channel's share of the frame: what a field's light is divided by while
+// it is on (optics::Emission::on_fraction), so a still image looks the same
+// whatever the fields. Unequal fields; a channel in each of two images.
+TEST(ColorFields, EachChannelIsOnForTheSumOfItsFields) {
+  const auto parsed = parse(R"({"fields": [
+      {"channel": "red", "offset": -0.4, "duration": 0.1},
+      {"channel": "green", "offset": -0.2, "duration": 0.25},
+      {"channel": "blue", "offset": 0.05, "duration": 0.2}]})");
+  ASSERT_TRUE(parsed) << parsed.error();
+  const ColorFields& c = parsed.value().projectors[0].color_fields;
+  EXPECT_DOUBLE_EQ(c.on_share(Channel::red), 0.1);
+  EXPECT_DOUBLE_EQ(c.on_share(Channel::green), 0.25);
+  EXPECT_DOUBLE_EQ(c.on_share(Channel::blue), 0.2);
+  const auto stereo = parse(R"({"preset": "dlp-stereo-as-mono"})", 60.0);
+  ASSERT_TRUE(stereo) << stereo.error();
+  for (const Channel channel : {Channel::red, Channel::green, Channel::blue}) {
+    EXPECT_NEAR(stereo.value().projectors[0].color_fields.on_share(channel), 1.0 / 3.0, 1e-15)
+        << "a sixth in each of the two images";
+  }
+}
+
 TEST(ColorFields, FieldsGivenOneByOne) {
   const auto parsed = parse(R"({"fields": [
       {"channel": "red", "offset": -0.3, "duration": 0.3},

@@ -64,8 +64,9 @@ TEST(Perceive, AStillImageSeenByAStillEyeIsTheImage) {
 
 // A bar moving at `speed` px/s on a projector with three fields: R at −⅓, G at 0,
 // B at +⅓ of the frame, each a third long. `per_field`: each channel drawn where
-// the bar is during its field; otherwise all at the frame's display time.
-image::FloatImage tracked(double speed, bool per_field) {
+// the bar is during its field; otherwise all at the frame's display time. The
+// exposure is centred on frame `centre_frame`'s display time.
+image::FloatImage tracked(double speed, bool per_field, int centre_frame = 0) {
   const double offsets[3] = {-1.0 / 3.0, 0.0, 1.0 / 3.0};
   std::vector<image::FloatImage> images;
   images.reserve(12);
@@ -88,8 +89,8 @@ image::FloatImage tracked(double speed, bool per_field) {
       emissions.push_back(e);
     }
   }
-  // One 60 Hz frame of exposure, centred on frame 0's display time.
-  return perceive(emissions, kWidth, kHeight, {0.0, 2.0 * kPeriod, {speed, 0.0}});
+  // One 60 Hz frame of exposure.
+  return perceive(emissions, kWidth, kHeight, {centre_frame * kPeriod, 2.0 * kPeriod, {speed, 0.0}});
 }
 
 TEST(Perceive, ATrackedBarShowsFringesOfSpeedTimesFieldSpacing) {
@@ -108,6 +109,15 @@ TEST(Perceive, ATrackedBarShowsFringesOfSpeedTimesFieldSpacing) {
   // Drawn per field and tracked, the bar is sharp: its edge within a pixel.
   EXPECT_GT(fields.at(100, kHeight / 2, 0), 0.99f);
   EXPECT_LT(fields.at(88, kHeight / 2, 0), 0.01f);
+}
+
+// The retina is aligned with the screen at the exposure's centre: the tracked
+// bar is seen where it is then (its middle at 100 px at frame 0, 6 px on a
+// frame later), not where it was when the exposure opened.
+TEST(Perceive, TheTrackedBarIsSeenWhereItIsAtTheExposuresCentre) {
+  const double speed = 6.0 / kPeriod;
+  EXPECT_NEAR(centre_of(tracked(speed, true, 0), 1), 100.0, 1e-3);
+  EXPECT_NEAR(centre_of(tracked(speed, true, 1), 1), 106.0, 1e-3);
 }
 
 }  // namespace
