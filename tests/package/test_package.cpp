@@ -46,22 +46,33 @@ TEST(Package, CmakeInstallPutsTheProgramsConfigsAndDocsUnderThePrefix) {
   EXPECT_NE(read_file(log).find("tracking: replay of"), std::string::npos) << read_file(log);
 }
 
-// The units run /usr/bin/optique-*: the service component refuses another
-// prefix (it would write to /usr and /etc anyway, units starting nothing), and
-// stages under DESTDIR with prefix /usr.
-TEST(Package, TheServiceComponentInstallsWithPrefixUsrOnly) {
+// The service component follows the prefix: under /usr/local the units go to
+// /usr/local/lib/systemd/system (where systemd looks), run the programs of that
+// prefix and read <prefix>/etc/optique; with prefix /usr they are the package's,
+// /etc/optique and all, staged under DESTDIR.
+TEST(Package, TheServiceComponentFollowsThePrefix) {
   const std::string dir = make_temp_dir("optique-service");
-  const std::string log = dir + "/refused.log";
-  EXPECT_NE(run({"/usr/bin/cmake", "--install", kBuild, "--prefix", dir + "/local", "--component", "service"}, log), 0);
-  EXPECT_NE(read_file(log).find("installs with --prefix /usr"), std::string::npos) << read_file(log);
-  EXPECT_FALSE(fs::exists(dir + "/local"));
+  const std::string prefix = dir + "/local";
+  ASSERT_EQ(run({"/usr/bin/cmake", "--install", kBuild, "--prefix", prefix, "--component", "service"},
+                dir + "/local.log"),
+            0)
+      << read_file(dir + "/local.log");
+  const std::string master = read_file(prefix + "/lib/systemd/system/optique-master.service");
+  EXPECT_NE(master.find("\nExecStart=" + prefix + "/bin/optique-master "), std::string::npos) << master;
+  EXPECT_NE(master.find("\nEnvironmentFile=" + prefix + "/etc/optique/master.env\n"), std::string::npos) << master;
+  EXPECT_EQ(master.find("/usr/bin"), std::string::npos) << master;
+  const std::string node = read_file(prefix + "/lib/systemd/system/optique-node@.service");
+  EXPECT_NE(node.find("--secret-file " + prefix + "/etc/optique/secret "), std::string::npos) << node;
+  EXPECT_NE(read_file(prefix + "/etc/optique/master.env").find("OPTIQUE_CONFIG=" + prefix + "/etc/optique/"),
+            std::string::npos);
   const std::string staged = dir + "/stage";
   ASSERT_EQ(run({"/usr/bin/env", "DESTDIR=" + staged, "/usr/bin/cmake", "--install", kBuild, "--prefix", "/usr",
                  "--component", "service"},
                 dir + "/staged.log"),
             0)
       << read_file(dir + "/staged.log");
-  EXPECT_TRUE(fs::exists(staged + "/usr/lib/systemd/system/optique-master.service"));
+  EXPECT_EQ(read_file(staged + "/usr/lib/systemd/system/optique-master.service"),
+            read_file(std::string(OPTIQUE_SOURCE_DIR) + "/packaging/systemd/optique-master.service"));
   EXPECT_TRUE(fs::exists(staged + "/usr/lib/systemd/system/optique-node@.service"));
   EXPECT_TRUE(fs::exists(staged + "/etc/optique/node.env"));
 }
