@@ -16,7 +16,9 @@ void NodeProtocol::log(Actions& out, spdlog::level::level_enum level, std::strin
 
 void NodeProtocol::stop(int exit_code, const std::string& reason, Actions& out) {
   if (phase_ == Phase::stopped) return;
-  if (copy_unfinished_) out.push_back(AbandonScene{});
+  // An unfinished copy stays (its lock let go): the next node to fetch the
+  // scene, this one restarted or another of the host, goes on from its chunks,
+  // each checked again. Only a copy the cache could not keep is removed.
   copy_unfinished_ = false;
   fetch_.reset();
   const bool connected = connection_open_;
@@ -275,6 +277,7 @@ void NodeProtocol::configure(Actions& out) {
 // The cache cannot hold the scene (no room, no permission): not something a
 // retry cures.
 void NodeProtocol::cache_failed(const std::string& error, Actions& out) {
+  if (copy_unfinished_) out.push_back(AbandonScene{});
   stop(kExitRefused, "cannot keep the master's scene here: " + error, out);
 }
 

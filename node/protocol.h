@@ -143,8 +143,9 @@ struct StoreSceneChunk {
 // Every chunk is stored: check the copy whole, put it in place and answer with
 // scene_copy_finished().
 struct FinishScene {};
-// The copy will not be finished (the node stops): remove it. A copy whose
-// connection went is kept, and goes on after the reconnect.
+// The copy cannot be kept (the cache could not write it): remove it. A copy
+// whose connection went, or whose node stops, is kept: it goes on after the
+// reconnect, or in the next node to fetch the scene.
 struct AbandonScene {};
 
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, Protect, SetLiveness, Configure, Render, Skip, PresentAt,

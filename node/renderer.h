@@ -32,17 +32,18 @@ struct FrameInput {
   std::uint64_t ahead_frame = 0;
 };
 
-// How a frame was drawn: in full, or (a node that up-converts) as a key frame,
-// between key frames (and a later key frame drawn ahead with it), or as a key
-// frame drawn ahead.
 // What configure()'s warm-up frame took: drawing it (every program and texture
-// used once), and reading it back as a captured frame is read. The master
-// waits that long for the first frame, and a captured frame that much longer.
+// used once), and reading it back as a captured frame is read (each of its
+// images). The master waits that long for the first frame, and a captured
+// frame that much longer.
 struct WarmUp {
   clock::Nanos frame = 0;    // 0: none was drawn
   clock::Nanos capture = 0;  // 0: not measured
 };
 
+// How a frame was drawn: in full, or (a node that up-converts) as a key frame,
+// between key frames (and a later key frame drawn ahead with it), or as a key
+// frame drawn ahead.
 struct Rendered {
   up::FrameKind kind = up::FrameKind::full;
   bool key_ahead = false;

@@ -255,38 +255,44 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
   fs::create_directories(folder_, error);
   if (error) return Error{"cannot make the scene cache " + folder_.string() + ": " + describe(error)};
   if (std::optional<Adopted> adopted = adopt_abandoned(folder_, sha256)) {
-    // A node killed midway (this one, restarted, or another of this host):
-    // what it fetched is kept; every file is there to be written into.
+    // A node stopped midway (this one, restarted, or another of this host):
+    // what it fetched is kept; every file is there, at its size, to be written
+    // into. Anything amiss, and a fresh copy is begun instead.
     partial_ = adopted->partial;
     lock_fd_ = adopted->lock_fd;
+    bool usable = true;
     for (const scene::SceneFile& file : manifest.files) {
       const fs::path path = partial_ / file.path;
       fs::create_directories(path.parent_path(), error);
       const int fd = open(path.c_str(), O_CREAT | O_WRONLY | O_CLOEXEC, 0644);
-      if (fd < 0) {
-        const std::string why = std::strerror(errno);
-        abandon();
-        return Error{"cannot write the scene cache " + folder_.string() + ": " + path.string() + ": " + why};
+      usable = usable && fd >= 0 && ftruncate(fd, static_cast<off_t>(file.size)) == 0;
+      if (fd >= 0) close(fd);
+    }
+    if (usable) {
+      mark_present();
+      manifest_ = manifest;
+      sha256_ = sha256;
+      std::size_t held = 0;
+      std::size_t chunks = 0;
+      std::uint64_t held_bytes = 0;
+      for (std::size_t f = 0; f < present.size(); ++f) {
+        for (std::size_t c = 0; c < present[f].size(); ++c) {
+          if (present[f][c]) held_bytes += manifest.chunk_length(f, c);
+        }
+        held += static_cast<std::size_t>(std::count(present[f].begin(), present[f].end(), true));
+        chunks += present[f].size();
       }
-      close(fd);
+      log_.info("going on with the copy of the scene {}… that a stopped node left: {} of its {} chunks are in",
+                sha256.substr(0, 12), held, chunks);
+      remove_abandoned_partials(folder_);
+      // Room for what is still to come.
+      if (auto room = make_room(manifest.total_bytes() - held_bytes, sha256); !room) {
+        abandon();
+        return Error{room.error()};
+      }
+      return present;
     }
-    mark_present();
-    manifest_ = manifest;
-    sha256_ = sha256;
-    std::size_t held = 0;
-    std::size_t chunks = 0;
-    for (const std::vector<bool>& file : present) {
-      held += static_cast<std::size_t>(std::count(file.begin(), file.end(), true));
-      chunks += file.size();
-    }
-    log_.info("going on with the copy of the scene {}… that a stopped node left: {} of its {} chunks are in",
-              sha256.substr(0, 12), held, chunks);
-    remove_abandoned_partials(folder_);
-    if (auto room = make_room(manifest.total_bytes(), sha256); !room) {
-      abandon();
-      return Error{room.error()};
-    }
-    return present;
+    abandon();
   }
   remove_abandoned_partials(folder_);
   if (auto room = make_room(manifest.total_bytes(), sha256); !room) return Error{room.error()};

@@ -8,8 +8,9 @@
 // nodes of one host may share a folder (even from several containers: the locks,
 // not process ids, tell a partial copy whose node is gone): each writes its own
 // partial copy, and the first to finish puts it in place. A partial copy whose
-// node stopped midway (killed, or its master gone) is taken over by the next
-// node that fetches the scene, with the chunks it holds. When the disk runs
+// node stopped midway (stopped, killed, or its master gone) is taken over by
+// the next node that fetches the scene, with the chunks it holds; it is removed
+// when a node begins to fetch another scene. When the disk runs
 // short, the copies used longest ago make room, if removing them would; if not,
 // none is removed and the scene is refused.
 

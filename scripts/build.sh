@@ -12,6 +12,6 @@ fi
 targets=()
 if [ -n "${OPTIQUE_BUILD_TARGETS:-}" ]; then
   read -ra names <<<"$OPTIQUE_BUILD_TARGETS"
-  targets=(--target "${names[@]}")
+  if [ ${#names[@]} -gt 0 ]; then targets=(--target "${names[@]}"); fi
 fi
 cmake --build "$build_dir" --parallel "$(nproc)" "${targets[@]}"

@@ -24,10 +24,10 @@ run_packages=(
   libegl-mesa0 libgl1-mesa-dri       # Mesa's EGL and llvmpipe: GL without a GPU
   libgtest-dev libgmock-dev          # tests (configured with the programs)
   libssl-dev                         # SHA-256, HKDF, AES-GCM (libcrypto)
+  python3                            # configuring: the tests' layer check, the benches' plot series
 )
 test_packages=(
   xvfb xauth                         # a virtual display for the window tests
-  python3                            # helper scripts, bench plot series
   gnuplot-nox                        # bench plots (scripts/plot-bench.sh)
   chromium fonts-dejavu-core         # the operator's page in a real browser (headless), with a font
   prometheus                         # promtool checks /metrics as a site's Prometheus reads it

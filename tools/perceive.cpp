@@ -75,6 +75,7 @@ Result<void> parse_track(const std::string& text, PerceiveOptions& options) {
   if (comma == std::string::npos) {
     if (text.empty()) return Error{"--track: give an object's name or vx,vy (screen pixels per frame)"};
     options.object = text;
+    options.velocity.reset();
     return {};
   }
   try {

@@ -56,9 +56,9 @@ struct UpConversion {
   friend bool operator==(const UpConversion&, const UpConversion&) = default;
 };
 
-// What the node draws, for its log ("a key frame every 4 frames (motion,
-// extrapolate; the ratio adapts to keep 30.0 dB PSNR_Y)"); empty when every
-// frame is rendered.
+// What the node draws, for its log ("a key frame every 4 frames, the frames
+// between by motion (extrapolate); the ratio adapts to keep 30.0 dB PSNR_Y");
+// empty when every frame is rendered.
 [[nodiscard]] std::string describe(const UpConversion& up);
 
 // Checks `up` (a projector's `up_conversion`, at `path` in the file) and types

@@ -67,9 +67,10 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   const clock::Nanos warm_up_started = clock::monotonic_now();
   pipeline_->warm_up(start);
   const clock::Nanos drawn = clock::monotonic_now();
-  // A captured frame is read back before it is ready, so it is that much later.
+  // A captured frame is read back before it is ready, so it is that much later:
+  // each of its images (a stereo projector used as mono draws two).
   (void)read_back();
-  warm_up_ = {drawn - warm_up_started, clock::monotonic_now() - drawn};
+  warm_up_ = {drawn - warm_up_started, (clock::monotonic_now() - drawn) * pipeline_->images()};
   if (!captures_) captures_.emplace(capture_folder_, log_);
   configured_for_ = key;
   const render::ProjectorView& view = pipeline_->view();
