@@ -135,6 +135,43 @@ std::optional<Adopted> adopt_abandoned(const fs::path& folder, const std::string
   return std::nullopt;
 }
 
+// Every file of `manifest` in `copy`, its folders made: empty (`whole`
+// false), or at its size, what it holds kept; what went wrong, naming the file.
+std::optional<std::string> make_files(const fs::path& copy, const scene::SceneManifest& manifest, bool whole) {
+  for (const scene::SceneFile& file : manifest.files) {
+    const fs::path path = copy / file.path;
+    std::error_code error;
+    fs::create_directories(path.parent_path(), error);
+    if (error) return path.string() + ": " + describe(error);
+    const int fd = open(path.c_str(), O_CREAT | O_WRONLY | O_CLOEXEC, 0644);
+    const bool sized = fd >= 0 && ftruncate(fd, whole ? static_cast<off_t>(file.size) : 0) == 0;
+    const std::string why = std::strerror(errno);
+    if (fd >= 0) close(fd);
+    if (!sized) return path.string() + ": " + why;
+  }
+  return std::nullopt;
+}
+
+// How much of a copy is in: chunks, of how many, and their bytes.
+struct Held {
+  std::size_t chunks = 0;
+  std::size_t of = 0;
+  std::uint64_t bytes = 0;
+};
+Held held_in(const std::vector<std::vector<bool>>& present, const scene::SceneManifest& manifest) {
+  Held held;
+  for (std::size_t f = 0; f < present.size(); ++f) {
+    for (std::size_t c = 0; c < present[f].size(); ++c) {
+      if (present[f][c]) {
+        ++held.chunks;
+        held.bytes += manifest.chunk_length(f, c);
+      }
+    }
+    held.of += present[f].size();
+  }
+  return held;
+}
+
 struct CachedCopy {
   fs::file_time_type used;
   fs::path path;
@@ -254,48 +291,32 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
   abandon();
   fs::create_directories(folder_, error);
   if (error) return Error{"cannot make the scene cache " + folder_.string() + ": " + describe(error)};
+  std::uint64_t held_bytes = 0;  // in a copy taken over
   if (std::optional<Adopted> adopted = adopt_abandoned(folder_, sha256)) {
     // A node stopped midway (this one, restarted, or another of this host):
     // what it fetched is kept; every file is there, at its size, to be written
     // into. Anything amiss, and a fresh copy is begun instead.
     partial_ = adopted->partial;
     lock_fd_ = adopted->lock_fd;
-    bool usable = true;
-    for (const scene::SceneFile& file : manifest.files) {
-      const fs::path path = partial_ / file.path;
-      fs::create_directories(path.parent_path(), error);
-      const int fd = open(path.c_str(), O_CREAT | O_WRONLY | O_CLOEXEC, 0644);
-      usable = usable && fd >= 0 && ftruncate(fd, static_cast<off_t>(file.size)) == 0;
-      if (fd >= 0) close(fd);
-    }
-    if (usable) {
+    if (make_files(partial_, manifest, true)) {
+      abandon();
+    } else {
       mark_present();
       manifest_ = manifest;
       sha256_ = sha256;
-      std::size_t held = 0;
-      std::size_t chunks = 0;
-      std::uint64_t held_bytes = 0;
-      for (std::size_t f = 0; f < present.size(); ++f) {
-        for (std::size_t c = 0; c < present[f].size(); ++c) {
-          if (present[f][c]) held_bytes += manifest.chunk_length(f, c);
-        }
-        held += static_cast<std::size_t>(std::count(present[f].begin(), present[f].end(), true));
-        chunks += present[f].size();
-      }
+      const Held held = held_in(present, manifest);
+      held_bytes = held.bytes;
       log_.info("going on with the copy of the scene {}… that a stopped node left: {} of its {} chunks are in",
-                sha256.substr(0, 12), held, chunks);
-      remove_abandoned_partials(folder_);
-      // Room for what is still to come.
-      if (auto room = make_room(manifest.total_bytes() - held_bytes, sha256); !room) {
-        abandon();
-        return Error{room.error()};
-      }
-      return present;
+                sha256.substr(0, 12), held.chunks, held.of);
     }
-    abandon();
   }
   remove_abandoned_partials(folder_);
-  if (auto room = make_room(manifest.total_bytes(), sha256); !room) return Error{room.error()};
+  // Room for what is still to come.
+  if (auto room = make_room(manifest.total_bytes() - held_bytes, sha256); !room) {
+    abandon();
+    return Error{room.error()};
+  }
+  if (manifest_) return present;  // taken over
   // The lock first: a partial copy without one is taken for abandoned.
   partial_ = folder_ / (sha256 + kPartial + std::to_string(std::random_device{}()) + "-" +
                         std::to_string(std::random_device{}()));
@@ -305,15 +326,9 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
     abandon();
     return Error{"cannot write the scene cache " + folder_.string() + ": " + why};
   }
-  for (const scene::SceneFile& file : manifest.files) {
-    const fs::path path = partial_ / file.path;
-    fs::create_directories(path.parent_path(), error);
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    if (error || !out) {
-      const std::string why = error ? describe(error) : std::strerror(errno);
-      abandon();
-      return Error{"cannot write the scene cache " + folder_.string() + ": " + path.string() + ": " + why};
-    }
+  if (const std::optional<std::string> problem = make_files(partial_, manifest, false)) {
+    abandon();
+    return Error{"cannot write the scene cache " + folder_.string() + ": " + *problem};
   }
   manifest_ = manifest;
   sha256_ = sha256;

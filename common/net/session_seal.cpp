@@ -79,9 +79,11 @@ namespace {
 
 CipherContextPtr keyed_context(const SessionKey& key, bool encrypt) {
   CipherContextPtr c(new CipherContext{EVP_CIPHER_CTX_new()});
-  const int done = encrypt ? EVP_EncryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr)
-                           : EVP_DecryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr);
-  if (c->context == nullptr || done != 1) throw std::runtime_error("AES-256-GCM set-up failed: " + openssl_error());
+  const bool keyed =
+      c->context != nullptr &&
+      (encrypt ? EVP_EncryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr)
+               : EVP_DecryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr)) == 1;
+  if (!keyed) throw std::runtime_error("AES-256-GCM set-up failed: " + openssl_error());
   return c;
 }
 

@@ -39,8 +39,6 @@ struct SessionKeys {
                                               std::span<const std::uint8_t> node_nonce, std::string_view node_id,
                                               std::uint32_t protocol_version);
 
-// One direction of a session: seals the frames it sends, or opens the frames it
-// receives, counting them; the count is the GCM nonce and never repeats (2^64).
 // OpenSSL's cipher context, keyed once: each frame then sets only its nonce
 // (fetching the cipher and expanding the key per frame cost ~20 µs a message).
 struct CipherContext;
@@ -49,6 +47,8 @@ struct CipherContextFree {
 };
 using CipherContextPtr = std::unique_ptr<CipherContext, CipherContextFree>;
 
+// One direction of a session: seals the frames it sends, or opens the frames it
+// receives, counting them; the count is the GCM nonce and never repeats (2^64).
 class Sealer {
  public:
   // Throws std::runtime_error when OpenSSL cannot set the key up.
