@@ -176,6 +176,13 @@ Actions MasterProtocol::message(PeerId peer, const wire::Envelope& message, cloc
       }
       on_scene_request(peer, session, message.scene_request(), now, out);
       break;
+    case wire::Envelope::kSceneWait:
+      if (session.phase != Phase::configuring) {
+        out.push_back(Close{peer, "waited for the scene after setting up"});
+        break;
+      }
+      on_scene_wait(peer, session, message.scene_wait(), now, out);
+      break;
     case wire::Envelope::kConfigured:
       if (session.phase != Phase::configuring) {
         out.push_back(Close{peer, "configured twice"});
@@ -392,6 +399,39 @@ void MasterProtocol::on_scene_request(PeerId peer, Session& session, const wire:
       out.push_back(Log{spdlog::level::info, fmt::format("sending the scene to '{}': {} %", id, 25 * quarters)});
     }
   }
+}
+
+// A node whose host has another node fetching the scene into the cache they
+// share waits for that copy: each word that it still waits gives it another
+// configure_timeout(), as a request would (the node gives up waiting, and
+// fetches, once the other copy stops growing), up to twice that in all: time
+// for a whole fetch at the rate configure_timeout() allows for.
+void MasterProtocol::on_scene_wait(PeerId peer, Session& session, const wire::SceneWait& wait, clock::Nanos now,
+                                   Actions& out) {
+  const scene::SceneManifest& manifest = scene_.manifest;
+  if (manifest.files.empty() || wait.scene_sha256() != scene_.content_sha256) {
+    out.push_back(Close{peer, "waited for another scene"});
+    return;
+  }
+  const std::chrono::seconds longest = 2 * configure_timeout();
+  if (session.waiting_since && now - *session.waiting_since > nanos(longest)) {
+    out.push_back(Close{peer, "waited for another node's copy of the scene for more than " +
+                                  std::to_string(longest.count()) + " s"});
+    return;
+  }
+  const std::uint64_t total = manifest.total_bytes();
+  if (!session.waiting_since) {
+    session.waiting_since = now;
+    out.push_back(Log{spdlog::level::info,
+                      fmt::format("'{}' waits for the copy of the scene another node of its host is fetching into "
+                                  "the cache they share ({:.1f} of {:.1f} MiB there)",
+                                  slot_id(*session.slot),
+                                  static_cast<double>(std::min(wait.bytes_there(), total)) / (1 << 20),
+                                  static_cast<double>(total) / (1 << 20))});
+  }
+  out.push_back(SetDeadline{peer, configure_timeout(),
+                            "node did not finish configuring within " + std::to_string(configure_timeout().count()) +
+                                " s of saying it waits for the scene"});
 }
 
 std::chrono::seconds MasterProtocol::configure_timeout() const {

@@ -208,6 +208,8 @@ class MasterProtocol {
     std::optional<std::uint64_t> drawing;
     RenderPace pace;
     bool said_slow = false;  // logged once that it draws slower than the period
+    // Since when it waits for another node's copy of the scene (SceneWait).
+    std::optional<clock::Nanos> waiting_since;
   };
   struct Slot {
     std::optional<PeerId> peer;
@@ -218,6 +220,7 @@ class MasterProtocol {
   void on_configured(PeerId peer, Session& session, const wire::Configured& configured, clock::Nanos now, Actions& out);
   void on_scene_request(PeerId peer, Session& session, const wire::SceneRequest& request, clock::Nanos now,
                         Actions& out);
+  void on_scene_wait(PeerId peer, Session& session, const wire::SceneWait& wait, clock::Nanos now, Actions& out);
   void on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now, Actions& out);
   // Whether every node that is up is behind (out of the barrier, still drawing
   // an earlier frame): then a frame would be shown by nobody, and the next one

@@ -27,6 +27,7 @@ Node::Node(asio::io_context& io, NodeOptions options, Renderer& renderer, spdlog
       resolver_(io),
       retry_timer_(io),
       ping_timer_(io),
+      scene_timer_(io),
       connect_timer_(io),
       present_timer_(io),
       signals_(io, SIGINT, SIGTERM),
@@ -163,6 +164,7 @@ void Node::carry_out(Action& action) {
             exit_code_ = a.exit_code;
             retry_timer_.cancel();
             ping_timer_.cancel();
+            scene_timer_.cancel();
             connect_timer_.cancel();
             present_timer_.cancel();
             signals_.cancel();
@@ -176,9 +178,25 @@ void Node::carry_out(Action& action) {
           [&](PrepareScene& a) {
             if (auto found = scene_cache_.find(a.manifest, a.sha256)) {
               carry_out(protocol_.scene_found(*found));
-            } else {
-              carry_out(protocol_.scene_copy_started(scene_cache_.begin(a.manifest, a.sha256), clock::monotonic_now()));
+              return;
             }
+            Result<SceneCache::Begun> begun = scene_cache_.begin(a.manifest, a.sha256, a.wait_for_others);
+            if (begun) {
+              if (const auto* elsewhere = std::get_if<SceneCache::FetchedElsewhere>(&begun.value())) {
+                carry_out(protocol_.scene_fetched_elsewhere(elsewhere->bytes_there, clock::monotonic_now()));
+                return;
+              }
+              carry_out(protocol_.scene_copy_started(std::get<SceneCache::Present>(std::move(begun).value()),
+                                                     clock::monotonic_now()));
+            } else {
+              carry_out(protocol_.scene_copy_started(Error{begun.error()}, clock::monotonic_now()));
+            }
+          },
+          [&](RecheckScene& a) {
+            scene_timer_.expires_after(a.after);
+            scene_timer_.async_wait([this](const boost::system::error_code& error) {
+              if (!error) carry_out(protocol_.scene_recheck_due(clock::monotonic_now()));
+            });
           },
           [&](StoreSceneChunk& a) {
             if (auto stored = scene_cache_.write(a.file, a.offset, a.data); !stored) {

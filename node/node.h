@@ -60,6 +60,7 @@ class Node {
   asio::ip::tcp::resolver resolver_;
   asio::steady_timer retry_timer_;
   asio::steady_timer ping_timer_;
+  asio::steady_timer scene_timer_;  // looking again at another node's copy of the scene
   asio::steady_timer connect_timer_;
   asio::steady_timer present_timer_;
   std::shared_ptr<asio::ip::tcp::socket> connecting_;

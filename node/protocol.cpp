@@ -81,6 +81,7 @@ Actions NodeProtocol::closed(const std::string& reason, clock::Nanos now) {
   if (phase_ == Phase::stopped) return out;
   const bool was_joined = phase_ == Phase::joined;
   fetch_.reset();  // its copy is kept: the fetch goes on from it after the reconnect
+  waiting_.reset();
   phase_ = Phase::disconnected;
   pending_.reset();
   held_.clear();
@@ -285,8 +286,58 @@ Actions NodeProtocol::scene_found(const std::string& gltf_path) {
   Actions out;
   if (phase_ != Phase::preparing_scene) return out;
   job_->scene_path = gltf_path;
-  log(out, spdlog::level::info, "the scene " + job_->scene_sha256.substr(0, 12) + "… is here: " + gltf_path);
+  log(out, spdlog::level::info,
+      "the scene " + job_->scene_sha256.substr(0, 12) + "… is here: " + gltf_path +
+          (waiting_ ? ", fetched by another node of this host" : ""));
+  waiting_.reset();
   configure(out);
+  return out;
+}
+
+Actions NodeProtocol::scene_fetched_elsewhere(std::uint64_t bytes_there, clock::Nanos now) {
+  Actions out;
+  if (phase_ != Phase::preparing_scene) return out;
+  const std::uint64_t total = job_->scene_files.total_bytes();
+  bytes_there = std::min(bytes_there, total);
+  const auto mib = [](std::uint64_t bytes) { return static_cast<double>(bytes) / (1 << 20); };
+  if (!waiting_) {
+    waiting_ = SceneWaiting{now, now, std::nullopt, bytes_there};
+    log(out, spdlog::level::info,
+        fmt::format("another node of this host is fetching the scene {} into this cache ({:.1f} of {:.1f} MiB "
+                    "there): waiting for its copy",
+                    job_->job.installation.scene.gltf, mib(bytes_there), mib(total)));
+  } else if (bytes_there > waiting_->bytes) {
+    waiting_->bytes = bytes_there;
+    waiting_->grew_at = now;
+  }
+  if (now - waiting_->grew_at >= kSceneStall.count() * clock::kNanosPerMilli) {
+    log(out, spdlog::level::warn,
+        fmt::format("the copy of the scene another node of this host is fetching has not grown for {} s "
+                    "({:.1f} of {:.1f} MiB there): fetching the scene from the master",
+                    kSceneStall.count() / 1000, mib(waiting_->bytes), mib(total)));
+    waiting_.reset();
+    out.push_back(PrepareScene{job_->scene_files, job_->scene_sha256, false});
+    return out;
+  }
+  if (!waiting_->told_at || now - *waiting_->told_at >= kSceneWaitWord.count() * clock::kNanosPerMilli) {
+    waiting_->told_at = now;
+    wire::Envelope wait;
+    wait.mutable_scene_wait()->set_scene_sha256(job_->scene_sha256);
+    wait.mutable_scene_wait()->set_bytes_there(waiting_->bytes);
+    out.push_back(Send{std::move(wait)});
+  }
+  // Past the stall, in case the cache stops answering: the connection goes.
+  out.push_back(SetDeadline{kSceneStall + 2 * kSceneWaitWord,
+                            "waited " + std::to_string((kSceneStall + 2 * kSceneWaitWord).count() / 1000) +
+                                " s for another node's copy of the scene"});
+  out.push_back(RecheckScene{kSceneRecheck});
+  return out;
+}
+
+Actions NodeProtocol::scene_recheck_due(clock::Nanos) {
+  Actions out;
+  if (phase_ != Phase::preparing_scene || !waiting_) return out;
+  out.push_back(PrepareScene{job_->scene_files, job_->scene_sha256});
   return out;
 }
 
@@ -298,6 +349,7 @@ Actions NodeProtocol::scene_copy_started(const Result<protocol::SceneFetch::Pres
     return out;
   }
   copy_unfinished_ = true;
+  waiting_.reset();
   fetch_.emplace(job_->scene_files, job_->scene_sha256, started.value());
   fetch_started_ = now;
   fetch_had_bytes_ = fetch_->bytes_stored();

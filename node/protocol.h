@@ -127,11 +127,19 @@ struct Log {
   std::string text;
 };
 // The scene's files (node/scene_cache.h): answer with scene_found() and the
-// glTF's path when a whole copy is here; else start a new copy and answer with
+// glTF's path when a whole copy is here; with scene_fetched_elsewhere() when
+// another node of this host is fetching it into the same cache (unless
+// `wait_for_others` is false); else start a new copy and answer with
 // scene_copy_started().
 struct PrepareScene {
   scene::SceneManifest manifest;
   std::string sha256;
+  bool wait_for_others = true;
+};
+// Waiting for another node's copy of the scene: look again after `after`, with
+// scene_recheck_due().
+struct RecheckScene {
+  std::chrono::milliseconds after{0};
 };
 // Write a chunk (checked against the manifest) into the copy; answer only a
 // failure, with scene_store_failed().
@@ -150,7 +158,7 @@ struct AbandonScene {};
 
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, Protect, SetLiveness, Configure, Render, Skip, PresentAt,
                             Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log, PrepareScene,
-                            StoreSceneChunk, FinishScene, AbandonScene>;
+                            RecheckScene, StoreSceneChunk, FinishScene, AbandonScene>;
 using Actions = std::vector<Action>;
 
 class NodeProtocol {
@@ -174,6 +182,12 @@ class NodeProtocol {
   static constexpr std::chrono::microseconds kRoundGuard{1000};
   // A scene being fetched: no chunk for this long and the connection is given up.
   static constexpr std::chrono::milliseconds kSceneStall{10000};
+  // Another node of this host fetching the scene into the shared cache: its
+  // copy is looked at this often, and the master told this often that this
+  // node still waits (SceneWait). A copy that has not grown for kSceneStall
+  // is not waited for any longer: this node fetches the scene itself.
+  static constexpr std::chrono::milliseconds kSceneRecheck{200};
+  static constexpr std::chrono::milliseconds kSceneWaitWord{1000};
 
   explicit NodeProtocol(NodeSettings settings);
 
@@ -189,6 +203,9 @@ class NodeProtocol {
                                    WarmUp warm_up = {});
   // Answers to PrepareScene, StoreSceneChunk and FinishScene.
   [[nodiscard]] Actions scene_found(const std::string& gltf_path);
+  // `bytes_there`: how much of the scene the other node's copy holds so far.
+  [[nodiscard]] Actions scene_fetched_elsewhere(std::uint64_t bytes_there, clock::Nanos now);
+  [[nodiscard]] Actions scene_recheck_due(clock::Nanos now);
   // `started`: which chunks the copy already holds (one going on after a lost connection).
   [[nodiscard]] Actions scene_copy_started(const Result<protocol::SceneFetch::Present>& started, clock::Nanos now);
   [[nodiscard]] Actions scene_store_failed(const std::string& error);
@@ -258,6 +275,14 @@ class NodeProtocol {
   clock::Nanos fetch_started_ = 0;
   std::uint64_t fetch_had_bytes_ = 0;  // here already when the fetch (re)started
   int fetch_quarters_logged_ = 0;
+  // Waiting for another node of this host to fetch the scene into the cache.
+  struct SceneWaiting {
+    clock::Nanos since = 0;
+    clock::Nanos grew_at = 0;  // when its copy last grew
+    std::optional<clock::Nanos> told_at;  // when the master was last told
+    std::uint64_t bytes = 0;
+  };
+  std::optional<SceneWaiting> waiting_;
   scene::SceneState state_;
   // The lag hook's memory: the last lag_frames + 1 frames as they came.
   struct PastFrame {

@@ -135,6 +135,52 @@ std::optional<Adopted> adopt_abandoned(const fs::path& folder, const std::string
   return std::nullopt;
 }
 
+// The copy of scene `sha256` another live process is writing into `folder`
+// (its lock held): the bytes its files hold on the disk so far. Taking a lock
+// to test it, and letting it go, is how a live holder is told from a gone one.
+std::optional<std::uint64_t> being_fetched(const fs::path& folder, const std::string& sha256) {
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!name.starts_with(sha256 + kPartial) || name.ends_with(kLock) || !entry.is_directory(error)) continue;
+    const int fd = open((entry.path().string() + kLock).c_str(), O_RDWR | O_CLOEXEC);
+    if (fd < 0) continue;
+    const bool held = flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
+    close(fd);
+    if (!held) continue;
+    std::uint64_t bytes = 0;
+    for (fs::recursive_directory_iterator it(entry.path(), error), end; !error && it != end; it.increment(error)) {
+      struct stat file {};
+      if (stat(it->path().c_str(), &file) == 0 && S_ISREG(file.st_mode)) {
+        bytes += std::min<std::uint64_t>(static_cast<std::uint64_t>(file.st_blocks) * 512,
+                                         static_cast<std::uint64_t>(file.st_size));
+      }
+    }
+    return bytes;
+  }
+  return std::nullopt;
+}
+
+// Held while a node looks for another's copy and starts its own, so that of
+// nodes sharing the folder that begin at once one fetches: an flock on
+// <folder>/.begin, let go when this goes.
+class BeginLock {
+ public:
+  explicit BeginLock(const fs::path& folder)
+      : fd_(open((folder / ".begin").c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644)) {
+    while (fd_ >= 0 && flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
+    }
+  }
+  ~BeginLock() {
+    if (fd_ >= 0) close(fd_);
+  }
+  BeginLock(const BeginLock&) = delete;
+  BeginLock& operator=(const BeginLock&) = delete;
+
+ private:
+  int fd_;
+};
+
 // Every file of `manifest` in `copy`, its folders made: empty (`whole`
 // false), or at its size, what it holds kept; what went wrong, naming the file.
 std::optional<std::string> make_files(const fs::path& copy, const scene::SceneManifest& manifest, bool whole) {
@@ -266,7 +312,8 @@ std::optional<std::string> SceneCache::find(const scene::SceneManifest& manifest
   return (copy / manifest.files.front().path).string();
 }
 
-Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manifest, const std::string& sha256) {
+Result<SceneCache::Begun> SceneCache::begin(const scene::SceneManifest& manifest, const std::string& sha256,
+                                            bool wait_for_others) {
   Present present(manifest.files.size());
   for (std::size_t f = 0; f < manifest.files.size(); ++f)
     present[f].assign(manifest.files[f].chunks(manifest.chunk_bytes), false);
@@ -286,28 +333,50 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
   std::error_code error;
   if (manifest_ && sha256_ == sha256 && fs::is_directory(partial_, error)) {
     mark_present();  // this process's unfinished copy (its connection went)
-    return present;
+    return Begun{std::move(present)};
   }
   abandon();
   fs::create_directories(folder_, error);
   if (error) return Error{"cannot make the scene cache " + folder_.string() + ": " + describe(error)};
-  std::uint64_t held_bytes = 0;  // in a copy taken over
-  if (std::optional<Adopted> adopted = adopt_abandoned(folder_, sha256)) {
-    // A node stopped midway (this one, restarted, or another of this host):
-    // what it fetched is kept; every file is there, at its size, to be written
-    // into. Anything amiss, and a fresh copy is begun instead.
-    partial_ = adopted->partial;
-    lock_fd_ = adopted->lock_fd;
-    if (make_files(partial_, manifest, true)) {
+  // A fresh copy, seen by the nodes that begin after this one: its lock first
+  // (a partial copy without one is taken for abandoned), then its folder.
+  const auto start_fresh = [&]() -> Result<void> {
+    partial_ = folder_ / (sha256 + kPartial + std::to_string(std::random_device{}()) + "-" +
+                          std::to_string(std::random_device{}()));
+    lock_fd_ = open((partial_.string() + kLock).c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
+    if (lock_fd_ < 0 || flock(lock_fd_, LOCK_EX | LOCK_NB) != 0 || !fs::create_directory(partial_, error)) {
+      const std::string why = error ? describe(error) : std::strerror(errno);
       abandon();
-    } else {
-      mark_present();
-      manifest_ = manifest;
-      sha256_ = sha256;
-      const Held held = held_in(present, manifest);
-      held_bytes = held.bytes;
-      log_.info("going on with the copy of the scene {}… that a stopped node left: {} of its {} chunks are in",
-                sha256.substr(0, 12), held.chunks, held.of);
+      return Error{"cannot write the scene cache " + folder_.string() + ": " + why};
+    }
+    return {};
+  };
+  std::uint64_t held_bytes = 0;  // in a copy taken over
+  {
+    const BeginLock begin_lock(folder_);
+    if (wait_for_others) {
+      if (const std::optional<std::uint64_t> bytes = being_fetched(folder_, sha256)) return Begun{FetchedElsewhere{*bytes}};
+    }
+    if (std::optional<Adopted> adopted = adopt_abandoned(folder_, sha256)) {
+      // A node stopped midway (this one, restarted, or another of this host):
+      // what it fetched is kept; every file is there, at its size, to be
+      // written into. Anything amiss, and a fresh copy is begun instead.
+      partial_ = adopted->partial;
+      lock_fd_ = adopted->lock_fd;
+      if (make_files(partial_, manifest, true)) {
+        abandon();
+      } else {
+        mark_present();
+        manifest_ = manifest;
+        sha256_ = sha256;
+        const Held held = held_in(present, manifest);
+        held_bytes = held.bytes;
+        log_.info("going on with the copy of the scene {}… that a stopped node left: {} of its {} chunks are in",
+                  sha256.substr(0, 12), held.chunks, held.of);
+      }
+    }
+    if (!manifest_) {
+      if (auto started = start_fresh(); !started) return Error{started.error()};
     }
   }
   remove_abandoned_partials(folder_);
@@ -316,23 +385,14 @@ Result<SceneCache::Present> SceneCache::begin(const scene::SceneManifest& manife
     abandon();
     return Error{room.error()};
   }
-  if (manifest_) return present;  // taken over
-  // The lock first: a partial copy without one is taken for abandoned.
-  partial_ = folder_ / (sha256 + kPartial + std::to_string(std::random_device{}()) + "-" +
-                        std::to_string(std::random_device{}()));
-  lock_fd_ = open((partial_.string() + kLock).c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644);
-  if (lock_fd_ < 0 || flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
-    const std::string why = std::strerror(errno);
-    abandon();
-    return Error{"cannot write the scene cache " + folder_.string() + ": " + why};
-  }
+  if (manifest_) return Begun{std::move(present)};  // taken over
   if (const std::optional<std::string> problem = make_files(partial_, manifest, false)) {
     abandon();
     return Error{"cannot write the scene cache " + folder_.string() + ": " + *problem};
   }
   manifest_ = manifest;
   sha256_ = sha256;
-  return present;
+  return Begun{std::move(present)};
 }
 
 Result<void> SceneCache::write(std::uint32_t file, std::uint64_t offset, std::string_view data) {

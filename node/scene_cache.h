@@ -22,6 +22,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "scene/manifest.h"
@@ -61,15 +62,25 @@ class SceneCache {
 
   // For each file of the manifest, which chunks are in the copy being written.
   using Present = std::vector<std::vector<bool>>;
+  // Another node (another process) is writing a copy of the scene into this
+  // folder: wait for it rather than fetch the scene a second time.
+  struct FetchedElsewhere {
+    std::uint64_t bytes_there = 0;  // of its copy so far (the disk's blocks)
+  };
+  using Begun = std::variant<Present, FetchedElsewhere>;
   // Starts a copy, or goes on with an unfinished copy of the same scene (this
   // process's, its connection lost midway, or one a stopped node left): which
-  // chunks it already holds, each checked against the manifest. Removes the
-  // other partial copies whose node is gone,
+  // chunks it already holds, each checked against the manifest. Unless
+  // `wait_for_others` is false, a copy that another live node is writing is
+  // left to it: FetchedElsewhere (the look and the start of a copy are one step
+  // for the nodes sharing the folder, so of two nodes that begin at once, one
+  // fetches). Removes the other partial copies whose node is gone,
   // makes room by removing the copies used longest ago, and fails, naming the
   // folder, when it cannot be written or the disk has no room for the scene;
   // when removing every other copy would not make room either, it removes none
   // and says how much the scene needs and how much there is.
-  [[nodiscard]] Result<Present> begin(const scene::SceneManifest& manifest, const std::string& sha256);
+  [[nodiscard]] Result<Begun> begin(const scene::SceneManifest& manifest, const std::string& sha256,
+                                    bool wait_for_others = true);
   [[nodiscard]] Result<void> write(std::uint32_t file, std::uint64_t offset, std::string_view data);
   // Every chunk is in (each was checked as it came): the copy put in place; the
   // path of its glTF.

@@ -223,6 +223,57 @@ TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
   EXPECT_EQ(copies, 1);
 }
 
+// Two nodes of one host sharing one cache fetch the scene once: the first
+// (through a proxy that holds each piece 300 ms while it fetches, so that the
+// fetch lasts) fetches,
+// the second waits for its copy, and both draw.
+TEST(SceneTransfer, TwoNodesOfOneHostSharingACacheFetchTheSceneOnce) {
+  const std::string dir = make_temp_dir("optique-transfer");
+  const std::string config_path = torus_config(dir, torus_scene(dir, 6u << 20), "127.0.0.1", false);
+  {
+    std::ifstream in(config_path);
+    nlohmann::json config = nlohmann::json::parse(in);
+    nlohmann::json left = config["projectors"][0];
+    left["width"] = 320;
+    left["region"] = {{"x", 0.0}, {"y", 0.0}, {"width", 1.0}, {"height", 1.125}};
+    nlohmann::json right = left;
+    right["id"] = "wall-b";
+    right["region"]["x"] = 1.0;
+    config["projectors"] = {left, right};
+    std::ofstream(config_path) << config.dump(1);
+  }
+  const std::string cache = dir + "/cache";
+  Process master({master_binary(), "--config", config_path, "--port-file", dir + "/port", "--frames",
+                  std::to_string(kFrames), "--no-status", "--out", dir + "/out"},
+                 dir + "/master.log");
+  const std::string port = wait_for_port(dir + "/port", 10s);
+  ASSERT_FALSE(port.empty()) << master.output();
+  FaultProxy proxy(static_cast<std::uint16_t>(std::stoi(port)));
+  proxy.set_delay(300ms, 0us);
+  Process first({node_binary(), "--master", "127.0.0.1:" + std::to_string(proxy.port()), "--id", "wall",
+                 "--cache-dir", cache},
+                dir + "/first.log");
+  ASSERT_TRUE(first.wait_for_output("fetching the scene", scaled(10s))) << first.output();
+  Process second({node_binary(), "--master", "127.0.0.1:" + port, "--id", "wall-b", "--cache-dir", cache},
+                 dir + "/second.log");
+  // Its fetch done, the first keeps up with the frames: no more delay.
+  EXPECT_TRUE(first.wait_for_output("fetched the scene", scaled(30s))) << first.output();
+  proxy.set_delay(0us, 0us);
+  EXPECT_EQ(master.wait(scaled(60s)), 0) << master.output();
+  EXPECT_EQ(first.wait(scaled(20s)), 0) << first.output();
+  EXPECT_EQ(second.wait(scaled(20s)), 0) << second.output();
+  EXPECT_TRUE(contains(second.output(), "another node of this host is fetching the scene")) << second.output();
+  EXPECT_TRUE(contains(second.output(), "fetched by another node of this host")) << second.output();
+  EXPECT_FALSE(contains(second.output(), "fetching the scene from the master")) << second.output();
+  EXPECT_TRUE(contains(master.output(), "sending the scene to 'wall', which has no copy")) << master.output();
+  EXPECT_FALSE(contains(master.output(), "sending the scene to 'wall-b'")) << master.output();
+  EXPECT_TRUE(contains(master.output(), "'wall-b' waits for the copy of the scene")) << master.output();
+  EXPECT_TRUE(contains(master.output(), "node 'wall-b' joined")) << master.output();
+  int copies = 0;
+  for (const auto& entry : fs::directory_iterator(cache + "/scenes")) copies += fs::is_directory(entry.path());
+  EXPECT_EQ(copies, 1);
+}
+
 // Two network namespaces' worth of hosts on this machine: the master's side of a
 // veth pair in this namespace (10.213.N.1), the node's in a namespace of its own
 // (10.213.N.2). Needs root (CAP_NET_ADMIN), as CI has; skipped where not.

@@ -311,6 +311,7 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
             },
             // Simulated clusters show built-in scenes: no files to fetch.
             [&](node::PrepareScene&) { violation("node " + std::to_string(i) + " was sent a scene's files"); },
+            [&](node::RecheckScene&) {},
             [&](node::StoreSceneChunk&) {},
             [&](node::FinishScene&) {},
             [&](node::AbandonScene&) {},

@@ -978,6 +978,52 @@ TEST_F(MasterTest, RequestsForAnotherSceneOrBeyondItsFilesCloseTheConnection) {
   EXPECT_NE(first<Close>(a)->reason.find("times over"), std::string::npos);
 }
 
+wire::Envelope scene_wait(const std::string& sha256, std::uint64_t bytes_there) {
+  wire::Envelope e = envelope();
+  e.mutable_scene_wait()->set_scene_sha256(sha256);
+  e.mutable_scene_wait()->set_bytes_there(bytes_there);
+  return e;
+}
+
+// A node waiting for the copy another node of its host fetches into their
+// shared cache: each word extends its configure timeout, up to twice the
+// timeout in all; it is logged once; a wait for another scene, or after
+// setting up, closes the connection.
+TEST_F(MasterTest, ANodeWaitingForAnotherNodesCopyIsGivenTimeUpToALimit) {
+  load("gltf-torus.json");
+  const std::string sha256 = run_.scene.content_sha256;
+  (void)hello(1, "wall");
+  const std::chrono::seconds timeout = kConfigureTimeout + std::chrono::seconds(1);
+  Actions a = master_->message(1, scene_wait(sha256, 1u << 20), now_);
+  EXPECT_TRUE(logged(a, "'wall' waits for the copy of the scene another node of its host is fetching"));
+  EXPECT_TRUE(logged(a, " MiB there)"));
+  ASSERT_NE(first<SetDeadline>(a), nullptr);
+  EXPECT_EQ(first<SetDeadline>(a)->after, std::chrono::milliseconds(timeout));
+  EXPECT_EQ(first<Close>(a), nullptr);
+  a = master_->message(1, scene_wait(sha256, ~std::uint64_t{0}), now_ + 1000 * kMs);
+  EXPECT_FALSE(logged(a, "waits for"));
+  ASSERT_NE(first<SetDeadline>(a), nullptr);
+  const clock::Nanos limit = 2 * timeout.count() * 1000 * kMs;
+  EXPECT_EQ(first<Close>(master_->message(1, scene_wait(sha256, 0), now_ + limit)), nullptr);
+  a = master_->message(1, scene_wait(sha256, 0), now_ + limit + kMs);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_NE(first<Close>(a)->reason.find("waited for another node's copy of the scene for more than 62 s"),
+            std::string::npos)
+      << first<Close>(a)->reason;
+  (void)master_->closed(1, "closed", now_);
+
+  (void)hello(2, "wall");
+  a = master_->message(2, scene_wait(std::string(64, '0'), 0), now_);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_NE(first<Close>(a)->reason.find("another scene"), std::string::npos);
+  (void)master_->closed(2, "closed", now_);
+  (void)hello(3, "wall");
+  (void)configured(3);
+  a = master_->message(3, scene_wait(sha256, 0), now_);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_NE(first<Close>(a)->reason.find("after setting up"), std::string::npos);
+}
+
 TEST_F(MasterTest, ABuiltInSceneHasNoFiles) {
   load("powerwall-2x2.json");
   const auto welcome = sent_to(hello(1, "top-left"), 1, wire::Envelope::kWelcome);

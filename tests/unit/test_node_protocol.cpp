@@ -803,6 +803,78 @@ TEST_F(SceneFetchTest, AFetchCutShortGoesOnFromWhatIsHere) {
   EXPECT_NE(first<FinishScene>(a), nullptr);
 }
 
+// Another node of this host is fetching the scene into the shared cache: this
+// one waits for its copy, looking again every kSceneRecheck and telling the
+// master about once a second, while the copy grows; the copy in place is used.
+TEST_F(SceneFetchTest, ANodeWaitsForTheCopyAnotherNodeOfItsHostIsFetching) {
+  NodeProtocol node(settings());
+  (void)welcome_with_files(node);
+  Actions a = node.scene_fetched_elsewhere(100, now_);
+  EXPECT_TRUE(logged(a, "another node of this host is fetching the scene")) << "logged";
+  EXPECT_TRUE(sent(a, wire::Envelope::kSceneRequest).empty());
+  auto waits = sent(a, wire::Envelope::kSceneWait);
+  ASSERT_EQ(waits.size(), 1u);
+  EXPECT_EQ(waits[0].scene_wait().scene_sha256(), scene_.sha256);
+  EXPECT_EQ(waits[0].scene_wait().bytes_there(), 100u);
+  ASSERT_NE(first<RecheckScene>(a), nullptr);
+  EXPECT_EQ(first<RecheckScene>(a)->after, NodeProtocol::kSceneRecheck);
+  ASSERT_NE(first<SetDeadline>(a), nullptr);
+  EXPECT_GT(first<SetDeadline>(a)->after, NodeProtocol::kSceneStall);
+
+  // The recheck asks the cache again, still waiting for others.
+  const clock::Nanos recheck = NodeProtocol::kSceneRecheck.count() * kMs;
+  now_ += recheck;
+  a = node.scene_recheck_due(now_);
+  ASSERT_NE(first<PrepareScene>(a), nullptr);
+  EXPECT_TRUE(first<PrepareScene>(a)->wait_for_others);
+  // The copy grows: not logged again, the master not told again within the second.
+  a = node.scene_fetched_elsewhere(500, now_);
+  EXPECT_FALSE(logged(a, "another node"));
+  EXPECT_TRUE(sent(a, wire::Envelope::kSceneWait).empty());
+  now_ += NodeProtocol::kSceneWaitWord.count() * kMs;
+  a = node.scene_fetched_elsewhere(600, now_);
+  waits = sent(a, wire::Envelope::kSceneWait);
+  ASSERT_EQ(waits.size(), 1u);
+  EXPECT_EQ(waits[0].scene_wait().bytes_there(), 600u);
+  // It grew until just now: waited for well past kSceneStall from the start.
+  now_ += NodeProtocol::kSceneStall.count() * kMs - recheck;
+  a = node.scene_fetched_elsewhere(900, now_);
+  EXPECT_EQ(first<PrepareScene>(a), nullptr);
+  ASSERT_NE(first<RecheckScene>(a), nullptr);
+
+  a = node.scene_found("/cache/scenes/abc/s.gltf");
+  ASSERT_NE(first<Configure>(a), nullptr);
+  EXPECT_TRUE(logged(a, "fetched by another node of this host"));
+  EXPECT_TRUE(node.scene_recheck_due(now_ + recheck).empty()) << "no longer waiting";
+}
+
+// A copy that stops growing for kSceneStall is not waited for any longer: the
+// node fetches the scene itself (not waiting for others).
+TEST_F(SceneFetchTest, ACopyThatStopsGrowingIsNotWaitedForAndTheNodeFetches) {
+  NodeProtocol node(settings());
+  (void)welcome_with_files(node);
+  (void)node.scene_fetched_elsewhere(100, now_);
+  now_ += NodeProtocol::kSceneStall.count() * kMs - kMs;
+  Actions a = node.scene_fetched_elsewhere(100, now_);
+  EXPECT_EQ(first<PrepareScene>(a), nullptr) << "a millisecond short of the stall";
+  now_ += kMs;
+  a = node.scene_fetched_elsewhere(100, now_);
+  ASSERT_NE(first<PrepareScene>(a), nullptr);
+  EXPECT_FALSE(first<PrepareScene>(a)->wait_for_others);
+  EXPECT_EQ(first<RecheckScene>(a), nullptr);
+  EXPECT_TRUE(logged(a, "has not grown for 10 s"));
+  EXPECT_TRUE(logged(a, "fetching the scene from the master"));
+  a = node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
+  EXPECT_EQ(sent(a, wire::Envelope::kSceneRequest).size(), 3u);
+
+  // The connection lost while waiting: a recheck due afterwards does nothing.
+  NodeProtocol lost(settings());
+  (void)welcome_with_files(lost);
+  (void)lost.scene_fetched_elsewhere(0, now_);
+  (void)lost.closed("gone", now_);
+  EXPECT_TRUE(lost.scene_recheck_due(now_).empty());
+}
+
 TEST_F(SceneFetchTest, ANodeWithoutARendererOrTooSmallALimitFetchesNothing) {
   {
     NodeSettings s = settings();

@@ -21,6 +21,8 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <thread>
+#include <variant>
 
 #include "scene/manifest.h"
 
@@ -54,15 +56,21 @@ class SceneCacheTest : public ::testing::Test {
     }
   }
 
-  Result<std::string> fetch(SceneCache& cache) {
-    if (auto begun = cache.begin(files_, sha_); !begun) return Error{begun.error()};
+  // A fetch of the whole scene; `wait_for_others` false: even while another
+  // node fetches it (SceneCache::begin).
+  Result<std::string> fetch(SceneCache& cache, bool wait_for_others = true) {
+    auto begun = cache.begin(files_, sha_, wait_for_others);
+    if (!begun) return Error{begun.error()};
+    if (!std::holds_alternative<SceneCache::Present>(begun.value())) return Error{"another node fetches the scene"};
     write_chunks(cache);
     return cache.commit();
   }
 
+  // Copies and partial copies with their locks; not the folder's lock for
+  // beginning a copy (.begin), which stays.
   int entries_in_scenes() const {
     int entries = 0;
-    for ([[maybe_unused]] const auto& entry : fs::directory_iterator(dir_ / "scenes")) ++entries;
+    for (const auto& entry : fs::directory_iterator(dir_ / "scenes")) entries += entry.path().filename() != ".begin";
     return entries;
   }
 
@@ -166,13 +174,13 @@ TEST_F(SceneCacheTest, ACopyCutShortGoesOnFromTheChunksItHolds) {
   SceneCache cache(dir_, log_);
   auto begun = cache.begin(files_, sha_);
   ASSERT_TRUE(begun.ok());
-  EXPECT_EQ(begun.value(), (SceneCache::Present{{false}, {false, false, false}}));
+  EXPECT_EQ(std::get<SceneCache::Present>(begun.value()), (SceneCache::Present{{false}, {false, false, false}}));
   write_chunks(cache, std::make_pair(0u, std::uint64_t{0}));
   write_chunks(cache, std::make_pair(1u, std::uint64_t{1}));
   // The connection went; the fetch starts again on the same copy.
   begun = cache.begin(files_, sha_);
   ASSERT_TRUE(begun.ok());
-  EXPECT_EQ(begun.value(), (SceneCache::Present{{true}, {false, true, false}}));
+  EXPECT_EQ(std::get<SceneCache::Present>(begun.value()), (SceneCache::Present{{true}, {false, true, false}}));
   write_chunks(cache, std::make_pair(1u, std::uint64_t{0}));
   write_chunks(cache, std::make_pair(1u, std::uint64_t{2}));
   const auto committed = cache.commit();
@@ -180,11 +188,74 @@ TEST_F(SceneCacheTest, ACopyCutShortGoesOnFromTheChunksItHolds) {
   EXPECT_EQ(read(dir_ / "scenes" / sha_ / "maps/s.bin"), bin_);
 }
 
+// The second node of a host to begin the scene waits for the first's copy,
+// seeing it grow; once it is in place, the second finds it.
+TEST_F(SceneCacheTest, TheSecondNodeToBeginWaitsForTheFirstsCopy) {
+  SceneCache first(dir_, log_);
+  SceneCache second(dir_, log_);
+  ASSERT_TRUE(first.begin(files_, sha_).ok());
+  auto begun = second.begin(files_, sha_);
+  ASSERT_TRUE(begun.ok()) << begun.error();
+  ASSERT_TRUE(std::holds_alternative<SceneCache::FetchedElsewhere>(begun.value()));
+  EXPECT_EQ(std::get<SceneCache::FetchedElsewhere>(begun.value()).bytes_there, 0u);
+  write_chunks(first, std::make_pair(1u, std::uint64_t{0}));
+  begun = second.begin(files_, sha_);
+  ASSERT_TRUE(begun.ok()) << begun.error();
+  ASSERT_TRUE(std::holds_alternative<SceneCache::FetchedElsewhere>(begun.value()));
+  // The disk's blocks: at least the chunk, and not more than the scene.
+  EXPECT_GE(std::get<SceneCache::FetchedElsewhere>(begun.value()).bytes_there, files_.chunk_length(1, 0));
+  EXPECT_LE(std::get<SceneCache::FetchedElsewhere>(begun.value()).bytes_there, files_.total_bytes() + 4096);
+  EXPECT_FALSE(second.find(files_, sha_).has_value());
+  write_chunks(first);
+  ASSERT_TRUE(first.commit().ok());
+  const auto found = second.find(files_, sha_);
+  ASSERT_TRUE(found.has_value());
+  EXPECT_EQ(read(*found), gltf_);
+  EXPECT_EQ(entries_in_scenes(), 1) << "the copy in place, no partial copy";
+}
+
+// The first node stops midway: the one waiting takes its copy over.
+TEST_F(SceneCacheTest, TheNodeWaitingTakesOverTheCopyOfOneThatStopped) {
+  SceneCache second(dir_, log_);
+  {
+    SceneCache first(dir_, log_);
+    ASSERT_TRUE(first.begin(files_, sha_).ok());
+    write_chunks(first, std::make_pair(1u, std::uint64_t{1}));
+    const auto waiting = second.begin(files_, sha_);
+    ASSERT_TRUE(waiting.ok() && std::holds_alternative<SceneCache::FetchedElsewhere>(waiting.value()));
+  }
+  auto begun = second.begin(files_, sha_);
+  ASSERT_TRUE(begun.ok()) << begun.error();
+  ASSERT_TRUE(std::holds_alternative<SceneCache::Present>(begun.value()));
+  EXPECT_EQ(std::get<SceneCache::Present>(begun.value()), (SceneCache::Present{{false}, {false, true, false}}));
+}
+
+// Two that begin at once: exactly one of them fetches (the folder's lock makes
+// the look and the start one step).
+TEST_F(SceneCacheTest, OfTwoNodesBeginningAtOnceOneFetches) {
+  for (int round = 0; round < 20; ++round) {
+    fs::remove_all(dir_ / "scenes");
+    SceneCache first(dir_, log_);
+    SceneCache second(dir_, log_);
+    Result<SceneCache::Begun> a = Error{"not begun"};
+    Result<SceneCache::Begun> b = Error{"not begun"};
+    std::thread other([&] { a = first.begin(files_, sha_); });
+    b = second.begin(files_, sha_);
+    other.join();
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_NE(std::holds_alternative<SceneCache::Present>(a.value()),
+              std::holds_alternative<SceneCache::Present>(b.value()))
+        << "round " << round;
+  }
+}
+
+// One that gave up waiting (the other's copy stopped growing) writes its own:
+// whichever finishes first is put in place and the other uses it.
 TEST_F(SceneCacheTest, TwoNodesOfOneHostFetchingTogetherShareTheCopy) {
   SceneCache first(dir_, log_);
   SceneCache second(dir_, log_);
   ASSERT_TRUE(first.begin(files_, sha_).ok());
-  auto by_second = fetch(second);  // finishes first; first's partial copy is left alone
+  auto by_second = fetch(second, false);  // finishes first; first's partial copy is left alone
   ASSERT_TRUE(by_second.ok()) << by_second.error();
   write_chunks(first);
   const auto by_first = first.commit();
@@ -203,7 +274,7 @@ TEST_F(SceneCacheTest, ACopyLeftByAStoppedNodeIsTakenOverWithItsChunks) {
     ASSERT_TRUE(stopped.begin(files_, sha_).ok());
     write_chunks(stopped, std::make_pair(0u, std::uint64_t{0}));
     write_chunks(stopped, std::make_pair(1u, std::uint64_t{2}));
-    ASSERT_TRUE(held.begin(files_, sha_).ok());
+    ASSERT_TRUE(held.begin(files_, sha_, false).ok());
   }  // its process ends without abandoning the copy: the lock is let go
   // Its glTF ran past its size (a crash mid-write): cut to its size, the chunk is kept.
   for (const auto& entry : fs::directory_iterator(dir_ / "scenes")) {
@@ -213,9 +284,9 @@ TEST_F(SceneCacheTest, ACopyLeftByAStoppedNodeIsTakenOverWithItsChunks) {
     }
   }
   SceneCache restarted(dir_, log_);
-  auto begun = restarted.begin(files_, sha_);
+  auto begun = restarted.begin(files_, sha_, false);  // not waiting for `held`
   ASSERT_TRUE(begun.ok()) << begun.error();
-  EXPECT_EQ(begun.value(), (SceneCache::Present{{true}, {false, false, true}}));
+  EXPECT_EQ(std::get<SceneCache::Present>(begun.value()), (SceneCache::Present{{true}, {false, false, true}}));
   EXPECT_NE(log_text_.str().find("that a stopped node left: 2 of its 4 chunks are in"), std::string::npos)
       << log_text_.str();
   write_chunks(restarted, std::make_pair(1u, std::uint64_t{0}));
