@@ -133,6 +133,16 @@ void expect_same_capture(const image::FloatImage& a, const image::FloatImage& b)
   EXPECT_GT(lit, 1000.0) << "the torus was drawn";
 }
 
+// The folders in the cache's scenes/: its copies, whole or partial (beside
+// them, the hidden lock nodes take to begin a copy).
+std::vector<fs::path> copies_in(const std::string& cache) {
+  std::vector<fs::path> copies;
+  for (const auto& entry : fs::directory_iterator(cache + "/scenes")) {
+    if (entry.is_directory()) copies.push_back(entry.path());
+  }
+  return copies;
+}
+
 std::string read_bytes(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -151,12 +161,9 @@ TEST(SceneTransfer, ANodeWithAnEmptyCacheFetchesTheSceneAndARestartedOneDoesNot)
       << fetched.master_log;
   EXPECT_TRUE(contains(fetched.master_log, "sent the scene to 'wall'")) << fetched.master_log;
   // The copy, under the scene's identity, holds the files as they are.
-  int copies = 0;
-  for (const auto& entry : fs::directory_iterator(cache + "/scenes")) {
-    ++copies;
-    EXPECT_EQ(read_bytes(entry.path() / "torus.png"), read_bytes(kTorus + "torus.png"));
-  }
-  EXPECT_EQ(copies, 1);
+  const std::vector<fs::path> copies = copies_in(cache);
+  ASSERT_EQ(copies.size(), 1u);
+  EXPECT_EQ(read_bytes(copies[0] / "torus.png"), read_bytes(kTorus + "torus.png"));
 
   const ClusterOutcome restarted = run(config, cache, "127.0.0.1");
   EXPECT_EQ(restarted.master_status, 0) << restarted.master_log;
@@ -181,12 +188,9 @@ TEST(SceneTransfer, TheMasterSendsTheFilesAsItLoadedThemNotAsTheyAreLater) {
   });
   EXPECT_EQ(fetched.master_status, 0) << fetched.master_log;
   EXPECT_EQ(fetched.node_status, 0) << fetched.node_log;
-  int copies = 0;
-  for (const auto& entry : fs::directory_iterator(cache + "/scenes")) {
-    ++copies;
-    EXPECT_EQ(read_bytes(entry.path() / "torus.png"), png);
-  }
-  EXPECT_EQ(copies, 1);
+  const std::vector<fs::path> copies = copies_in(cache);
+  ASSERT_EQ(copies.size(), 1u);
+  EXPECT_EQ(read_bytes(copies[0] / "torus.png"), png);
 }
 
 TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
@@ -215,12 +219,9 @@ TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
   EXPECT_TRUE(contains(node.output(), "1 chunk(s) asked for again")) << node.output();
   EXPECT_TRUE(contains(master.output(), "'wall' asked again for chunk 1 of 'big.bin' of the scene")) << master.output();
   EXPECT_TRUE(contains(master.output(), "node 'wall' joined")) << master.output();
-  int copies = 0;
-  for (const auto& entry : fs::directory_iterator(cache + "/scenes")) {
-    ++copies;
-    EXPECT_EQ(read_bytes(entry.path() / "big.bin"), read_bytes(fs::path(dir) / "scene/big.bin"));
-  }
-  EXPECT_EQ(copies, 1);
+  const std::vector<fs::path> copies = copies_in(cache);
+  ASSERT_EQ(copies.size(), 1u);
+  EXPECT_EQ(read_bytes(copies[0] / "big.bin"), read_bytes(fs::path(dir) / "scene/big.bin"));
 }
 
 // Two nodes of one host sharing one cache fetch the scene once: the first
@@ -269,9 +270,7 @@ TEST(SceneTransfer, TwoNodesOfOneHostSharingACacheFetchTheSceneOnce) {
   EXPECT_FALSE(contains(master.output(), "sending the scene to 'wall-b'")) << master.output();
   EXPECT_TRUE(contains(master.output(), "'wall-b' waits for the copy of the scene")) << master.output();
   EXPECT_TRUE(contains(master.output(), "node 'wall-b' joined")) << master.output();
-  int copies = 0;
-  for (const auto& entry : fs::directory_iterator(cache + "/scenes")) copies += fs::is_directory(entry.path());
-  EXPECT_EQ(copies, 1);
+  EXPECT_EQ(copies_in(cache).size(), 1u);
 }
 
 // Two network namespaces' worth of hosts on this machine: the master's side of a
