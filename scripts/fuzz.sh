@@ -7,6 +7,7 @@
 # Environment:
 #   FUZZ_TARGETS   which targets (default "frames deltas protocol node tracker")
 #   FUZZ_JOBS      build parallelism (default: nproc)
+#   FUZZ_PARALLEL  targets run at a time, one core each (default: nproc)
 #   FUZZ_KEEP=1    keep the work folder (new corpus entries) even when nothing crashed
 #
 # Installs nothing (scripts/install-deps.sh --fuzz does). On Debian 12 it needs the packages clang and libclang-rt-14-dev
@@ -63,24 +64,48 @@ echo "fuzz: built in $((t1 - t0)) s"
 work="$(mktemp -d /tmp/optique-fuzz.XXXXXX)"
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
-failed=()
-for t in "${targets[@]}"; do
-  corpus="$work/$t/corpus"
-  artifacts="$work/$t/artifacts"
+# fuzz_one TARGET: runs one target from a copy of its seeds; what it prints
+# goes to $work/TARGET/report, its exit status to $work/TARGET/status.
+fuzz_one() {
+  local t="$1" corpus="$work/$1/corpus" artifacts="$work/$1/artifacts" seeds rc=0
   mkdir -p "$corpus" "$artifacts"
   # A copy: libFuzzer adds to and prunes its first corpus folder.
   cp "$root/tests/fuzz/corpus/$t/"* "$corpus/"
   seeds=$(find "$corpus" -type f | wc -l)
-  echo "fuzz: optique-fuzz-$t for ${seconds} s from $seeds seeds (log: $work/$t/log)"
-  rc=0
-  "$build_dir/bin/optique-fuzz-$t" "$corpus" -max_total_time="$seconds" -timeout=5 -rss_limit_mb=2048 \
-    -artifact_prefix="$artifacts/" -print_final_stats=1 >"$work/$t/log" 2>&1 || rc=$?
-  grep -E '^(stat::number_of_executed_units|stat::new_units_added|Done [0-9]+ runs)' "$work/$t/log" | sed 's/^/  /' || true
-  found=("$artifacts"/*)
-  if [ "$rc" -ne 0 ] || [ -e "${found[0]}" ]; then
+  {
+    echo "fuzz: optique-fuzz-$t for ${seconds} s from $seeds seeds (log: $work/$t/log)"
+    "$build_dir/bin/optique-fuzz-$t" "$corpus" -max_total_time="$seconds" -timeout=5 -rss_limit_mb=2048 \
+      -artifact_prefix="$artifacts/" -print_final_stats=1 >"$work/$t/log" 2>&1 || rc=$?
+    grep -E '^(stat::number_of_executed_units|stat::new_units_added|Done [0-9]+ runs)' "$work/$t/log" | sed 's/^/  /' || true
+    echo "  corpus: $seeds -> $(find "$corpus" -type f | wc -l) files"
+  } >"$work/$t/report"
+  echo "$rc" >"$work/$t/status"
+}
+
+# Each target is one process on one core: `runs` of them at a time.
+runs="${FUZZ_PARALLEL:-$(nproc)}"
+if ! [[ "$runs" =~ ^[0-9]+$ ]] || [ "$runs" -eq 0 ]; then runs=1; fi
+echo "fuzz: ${#targets[@]} target(s), $runs at a time"
+running=0
+for t in "${targets[@]}"; do
+  if [ "$running" -ge "$runs" ]; then
+    wait -n || true
+    running=$((running - 1))
+  fi
+  fuzz_one "$t" &
+  running=$((running + 1))
+done
+wait || true
+
+failed=()
+for t in "${targets[@]}"; do
+  cat "$work/$t/report" 2>/dev/null || echo "fuzz: optique-fuzz-$t did not run"
+  rc=$(cat "$work/$t/status" 2>/dev/null || echo "not run")
+  found=("$work/$t/artifacts"/*)
+  if [ "$rc" != 0 ] || [ -e "${found[0]}" ]; then
     failed+=("$t")
     echo "fuzz: optique-fuzz-$t FAILED (exit $rc); the end of its log:" >&2
-    tail -n 60 "$work/$t/log" | sed 's/^/  /' >&2
+    tail -n 60 "$work/$t/log" 2>/dev/null | sed 's/^/  /' >&2
     mkdir -p "$build_dir/crashes/$t"
     for a in "${found[@]}"; do
       [ -e "$a" ] || continue
@@ -88,8 +113,6 @@ for t in "${targets[@]}"; do
       echo "fuzz: crash input: $build_dir/crashes/$t/$(basename "$a")" >&2
       echo "fuzz:   replay with: $build_dir/bin/optique-fuzz-$t $build_dir/crashes/$t/$(basename "$a")" >&2
     done
-  else
-    echo "  corpus: $seeds -> $(find "$corpus" -type f | wc -l) files"
   fi
 done
 
