@@ -8,13 +8,13 @@
 //   optique-bench-barrier [--out DIR] [--frames N] [--rate HZ] [--repeats R] [--nodes 1,2,4]
 //                         [--secret-nodes 1,8]
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "bench_options.h"
 #include "cluster_run.h"
 #include "draw_plot.h"
 #include "metrics/distribution.h"
@@ -99,26 +99,23 @@ Sample run_once(const std::string& master_bin, const std::string& work, std::siz
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique barrier benchmark"};
+  optique::bench::BenchOptions app{"optique barrier benchmark"};
   std::string out = "docs/bench";
   std::size_t frames = 600;  // 10 s at 60 Hz
   double rate = 60.0;
   std::size_t repeats = 3;
   std::vector<std::size_t> node_counts{1, 2, 4, 8, 16, 32, 64};
   std::string master_bin = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
-  app.add_option("--out", out, "folder for barrier.md, barrier.csv and barrier.png");
-  app.add_option("--frames", frames, "frames (and baseline rounds) per run");
-  app.add_option("--rate", rate, "frame rate in Hz (both barriers are paced at it)");
-  app.add_option("--repeats", repeats, "runs per node count; the table shows the median and the min–max");
-  app.add_option("--nodes", node_counts, "node counts")->delimiter(',');
+  app.option("--out", out, "folder for barrier.md, barrier.csv and barrier.png");
+  app.option("--frames", frames, "frames (and baseline rounds) per run", optique::bench::Bounds::more_than_zero());
+  app.option("--rate", rate, "frame rate in Hz (both barriers are paced at it)", optique::bench::Bounds::more_than_zero());
+  app.option("--repeats", repeats, "runs per node count; the table shows the median and the min–max",
+             optique::bench::Bounds::more_than_zero());
+  app.list("--nodes", node_counts, "node counts");
   std::vector<std::size_t> secret_nodes{1, 8};
-  app.add_option("--secret-nodes", secret_nodes, "node counts run with and without the shared secret (none: skip)")
-      ->delimiter(',');
-  app.add_option("--master", master_bin, "optique-master binary");
-  app.get_option("--frames")->check(CLI::PositiveNumber);
-  app.get_option("--repeats")->check(CLI::PositiveNumber);
-  app.get_option("--rate")->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+  app.list("--secret-nodes", secret_nodes, "node counts run with and without the shared secret (none: skip)");
+  app.option("--master", master_bin, "optique-master binary");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
   if (node_counts.empty() || std::find(node_counts.begin(), node_counts.end(), 0u) != node_counts.end()) {
     std::cerr << "optique-bench-barrier: --nodes needs one or more node counts, each at least 1\n";
     return 2;

@@ -6,7 +6,6 @@
 //
 //   optique-bench-calib [--out DIR] [--trials T] [--repeats R]
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -16,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "bench_options.h"
 #include "calib/fit.h"
 #include "clock/clock.h"
 #include "draw_plot.h"
@@ -124,14 +124,14 @@ Sample run_repeat(const testing::PinholeProjector& p, const Case& c, Method m, i
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique calibration benchmark"};
+  optique::bench::BenchOptions app{"optique calibration benchmark"};
   std::string out = "docs/bench";
   int trials = 100;
   int repeats = 7;
-  app.add_option("--out", out, "folder for calibration.md, .csv and .png");
-  app.add_option("--trials", trials, "fits of fresh noisy data per repeat (timed together)");
-  app.add_option("--repeats", repeats, "repeats per row; the table shows the median and the min–max over repeats");
-  CLI11_PARSE(app, argc, argv);
+  app.option("--out", out, "folder for calibration.md, .csv and .png");
+  app.option("--trials", trials, "fits of fresh noisy data per repeat (timed together)");
+  app.option("--repeats", repeats, "repeats per row; the table shows the median and the min–max over repeats");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
 
   const testing::PinholeProjector projector = testing::projector_cases()[1];  // strong oblique
   const std::vector<Case> cases{{2, 2, 0.0}, {5, 4, 0.0}, {20, 10, 0.0}, {5, 4, 0.1}, {20, 10, 0.1}};

@@ -8,7 +8,6 @@
 //
 //   optique-bench-dof [--out DIR] [--runs R] [--frames F] [--config FILE]
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -26,6 +25,7 @@
 
 #include <epoxy/gl.h>
 
+#include "bench_options.h"
 #include "dof_experiment.h"
 #include "draw_plot.h"
 #include "image/compare.h"
@@ -237,18 +237,18 @@ struct ObjectScore {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique depth-of-field benchmark"};
+  optique::bench::BenchOptions app{"optique depth-of-field benchmark"};
   std::string out = "docs/bench";
   std::string config = std::string(OPTIQUE_SOURCE_DIR) + "/configs/dof-pair.json";
   int runs = 5;
   int frames = 12;
   double image_focus = 2.5;
-  app.add_option("--out", out, "folder for dof.md, dof.csv, dof.png and dof-images.png");
-  app.add_option("--config", config, "the installation (a focus and a defocus projector)");
-  app.add_option("--runs", runs, "timing runs; a cell is the median over runs with their min–max");
-  app.add_option("--frames", frames, "frames per run, each method once per frame in rotating order");
-  app.add_option("--image-focus", image_focus, "focal depth of the images in dof-images.png (m)");
-  CLI11_PARSE(app, argc, argv);
+  app.option("--out", out, "folder for dof.md, dof.csv, dof.png and dof-images.png");
+  app.option("--config", config, "the installation (a focus and a defocus projector)");
+  app.option("--runs", runs, "timing runs; a cell is the median over runs with their min–max");
+  app.option("--frames", frames, "frames per run, each method once per frame in rotating order");
+  app.option("--image-focus", image_focus, "focal depth of the images in dof-images.png (m)");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
 
   try {
     auto context = render::make_headless_context();

@@ -9,7 +9,6 @@
 //
 //   optique-bench-fields [--out DIR] [--frames N] [--runs R]
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -19,6 +18,7 @@
 
 #include <spdlog/sinks/null_sink.h>
 
+#include "bench_options.h"
 #include "clock/clock.h"
 #include "config/job.h"
 #include "draw_plot.h"
@@ -128,14 +128,14 @@ std::string fixed(double value, int decimals) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique colour-field benchmark"};
+  optique::bench::BenchOptions app{"optique colour-field benchmark"};
   std::string out = "docs/bench";
   int frames = 24;
   int runs = 5;
-  app.add_option("--out", out, "folder for fields.md, fields.csv and fields.png");
-  app.add_option("--frames", frames, "timed frames per run and method");
-  app.add_option("--runs", runs, "runs; the methods alternate within each");
-  CLI11_PARSE(app, argc, argv);
+  app.option("--out", out, "folder for fields.md, fields.csv and fields.png");
+  app.option("--frames", frames, "timed frames per run and method");
+  app.option("--runs", runs, "runs; the methods alternate within each");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
   try {
     std::filesystem::create_directories(out);
     const std::string scratch = out + "/.fields-scratch";

@@ -18,7 +18,6 @@
 //
 //   optique-bench-lighting [--config FILE] [--auto-config FILE] [--out DIR] [--frames N] [--repeats R]
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -32,6 +31,7 @@
 #include <span>
 #include <sstream>
 
+#include "bench_options.h"
 #include "clock/clock.h"
 #include "config/job.h"
 #include "config/light_list.h"
@@ -231,19 +231,18 @@ RunTimes run_times(const Stack& stack) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique lighting-split benchmark: stacked nodes against one full render"};
+  optique::bench::BenchOptions app{"optique lighting-split benchmark: stacked nodes against one full render"};
   std::string config_path = std::string(OPTIQUE_SOURCE_DIR) + "/configs/stacked-lighting-3.json";
   std::string auto_config_path = std::string(OPTIQUE_SOURCE_DIR) + "/configs/stacked-lighting-3-auto.json";
   std::string out = "docs/bench";
   int frames = 5;
   int repeats = 5;
-  app.add_option("--config", config_path, "stacked group whose first projector every identical node copies");
-  app.add_option("--auto-config", auto_config_path, "mixed stacked group with lights \"auto\"");
-  app.add_option("--out", out, "folder for lighting.md, lighting.csv and lighting.png");
-  app.add_option("--frames", frames, "measured frames per run (1 s of animation apart)")->check(CLI::PositiveNumber);
-  app.add_option("--repeats", repeats, "runs; times are medians per run, tables their median and min–max")
-      ->check(CLI::PositiveNumber);
-  CLI11_PARSE(app, argc, argv);
+  app.option("--config", config_path, "stacked group whose first projector every identical node copies");
+  app.option("--auto-config", auto_config_path, "mixed stacked group with lights \"auto\"");
+  app.option("--out", out, "folder for lighting.md, lighting.csv and lighting.png");
+  app.option("--frames", frames, "measured frames per run (1 s of animation apart)", optique::bench::Bounds::more_than_zero());
+  app.option("--repeats", repeats, "runs; times are medians per run, tables their median and min–max", optique::bench::Bounds::more_than_zero());
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
 
   try {
     auto loaded = config::load_installation(config_path);

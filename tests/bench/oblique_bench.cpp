@@ -9,7 +9,6 @@
 //
 //   optique-bench-oblique [--config FILE] [--out DIR] [--frames N] [--repeats R]
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -18,6 +17,7 @@
 #include <iostream>
 #include <map>
 
+#include "bench_options.h"
 #include "clock/clock.h"
 #include "config/installation_scene.h"
 #include "config/job.h"
@@ -87,16 +87,16 @@ double psnr_luma(const image::FloatImage& a, const image::FloatImage& b, const s
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique oblique-projection benchmark: single pass vs two passes"};
+  optique::bench::BenchOptions app{"optique oblique-projection benchmark: single pass vs two passes"};
   std::string config_path = std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-oblique-3.json";
   std::string out = "docs/bench";
   int frames = 12;
   int repeats = 3;
-  app.add_option("--config", config_path, "installation with keystoned projectors (fixed eye)");
-  app.add_option("--out", out, "folder for oblique.md and oblique.csv");
-  app.add_option("--frames", frames, "frames per run (0.25 s of animation apart)");
-  app.add_option("--repeats", repeats, "runs; times are medians per run, the table their median and min–max");
-  CLI11_PARSE(app, argc, argv);
+  app.option("--config", config_path, "installation with keystoned projectors (fixed eye)");
+  app.option("--out", out, "folder for oblique.md and oblique.csv");
+  app.option("--frames", frames, "frames per run (0.25 s of animation apart)");
+  app.option("--repeats", repeats, "runs; times are medians per run, the table their median and min–max");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
 
   try {
     auto loaded = config::load_installation(config_path);

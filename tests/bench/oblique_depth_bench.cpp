@@ -8,7 +8,6 @@
 //
 //   optique-bench-oblique-depth [--out DIR]
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -21,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_options.h"
 #include "draw_plot.h"
 #include "image/image_io.h"
 #include "oblique_depth_experiment.h"
@@ -161,10 +161,10 @@ struct GapBins {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique oblique depth benchmark"};
+  optique::bench::BenchOptions app{"optique oblique depth benchmark"};
   std::string out = "docs/bench";
-  app.add_option("--out", out, "folder for oblique-depth.md, .csv, .png (plot) and -maps.png");
-  CLI11_PARSE(app, argc, argv);
+  app.option("--out", out, "folder for oblique-depth.md, .csv, .png (plot) and -maps.png");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
 
   auto context = render::make_headless_context();
   if (!context) {

@@ -5,11 +5,11 @@
 //
 //   optique-bench-render [--out DIR] [--frames N] [--repeats R]
 
-#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 
+#include "bench_options.h"
 #include "clock/clock.h"
 #include "geometry/projection.h"
 #include "metrics/distribution.h"
@@ -60,14 +60,14 @@ std::vector<double> frame_times(const Case& c, int frames) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique render benchmark"};
+  optique::bench::BenchOptions app{"optique render benchmark"};
   std::string out = "docs/bench";
   int frames = 100;
   int repeats = 3;
-  app.add_option("--out", out, "folder for render.md and render.csv");
-  app.add_option("--frames", frames, "measured frames per run");
-  app.add_option("--repeats", repeats, "runs per case; the table shows the median and the min–max over runs");
-  CLI11_PARSE(app, argc, argv);
+  app.option("--out", out, "folder for render.md and render.csv");
+  app.option("--frames", frames, "measured frames per run");
+  app.option("--repeats", repeats, "runs per case; the table shows the median and the min–max over runs");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
 
   auto context = render::make_headless_context();
   if (!context) {

@@ -16,7 +16,6 @@
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
-#include <CLI/CLI.hpp>
 #include <spdlog/sinks/null_sink.h>
 
 #include <algorithm>
@@ -32,6 +31,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "bench_options.h"
 #include "draw_plot.h"
 #include "external_master.h"
 #include "node/scene_cache.h"
@@ -283,14 +283,14 @@ int run(const std::string& out, std::size_t mib, int runs) {
 }  // namespace optique::bench
 
 int main(int argc, char** argv) {
-  CLI::App app{"optique-bench-scene-transfer: a large scene from the master to a node with an empty cache"};
+  optique::bench::BenchOptions app{"optique-bench-scene-transfer: a large scene from the master to a node with an empty cache"};
   std::string out = "docs/bench";
   std::size_t mib = 200;
   int runs = 5;
-  app.add_option("--out", out, "where scene-transfer.{md,csv,png} go");
-  app.add_option("--mib", mib, "the scene's extra buffer, MiB")->check(CLI::Range(1, 4096));
-  app.add_option("--runs", runs, "runs (each measures every row)")->check(CLI::Range(1, 50));
-  CLI11_PARSE(app, argc, argv);
+  app.option("--out", out, "where scene-transfer.{md,csv,png} go");
+  app.option("--mib", mib, "the scene's extra buffer, MiB", optique::bench::Bounds::within(1, 4096));
+  app.option("--runs", runs, "runs (each measures every row)", optique::bench::Bounds::within(1, 50));
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
   try {
     return optique::bench::run(out, mib, runs);
   } catch (const std::exception& e) {

@@ -8,7 +8,6 @@
 //
 //   optique-bench-tracking --out docs/bench     (a second)
 
-#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -21,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_options.h"
 #include "config/tracking.h"
 #include "draw_plot.h"
 #include "head_walk.h"
@@ -100,10 +100,10 @@ Cell measure(const Method& method, double latency) {
 int main(int argc, char** argv) {
   using namespace optique;
   using namespace optique::bench;
-  CLI::App app{"head prediction against tracker latency"};
+  optique::bench::BenchOptions app{"head prediction against tracker latency"};
   std::string out;
-  app.add_option("--out", out, "folder for tracking.md, .csv and .png (none: print only)");
-  CLI11_PARSE(app, argc, argv);
+  app.option("--out", out, "folder for tracking.md, .csv and .png (none: print only)");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
 
   const std::vector<Method> methods{
       {"none", config::HeadPrediction::none, 0.5},

@@ -11,7 +11,6 @@
 //   optique-bench-upconversion --find-rates        (how the scenes were framed)
 //   optique-bench-upconversion --cost-only [--runs R]   (the cost goal alone, printed; nothing written)
 
-#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -23,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_options.h"
 #include "draw_plot.h"
 #include "image/compare.h"
 #include "image/convert.h"
@@ -121,18 +121,18 @@ bool write_hardest(const std::string& path, const std::vector<const Row*>& rows)
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"frame-rate up-conversion: accuracy on the paper's scenes, speed against error"};
+  optique::bench::BenchOptions app{"frame-rate up-conversion: accuracy on the paper's scenes, speed against error"};
   std::string out = "docs/bench";
   int runs = 3;
   int frames = 24;
   bool rates = false;
   bool cost_only = false;
-  app.add_option("--out", out, "folder for upconversion.md, .csv, .png and upconversion-hardest.png");
-  app.add_option("--runs", runs, "timing runs; a cell is the median over runs with their min–max");
-  app.add_option("--frames", frames, "display frames per run (from each scene's start)");
-  app.add_flag("--find-rates", rates, "only choose each scene's framing and print it");
-  app.add_flag("--cost-only", cost_only, "only the cost goal on many-lights at 1280×720, printed; writes nothing");
-  CLI11_PARSE(app, argc, argv);
+  app.option("--out", out, "folder for upconversion.md, .csv, .png and upconversion-hardest.png");
+  app.option("--runs", runs, "timing runs; a cell is the median over runs with their min–max");
+  app.option("--frames", frames, "display frames per run (from each scene's start)");
+  app.flag("--find-rates", rates, "only choose each scene's framing and print it");
+  app.flag("--cost-only", cost_only, "only the cost goal on many-lights at 1280×720, printed; writes nothing");
+  if (const std::optional<int> status = app.parse(argc, argv)) return *status;
   if (runs < 1 || frames < 4) {
     std::cerr << "--runs must be at least 1 and --frames at least 4 (a key frame and frames between)\n";
     return 2;
