@@ -85,6 +85,17 @@ bool is_identity(const std::string& name) {
          });
 }
 
+// Whether the node writing partial copy `partial` is alive: its lock file is
+// there and held (by another open file than any of this cache's). Taking the
+// lock to test it, and letting it go, is how a live holder is told from a gone
+// one; where the lock cannot be taken at all, the holder is taken for alive.
+bool writer_alive(const fs::path& partial) {
+  const int fd = open((partial.string() + kLock).c_str(), O_RDWR | O_CLOEXEC);
+  const bool alive = fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) != 0;
+  if (fd >= 0) close(fd);
+  return alive;
+}
+
 // Partial copies whose node is gone: nobody holds their lock (or they have none).
 void remove_abandoned_partials(const fs::path& folder) {
   std::error_code error;
@@ -94,14 +105,10 @@ void remove_abandoned_partials(const fs::path& folder) {
     if (name.find(kPartial) != std::string::npos && !name.ends_with(kLock)) partials.push_back(entry.path());
   }
   for (const fs::path& partial : partials) {
-    const fs::path lock = partial.string() + kLock;
-    const int fd = open(lock.c_str(), O_RDWR | O_CLOEXEC);
-    const bool alive = fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) != 0;
-    if (!alive) {
+    if (!writer_alive(partial)) {
       fs::remove_all(partial, error);
-      fs::remove(lock, error);
+      fs::remove(partial.string() + kLock, error);
     }
-    if (fd >= 0) close(fd);
   }
 }
 
@@ -135,28 +142,30 @@ std::optional<Adopted> adopt_abandoned(const fs::path& folder, const std::string
   return std::nullopt;
 }
 
-// The copy of scene `sha256` another live process is writing into `folder`
-// (its lock held): the bytes its files hold on the disk so far. Taking a lock
-// to test it, and letting it go, is how a live holder is told from a gone one.
+// The bytes of the files under `folder`: their sizes, or what the disk holds
+// of them (a copy being written: its files may be sized, or written out of
+// order, before their bytes are in).
+enum class Measure { sizes, on_disk };
+std::uintmax_t bytes_under(const fs::path& folder, Measure measure = Measure::sizes) {
+  std::uintmax_t bytes = 0;
+  std::error_code error;
+  for (fs::recursive_directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
+    struct stat file {};
+    if (stat(it->path().c_str(), &file) != 0 || !S_ISREG(file.st_mode)) continue;
+    const auto size = static_cast<std::uintmax_t>(file.st_size);
+    bytes += measure == Measure::sizes ? size : std::min(size, static_cast<std::uintmax_t>(file.st_blocks) * 512);
+  }
+  return bytes;
+}
+
+// The copy of scene `sha256` another live process is writing into `folder`:
+// the bytes its files hold on the disk so far.
 std::optional<std::uint64_t> being_fetched(const fs::path& folder, const std::string& sha256) {
   std::error_code error;
   for (const auto& entry : fs::directory_iterator(folder, error)) {
     const std::string name = entry.path().filename().string();
     if (!name.starts_with(sha256 + kPartial) || name.ends_with(kLock) || !entry.is_directory(error)) continue;
-    const int fd = open((entry.path().string() + kLock).c_str(), O_RDWR | O_CLOEXEC);
-    if (fd < 0) continue;
-    const bool held = flock(fd, LOCK_EX | LOCK_NB) != 0 && errno == EWOULDBLOCK;
-    close(fd);
-    if (!held) continue;
-    std::uint64_t bytes = 0;
-    for (fs::recursive_directory_iterator it(entry.path(), error), end; !error && it != end; it.increment(error)) {
-      struct stat file {};
-      if (stat(it->path().c_str(), &file) == 0 && S_ISREG(file.st_mode)) {
-        bytes += std::min<std::uint64_t>(static_cast<std::uint64_t>(file.st_blocks) * 512,
-                                         static_cast<std::uint64_t>(file.st_size));
-      }
-    }
-    return bytes;
+    if (writer_alive(entry.path())) return bytes_under(entry.path(), Measure::on_disk);
   }
   return std::nullopt;
 }
@@ -223,19 +232,6 @@ struct CachedCopy {
   fs::path path;
   std::uintmax_t bytes = 0;  // its files' sizes: about what removing it frees
 };
-
-std::uintmax_t bytes_under(const fs::path& folder) {
-  std::uintmax_t bytes = 0;
-  std::error_code error;
-  for (fs::recursive_directory_iterator it(folder, error), end; !error && it != end; it.increment(error)) {
-    std::error_code ignored;
-    if (it->is_regular_file(ignored)) {
-      const std::uintmax_t size = it->file_size(ignored);
-      if (!ignored) bytes += size;
-    }
-  }
-  return bytes;
-}
 
 // The copies in place but `keep`, used longest ago first.
 std::vector<CachedCopy> copies_by_age(const fs::path& folder, const std::string& keep) {
