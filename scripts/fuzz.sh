@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (tests/fuzz) with clang into build-fuzz and runs
-# each for a while, starting from a copy of the committed seed corpus.
+# Builds the libFuzzer targets (tests/fuzz) in build-asan, the clang ASan + UBSan
+# build scripts/sanitize.sh uses too (scripts/asan-build.sh), and runs each for a
+# while, starting from a copy of the committed seed corpus. After
+# scripts/sanitize.sh only the targets' own files are left to build.
 #
 #   scripts/fuzz.sh [SECONDS]      seconds per target (or FUZZ_SECONDS; default 30)
 #
@@ -13,16 +15,14 @@
 # Installs nothing (scripts/install-deps.sh --fuzz does). On Debian 12 it needs the packages clang and libclang-rt-14-dev
 # (libFuzzer and the sanitizer runtimes), and llvm for readable stacks
 # (llvm-symbolizer). Exits non-zero if any target crashed, leaked, timed out or ran
-# out of memory; the input that did it is copied to build-fuzz/crashes/.
+# out of memory; the input that did it is copied to build-asan/crashes/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root="$PWD"
 
-if ! command -v clang >/dev/null 2>&1 || ! command -v clang++ >/dev/null 2>&1; then
-  echo "fuzz: clang and clang++ are needed (libFuzzer comes with clang only)." >&2
-  echo "fuzz: on Debian 12: scripts/install-deps.sh --fuzz (clang libclang-rt-14-dev llvm)" >&2
-  exit 1
-fi
+# shellcheck source=asan-build.sh
+source "$root/scripts/asan-build.sh"
+asan_build_check_clang fuzz
 
 seconds="${1:-${FUZZ_SECONDS:-30}}"
 if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -eq 0 ]; then
@@ -31,32 +31,10 @@ if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -eq 0 ]; then
 fi
 read -ra targets <<<"${FUZZ_TARGETS:-frames deltas protocol node tracker}"
 jobs="${FUZZ_JOBS:-$(nproc)}"
-build_dir="$root/build-fuzz"
+build_dir="$root/$asan_build_dir"
 
-# clang without its runtime package compiles fine and fails only at the link.
-probe_dir="$(mktemp -d)"
-trap 'rm -rf "$probe_dir"' EXIT
-printf '#include <cstddef>\n#include <cstdint>\nextern "C" int LLVMFuzzerTestOneInput(const std::uint8_t*, std::size_t) { return 0; }\n' \
-  >"$probe_dir/probe.cpp"
-if ! clang++ -fsanitize=fuzzer,address,undefined "$probe_dir/probe.cpp" -o "$probe_dir/probe" 2>"$probe_dir/err"; then
-  echo "fuzz: clang++ cannot link a libFuzzer target:" >&2
-  sed 's/^/  /' "$probe_dir/err" >&2
-  echo "fuzz: on Debian 12 the runtime is in libclang-rt-14-dev (apt-get install libclang-rt-14-dev)" >&2
-  exit 1
-fi
-
-# The whole build dir gets coverage instrumentation and the sanitizers, so the
-# library under test is instrumented, not just the entry points; asserts stay on.
-flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
-generator=()
-if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
 t0=$(date +%s)
-CC=clang CXX=clang++ cmake -S . -B "$build_dir" "${generator[@]}" \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
-  -DCMAKE_CXX_FLAGS="$flags" \
-  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
-  -DOPTIQUE_FUZZ=ON >/dev/null
+asan_build_configure "$root"
 cmake --build "$build_dir" --parallel "$jobs" --target "${targets[@]/#/optique-fuzz-}"
 t1=$(date +%s)
 echo "fuzz: built in $((t1 - t0)) s"

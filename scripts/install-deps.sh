@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs everything optique needs to build and test, from Debian 12 packages.
 #   scripts/install-deps.sh          build and test
-#   scripts/install-deps.sh --fuzz   also clang for the libFuzzer targets (CI)
+#   scripts/install-deps.sh --fuzz   also clang for the sanitizer build and the
+#                                    libFuzzer targets (CI)
 #   scripts/install-deps.sh --run    only what building and running the programs
 #                                    needs (scripts/run-local.sh): no browser,
 #                                    Prometheus, virtual display or plotting

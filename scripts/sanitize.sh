@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
-# Builds optique with gcc's sanitizers in a build dir of its own and runs the tests.
+# Builds optique with sanitizers in a build dir of its own and runs the tests.
 #
-#   scripts/sanitize.sh [address] [ctest args...]   ASan + UBSan -> build-asan
-#   scripts/sanitize.sh thread    [ctest args...]   TSan         -> build-tsan
+#   scripts/sanitize.sh [address] [ctest args...]   ASan + UBSan, clang -> build-asan
+#   scripts/sanitize.sh thread    [ctest args...]   TSan, gcc           -> build-tsan
+#
+# build-asan is the build scripts/fuzz.sh uses too (scripts/asan-build.sh says
+# how and why); it needs clang (scripts/install-deps.sh --fuzz).
 #
 # Environment:
 #   SANITIZE_LABELS   test labels (the test folders), a regex (default 'unit|process|gpu';
@@ -38,30 +41,18 @@ case "${1:-}" in
     ;;
 esac
 
-# -O1: the sanitizers' own docs recommend it (usable speed, exact stacks); asserts
-# stay on, they are checks too. A test's own file is built at -O0
-# (OPTIQUE_TEST_COMPILE_OPTIONS): still instrumented, in half the time (their
-# loops are few; the code under test, and tests/support, stay at -O1). -g1: reports keep file and line; full -g doubles
-# the build (UBSan over Eigen's templates: 62 vs 34 s for calib/plane_fit.cpp).
-# -Wno-maybe-uninitialized: gcc's flow analysis at -O1 under the sanitizers'
-# instrumentation reports "may be used uninitialized" for a std::optional's
-# vector that is initialized (fuzz_protocol_bodies.cpp); -Werror would stop the
-# build. The plain build (-O2, no sanitizer) keeps the warning.
-common_flags="-O1 -g1 -fno-omit-frame-pointer -Wno-maybe-uninitialized"
 if [ "$mode" = address ]; then
-  build_dir=build-asan
-  # UBSan without its null and alignment checks: those two instrument every
-  # pointer dereference and double the build of template-heavy files (gltf.cpp
-  # 64 -> 32 s, plane_fit.cpp 27 -> 15 s; ASan alone: 21 s for a file taking
-  # 36 with them). ASan reports a dereference of null as a SEGV with its stack;
-  # the fuzz targets (scripts/fuzz.sh: clang, every UBSan check) keep the
-  # alignment check on the decoders of peer bytes, where it matters.
-  sanitize_flags="-fsanitize=address,undefined -fno-sanitize=null,alignment -fno-sanitize-recover=undefined"
+  # shellcheck source=asan-build.sh
+  source "$root/scripts/asan-build.sh"
+  build_dir="$asan_build_dir"
 else
   build_dir=build-tsan
-  # gcc 12 warns (-Wtsan) that TSan does not model atomic_thread_fence, which
-  # Boost.Asio's handler queue uses; -Werror would stop the build on it.
-  sanitize_flags="-fsanitize=thread -Wno-tsan"
+  # -O1 -g1 as in scripts/asan-build.sh. gcc 12 warns (-Wtsan) that TSan does
+  # not model atomic_thread_fence, which Boost.Asio's handler queue uses;
+  # -Werror would stop the build on it. -Wno-maybe-uninitialized: gcc's flow
+  # analysis at -O1 under instrumentation reports "may be used uninitialized"
+  # for a std::optional's vector that is initialized (fuzz_protocol_bodies.cpp).
+  tsan_flags="-fsanitize=thread -Wno-tsan -Wno-maybe-uninitialized"
 fi
 # Under TSan (5-15x slower) nodes that draw with llvmpipe on 2 cores cannot answer
 # within the master's 500 ms frame timeout: only the unit tests by default.
@@ -74,7 +65,9 @@ exclude="${SANITIZE_EXCLUDE:-}"
 jobs="${SANITIZE_JOBS:-$(nproc)}"
 log_dir="$root/$build_dir/sanitizer-logs"
 
-if ! command -v gcc >/dev/null 2>&1 || ! command -v g++ >/dev/null 2>&1; then
+if [ "$mode" = address ]; then
+  asan_build_check_clang sanitize
+elif ! command -v gcc >/dev/null 2>&1 || ! command -v g++ >/dev/null 2>&1; then
   echo "sanitize: gcc/g++ not found (scripts/install-deps.sh installs them)" >&2
   exit 1
 fi
@@ -82,15 +75,19 @@ fi
 stamp() { date +%s; }
 t0=$(stamp)
 
-generator=()
-if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
-CC=gcc CXX=g++ cmake -S . -B "$build_dir" "${generator[@]}" \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="$common_flags" \
-  -DCMAKE_CXX_FLAGS="$sanitize_flags" \
-  -DCMAKE_EXE_LINKER_FLAGS="$sanitize_flags" \
-  -DCMAKE_SHARED_LINKER_FLAGS="$sanitize_flags" \
-  -DOPTIQUE_TEST_COMPILE_OPTIONS=-O0 >/dev/null
+if [ "$mode" = address ]; then
+  asan_build_configure "$root"
+else
+  generator=()
+  if command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
+  CC=gcc CXX=g++ cmake -S . -B "$build_dir" "${generator[@]}" \
+    -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -fno-omit-frame-pointer" \
+    -DCMAKE_CXX_FLAGS="$tsan_flags" \
+    -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" \
+    -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=thread" \
+    -DOPTIQUE_TEST_COMPILE_OPTIONS=-O0 >/dev/null
+fi
 t1=$(stamp)
 
 # The test executables whose label matches regex $1, read from the optique_test()

@@ -199,7 +199,7 @@ TEST(BuiltinScenes, TheColourFieldScenesMoveWithoutJumps) {
        {std::tuple{"scrolling-stripes", "stripes", 1.5}, std::tuple{"pinball", "ball", std::hypot(2.6, 1.9)}}) {
     const SceneDefinition scene = load(name);
     const auto found = std::find_if(scene.objects.begin(), scene.objects.end(),
-                                    [&](const AnimatedObject& o) { return o.name == object; });
+                                    [wanted = object](const AnimatedObject& o) { return o.name == wanted; });
     ASSERT_NE(found, scene.objects.end()) << name;
     constexpr double kStep = 1.0 / 240.0;
     double fastest = 0.0;

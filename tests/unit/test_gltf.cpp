@@ -673,7 +673,7 @@ TEST(Gltf, UrisThatLeaveTheFolderAreRefusedByName) {
   for (const auto& [uri, reason] : cases) {
     SCOPED_TRACE(uri);
     TempDir dir;
-    const auto path = torus_variant(dir, [&](json& doc) { doc["buffers"][0]["uri"] = uri; });
+    const auto path = torus_variant(dir, [u = uri](json& doc) { doc["buffers"][0]["uri"] = u; });
     expect_error(path, {"buffer 0", reason});
   }
 }
