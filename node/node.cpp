@@ -86,15 +86,42 @@ void Node::connect() {
       });
 }
 
+// The answers an action asks for (configured, rendered, presented, the cache's)
+// are queued and given to the core after the whole list, in the order they
+// came, by the outermost call: the core never hears of an action's outcome
+// while the rest of its list is still being carried out. (A Close reaches the
+// core at once, as closed(): the connection calls back when it closes.)
 void Node::carry_out(Actions actions) {
-  // Once an action's answer stopped the protocol, what came after it in this
-  // list is moot (a deadline, a step of a fetch that has ended); the stop's
-  // own list (goodbye, close, stop) began stopped and runs whole.
-  const bool stopped_before = protocol_.stopped();
-  for (Action& action : actions) {
-    if (!stopped_before && protocol_.stopped()) break;
-    carry_out(action);
+  // Once the core stopped (the master gone for good), what came after in this
+  // list is moot (a deadline, a step of a fetch that has ended); the stop's own
+  // list (goodbye, close, stop) began stopped and runs whole.
+  const auto run = [this](Actions& list) {
+    const bool stopped_before = protocol_.stopped();
+    for (Action& action : list) {
+      if (!stopped_before && protocol_.stopped()) break;
+      carry_out(action);
+    }
+  };
+  ++depth_;
+  run(actions);
+  if (depth_ == 1) {
+    while (!completions_.empty() && !protocol_.stopped()) {
+      Completion next = std::move(completions_.front());
+      completions_.pop_front();
+      Actions more = std::visit(util::Overloaded{
+                                    [&](Answer& answer) { return protocol_.answer(std::move(answer), next.at); },
+                                    [&](Due timer) { return protocol_.due(timer, next.at); },
+                                },
+                                next.event);
+      run(more);
+    }
+    completions_.clear();  // after a stop: moot
   }
+  --depth_;
+}
+
+void Node::complete(std::variant<Answer, Due> event, clock::Nanos at) {
+  completions_.push_back(Completion{std::move(event), at});
 }
 
 void Node::carry_out(Action& action) {
@@ -128,13 +155,14 @@ void Node::carry_out(Action& action) {
             if (connection_) connection_->set_liveness_timeout(a.timeout, a.reason);
           },
           [&](Configure& a) {
-            const Result<void> result = renderer_.configure(a.job);
-            carry_out(protocol_.configured(result, renderer_.description(), renderer_.warm_up()));
+            Result<void> result = renderer_.configure(a.job);
+            complete(Configured{std::move(result), renderer_.description(), renderer_.warm_up()}, clock::monotonic_now());
           },
           [&](Render& a) {
             const clock::Nanos started = clock::monotonic_now();
             const Rendered how = renderer_.render(a.frame);
-            carry_out(protocol_.rendered(a.frame.frame_id, clock::monotonic_now() - started, how));
+            const clock::Nanos done = clock::monotonic_now();
+            complete(FrameRendered{a.frame.frame_id, done - started, how}, done);
           },
           [&](Skip& a) { renderer_.skip(a.frame); },
           [&](PresentAt& a) { wait_for_present(a.deadline); },
@@ -144,13 +172,13 @@ void Node::carry_out(Action& action) {
             // Nodes sharing a machine present at the same instant: let the others
             // on this core show theirs before this one does its bookkeeping.
             std::this_thread::yield();
-            carry_out(protocol_.presented(shown));
+            complete(ImagePresented{}, shown);
           },
           [&](ShowBlack&) { renderer_.show_black(); },
           [&](PingIn& a) {
             ping_timer_.expires_after(a.after);
             ping_timer_.async_wait([this](const boost::system::error_code& error) {
-              if (!error) carry_out(protocol_.ping_due(clock::monotonic_now()));
+              if (!error) carry_out(protocol_.due(Due::ping, clock::monotonic_now()));
             });
           },
           [&](CancelPings&) { ping_timer_.cancel(); },
@@ -177,34 +205,32 @@ void Node::carry_out(Action& action) {
           [&](Log& a) { log_.log(a.level, "{}", a.text); },
           [&](PrepareScene& a) {
             if (auto found = scene_cache_.find(a.manifest, a.sha256)) {
-              carry_out(protocol_.scene_found(*found));
+              complete(SceneFound{*found}, clock::monotonic_now());
               return;
             }
             Result<SceneCache::Begun> begun = scene_cache_.begin(a.manifest, a.sha256, a.wait_for_others);
-            if (begun) {
-              if (const auto* elsewhere = std::get_if<SceneCache::FetchedElsewhere>(&begun.value())) {
-                carry_out(protocol_.scene_fetched_elsewhere(elsewhere->bytes_there, clock::monotonic_now()));
-                return;
-              }
-              carry_out(protocol_.scene_copy_started(std::get<SceneCache::Present>(std::move(begun).value()),
-                                                     clock::monotonic_now()));
+            if (!begun) {
+              complete(SceneCopyStarted{Error{begun.error()}}, clock::monotonic_now());
+            } else if (const auto* elsewhere = std::get_if<SceneCache::FetchedElsewhere>(&begun.value())) {
+              complete(SceneFetchedElsewhere{elsewhere->bytes_there}, clock::monotonic_now());
             } else {
-              carry_out(protocol_.scene_copy_started(Error{begun.error()}, clock::monotonic_now()));
+              complete(SceneCopyStarted{std::get<SceneCache::Present>(std::move(begun).value())},
+                       clock::monotonic_now());
             }
           },
           [&](RecheckScene& a) {
             scene_timer_.expires_after(a.after);
             scene_timer_.async_wait([this](const boost::system::error_code& error) {
-              if (!error) carry_out(protocol_.scene_recheck_due(clock::monotonic_now()));
+              if (!error) carry_out(protocol_.due(Due::scene_recheck, clock::monotonic_now()));
             });
           },
           [&](StoreSceneChunk& a) {
             if (auto stored = scene_cache_.write(a.file, a.offset, a.data); !stored) {
-              carry_out(protocol_.scene_store_failed(stored.error()));
+              complete(SceneStoreFailed{stored.error()}, clock::monotonic_now());
             }
           },
           [&](FinishScene&) {
-            carry_out(protocol_.scene_copy_finished(scene_cache_.commit(), clock::monotonic_now()));
+            complete(SceneCopyFinished{scene_cache_.commit()}, clock::monotonic_now());
           },
           [&](AbandonScene&) { scene_cache_.abandon(); },
       },
@@ -217,18 +243,17 @@ void Node::carry_out(Action& action) {
 // timer wakes up late by the scheduler's delay.
 void Node::wait_for_present(clock::Nanos deadline) {
   const clock::Nanos spin = options_.present_spin.count() * clock::kNanosPerMicro;
-  const auto finish = [this, deadline, spin] {
-    clock::sleep_until_monotonic(deadline, spin);
-    carry_out(protocol_.present_due(clock::monotonic_now()));
-  };
   const clock::Nanos wake = deadline - spin - clock::monotonic_now();
   if (wake <= 0) {
-    finish();
+    clock::sleep_until_monotonic(deadline, spin);
+    complete(Due::present, clock::monotonic_now());  // given after this list
     return;
   }
   present_timer_.expires_after(std::chrono::nanoseconds(wake));
-  present_timer_.async_wait([finish](const boost::system::error_code& error) {
-    if (!error) finish();
+  present_timer_.async_wait([this, deadline, spin](const boost::system::error_code& error) {
+    if (error) return;
+    clock::sleep_until_monotonic(deadline, spin);
+    carry_out(protocol_.due(Due::present, clock::monotonic_now()));
   });
 }
 

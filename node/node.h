@@ -11,8 +11,10 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include <chrono>
+#include <deque>
 #include <memory>
 #include <string>
+#include <variant>
 
 #include "net/connection.h"
 #include "node/protocol.h"
@@ -48,6 +50,9 @@ class Node {
   void connect();
   void carry_out(Actions actions);
   void carry_out(Action& action);
+  // Queues the answer to an action (or a timer already run out while carrying
+  // one out), for carry_out to give the core after the list.
+  void complete(std::variant<Answer, Due> event, clock::Nanos at);
   void wait_for_present(clock::Nanos deadline);
   void on_signal(int signal);
 
@@ -68,6 +73,12 @@ class Node {
   SceneCache scene_cache_;
   std::shared_ptr<net::Connection> connection_;
   int exit_code_ = kExitOk;
+  struct Completion {
+    std::variant<Answer, Due> event;
+    clock::Nanos at = 0;
+  };
+  std::deque<Completion> completions_;
+  int depth_ = 0;  // carry_out calls running (a Close calls back into it)
 };
 
 }  // namespace optique::node

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 
+#include "util/overloaded.h"
+
 namespace optique::node {
 
 using std::chrono::milliseconds;
@@ -114,6 +116,27 @@ Actions NodeProtocol::interrupted(const std::string& signal_name) {
 
 // ---------------------------------------------------------------- messages
 
+// Which messages each phase takes; a Challenge, a Refuse and a Goodbye are taken
+// in every phase, before the version is checked (message()).
+bool NodeProtocol::accepts(Phase phase, wire::Envelope::BodyCase kind) {
+  switch (kind) {
+    case wire::Envelope::kWelcome:
+      return phase == Phase::awaiting_welcome;
+    case wire::Envelope::kSceneChunk:
+      return phase == Phase::fetching_scene;
+    case wire::Envelope::kHeartbeat:
+      return phase == Phase::preparing_scene || phase == Phase::fetching_scene || phase == Phase::joined;
+    case wire::Envelope::kResync:
+      return phase == Phase::awaiting_state || phase == Phase::joined;
+    case wire::Envelope::kFrameBegin:
+    case wire::Envelope::kSwap:
+    case wire::Envelope::kPong:
+      return phase == Phase::joined;
+    default:
+      return false;
+  }
+}
+
 Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
   Actions out;
   if (phase_ == Phase::stopped || !connection_open_) return out;
@@ -142,43 +165,29 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
          out);
     return out;
   }
-  if (phase_ == Phase::awaiting_welcome && message.body_case() == wire::Envelope::kWelcome) {
-    on_welcome(message.welcome(), out);
-    return out;
-  }
-  if (phase_ == Phase::fetching_scene && message.body_case() == wire::Envelope::kSceneChunk) {
-    on_scene_chunk(message.scene_chunk(), out);
-    return out;
-  }
-  if ((phase_ == Phase::preparing_scene || phase_ == Phase::fetching_scene) &&
-      message.body_case() == wire::Envelope::kHeartbeat) {
-    return out;
-  }
-  if ((phase_ == Phase::awaiting_state || phase_ == Phase::joined) && message.body_case() == wire::Envelope::kResync) {
-    if (pending_) {
-      held_.push_back(message);  // after the frame waiting to be shown
-    } else {
-      on_resync(message.resync(), now, out);
-    }
-    return out;
-  }
-  if (phase_ != Phase::joined) {
-    out.push_back(Close{std::string("unexpected ") + net::body_name(message) + " before the welcome"});
+  if (!accepts(phase_, message.body_case())) {
+    out.push_back(Close{std::string("unexpected ") + net::body_name(message) +
+                        (phase_ == Phase::joined ? " from the master" : " before the welcome")});
     return out;
   }
   switch (message.body_case()) {
-    case wire::Envelope::kFrameBegin:
-      // A frame is waiting for its deadline: the next one must not be drawn over
-      // it before it is shown.
-      if (pending_) {
-        held_.push_back(message);
-      } else {
-        on_frame_begin(message.frame_begin(), now, out);
-      }
+    case wire::Envelope::kWelcome:
+      on_welcome(message.welcome(), out);
       break;
+    case wire::Envelope::kSceneChunk:
+      on_scene_chunk(message.scene_chunk(), out);
+      break;
+    case wire::Envelope::kResync:
+    case wire::Envelope::kFrameBegin:
     case wire::Envelope::kSwap:
+      // A frame is waiting for its deadline: nothing may touch it (a new state,
+      // the next frame drawn over it) before it is shown.
       if (pending_) {
         held_.push_back(message);
+      } else if (message.has_resync()) {
+        on_resync(message.resync(), now, out);
+      } else if (message.has_frame_begin()) {
+        on_frame_begin(message.frame_begin(), now, out);
       } else {
         on_swap(message.swap(), now, out);
       }
@@ -186,10 +195,39 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
     case wire::Envelope::kPong:
       on_pong(message.pong(), now, out);
       break;
-    case wire::Envelope::kHeartbeat:
+    default:  // a heartbeat: the connection is alive, which it already knows
       break;
-    default:
-      out.push_back(Close{std::string("unexpected ") + net::body_name(message) + " from the master"});
+  }
+  return out;
+}
+
+Actions NodeProtocol::answer(Answer answer, clock::Nanos now) {
+  Actions out;
+  std::visit(util::Overloaded{
+                 [&](const Configured& a) { on_configured(a, out); },
+                 [&](const SceneFound& a) { on_scene_found(a, out); },
+                 [&](const SceneFetchedElsewhere& a) { on_scene_fetched_elsewhere(a, now, out); },
+                 [&](const SceneCopyStarted& a) { on_scene_copy_started(a, now, out); },
+                 [&](const SceneStoreFailed& a) { on_scene_store_failed(a, out); },
+                 [&](const SceneCopyFinished& a) { on_scene_copy_finished(a, now, out); },
+                 [&](const FrameRendered& a) { on_rendered(a, out); },
+                 [&](const ImagePresented&) { on_presented(now, out); },
+             },
+             answer);
+  return out;
+}
+
+Actions NodeProtocol::due(Due timer, clock::Nanos now) {
+  Actions out;
+  switch (timer) {
+    case Due::ping:
+      on_ping_due(now, out);
+      break;
+    case Due::present:
+      on_present_due(now, out);
+      break;
+    case Due::scene_recheck:
+      on_scene_recheck_due(out);
       break;
   }
   return out;
@@ -275,171 +313,19 @@ void NodeProtocol::configure(Actions& out) {
   out.push_back(Configure{*job_});
 }
 
-// The cache cannot hold the scene (no room, no permission): not something a
-// retry cures.
-void NodeProtocol::cache_failed(const std::string& error, Actions& out) {
-  if (copy_unfinished_) out.push_back(AbandonScene{});
-  stop(kExitRefused, "cannot keep the master's scene here: " + error, out);
-}
-
-Actions NodeProtocol::scene_found(const std::string& gltf_path) {
-  Actions out;
-  if (phase_ != Phase::preparing_scene) return out;
-  job_->scene_path = gltf_path;
-  log(out, spdlog::level::info,
-      "the scene " + job_->scene_sha256.substr(0, 12) + "… is here: " + gltf_path +
-          (waiting_ ? ", fetched by another node of this host" : ""));
-  waiting_.reset();
-  configure(out);
-  return out;
-}
-
-Actions NodeProtocol::scene_fetched_elsewhere(std::uint64_t bytes_there, clock::Nanos now) {
-  Actions out;
-  if (phase_ != Phase::preparing_scene) return out;
-  const std::uint64_t total = job_->scene_files.total_bytes();
-  bytes_there = std::min(bytes_there, total);
-  const auto mib = [](std::uint64_t bytes) { return static_cast<double>(bytes) / (1 << 20); };
-  if (!waiting_) {
-    waiting_ = SceneWaiting{now, now, std::nullopt, bytes_there};
-    log(out, spdlog::level::info,
-        fmt::format("another node of this host is fetching the scene {} into this cache ({:.1f} of {:.1f} MiB "
-                    "there): waiting for its copy",
-                    job_->job.installation.scene.gltf, mib(bytes_there), mib(total)));
-  } else if (bytes_there > waiting_->bytes) {
-    waiting_->bytes = bytes_there;
-    waiting_->grew_at = now;
-  }
-  if (now - waiting_->grew_at >= kSceneStall.count() * clock::kNanosPerMilli) {
-    log(out, spdlog::level::warn,
-        fmt::format("the copy of the scene another node of this host is fetching has not grown for {} s "
-                    "({:.1f} of {:.1f} MiB there): fetching the scene from the master",
-                    kSceneStall.count() / 1000, mib(waiting_->bytes), mib(total)));
-    waiting_.reset();
-    out.push_back(PrepareScene{job_->scene_files, job_->scene_sha256, false});
-    return out;
-  }
-  if (!waiting_->told_at || now - *waiting_->told_at >= kSceneWaitWord.count() * clock::kNanosPerMilli) {
-    waiting_->told_at = now;
-    wire::Envelope wait;
-    wait.mutable_scene_wait()->set_scene_sha256(job_->scene_sha256);
-    wait.mutable_scene_wait()->set_bytes_there(waiting_->bytes);
-    out.push_back(Send{std::move(wait)});
-  }
-  // Past the stall, in case the cache stops answering: the connection goes.
-  out.push_back(SetDeadline{kSceneStall + 2 * kSceneWaitWord,
-                            "waited " + std::to_string((kSceneStall + 2 * kSceneWaitWord).count() / 1000) +
-                                " s for another node's copy of the scene"});
-  out.push_back(RecheckScene{kSceneRecheck});
-  return out;
-}
-
-Actions NodeProtocol::scene_recheck_due(clock::Nanos) {
-  Actions out;
-  if (phase_ != Phase::preparing_scene || !waiting_) return out;
-  out.push_back(PrepareScene{job_->scene_files, job_->scene_sha256});
-  return out;
-}
-
-Actions NodeProtocol::scene_copy_started(const Result<protocol::SceneFetch::Present>& started, clock::Nanos now) {
-  Actions out;
-  if (phase_ != Phase::preparing_scene) return out;
-  if (!started) {
-    cache_failed(started.error(), out);
-    return out;
-  }
-  copy_unfinished_ = true;
-  waiting_.reset();
-  fetch_.emplace(job_->scene_files, job_->scene_sha256, started.value());
-  fetch_started_ = now;
-  fetch_had_bytes_ = fetch_->bytes_stored();
-  fetch_quarters_logged_ = 0;
-  phase_ = Phase::fetching_scene;
-  const double total = static_cast<double>(job_->scene_files.total_bytes()) / (1 << 20);
-  log(out, spdlog::level::info,
-      fetch_->bytes_stored() == 0
-          ? fmt::format("fetching the scene {} from the master: {} file(s), {:.1f} MiB",
-                        job_->job.installation.scene.gltf, job_->scene_files.files.size(), total)
-          : fmt::format("fetching the rest of the scene {} from the master: {:.1f} of {:.1f} MiB were here already",
-                        job_->job.installation.scene.gltf, static_cast<double>(fetch_->bytes_stored()) / (1 << 20),
-                        total));
-  out.push_back(SetDeadline{
-      kSceneStall, "no part of the scene from the master for " + std::to_string(kSceneStall.count() / 1000) + " s"});
-  for (wire::Envelope& request : fetch_->requests()) out.push_back(Send{std::move(request)});
-  if (fetch_->done()) out.push_back(FinishScene{});  // only empty files
-  return out;
-}
-
-void NodeProtocol::on_scene_chunk(const wire::SceneChunk& chunk, Actions& out) {
-  const protocol::SceneFetch::Verdict verdict = fetch_->take(chunk);
-  switch (verdict.kind) {
-    case protocol::SceneFetch::Verdict::Kind::fail:
-      out.push_back(Close{"the scene from the master: " + verdict.problem});
-      return;
-    case protocol::SceneFetch::Verdict::Kind::ask_again:
-      log(out, spdlog::level::warn, "the scene from the master: " + verdict.problem + "; asking for it again");
-      break;
-    case protocol::SceneFetch::Verdict::Kind::store:
-      out.push_back(StoreSceneChunk{verdict.file, verdict.offset, chunk.data()});
-      break;
-  }
-  out.push_back(SetDeadline{
-      kSceneStall, "no part of the scene from the master for " + std::to_string(kSceneStall.count() / 1000) + " s"});
-  const std::uint64_t total = fetch_->manifest().total_bytes();
-  const int quarters = total == 0 ? 4 : static_cast<int>(4 * fetch_->bytes_stored() / total);
-  if (quarters > fetch_quarters_logged_ && quarters < 4 && total >= protocol::kSceneProgressBytes) {
-    fetch_quarters_logged_ = quarters;
-    log(out, spdlog::level::info, fmt::format("fetching the scene: {} %", 25 * quarters));
-  }
-  if (fetch_->done()) {
-    out.push_back(FinishScene{});
+void NodeProtocol::on_configured(const Configured& answer, Actions& out) {
+  const WarmUp& warm_up = answer.warm_up;
+  if (phase_ != Phase::configuring) return;  // the connection went meanwhile
+  if (!answer.result) {
+    stop(kExitRefused, "cannot drive projector '" + settings_.id + "': " + answer.result.error(), out);
     return;
-  }
-  for (wire::Envelope& request : fetch_->requests()) out.push_back(Send{std::move(request)});
-}
-
-Actions NodeProtocol::scene_store_failed(const std::string& error) {
-  Actions out;
-  if (phase_ != Phase::fetching_scene) return out;
-  cache_failed(error, out);
-  return out;
-}
-
-Actions NodeProtocol::scene_copy_finished(const Result<std::string>& gltf_path, clock::Nanos now) {
-  Actions out;
-  if (phase_ != Phase::fetching_scene) return out;
-  if (!gltf_path) {
-    cache_failed(gltf_path.error(), out);
-    return out;
-  }
-  copy_unfinished_ = false;
-  // From the first request to the copy in place.
-  log(out, spdlog::level::info,
-      fmt::format("fetched the scene: {}{}",
-                  protocol::transfer_text(fetch_->manifest().total_bytes() - fetch_had_bytes_, now - fetch_started_),
-                  fetch_->chunks_asked_again() > 0
-                      ? fmt::format(", {} chunk(s) asked for again", fetch_->chunks_asked_again())
-                      : ""));
-  fetch_.reset();
-  job_->scene_path = gltf_path.value();
-  configure(out);
-  return out;
-}
-
-Actions NodeProtocol::configured(const Result<void>& result, const std::string& renderer_description,
-                                 WarmUp warm_up) {
-  Actions out;
-  if (phase_ != Phase::configuring) return out;  // the connection went meanwhile
-  if (!result) {
-    stop(kExitRefused, "cannot drive projector '" + settings_.id + "': " + result.error(), out);
-    return out;
   }
   frame_period_ = job_->frame_period;
   images_ = job_->job.self().color_fields.images;
   heartbeat_ = std::max(job_->heartbeat, milliseconds(10));
   liveness_timeout_ = job_->liveness_timeout;
   wire::Envelope envelope;
-  envelope.mutable_configured()->set_renderer(renderer_description);
+  envelope.mutable_configured()->set_renderer(answer.renderer);
   envelope.mutable_configured()->set_warm_up_ns(warm_up.frame);
   envelope.mutable_configured()->set_capture_ns(warm_up.capture);
   out.push_back(Send{std::move(envelope)});
@@ -454,7 +340,7 @@ Actions NodeProtocol::configured(const Result<void>& result, const std::string& 
   log(out, spdlog::level::info,
       fmt::format("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}{}{}", p.id, p.width,
                   p.height, job_->job.screen().id, config::to_string(p.eye), static_cast<double>(frame_period_) / 1e6,
-                  renderer_description,
+                  answer.renderer,
                   warm_up.frame > 0 ? fmt::format("; warm-up frame {:.1f} ms{}", static_cast<double>(warm_up.frame) / 1e6,
                                                   warm_up.capture > 0
                                                       ? fmt::format(", {:.1f} ms more when captured",
@@ -462,7 +348,6 @@ Actions NodeProtocol::configured(const Result<void>& result, const std::string& 
                                                       : "")
                                     : "",
                   drawing));
-  return out;
 }
 
 void NodeProtocol::on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out) {
@@ -520,67 +405,48 @@ void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos no
         fmt::format("state hash {:016x} differs from the master's {:016x} at frame {}", last_hash_, begin.state_hash(),
                     begin.frame_id()));
   }
-  // A node that lags shows an older frame's content (the light share applies at
-  // once: it is how this node's light is split, not content).
-  const wire::FrameBegin* shown = &begin;
+  auto decoded = protocol::decode_frame_begin(begin, job_ ? job_->light_count : 0);
+  if (!decoded) {
+    out.push_back(Close{decoded.error()});
+    return;
+  }
+  protocol::FrameMessage frame = std::move(decoded).value();
+  // A node that lags shows an older frame's content (the light share and the
+  // scene sent ahead apply at once: they are how this node draws, not content).
+  const protocol::FrameMessage* shown = &frame;
   const scene::SceneState* shown_state = &state_;
   if (settings_.lag_frames > 0) {
-    past_frames_.push_back({begin, state_});
+    protocol::FrameMessage kept = frame;
+    kept.lights.reset();
+    kept.ahead.reset();
+    past_frames_.push_back({std::move(kept), state_});
     while (past_frames_.size() > settings_.lag_frames + 1) past_frames_.pop_front();
-    shown = &past_frames_.front().begin;
+    shown = &past_frames_.front().frame;
     shown_state = &past_frames_.front().state;
   }
   FrameInput input;
-  input.frame_id = begin.frame_id();
-  input.simulation_time = shown->simulation_time_ns();
-  input.present_time = shown->present_time_ns();
+  input.frame_id = frame.frame_id;
+  input.simulation_time = shown->simulation_time;
+  input.present_time = shown->present_time;
   input.frame_period = frame_period_;
   input.state = shown_state;
-  input.capture = begin.capture();
-  if (shown->has_focus()) {
-    auto focus = protocol::decode_focus(shown->focus());
-    if (!focus) {
-      out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": " + focus.error()});
-      return;
-    }
-    input.focus = focus.value();
-  }
-  share_.reset();
-  if (begin.has_lights()) {
-    auto share = protocol::decode_light_share(begin.lights(), job_ ? job_->light_count : 0);
-    if (!share) {
-      out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": lights: " + share.error()});
-      return;
-    }
-    share_ = std::move(share).value();
-    input.lights = &*share_;
-  }
-  ahead_.reset();
-  if (begin.has_ahead()) {
-    const std::uint64_t on = begin.ahead_frame() - begin.frame_id();
-    if (begin.ahead_frame() <= begin.frame_id() || on > static_cast<std::uint64_t>(config::kMostFramesAhead)) {
-      out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": the scene sent ahead is for frame " +
-                          std::to_string(begin.ahead_frame()) + ", not 1…" + std::to_string(config::kMostFramesAhead) +
-                          " frames on"});
-      return;
-    }
-    auto ahead = scene::from_snapshot(begin.ahead());
-    if (!ahead) {
-      out.push_back(Close{"frame " + std::to_string(begin.frame_id()) + ": the scene sent ahead: " + ahead.error()});
-      return;
-    }
-    ahead_ = std::move(ahead).value();
+  input.capture = frame.capture;
+  input.focus = shown->focus;
+  share_ = std::move(frame.lights);
+  if (share_) input.lights = &*share_;
+  ahead_ = std::move(frame.ahead);
+  if (ahead_) {
     input.ahead = &*ahead_;
-    input.ahead_frame = begin.ahead_frame();
+    input.ahead_frame = frame.ahead_frame;
   }
-  if (begin.skip()) {
+  if (frame.skip) {
     ++skipped_;
     if (!skipping_) {
       skipping_ = true;
       log(out, spdlog::level::warn,
           fmt::format("behind: skipping frames from frame {} (the master no longer waits for this node); drawing the "
                       "newest once the frame being drawn is done",
-                      begin.frame_id()));
+                      frame.frame_id));
     }
     out.push_back(Skip{input});
     return;
@@ -588,10 +454,10 @@ void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos no
   if (skipping_) {
     skipping_ = false;
     log(out, spdlog::level::info,
-        fmt::format("caught up: drawing frame {} after skipping {} frame(s)", begin.frame_id(), skipped_));
+        fmt::format("caught up: drawing frame {} after skipping {} frame(s)", frame.frame_id, skipped_));
     skipped_ = 0;
   }
-  last_content_frame_ = shown->frame_id();
+  last_content_frame_ = shown->frame_id;
   rendering_ = input;
   out.push_back(Render{input});
 }
@@ -614,192 +480,20 @@ wire::DrawnAs drawn_as(const Rendered& how) {
 
 }  // namespace
 
-Actions NodeProtocol::rendered(std::uint64_t frame_id, clock::Nanos render_time, const Rendered& how) {
-  Actions out;
-  if (!rendering_ || rendering_->frame_id != frame_id) return out;
+void NodeProtocol::on_rendered(const FrameRendered& answer, Actions& out) {
+  const std::uint64_t frame_id = answer.frame_id;
+  if (!rendering_ || rendering_->frame_id != frame_id) return;
   rendering_.reset();
   last_rendered_ = frame_id;
   rendered_any_ = true;
-  if (phase_ != Phase::joined || !connection_open_) return out;
+  if (phase_ != Phase::joined || !connection_open_) return;
   wire::Envelope envelope;
   auto& ready = *envelope.mutable_frame_ready();
   ready.set_frame_id(frame_id);
-  ready.set_render_ns(render_time);
+  ready.set_render_ns(answer.render_time);
   ready.set_state_hash(last_hash_);
-  ready.set_drawn_as(drawn_as(how));
+  ready.set_drawn_as(drawn_as(answer.how));
   out.push_back(Send{std::move(envelope)});
-  return out;
-}
-
-void NodeProtocol::on_swap(const wire::FrameSwap& swap, clock::Nanos now, Actions& out) {
-  if (!rendered_any_ || swap.frame_id() != last_rendered_) {
-    log(out, spdlog::level::warn,
-        "swap for frame " + std::to_string(swap.frame_id()) + " but the last rendered frame is " +
-            std::to_string(last_rendered_) + "; not presenting");
-    end_round(now, out);
-    return;
-  }
-  const std::optional<clock::ClockEstimate> estimate = estimator_.at(settings_.clock.to_local(now));
-  const clock::Nanos to_master = estimate ? estimate->offset : 0;
-  clock::Nanos deadline = settings_.clock.to_monotonic(swap.present_deadline_ns() - to_master);
-  // Never wait on a deadline from a broken or hostile master for longer than a
-  // few frames.
-  const clock::Nanos longest = std::max<clock::Nanos>(4 * frame_period_, 100 * clock::kNanosPerMilli);
-  if (deadline > now + longest) {
-    log(out, spdlog::level::warn,
-        fmt::format("swap for frame {} asks to present {:.1f} ms from now; presenting in {:.1f} ms", swap.frame_id(),
-                    static_cast<double>(deadline - now) / 1e6, static_cast<double>(longest) / 1e6));
-    deadline = now + longest;
-  }
-  pending_ = Pending{swap.frame_id(), deadline, swap.present_deadline_ns(), false};
-  wait_for_pending(now, out);
-}
-
-// Checked when the swap comes and again when the deadline does: a stop can
-// stretch the wait too. An image is stale once the next one's time has come.
-bool NodeProtocol::stale(clock::Nanos now, Actions& out) const {
-  if (now <= pending_->deadline + frame_period_ / images_) return false;
-  log(out, spdlog::level::warn,
-      fmt::format("frame {}{}'s present deadline passed {:.1f} ms ago: not showing a stale frame", pending_->frame_id,
-                  images_ > 1 ? fmt::format(" image {}", pending_->image) : "",
-                  static_cast<double>(now - pending_->deadline) / 1e6));
-  return true;
-}
-
-bool NodeProtocol::next_image() {
-  if (pending_->image + 1 >= images_) return false;
-  const clock::Nanos later = frame_period_ / images_;
-  pending_->image += 1;
-  pending_->deadline += later;
-  pending_->master_deadline += later;
-  pending_->due = false;
-  return true;
-}
-
-void NodeProtocol::wait_for_pending(clock::Nanos now, Actions& out) {
-  do {
-    if (!stale(now, out)) {
-      out.push_back(PresentAt{pending_->frame_id, pending_->deadline});
-      return;
-    }
-  } while (next_image());
-  pending_.reset();
-  end_round(now, out);
-}
-
-// The frame's next image, its share of the frame later, while what came
-// meanwhile waits for it; or, after the last, the frame is over and that goes on.
-void NodeProtocol::image_done(clock::Nanos now, Actions& out) {
-  if (next_image()) {
-    wait_for_pending(now, out);
-  } else {
-    pending_.reset();
-    end_round(now, out);
-  }
-  if (!pending_) release_held(now, out);
-}
-
-Actions NodeProtocol::present_due(clock::Nanos now) {
-  Actions out;
-  if (!pending_ || pending_->due) return out;
-  if (!stale(now, out)) {
-    pending_->due = true;
-    out.push_back(Present{pending_->image});
-    return out;
-  }
-  image_done(now, out);  // not shown
-  return out;
-}
-
-// What came while a frame waited for its deadline, in order, until one of them
-// waits again.
-void NodeProtocol::release_held(clock::Nanos now, Actions& out) {
-  while (!held_.empty() && !pending_) {
-    wire::Envelope next = std::move(held_.front());
-    held_.pop_front();
-    Actions more = message(next, now);
-    out.insert(out.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
-  }
-}
-
-Actions NodeProtocol::presented(clock::Nanos now) {
-  Actions out;
-  if (!pending_ || !pending_->due) return out;
-  const Pending shown = *pending_;
-  const clock::Nanos local = settings_.clock.to_local(now);
-  // The offset drifts while the node waits for the deadline: convert at this instant.
-  const std::optional<clock::ClockEstimate> estimate = estimator_.at(local);
-  const clock::Nanos offset = estimate ? estimate->offset : 0;
-  const clock::Nanos presented_at = local + offset;
-  if (connection_open_ && phase_ == Phase::joined) {
-    // The frame's first image is what the master's deadline is for, and what
-    // it measures sync by: one report per frame.
-    if (shown.image == 0) {
-      wire::Envelope envelope;
-      auto& report = *envelope.mutable_presented();
-      report.set_frame_id(shown.frame_id);
-      report.set_presented_ns(presented_at);
-      report.set_content_frame_id(last_content_frame_);
-      report.set_clock_offset_ns(offset);
-      if (estimate) {
-        report.set_clock_rtt_ns(estimate->round_trip);
-        report.set_clock_drift_ppm(estimate->drift_ppm);
-        report.set_clock_error_bound_ns(estimate->error_bound);
-      }
-      if (settings_.clock.skewed()) {
-        report.set_clock_truth_known(true);
-        report.set_clock_true_error_ns(offset - (now - local));
-      }
-      out.push_back(Send{std::move(envelope)});
-    }
-    log(out, spdlog::level::debug,
-        fmt::format("presented frame {}{} at master time {} ns ({:+.1f} µs from the deadline)", shown.frame_id,
-                    images_ > 1 ? fmt::format(" image {}", shown.image) : "", presented_at,
-                    static_cast<double>(presented_at - shown.master_deadline) / 1e3));
-  }
-  image_done(now, out);
-  return out;
-}
-
-// ---------------------------------------------------------------- clock
-
-void NodeProtocol::send_ping(clock::Nanos now, Actions& out) {
-  ping_owed_ = false;
-  if (phase_ != Phase::joined || !connection_open_) return;
-  wire::Envelope envelope;
-  envelope.mutable_ping()->set_t1(settings_.clock.to_local(now));
-  out.push_back(Send{std::move(envelope)});
-  if (pings_in_burst_ > 0) --pings_in_burst_;
-  out.push_back(PingIn{pings_in_burst_ > 0 ? kBurstInterval : std::min(heartbeat_, kPingInterval)});
-}
-
-Actions NodeProtocol::ping_due(clock::Nanos now) {
-  Actions out;
-  if (!ping_owed_ && pings_in_burst_ == 0 && in_round(now)) {
-    ping_owed_ = true;
-    out.push_back(PingIn{kPingDeferral});  // in case the round never ends here (no swap comes)
-    return out;
-  }
-  send_ping(now, out);
-  return out;
-}
-
-bool NodeProtocol::in_round(clock::Nanos now) const {
-  if (round_open_) return true;
-  if (!last_begin_ || frame_period_ <= 0) return false;
-  const clock::Nanos next_begin = *last_begin_ + frame_period_;
-  const clock::Nanos guard = std::chrono::nanoseconds(kRoundGuard).count();
-  return now >= next_begin - guard && now < next_begin + guard;
-}
-
-void NodeProtocol::end_round(clock::Nanos now, Actions& out) {
-  round_open_ = false;
-  if (ping_owed_) send_ping(now, out);
-}
-
-void NodeProtocol::on_pong(const wire::Pong& pong, clock::Nanos now, Actions& out) {
-  const clock::PingSample sample{pong.t1(), pong.t2(), pong.t3(), settings_.clock.to_local(now)};
-  if (!estimator_.add(sample)) log(out, spdlog::level::debug, "dropped an impossible clock sample");
 }
 
 }  // namespace optique::node

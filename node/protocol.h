@@ -1,9 +1,9 @@
 #pragma once
 // The node's side of the protocol, without sockets, timers or GL: it takes events
-// (connected, a message, closed, the ping timer, a present deadline reached,
-// rendered, configured, a signal) with the time they happened, and answers with
-// actions for its shell (node/node.h) to carry out, in order, before the next
-// event: send, close, arm a deadline, render, present at, reconnect, stop, log.
+// (connected, a message, closed, a signal, a timer run out, the answer to an
+// action: configured, rendered, presented, the cache's) with the time they
+// happened, and answers with actions for its shell (node/node.h) to carry out,
+// in order: send, close, arm a deadline, render, present at, reconnect, stop, log.
 // So every rule — the handshake, joining and rejoining, applying the state,
 // which frames are shown and when, the clock estimate, giving up — is tested in
 // microseconds (tests/unit/test_node_protocol.cpp).
@@ -25,9 +25,11 @@
 #include "net/session_seal.h"
 #include "node/renderer.h"
 #include "optique/wire.pb.h"
+#include "protocol/frame_message.h"
 #include "protocol/scene_fetch.h"
 #include "protocol/welcome.h"
 #include "scene/state.h"
+#include "util/result.h"
 
 namespace optique::node {
 
@@ -85,11 +87,11 @@ struct SetLiveness {
   std::chrono::milliseconds timeout{0};
   std::string reason;
 };
-// Set the renderer up for the job; answer with configured().
+// Set the renderer up for the job; answer Configured.
 struct Configure {
   protocol::NodeJob job;
 };
-// Draw the frame; answer with rendered(). The frame's state lives in the core
+// Draw the frame; answer FrameRendered. The frame's state lives in the core
 // until the next event.
 struct Render {
   FrameInput frame;
@@ -100,18 +102,19 @@ struct Skip {
   FrameInput frame;
 };
 // Wait, without holding up other events, until the monotonic time `deadline`;
-// then answer with present_due().
+// then tell due(Due::present).
 struct PresentAt {
   std::uint64_t frame_id = 0;
   clock::Nanos deadline = 0;
 };
-// Show image `image` of the rendered frame now; answer with presented(). A
+// Show image `image` of the rendered frame now; answer ImagePresented. A
 // projector that shows two images per frame (a stereo one used as mono) shows
 // the second half a frame after the first.
 struct Present {
   int image = 0;
 };
 struct ShowBlack {};
+// Tell due(Due::ping) after `after`.
 struct PingIn {
   std::chrono::milliseconds after{0};
 };
@@ -126,30 +129,29 @@ struct Log {
   spdlog::level::level_enum level = spdlog::level::info;
   std::string text;
 };
-// The scene's files (node/scene_cache.h): answer with scene_found() and the
-// glTF's path when a whole copy is here; with scene_fetched_elsewhere() when
-// another node of this host is fetching it into the same cache (unless
-// `wait_for_others` is false); else start a new copy and answer with
-// scene_copy_started().
+// The scene's files (node/scene_cache.h): answer SceneFound with the glTF's
+// path when a whole copy is here; SceneFetchedElsewhere when another node of
+// this host is fetching it into the same cache (unless `wait_for_others` is
+// false); else start a new copy and answer SceneCopyStarted.
 struct PrepareScene {
   scene::SceneManifest manifest;
   std::string sha256;
   bool wait_for_others = true;
 };
 // Waiting for another node's copy of the scene: look again after `after`, with
-// scene_recheck_due().
+// due(Due::scene_recheck).
 struct RecheckScene {
   std::chrono::milliseconds after{0};
 };
 // Write a chunk (checked against the manifest) into the copy; answer only a
-// failure, with scene_store_failed().
+// failure, SceneStoreFailed.
 struct StoreSceneChunk {
   std::uint32_t file = 0;
   std::uint64_t offset = 0;
   std::string data;
 };
-// Every chunk is stored: check the copy whole, put it in place and answer with
-// scene_copy_finished().
+// Every chunk is stored: check the copy whole, put it in place and answer
+// SceneCopyFinished.
 struct FinishScene {};
 // The copy cannot be kept (the cache could not write it): remove it. A copy
 // whose connection went, or whose node stops, is kept: it goes on after the
@@ -160,6 +162,53 @@ using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, Protect, S
                             Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log, PrepareScene,
                             RecheckScene, StoreSceneChunk, FinishScene, AbandonScene>;
 using Actions = std::vector<Action>;
+
+// --- answers: what the shell reports after carrying out an action that asks
+// for one. The shell gives them to answer() after the list the action was in,
+// in the order they came (node/node.cpp).
+
+// To Configure.
+struct Configured {
+  Result<void> result;
+  std::string renderer;  // what draws, for the logs
+  WarmUp warm_up;        // how long the renderer's warm-up frame took
+};
+// To PrepareScene: a whole copy of the scene is here.
+struct SceneFound {
+  std::string gltf_path;
+};
+// To PrepareScene: another node of this host is fetching it into the same
+// cache; its copy holds `bytes_there` so far.
+struct SceneFetchedElsewhere {
+  std::uint64_t bytes_there = 0;
+};
+// To PrepareScene: a copy is started; `started` says which chunks it already
+// holds (one going on after a lost connection).
+struct SceneCopyStarted {
+  Result<protocol::SceneFetch::Present> started;
+};
+// To StoreSceneChunk, only when it failed.
+struct SceneStoreFailed {
+  std::string error;
+};
+// To FinishScene: the copy is in place, or why not.
+struct SceneCopyFinished {
+  Result<std::string> gltf_path;
+};
+// To Render.
+struct FrameRendered {
+  std::uint64_t frame_id = 0;
+  clock::Nanos render_time = 0;
+  Rendered how;
+};
+// To Present: the image is shown (at the answer's time).
+struct ImagePresented {};
+
+using Answer = std::variant<Configured, SceneFound, SceneFetchedElsewhere, SceneCopyStarted, SceneStoreFailed,
+                            SceneCopyFinished, FrameRendered, ImagePresented>;
+
+// The shell's timers, armed by PingIn, PresentAt and RecheckScene.
+enum class Due { ping, present, scene_recheck };
 
 class NodeProtocol {
  public:
@@ -198,22 +247,10 @@ class NodeProtocol {
   [[nodiscard]] Actions connect_failed(const std::string& reason, clock::Nanos now);
   [[nodiscard]] Actions message(const wire::Envelope& message, clock::Nanos now);
   [[nodiscard]] Actions closed(const std::string& reason, clock::Nanos now);
-  // `warm_up`: how long the renderer's warm-up frame took (Renderer::warm_up).
-  [[nodiscard]] Actions configured(const Result<void>& result, const std::string& renderer_description,
-                                   WarmUp warm_up = {});
-  // Answers to PrepareScene, StoreSceneChunk and FinishScene.
-  [[nodiscard]] Actions scene_found(const std::string& gltf_path);
-  // `bytes_there`: how much of the scene the other node's copy holds so far.
-  [[nodiscard]] Actions scene_fetched_elsewhere(std::uint64_t bytes_there, clock::Nanos now);
-  [[nodiscard]] Actions scene_recheck_due(clock::Nanos now);
-  // `started`: which chunks the copy already holds (one going on after a lost connection).
-  [[nodiscard]] Actions scene_copy_started(const Result<protocol::SceneFetch::Present>& started, clock::Nanos now);
-  [[nodiscard]] Actions scene_store_failed(const std::string& error);
-  [[nodiscard]] Actions scene_copy_finished(const Result<std::string>& gltf_path, clock::Nanos now);
-  [[nodiscard]] Actions rendered(std::uint64_t frame_id, clock::Nanos render_time, const Rendered& how = {});
-  [[nodiscard]] Actions ping_due(clock::Nanos now);
-  [[nodiscard]] Actions present_due(clock::Nanos now);
-  [[nodiscard]] Actions presented(clock::Nanos now);
+  // The answer to an action, at `now` (for ImagePresented: when it was shown).
+  [[nodiscard]] Actions answer(Answer answer, clock::Nanos now);
+  // A timer the core armed has run out.
+  [[nodiscard]] Actions due(Due timer, clock::Nanos now);
   // SIGINT or SIGTERM: say goodbye and stop.
   [[nodiscard]] Actions interrupted(const std::string& signal_name);
 
@@ -235,6 +272,18 @@ class NodeProtocol {
     stopped
   };
 
+  [[nodiscard]] static bool accepts(Phase phase, wire::Envelope::BodyCase kind);
+  void on_configured(const Configured& answer, Actions& out);
+  void on_scene_found(const SceneFound& answer, Actions& out);
+  void on_scene_fetched_elsewhere(const SceneFetchedElsewhere& answer, clock::Nanos now, Actions& out);
+  void on_scene_recheck_due(Actions& out);
+  void on_scene_copy_started(const SceneCopyStarted& answer, clock::Nanos now, Actions& out);
+  void on_scene_store_failed(const SceneStoreFailed& answer, Actions& out);
+  void on_scene_copy_finished(const SceneCopyFinished& answer, clock::Nanos now, Actions& out);
+  void on_rendered(const FrameRendered& answer, Actions& out);
+  void on_ping_due(clock::Nanos now, Actions& out);
+  void on_present_due(clock::Nanos now, Actions& out);
+  void on_presented(clock::Nanos now, Actions& out);
   void on_challenge(const wire::Envelope& message, Actions& out);
   void on_welcome(const wire::Welcome& welcome, Actions& out);
   void on_scene_chunk(const wire::SceneChunk& chunk, Actions& out);
@@ -286,7 +335,7 @@ class NodeProtocol {
   scene::SceneState state_;
   // The lag hook's memory: the last lag_frames + 1 frames as they came.
   struct PastFrame {
-    wire::FrameBegin begin;
+    protocol::FrameMessage frame;
     scene::SceneState state;
   };
   std::deque<PastFrame> past_frames_;

@@ -397,16 +397,24 @@ Result<void> SceneCache::write(std::uint32_t file, std::uint64_t offset, std::st
   if (open_file_ != file) {
     close_file();
     file_fd_ = open(path.c_str(), O_WRONLY | O_CLOEXEC);
-    if (file_fd_ < 0) return Error{"cannot write " + path.string() + ": " + std::strerror(errno)};
+    if (file_fd_ < 0) return write_failed(path, errno);
     open_file_ = file;
   }
   for (std::size_t done = 0; done < data.size();) {
     const ssize_t n = pwrite(file_fd_, data.data() + done, data.size() - done, static_cast<off_t>(offset + done));
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return Error{"cannot write " + path.string() + ": " + std::strerror(errno)};
+    if (n <= 0) return write_failed(path, errno);
     done += static_cast<std::size_t>(n);
   }
   return {};
+}
+
+// Remembered: the copy's files have their full size from the start, so a chunk
+// that did not reach the disk leaves a hole that commit() must not put in place.
+Error SceneCache::write_failed(const std::filesystem::path& path, int error) {
+  Error failed{"cannot write " + path.string() + ": " + std::strerror(error)};
+  if (!write_failed_) write_failed_ = failed.message;
+  return failed;
 }
 
 void SceneCache::close_file() {
@@ -418,6 +426,11 @@ void SceneCache::close_file() {
 Result<std::string> SceneCache::commit() {
   if (!manifest_) return Error{"no scene is being written"};
   close_file();
+  if (write_failed_) {
+    const std::string problem = "the scene's copy is not whole: " + *write_failed_;
+    abandon();  // clears write_failed_: the message first
+    return Error{problem};
+  }
   const scene::SceneManifest manifest = *manifest_;
   // Each chunk was checked against the manifest as it came; what the disk did
   // with them the loader sees (it checks the scene's identity again).
@@ -485,6 +498,7 @@ void SceneCache::abandon() {
   release_lock();
   partial_.clear();
   manifest_.reset();
+  write_failed_.reset();
 }
 
 void SceneCache::release_lock() {

@@ -93,6 +93,7 @@ class SceneCache {
   void close_file();
 
   [[nodiscard]] Result<void> make_room(std::uintmax_t needed, const std::string& keep);
+  [[nodiscard]] Error write_failed(const std::filesystem::path& path, int error);
 
   std::filesystem::path folder_;
   spdlog::logger& log_;
@@ -106,6 +107,7 @@ class SceneCache {
   // The file written last, kept open: chunks come file by file.
   std::int64_t open_file_ = -1;
   int file_fd_ = -1;
+  std::optional<std::string> write_failed_;  // the first chunk that could not be written
   // Checked whole in this process already: not read again on a rejoin.
   std::string verified_;
 };

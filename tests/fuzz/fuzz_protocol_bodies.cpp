@@ -85,20 +85,20 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
               ++outcome.configured;
               broken = check_job(a.job);
               light_count = a.job.light_count;
-              if (broken.empty()) broken = carry_out(node, node.configured({}, "fuzz"), light_count, outcome);
+              if (broken.empty()) broken = carry_out(node, node.answer(node::Configured{{}, "fuzz", {}}, 0), light_count, outcome);
             },
             [&](node::Render& a) {
               ++outcome.renders;
               broken = check_frame(a.frame, light_count);
               if (broken.empty()) {
-                broken = carry_out(node, node.rendered(a.frame.frame_id, 1000), light_count, outcome);
+                broken = carry_out(node, node.answer(node::FrameRendered{a.frame.frame_id, 1000, {}}, 0), light_count, outcome);
               }
             },
             [&](node::Skip& a) { broken = check_frame(a.frame, light_count); },
-            [&](node::PresentAt& a) { broken = carry_out(node, node.present_due(a.deadline), light_count, outcome); },
+            [&](node::PresentAt& a) { broken = carry_out(node, node.due(node::Due::present, a.deadline), light_count, outcome); },
             [&](node::Present&) {
               ++outcome.frames_presented;
-              broken = carry_out(node, node.presented(0), light_count, outcome);
+              broken = carry_out(node, node.answer(node::ImagePresented{}, 0), light_count, outcome);
             },
             [&](node::Close&) { ++outcome.closes; },
             [&](node::Stop&) { ++outcome.closes; },
@@ -106,7 +106,7 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
             [&](node::PrepareScene& a) {
               outcome.scene_files = a.manifest;
               broken =
-                  carry_out(node, node.scene_copy_started(protocol::SceneFetch::Present{}, 0), light_count, outcome);
+                  carry_out(node, node.answer(node::SceneCopyStarted{protocol::SceneFetch::Present{}}, 0), light_count, outcome);
             },
             [&](node::StoreSceneChunk& a) {
               if (a.file >= outcome.scene_files.files.size() ||
@@ -116,7 +116,7 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
               ++outcome.scene_chunks;
             },
             [&](node::FinishScene&) {
-              broken = carry_out(node, node.scene_copy_finished(std::string("fuzz.gltf"), 0), light_count, outcome);
+              broken = carry_out(node, node.answer(node::SceneCopyFinished{std::string("fuzz.gltf")}, 0), light_count, outcome);
             },
             [](auto&) {},
         },

@@ -277,10 +277,10 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
               link->node_liveness = std::chrono::nanoseconds(a.timeout).count();
               link->node_heard = now_;
             },
-            [&](node::Configure&) { node_actions(i, n.protocol.configured({}, "sim")); },
+            [&](node::Configure&) { node_actions(i, n.protocol.answer(node::Configured{{}, "sim", {}}, now_)); },
             [&](node::Render& a) {
               n.last_rendered = a.frame.frame_id;
-              node_actions(i, n.protocol.rendered(a.frame.frame_id, clock::kNanosPerMilli));
+              node_actions(i, n.protocol.answer(node::FrameRendered{a.frame.frame_id, clock::kNanosPerMilli, {}}, now_));
             },
             [&](node::Skip&) {},
             [&](node::Protect&) {},
@@ -293,7 +293,7 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
                           " after frame " + std::to_string(n.presented.back()));
               }
               n.presented.push_back(n.last_rendered);
-              node_actions(i, n.protocol.presented(now_));
+              node_actions(i, n.protocol.answer(node::ImagePresented{}, now_));
             },
             [&](node::ShowBlack&) {},
             [&](node::PingIn& a) { n.ping_at = now_ + std::chrono::nanoseconds(a.after).count(); },
@@ -371,11 +371,11 @@ bool SimCluster::fire_next_timer() {
       break;
     case Kind::ping:
       n.ping_at.reset();
-      node_actions(index, n.protocol.ping_due(now_));
+      node_actions(index, n.protocol.due(node::Due::ping, now_));
       break;
     case Kind::present:
       n.present_at.reset();
-      node_actions(index, n.protocol.present_due(now_));
+      node_actions(index, n.protocol.due(node::Due::present, now_));
       break;
     case Kind::reconnect:
       n.reconnect_at.reset();

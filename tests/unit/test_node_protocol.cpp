@@ -68,7 +68,7 @@ class NodeTest : public ::testing::Test {
     *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr);
     a = node.message(welcome, now_);
     ASSERT_NE(first<Configure>(a), nullptr);
-    a = node.configured({}, "test renderer");
+    a = node.answer(Configured{{}, "test renderer", {}}, now_);
     ASSERT_EQ(sent(a, wire::Envelope::kConfigured).size(), 1u);
     wire::Envelope resync = envelope();
     *resync.mutable_resync()->mutable_snapshot() = scene::to_snapshot(state_);
@@ -82,7 +82,7 @@ class NodeTest : public ::testing::Test {
 
   // The master answers a ping `one_way` later, holding it `hold`; the pong comes back `one_way` after that.
   void pong(NodeProtocol& node, clock::Nanos one_way, clock::Nanos hold, clock::Nanos master_ahead) {
-    Actions a = node.ping_due(now_);
+    Actions a = node.due(Due::ping, now_);
     const auto pings = sent(a, wire::Envelope::kPing);
     ASSERT_EQ(pings.size(), 1u);
     wire::Envelope reply = envelope();
@@ -249,7 +249,7 @@ TEST_F(NodeTest, AFrameIsRenderedReportedAndShownAtItsDeadline) {
   ASSERT_NE(render, nullptr);
   EXPECT_EQ(render->frame.frame_id, 5u);
   EXPECT_EQ(render->frame.state, &node.state());
-  a = node.rendered(5, 3 * kMs);
+  a = node.answer(FrameRendered{5, 3 * kMs, {}}, now_);
   const auto ready = sent(a, wire::Envelope::kFrameReady);
   ASSERT_EQ(ready.size(), 1u);
   EXPECT_EQ(ready.front().frame_ready().state_hash(), scene::state_hash(state_));
@@ -262,14 +262,14 @@ TEST_F(NodeTest, AFrameIsRenderedReportedAndShownAtItsDeadline) {
   ASSERT_NE(at, nullptr);
   EXPECT_NEAR(static_cast<double>(at->deadline - now_), 2e6, 1e3) << "the offset estimate converts the deadline";
   now_ = at->deadline;
-  a = node.present_due(now_);
+  a = node.due(Due::present, now_);
   ASSERT_NE(first<Present>(a), nullptr);
-  a = node.presented(now_ + 10'000);
+  a = node.answer(ImagePresented{}, now_ + 10'000);
   const auto reports = sent(a, wire::Envelope::kPresented);
   ASSERT_EQ(reports.size(), 1u);
   EXPECT_EQ(reports.front().presented().frame_id(), 5u);
   EXPECT_NEAR(static_cast<double>(reports.front().presented().presented_ns() - master_deadline), 10e3, 1e3);
-  EXPECT_TRUE(node.presented(now_).empty()) << "shown once";
+  EXPECT_TRUE(node.answer(ImagePresented{}, now_).empty()) << "shown once";
 }
 
 // A 2×60 Hz stereo projector used as mono shows two images per frame: the second
@@ -281,59 +281,59 @@ TEST_F(NodeTest, AStereoProjectorUsedAsMonoShowsItsSecondImageHalfAFrameLater) {
   NodeProtocol node(s);
   join(node);
   (void)begin(node, 0);
-  (void)node.rendered(0, kMs);
+  (void)node.answer(FrameRendered{0, kMs, {}}, now_);
   const clock::Nanos deadline = now_ + 2 * kMs;
   Actions a = swap(node, 0, deadline);
   const PresentAt* at = first<PresentAt>(a);
   ASSERT_NE(at, nullptr);
   now_ = at->deadline;
-  a = node.present_due(now_);
+  a = node.due(Due::present, now_);
   ASSERT_NE(first<Present>(a), nullptr);
   EXPECT_EQ(first<Present>(a)->image, 0);
   // Frame 1 comes meanwhile: it waits for both images of frame 0.
   now_ += kMs;
   EXPECT_EQ(first<Render>(begin(node, 1)), nullptr);
-  a = node.presented(now_);
+  a = node.answer(ImagePresented{}, now_);
   ASSERT_EQ(sent(a, wire::Envelope::kPresented).size(), 1u) << "the first image is reported";
   EXPECT_EQ(first<Render>(a), nullptr) << "the second image is not shown yet";
   at = first<PresentAt>(a);
   ASSERT_NE(at, nullptr);
   EXPECT_EQ(at->deadline - (deadline), kPeriod / 2) << "half a frame after the first";
   now_ = at->deadline;
-  a = node.present_due(now_);
+  a = node.due(Due::present, now_);
   ASSERT_NE(first<Present>(a), nullptr);
   EXPECT_EQ(first<Present>(a)->image, 1);
-  a = node.presented(now_);
+  a = node.answer(ImagePresented{}, now_);
   EXPECT_TRUE(sent(a, wire::Envelope::kPresented).empty()) << "one report per frame";
   const Render* render = first<Render>(a);
   ASSERT_NE(render, nullptr) << "frame 1 is drawn once frame 0's second image is shown";
   EXPECT_EQ(render->frame.frame_id, 1u);
   // An image is stale once the next one's time has come: a first image shown
   // late is followed by its second only if that is not late too.
-  (void)node.rendered(1, kMs);
+  (void)node.answer(FrameRendered{1, kMs, {}}, now_);
   a = swap(node, 1, now_ + kMs);
   at = first<PresentAt>(a);
   ASSERT_NE(at, nullptr);
   now_ = at->deadline;
-  (void)node.present_due(now_);
-  a = node.presented(now_ + kPeriod + kMs);
+  (void)node.due(Due::present, now_);
+  a = node.answer(ImagePresented{}, now_ + kPeriod + kMs);
   EXPECT_EQ(first<PresentAt>(a), nullptr);
   EXPECT_TRUE(logged(a, "frame 1 image 1's present deadline passed"));
   // And a first image woken too late gives way to the second.
   now_ += kPeriod;
   (void)begin(node, 2);
-  (void)node.rendered(2, kMs);
+  (void)node.answer(FrameRendered{2, kMs, {}}, now_);
   a = swap(node, 2, now_ + kMs);
   at = first<PresentAt>(a);
   ASSERT_NE(at, nullptr);
   now_ = at->deadline + kPeriod / 2 + kMs;
-  a = node.present_due(now_);
+  a = node.due(Due::present, now_);
   EXPECT_TRUE(logged(a, "frame 2 image 0's present deadline passed"));
   EXPECT_EQ(first<Present>(a), nullptr);
   at = first<PresentAt>(a);
   ASSERT_NE(at, nullptr) << "the second image's time has not passed";
   const clock::Nanos second = at->deadline;
-  a = node.present_due(second);
+  a = node.due(Due::present, second);
   ASSERT_NE(first<Present>(a), nullptr);
   EXPECT_EQ(first<Present>(a)->image, 1);
 }
@@ -347,23 +347,23 @@ TEST_F(NodeTest, BetweenTheTwoImagesALostMasterOrALateWakeUpEndsTheFrame) {
     NodeProtocol node(s);
     join(node);
     (void)begin(node, 0);
-    (void)node.rendered(0, kMs);
+    (void)node.answer(FrameRendered{0, kMs, {}}, now_);
     Actions a = swap(node, 0, now_ + kMs);
     ASSERT_NE(first<PresentAt>(a), nullptr);
     now_ = first<PresentAt>(a)->deadline;
-    ASSERT_NE(first<Present>(node.present_due(now_)), nullptr);
-    a = node.presented(now_);
+    ASSERT_NE(first<Present>(node.due(Due::present, now_)), nullptr);
+    a = node.answer(ImagePresented{}, now_);
     ASSERT_NE(first<PresentAt>(a), nullptr);
     const clock::Nanos second = first<PresentAt>(a)->deadline;
     if (lose_master) {
       a = node.closed("reset by peer", now_);
       EXPECT_NE(first<ShowBlack>(a), nullptr);
-      EXPECT_TRUE(node.present_due(second).empty()) << "the frame's second image is not shown";
+      EXPECT_TRUE(node.due(Due::present, second).empty()) << "the frame's second image is not shown";
       continue;
     }
     EXPECT_EQ(first<Render>(begin(node, 1)), nullptr) << "frame 1 waits for the second image";
     now_ = second + kPeriod / 2 + kMs;
-    a = node.present_due(now_);
+    a = node.due(Due::present, now_);
     EXPECT_EQ(first<Present>(a), nullptr);
     EXPECT_TRUE(logged(a, "frame 0 image 1's present deadline passed"));
     const Render* render = first<Render>(a);
@@ -376,7 +376,7 @@ TEST_F(NodeTest, AFrameThatComesWhileOneWaitsForItsDeadlineWaitsForIt) {
   NodeProtocol node(settings());
   join(node);
   (void)begin(node, 0);
-  (void)node.rendered(0, kMs);
+  (void)node.answer(FrameRendered{0, kMs, {}}, now_);
   Actions a = swap(node, 0, now_ + 2 * kMs);
   ASSERT_NE(first<PresentAt>(a), nullptr);
   // Frame 1 arrives early (a master behind schedule): not drawn over frame 0.
@@ -386,9 +386,9 @@ TEST_F(NodeTest, AFrameThatComesWhileOneWaitsForItsDeadlineWaitsForIt) {
   pong(node, 20'000, 5'000, 0);
   EXPECT_GE(node.estimator().size(), 1u);
   now_ += 2 * kMs;
-  a = node.present_due(now_);
+  a = node.due(Due::present, now_);
   ASSERT_NE(first<Present>(a), nullptr);
-  a = node.presented(now_);
+  a = node.answer(ImagePresented{}, now_);
   ASSERT_EQ(sent(a, wire::Envelope::kPresented).size(), 1u);
   const Render* render = first<Render>(a);
   ASSERT_NE(render, nullptr) << "frame 1 is drawn once frame 0 is shown";
@@ -399,18 +399,18 @@ TEST_F(NodeTest, AStaleFrameIsNotShown) {
   NodeProtocol node(settings());
   join(node);
   (void)begin(node, 0);
-  (void)node.rendered(0, kMs);
+  (void)node.answer(FrameRendered{0, kMs, {}}, now_);
   // The deadline passed more than a frame ago already (the process was stopped).
   Actions a = swap(node, 0, now_ - 2 * kPeriod);
   EXPECT_EQ(first<PresentAt>(a), nullptr);
   EXPECT_TRUE(logged(a, "not showing a stale frame"));
   // Or the wait itself was stretched past the next frame's time.
   (void)begin(node, 1);
-  (void)node.rendered(1, kMs);
+  (void)node.answer(FrameRendered{1, kMs, {}}, now_);
   a = swap(node, 1, now_ + 2 * kMs);
   ASSERT_NE(first<PresentAt>(a), nullptr);
   now_ += 2 * kMs + kPeriod + kMs;
-  a = node.present_due(now_);
+  a = node.due(Due::present, now_);
   EXPECT_EQ(first<Present>(a), nullptr);
   EXPECT_TRUE(logged(a, "not showing a stale frame"));
 }
@@ -422,10 +422,10 @@ TEST_F(NodeTest, AFrameIsStaleOneFramePeriodAfterItsDeadline) {
     NodeProtocol node(settings());
     join(node);
     (void)begin(node, 0);
-    (void)node.rendered(0, kMs);
+    (void)node.answer(FrameRendered{0, kMs, {}}, now_);
     const clock::Nanos deadline = now_ + 2 * kMs;
     ASSERT_NE(first<PresentAt>(swap(node, 0, deadline)), nullptr);
-    const Actions a = node.present_due(deadline + late);
+    const Actions a = node.due(Due::present, deadline + late);
     if (late < kPeriod) {
       EXPECT_NE(first<Present>(a), nullptr) << late << " ns late is still this frame's time";
     } else {
@@ -439,7 +439,7 @@ TEST_F(NodeTest, ASwapForAFrameNotRenderedIsNotShown) {
   NodeProtocol node(settings());
   join(node);
   (void)begin(node, 0);
-  (void)node.rendered(0, kMs);
+  (void)node.answer(FrameRendered{0, kMs, {}}, now_);
   const Actions a = swap(node, 7, now_ + 2 * kMs);
   EXPECT_EQ(first<PresentAt>(a), nullptr);
   EXPECT_TRUE(logged(a, "swap for frame 7 but the last rendered frame is 0"));
@@ -449,7 +449,7 @@ TEST_F(NodeTest, ADeadlineFarAwayIsCutToFourFrames) {
   NodeProtocol node(settings());
   join(node);
   (void)begin(node, 0);
-  (void)node.rendered(0, kMs);
+  (void)node.answer(FrameRendered{0, kMs, {}}, now_);
   const Actions a = swap(node, 0, now_ + 60'000 * kMs);
   const PresentAt* at = first<PresentAt>(a);
   ASSERT_NE(at, nullptr);
@@ -499,7 +499,7 @@ TEST_F(NodeTest, TheSceneSentAheadReachesTheRendererAndHowTheFrameWasDrawnGoesBa
   ASSERT_NE(render->frame.ahead, nullptr);
   EXPECT_EQ(*render->frame.ahead, later);
   EXPECT_EQ(render->frame.ahead_frame, 3u);
-  a = node.rendered(0, kMs, {up::FrameKind::between, true});
+  a = node.answer(FrameRendered{0, kMs, {up::FrameKind::between, true}}, now_);
   const auto ready = sent(a, wire::Envelope::kFrameReady);
   ASSERT_EQ(ready.size(), 1u);
   EXPECT_EQ(ready.front().frame_ready().drawn_as(), wire::DRAWN_BETWEEN_AND_KEY_AHEAD);
@@ -585,7 +585,7 @@ TEST_F(NodeTest, ALaggingNodeShowsAnOlderFramesContent) {
     const Render* render = first<Render>(a);
     ASSERT_NE(render, nullptr);
     EXPECT_EQ(render->frame.simulation_time, static_cast<clock::Nanos>(frame >= 2 ? frame - 2 : 0) * kPeriod);
-    (void)node.rendered(frame, kMs);
+    (void)node.answer(FrameRendered{frame, kMs, {}}, now_);
   }
 }
 
@@ -607,7 +607,7 @@ TEST_F(NodeTest, PingsComeInABurstOnJoiningThenFortyASecond) {
   join(node);
   std::vector<long> intervals;
   for (int i = 0; i < 10; ++i) {
-    const Actions a = node.ping_due(now_);
+    const Actions a = node.due(Due::ping, now_);
     ASSERT_NE(first<PingIn>(a), nullptr);
     intervals.push_back(first<PingIn>(a)->after.count());
   }
@@ -617,17 +617,17 @@ TEST_F(NodeTest, PingsComeInABurstOnJoiningThenFortyASecond) {
 TEST_F(NodeTest, APingDueDuringARoundWaitsUntilTheFrameIsShown) {
   NodeProtocol node(settings());
   join(node);
-  for (int i = 1; i < NodeProtocol::kPingBurst; ++i) (void)node.ping_due(now_);  // the burst is over
+  for (int i = 1; i < NodeProtocol::kPingBurst; ++i) (void)node.due(Due::ping, now_);  // the burst is over
   (void)begin(node, 0);
-  Actions a = node.ping_due(now_);
+  Actions a = node.due(Due::ping, now_);
   EXPECT_TRUE(sent(a, wire::Envelope::kPing).empty()) << "not while the master waits for this node's ready";
   ASSERT_NE(first<PingIn>(a), nullptr);
   EXPECT_EQ(first<PingIn>(a)->after, NodeProtocol::kPingDeferral);
-  (void)node.rendered(0, kMs);
+  (void)node.answer(FrameRendered{0, kMs, {}}, now_);
   a = swap(node, 0, now_ + 2 * kMs);
   now_ = first<PresentAt>(a)->deadline;
-  (void)node.present_due(now_);
-  a = node.presented(now_);
+  (void)node.due(Due::present, now_);
+  a = node.answer(ImagePresented{}, now_);
   const auto presented = std::find_if(a.begin(), a.end(), [](const Action& x) {
     return std::holds_alternative<Send>(x) && std::get<Send>(x).message.has_presented();
   });
@@ -641,17 +641,17 @@ TEST_F(NodeTest, APingDueDuringARoundWaitsUntilTheFrameIsShown) {
 
   // Mid-frame: sent at once.
   now_ += 5 * kMs;
-  EXPECT_EQ(sent(node.ping_due(now_), wire::Envelope::kPing).size(), 1u);
+  EXPECT_EQ(sent(node.due(Due::ping, now_), wire::Envelope::kPing).size(), 1u);
   // Half a millisecond before the next FrameBegin is expected: held back.
   now_ += kPeriod - 2 * kMs - 5 * kMs - kMs / 2;
-  EXPECT_TRUE(sent(node.ping_due(now_), wire::Envelope::kPing).empty());
+  EXPECT_TRUE(sent(node.due(Due::ping, now_), wire::Envelope::kPing).empty());
 
   // A round that never ends here (the master dropped the frame: no swap comes)
   // holds a ping back once, not forever.
   (void)begin(node, 1);
-  (void)node.rendered(1, kMs);
+  (void)node.answer(FrameRendered{1, kMs, {}}, now_);
   now_ += NodeProtocol::kPingDeferral.count() * kMs;
-  EXPECT_EQ(sent(node.ping_due(now_), wire::Envelope::kPing).size(), 1u);
+  EXPECT_EQ(sent(node.due(Due::ping, now_), wire::Envelope::kPing).size(), 1u);
 }
 
 // --- a glTF scene's files, fetched from the master when this node has no copy
@@ -695,7 +695,7 @@ TEST_F(SceneFetchTest, ACopyInTheCacheIsUsedWithoutAFetch) {
   EXPECT_EQ(prepare->sha256, scene_.sha256);
   EXPECT_EQ(prepare->manifest.files.size(), 2u);
   EXPECT_EQ(first<Configure>(a), nullptr);
-  a = node.scene_found("/cache/scenes/abc/s.gltf");
+  a = node.answer(SceneFound{"/cache/scenes/abc/s.gltf"}, now_);
   ASSERT_NE(first<Configure>(a), nullptr);
   EXPECT_EQ(first<Configure>(a)->job.scene_path, "/cache/scenes/abc/s.gltf");
   EXPECT_TRUE(sent(a, wire::Envelope::kSceneRequest).empty());
@@ -704,7 +704,7 @@ TEST_F(SceneFetchTest, ACopyInTheCacheIsUsedWithoutAFetch) {
 TEST_F(SceneFetchTest, AMissingSceneIsFetchedChunkByChunkAndCheckedThenConfigured) {
   NodeProtocol node(settings());
   (void)welcome_with_files(node);
-  Actions a = node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
+  Actions a = node.answer(SceneCopyStarted{protocol::SceneFetch::Present{}}, now_);
   auto requests = sent(a, wire::Envelope::kSceneRequest);
   ASSERT_EQ(requests.size(), 3u);  // every chunk there is, up to four at once
   EXPECT_EQ(requests[0].scene_request().scene_sha256(), scene_.sha256);
@@ -733,7 +733,7 @@ TEST_F(SceneFetchTest, AMissingSceneIsFetchedChunkByChunkAndCheckedThenConfigure
   ASSERT_NE(first<StoreSceneChunk>(a), nullptr);
   ASSERT_NE(first<FinishScene>(a), nullptr);
 
-  a = node.scene_copy_finished(std::string("/cache/scenes/x/s.gltf"), now_ + 30 * kMs);
+  a = node.answer(SceneCopyFinished{std::string("/cache/scenes/x/s.gltf")}, now_ + 30 * kMs);
   EXPECT_TRUE(logged(a, "fetched the scene: 0.0 MiB in 0.03 s"));
   EXPECT_TRUE(logged(a, "1 chunk(s) asked for again"));
   ASSERT_NE(first<Configure>(a), nullptr);
@@ -744,7 +744,7 @@ TEST_F(SceneFetchTest, AChunkNotAskedForClosesAndAFailedCopyStopsTheNode) {
   {
     NodeProtocol node(settings());
     (void)welcome_with_files(node);
-    (void)node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
+    (void)node.answer(SceneCopyStarted{protocol::SceneFetch::Present{}}, now_);
     const Actions a = node.message(chunk(1, 9, "x"), now_);
     ASSERT_NE(first<Close>(a), nullptr);
     EXPECT_NE(first<Close>(a)->reason.find("not asked for"), std::string::npos);
@@ -757,7 +757,7 @@ TEST_F(SceneFetchTest, AChunkNotAskedForClosesAndAFailedCopyStopsTheNode) {
   {
     NodeProtocol node(settings());
     (void)welcome_with_files(node);
-    const Actions a = node.scene_copy_started(Error{"no room"}, now_);
+    const Actions a = node.answer(SceneCopyStarted{Error{"no room"}}, now_);
     ASSERT_NE(first<Stop>(a), nullptr);
     EXPECT_EQ(first<Stop>(a)->exit_code, kExitRefused);
     EXPECT_TRUE(logged(a, "no room"));
@@ -765,8 +765,8 @@ TEST_F(SceneFetchTest, AChunkNotAskedForClosesAndAFailedCopyStopsTheNode) {
   {
     NodeProtocol node(settings());
     (void)welcome_with_files(node);
-    (void)node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
-    const Actions a = node.scene_store_failed("disk full");
+    (void)node.answer(SceneCopyStarted{protocol::SceneFetch::Present{}}, now_);
+    const Actions a = node.answer(SceneStoreFailed{"disk full"}, now_);
     ASSERT_NE(first<Stop>(a), nullptr);
     EXPECT_NE(first<AbandonScene>(a), nullptr);
   }
@@ -774,7 +774,7 @@ TEST_F(SceneFetchTest, AChunkNotAskedForClosesAndAFailedCopyStopsTheNode) {
     // The same chunk spoilt on every try: the fetch gives the connection up.
     NodeProtocol node(settings());
     (void)welcome_with_files(node);
-    (void)node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
+    (void)node.answer(SceneCopyStarted{protocol::SceneFetch::Present{}}, now_);
     Actions a;
     for (int i = 0; i < protocol::SceneFetch::kMostTries; ++i) a = node.message(chunk(0, 0, "{}"), now_);
     ASSERT_NE(first<Close>(a), nullptr);
@@ -787,7 +787,7 @@ TEST_F(SceneFetchTest, AFetchCutShortGoesOnFromWhatIsHere) {
   (void)welcome_with_files(node);
   // The glTF and the binary's first chunk came before the connection went.
   const protocol::SceneFetch::Present present{{true}, {true, false}};
-  Actions a = node.scene_copy_started(present, now_);
+  Actions a = node.answer(SceneCopyStarted{present}, now_);
   EXPECT_TRUE(logged(a, "fetching the rest of the scene"));
   const auto requests = sent(a, wire::Envelope::kSceneRequest);
   ASSERT_EQ(requests.size(), 1u);
@@ -798,7 +798,7 @@ TEST_F(SceneFetchTest, AFetchCutShortGoesOnFromWhatIsHere) {
   // Everything here already: put in place at once.
   NodeProtocol whole(settings());
   (void)welcome_with_files(whole);
-  a = whole.scene_copy_started(protocol::SceneFetch::Present{{true}, {true, true}}, now_);
+  a = whole.answer(SceneCopyStarted{protocol::SceneFetch::Present{{true}, {true, true}}}, now_);
   EXPECT_TRUE(sent(a, wire::Envelope::kSceneRequest).empty());
   EXPECT_NE(first<FinishScene>(a), nullptr);
 }
@@ -809,7 +809,7 @@ TEST_F(SceneFetchTest, AFetchCutShortGoesOnFromWhatIsHere) {
 TEST_F(SceneFetchTest, ANodeWaitsForTheCopyAnotherNodeOfItsHostIsFetching) {
   NodeProtocol node(settings());
   (void)welcome_with_files(node);
-  Actions a = node.scene_fetched_elsewhere(100, now_);
+  Actions a = node.answer(SceneFetchedElsewhere{100}, now_);
   EXPECT_TRUE(logged(a, "another node of this host is fetching the scene")) << "logged";
   EXPECT_TRUE(sent(a, wire::Envelope::kSceneRequest).empty());
   auto waits = sent(a, wire::Envelope::kSceneWait);
@@ -824,28 +824,28 @@ TEST_F(SceneFetchTest, ANodeWaitsForTheCopyAnotherNodeOfItsHostIsFetching) {
   // The recheck asks the cache again, still waiting for others.
   const clock::Nanos recheck = NodeProtocol::kSceneRecheck.count() * kMs;
   now_ += recheck;
-  a = node.scene_recheck_due(now_);
+  a = node.due(Due::scene_recheck, now_);
   ASSERT_NE(first<PrepareScene>(a), nullptr);
   EXPECT_TRUE(first<PrepareScene>(a)->wait_for_others);
   // The copy grows: not logged again, the master not told again within the second.
-  a = node.scene_fetched_elsewhere(500, now_);
+  a = node.answer(SceneFetchedElsewhere{500}, now_);
   EXPECT_FALSE(logged(a, "another node"));
   EXPECT_TRUE(sent(a, wire::Envelope::kSceneWait).empty());
   now_ += NodeProtocol::kSceneWaitWord.count() * kMs;
-  a = node.scene_fetched_elsewhere(600, now_);
+  a = node.answer(SceneFetchedElsewhere{600}, now_);
   waits = sent(a, wire::Envelope::kSceneWait);
   ASSERT_EQ(waits.size(), 1u);
   EXPECT_EQ(waits[0].scene_wait().bytes_there(), 600u);
   // It grew until just now: waited for well past kSceneStall from the start.
   now_ += NodeProtocol::kSceneStall.count() * kMs - recheck;
-  a = node.scene_fetched_elsewhere(900, now_);
+  a = node.answer(SceneFetchedElsewhere{900}, now_);
   EXPECT_EQ(first<PrepareScene>(a), nullptr);
   ASSERT_NE(first<RecheckScene>(a), nullptr);
 
-  a = node.scene_found("/cache/scenes/abc/s.gltf");
+  a = node.answer(SceneFound{"/cache/scenes/abc/s.gltf"}, now_);
   ASSERT_NE(first<Configure>(a), nullptr);
   EXPECT_TRUE(logged(a, "fetched by another node of this host"));
-  EXPECT_TRUE(node.scene_recheck_due(now_ + recheck).empty()) << "no longer waiting";
+  EXPECT_TRUE(node.due(Due::scene_recheck, now_ + recheck).empty()) << "no longer waiting";
 }
 
 // A copy that stops growing for kSceneStall is not waited for any longer: the
@@ -853,26 +853,26 @@ TEST_F(SceneFetchTest, ANodeWaitsForTheCopyAnotherNodeOfItsHostIsFetching) {
 TEST_F(SceneFetchTest, ACopyThatStopsGrowingIsNotWaitedForAndTheNodeFetches) {
   NodeProtocol node(settings());
   (void)welcome_with_files(node);
-  (void)node.scene_fetched_elsewhere(100, now_);
+  (void)node.answer(SceneFetchedElsewhere{100}, now_);
   now_ += NodeProtocol::kSceneStall.count() * kMs - kMs;
-  Actions a = node.scene_fetched_elsewhere(100, now_);
+  Actions a = node.answer(SceneFetchedElsewhere{100}, now_);
   EXPECT_EQ(first<PrepareScene>(a), nullptr) << "a millisecond short of the stall";
   now_ += kMs;
-  a = node.scene_fetched_elsewhere(100, now_);
+  a = node.answer(SceneFetchedElsewhere{100}, now_);
   ASSERT_NE(first<PrepareScene>(a), nullptr);
   EXPECT_FALSE(first<PrepareScene>(a)->wait_for_others);
   EXPECT_EQ(first<RecheckScene>(a), nullptr);
   EXPECT_TRUE(logged(a, "has not grown for 10 s"));
   EXPECT_TRUE(logged(a, "fetching the scene from the master"));
-  a = node.scene_copy_started(protocol::SceneFetch::Present{}, now_);
+  a = node.answer(SceneCopyStarted{protocol::SceneFetch::Present{}}, now_);
   EXPECT_EQ(sent(a, wire::Envelope::kSceneRequest).size(), 3u);
 
   // The connection lost while waiting: a recheck due afterwards does nothing.
   NodeProtocol lost(settings());
   (void)welcome_with_files(lost);
-  (void)lost.scene_fetched_elsewhere(0, now_);
+  (void)lost.answer(SceneFetchedElsewhere{0}, now_);
   (void)lost.closed("gone", now_);
-  EXPECT_TRUE(lost.scene_recheck_due(now_).empty());
+  EXPECT_TRUE(lost.due(Due::scene_recheck, now_).empty());
 }
 
 TEST_F(SceneFetchTest, ANodeWithoutARendererOrTooSmallALimitFetchesNothing) {
@@ -947,7 +947,7 @@ TEST_F(NodeTest, AFrameToSkipIsAppliedButNotDrawnOrAnswered) {
   EXPECT_TRUE(sent(a, wire::Envelope::kFrameReady).empty());
   EXPECT_TRUE(logged(a, "behind: skipping frames from frame 3"));
   // A ping falling due now is not held back for a round that never ends.
-  a = node.ping_due(now_);
+  a = node.due(Due::ping, now_);
   EXPECT_EQ(sent(a, wire::Envelope::kPing).size(), 1u);
 
   b.set_frame_id(4);
@@ -961,7 +961,7 @@ TEST_F(NodeTest, AFrameToSkipIsAppliedButNotDrawnOrAnswered) {
   ASSERT_NE(render, nullptr);
   EXPECT_EQ(render->frame.frame_id, 5u);
   EXPECT_TRUE(logged(a, "caught up: drawing frame 5 after skipping 2 frame(s)"));
-  a = node.rendered(5, 3 * kMs);
+  a = node.answer(FrameRendered{5, 3 * kMs, {}}, now_);
   EXPECT_EQ(sent(a, wire::Envelope::kFrameReady).size(), 1u);
 }
 
@@ -974,7 +974,7 @@ TEST_F(NodeTest, ConfiguredSaysHowLongTheWarmUpFrameTook) {
   wire::Envelope welcome = envelope();
   *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr);
   (void)node.message(welcome, now_);
-  const Actions a = node.configured({}, "test renderer", {420 * kMs, 130 * kMs});
+  const Actions a = node.answer(Configured{{}, "test renderer", {420 * kMs, 130 * kMs}}, now_);
   const auto configured = sent(a, wire::Envelope::kConfigured);
   ASSERT_EQ(configured.size(), 1u);
   EXPECT_EQ(configured.front().configured().warm_up_ns(), 420 * kMs);

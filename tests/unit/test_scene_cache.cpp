@@ -12,9 +12,11 @@
 #include <spdlog/sinks/null_sink.h>
 #include <spdlog/sinks/ostream_sink.h>
 #include <sys/mount.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
@@ -166,6 +168,34 @@ TEST_F(SceneCacheTest, ACopyMissingChunksIsNotPutInPlace) {
   ASSERT_FALSE(committed.ok());
   EXPECT_NE(committed.error().find("not whole: " + (dir_ / "scenes").string()), std::string::npos)
       << "names the file where it is: " << committed.error();
+  EXPECT_FALSE(fs::exists(dir_ / "scenes" / sha_));
+  EXPECT_EQ(entries_in_scenes(), 0) << "the partial copy and its lock are removed";
+}
+
+// A chunk that did not reach the disk leaves a hole in a file already at its
+// full size (the chunks after it were written): the copy is not put in place.
+// The disk refuses here through the file-size limit (EFBIG), as a full disk would.
+TEST_F(SceneCacheTest, ACopyWithAChunkTheDiskRefusedIsNotPutInPlace) {
+  SceneCache cache(dir_, log_);
+  ASSERT_TRUE(cache.begin(files_, sha_).ok());
+  write_chunks(cache, std::make_pair(0u, std::uint64_t{0}));
+  write_chunks(cache, std::make_pair(1u, std::uint64_t{0}));
+  write_chunks(cache, std::make_pair(1u, std::uint64_t{2}));  // the file is at its full size now
+  rlimit before{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &before), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit small = before;
+  small.rlim_cur = files_.chunk_bytes;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  const std::string middle = bin_.substr(files_.chunk_offset(1), files_.chunk_length(1, 1));
+  const Result<void> refused = cache.write(1, files_.chunk_offset(1), middle);
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &before), 0);
+  std::signal(SIGXFSZ, old_handler);
+  ASSERT_FALSE(refused.ok()) << "the limit did not stop the write";
+  const auto committed = cache.commit();
+  ASSERT_FALSE(committed.ok()) << "a copy with a hole was put in place";
+  EXPECT_NE(committed.error().find("not whole: cannot write " + (dir_ / "scenes").string()), std::string::npos)
+      << committed.error();
   EXPECT_FALSE(fs::exists(dir_ / "scenes" / sha_));
   EXPECT_EQ(entries_in_scenes(), 0) << "the partial copy and its lock are removed";
 }
