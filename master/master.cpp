@@ -14,7 +14,21 @@
 #include "util/overloaded.h"
 
 namespace optique::master {
+
 namespace {
+
+// A port chosen by the system (port 0), for whoever started the master: written
+// whole under another name and renamed, so a reader never sees half of it.
+// `path` empty: not asked for.
+Result<void> write_port_file(const std::string& path, unsigned port, const std::string& what) {
+  if (path.empty()) return {};
+  const std::string temp = path + ".tmp";
+  std::ofstream(temp) << port << "\n";
+  std::error_code renamed;
+  std::filesystem::rename(temp, path, renamed);
+  if (renamed) return Error{"cannot write the " + what + " '" + path + "': " + renamed.message()};
+  return {};
+}
 
 using std::chrono::milliseconds;
 
@@ -98,7 +112,7 @@ Result<void> Master::start() {
     const auto head_path = std::filesystem::path(options_.out_dir) / "head.csv";
     head_csv_.open(head_path);
     if (!head_csv_) return Error{"cannot write " + head_path.string()};
-    run.head_csv = &head_csv_;
+    head_csv_ << head_csv_header();
   }
   protocol_.emplace(installation, options_.scene, std::move(run), *recorder_);
 
@@ -115,13 +129,7 @@ Result<void> Master::start() {
     return Error{"cannot listen on " + settings.listen + ":" + std::to_string(settings.port) + ": " + ec.message()};
   }
   port_ = acceptor_.local_endpoint().port();
-  if (!options_.port_file.empty()) {
-    const std::string temp = options_.port_file + ".tmp";
-    std::ofstream(temp) << port_ << "\n";
-    std::error_code renamed;
-    std::filesystem::rename(temp, options_.port_file, renamed);
-    if (renamed) return Error{"cannot write the port file '" + options_.port_file + "': " + renamed.message()};
-  }
+  if (auto written = write_port_file(options_.port_file, port_, "port file"); !written) return written;
   std::string id_list;
   for (const auto& id : ids) id_list += (id_list.empty() ? "" : ", ") + id;
   log_.info("listening on {}:{}; waiting for {} node(s): {}", settings.listen, port_, ids.size(), id_list);
@@ -190,16 +198,7 @@ Result<void> Master::start_status_service(const config::StatusServer& settings) 
             options_.run.secret ? "need the token (optique-master --print-status-token)"
                                 : "off (no master.secret_file, so no token)");
   publish_status();  // before the port is told: a first request finds a status
-  if (!options_.status_port_file.empty()) {
-    const std::string temp = options_.status_port_file + ".tmp";
-    std::ofstream(temp) << port.value() << "\n";
-    std::error_code renamed;
-    std::filesystem::rename(temp, options_.status_port_file, renamed);
-    if (renamed) {
-      return Error{"cannot write the status port file '" + options_.status_port_file + "': " + renamed.message()};
-    }
-  }
-  return {};
+  return write_port_file(options_.status_port_file, port.value(), "status port file");
 }
 
 void Master::publish_status() {
@@ -313,6 +312,9 @@ void Master::carry_out(Action& action) {
                  },
                  [&](SignalLocalNodes& a) {
                    if (launcher_) launcher_->signal_all(a.signal);
+                 },
+                 [&](HeadShown& a) {
+                   if (head_csv_.is_open()) head_csv_ << head_csv_row(a);
                  },
                  [&](Finish& a) { finish(a.exit_code); },
                  [&](Log& a) { log_.log(a.level, "{}", a.text); },

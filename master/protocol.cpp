@@ -44,10 +44,8 @@ MasterProtocol::MasterProtocol(const config::Installation& installation, const s
       focus_(FocusSchedule::make(installation)) {
   frame_period_ = authority_.frame_period();
   if (installation.viewer.tracking) {
-    head_tracker_.emplace(*installation.viewer.tracking, tracking::turn_onto_x(installation.viewer.head_right));
-    if (settings_.head_csv != nullptr) {
-      *settings_.head_csv << "frame_id,display_ns,tracker,eye_x,eye_y,eye_z,right_x,right_y,right_z\n";
-    }
+    head_.emplace(*installation.viewer.tracking, installation.viewer.head_right, frame_period_,
+                  std::move(settings_.replay));
   }
   current_state_ = authority_.state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
@@ -86,7 +84,7 @@ const MasterProtocol::Session* MasterProtocol::session_of(std::size_t slot) cons
 
 Actions MasterProtocol::start(clock::Nanos now) {
   Actions out;
-  if (head_tracker_ && !settings_.replay.empty()) replay_.emplace(std::move(settings_.replay), now);
+  if (head_) head_->start(now);
   out.push_back(Arm{Timer::startup, now + nanos(config_.startup_timeout)});
   out.push_back(Arm{Timer::heartbeat, now + nanos(config_.heartbeat)});
   return out;
@@ -621,7 +619,12 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   scene::SceneState state = authority_.state_at_frame(frame);
   const clock::Nanos display =
       schedule_origin_ + static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_;
-  if (head_tracker_) track_head(state, frame, display, now, out);
+  if (head_) {
+    std::vector<std::string> said;
+    const HeadShown shown = head_->track(state, frame, display, now, said);
+    for (std::string& text : said) out.push_back(Log{spdlog::level::warn, std::move(text)});
+    out.push_back(shown);
+  }
   wire::Envelope envelope;
   auto& begin = *envelope.mutable_frame_begin();
   begin.set_frame_id(frame);
@@ -694,8 +697,7 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
         auto& begin_ahead = *to_node.mutable_frame_begin();
         scene::SceneState ahead_state = authority_.state_at_frame(ahead);
         // A tracked head that far ahead is a prediction that far ahead.
-        if (head_tracker_)
-          (void)head_into(ahead_state, display + static_cast<clock::Nanos>(ahead - frame) * frame_period_);
+        if (head_) (void)head_->into(ahead_state, display + static_cast<clock::Nanos>(ahead - frame) * frame_period_);
         *begin_ahead.mutable_ahead() = scene::to_snapshot(ahead_state);
         begin_ahead.set_ahead_frame(ahead);
       }
@@ -940,28 +942,8 @@ report::RunReport MasterProtocol::report() const {
   report.set_frame_rate(config_.frame_rate);
   report.set_stopped_because(stopped_because_);
   report.set_connections_refused(refused_connections_);
-  if (auto tracking = tracking_report()) *report.mutable_tracking() = std::move(*tracking);
+  if (head_) *report.mutable_tracking() = head_->report();
   return report;
-}
-
-std::optional<report::TrackingReport> MasterProtocol::tracking_report() const {
-  if (!head_tracker_) return std::nullopt;
-  const config::Tracking& settings = *installation_.viewer.tracking;
-  const tracking::TrackingCounts& counts = head_tracker_->counts();
-  report::TrackingReport t;
-  t.set_source(std::string(config::to_string(settings.source)));
-  t.set_prediction(std::string(config::to_string(settings.prediction)));
-  t.set_datagrams(counts.datagrams);
-  t.set_samples(counts.samples);
-  t.set_malformed(counts.malformed);
-  t.set_without_body(counts.without_body);
-  t.set_backwards(counts.backwards);
-  t.set_flood(counts.flood);
-  t.set_other_sender(counts.other_sender);
-  t.set_losses(counts.losses);
-  t.set_lost_seconds(static_cast<double>(counts.lost_ns) / 1e9);
-  t.set_state(std::string(tracking::to_string(head_tracker_->state())));
-  return t;
 }
 
 LiveStatus MasterProtocol::live(clock::Nanos now) const {
@@ -1017,7 +999,7 @@ LiveStatus MasterProtocol::live(clock::Nanos now) const {
     }
     status.nodes.push_back(std::move(node));
   }
-  status.tracking = tracking_report();
+  if (head_) status.tracking = head_->report();
   summarize_recent(recorder_.recent(), now, status);
   return status;
 }
@@ -1074,38 +1056,11 @@ Actions MasterProtocol::operator_command(OperatorCommand command, const std::str
 
 Actions MasterProtocol::tracker_input(tracking::TrackerInput input) {
   Actions out;
-  if (!head_tracker_) return out;
+  if (!head_) return out;
   std::vector<std::string> said;
-  head_tracker_->input(std::move(input), said);
+  head_->input(std::move(input), said);
   for (std::string& text : said) out.push_back(Log{spdlog::level::warn, std::move(text)});
   return out;
-}
-
-tracking::TrackerState MasterProtocol::head_into(scene::SceneState& state, clock::Nanos display) const {
-  // Where the viewer rests (eye or path) is what the authority gave.
-  const tracking::HeadAt now_head = head_tracker_->at(display, state.eye_now);
-  const tracking::HeadAt next_head = head_tracker_->at(display + frame_period_, state.eye_next);
-  state.eye_now = now_head.pose.position;
-  state.eye_next = next_head.pose.position;
-  state.head_now = now_head.pose.orientation;
-  state.head_next = next_head.pose.orientation;
-  return now_head.state;
-}
-
-void MasterProtocol::track_head(scene::SceneState& state, std::uint64_t frame, clock::Nanos display, clock::Nanos now,
-                                Actions& out) {
-  if (replay_) replay_->feed(now, *head_tracker_);
-  std::vector<std::string> said;
-  head_tracker_->notice(now, said);
-  for (std::string& text : said) out.push_back(Log{spdlog::level::warn, std::move(text)});
-  const tracking::TrackerState tracker = head_into(state, display);
-  if (settings_.head_csv != nullptr) {
-    const glm::dvec3 right = state.head_now * installation_.viewer.head_right;
-    *settings_.head_csv << frame << ',' << display << ',' << tracking::to_string(tracker) << ','
-                        << fmt::format("{:.6f},{:.6f},{:.6f},{:.6f},{:.6f},{:.6f}", state.eye_now.x, state.eye_now.y,
-                                       state.eye_now.z, right.x, right.y, right.z)
-                        << '\n';
-  }
 }
 
 Actions MasterProtocol::local_node_exited(const std::string& id, const std::string& how, bool clean,

@@ -33,6 +33,7 @@
 #include "master/run_recorder.h"
 #include "master/scene_authority.h"
 #include "master/stacked_groups.h"
+#include "master/viewer_head.h"
 #include "net/auth.h"
 #include "net/session_seal.h"
 #include "optique/report.pb.h"
@@ -104,6 +105,7 @@ struct StopAccepting {};
 struct SignalLocalNodes {
   int signal = 0;
 };
+// HeadShown (master/viewer_head.h): the head shown in a frame, for head.csv.
 // The run is over: write the outputs (report()) and end with this status.
 struct Finish {
   int exit_code = kExitOk;
@@ -114,7 +116,7 @@ struct Log {
 };
 
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Protect, Arm, Disarm,
-                            StopAccepting, SignalLocalNodes, Finish, Log>;
+                            StopAccepting, SignalLocalNodes, HeadShown, Finish, Log>;
 using Actions = std::vector<Action>;
 
 struct RunSettings {
@@ -125,9 +127,6 @@ struct RunSettings {
   // A `replay` tracker's samples (tracking/replay.h), loaded before the run:
   // fed at their times from the start.
   std::vector<tracking::ReplaySample> replay;
-  // Where the head shown each frame goes (frame, display time, tracker state,
-  // the eyes' centre and the axis to the right eye), CSV; none: nowhere.
-  std::ostream* head_csv = nullptr;
   // Reads the clock at the instant a FrameBegin goes out, once the frame's state
   // is computed: a barrier round is from then to the Swap, not the master's own
   // work on the frame. Unset (tests): the time of the event that began the frame.
@@ -258,7 +257,6 @@ class MasterProtocol {
   [[nodiscard]] std::chrono::seconds configure_timeout() const;
   [[nodiscard]] Session* session_of(std::size_t slot);
   [[nodiscard]] const Session* session_of(std::size_t slot) const;
-  [[nodiscard]] std::optional<report::TrackingReport> tracking_report() const;
 
   const config::Installation& installation_;
   const config::MasterSettings& config_;
@@ -271,13 +269,7 @@ class MasterProtocol {
   SceneAuthority authority_;
   LightPlan light_plan_;
   std::optional<FocusSchedule> focus_;
-  std::optional<tracking::HeadTracker> head_tracker_;  // viewer.tracking
-  std::optional<tracking::ReplayFeed> replay_;
-  // The head as the tracker says at `display` and a frame later, into `state`;
-  // the tracker's state then.
-  [[nodiscard]] tracking::TrackerState head_into(scene::SceneState& state, clock::Nanos display) const;
-  // Feeds a replay, notices loss (logged), and puts the head into the frame's state.
-  void track_head(scene::SceneState& state, std::uint64_t frame, clock::Nanos display, clock::Nanos now, Actions& out);
+  std::optional<ViewerHead> head_;  // viewer.tracking
   scene::SceneState current_state_;
   std::uint64_t current_hash_ = 0;
   Barrier barrier_;

@@ -90,14 +90,6 @@ glm::dmat3 aligned_homography(const ScreenRect& region, int width, int height) {
   return m;
 }
 
-glm::dvec2 pixel_to_ndc(const glm::dvec2& pixel, int width, int height) {
-  return glm::dvec2(2.0 * pixel.x / width - 1.0, 1.0 - 2.0 * pixel.y / height);
-}
-
-glm::dvec2 ndc_to_pixel(const glm::dvec2& ndc, int width, int height) {
-  return glm::dvec2((ndc.x + 1.0) * 0.5 * width, (1.0 - ndc.y) * 0.5 * height);
-}
-
 ProjectorGeometry::ProjectorGeometry(const glm::dmat3& screen_to_pixel, const glm::dmat3& pixel_to_screen, int width,
                                      int height)
     : screen_to_pixel_(screen_to_pixel), pixel_to_screen_(pixel_to_screen), width_(width), height_(height) {}

@@ -94,8 +94,4 @@ struct ObliqueProjection {
 // shown; outside it the projector is masked to black).
 [[nodiscard]] Result<ObliqueProjection> oblique_projection(const ProjectorGeometry& geometry, const ScreenRect& usable);
 
-// Pixel ↔ NDC of an image `width` × `height` (y flips: pixels go down, NDC up).
-[[nodiscard]] glm::dvec2 pixel_to_ndc(const glm::dvec2& pixel, int width, int height);
-[[nodiscard]] glm::dvec2 ndc_to_pixel(const glm::dvec2& ndc, int width, int height);
-
 }  // namespace optique::geometry

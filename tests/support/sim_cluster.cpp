@@ -233,6 +233,7 @@ void SimCluster::master_actions(master::Actions actions) {
                    [&](master::Disarm& a) { master_timers_.erase(a.timer); },
                    [&](master::StopAccepting&) { accepting_ = false; },
                    [&](master::SignalLocalNodes&) {},
+                   [&](master::HeadShown&) {},
                    [&](master::Finish& a) { finished_ = a.exit_code; },
                    [&](master::Log&) {},
                },

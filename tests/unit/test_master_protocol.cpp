@@ -375,6 +375,19 @@ TEST_F(MasterTest, EachFrameCarriesTheTrackedHead) {
   ASSERT_TRUE(viewer.has_head_now());
   EXPECT_NEAR(viewer.head_now().w(), std::sqrt(0.5), 1e-9);
   EXPECT_NEAR(viewer.head_now().z(), std::sqrt(0.5), 1e-9);
+  // The head shown leaves as an action, for the shell's head.csv: the right
+  // eye's axis turned a quarter with the head.
+  const HeadShown* head = nullptr;
+  for (const Action& action : a) {
+    if (const auto* h = std::get_if<HeadShown>(&action)) head = h;
+  }
+  ASSERT_NE(head, nullptr);
+  EXPECT_EQ(head->frame, 1u);
+  EXPECT_EQ(head->tracker, tracking::TrackerState::tracking);
+  EXPECT_DOUBLE_EQ(head->eye.x, 0.5);
+  EXPECT_NEAR(head->right.y, 1.0, 1e-9);
+  EXPECT_EQ(head_csv_row(*head).substr(0, 2), "1,");
+  EXPECT_NE(head_csv_row(*head).find(",tracking,0.500000,"), std::string::npos) << head_csv_row(*head);
   const report::RunReport report = master_->report();
   const report::TrackingReport& t = report.tracking();
   EXPECT_EQ(t.source(), "dtrack");
