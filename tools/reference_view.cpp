@@ -1,14 +1,15 @@
 #include "tools/reference_view.h"
 
 #include "geometry/projection.h"
-#include "image/convert.h"
 #include "optics/compose.h"
 
 namespace optique::tools {
 
-ReferenceView::ReferenceView(std::unique_ptr<render::SceneRenderer> renderer, const config::Installation& installation,
-                             const ScreenImage& image, int width, int height, int supersample)
+ReferenceView::ReferenceView(std::unique_ptr<render::SceneRenderer> renderer, std::optional<render::BoxReduce> reduce,
+                             const config::Installation& installation, const ScreenImage& image, int width, int height,
+                             int supersample)
     : renderer_(std::move(renderer)),
+      reduce_(std::move(reduce)),
       viewer_(&installation.viewer),
       screen_(image.screen),
       eye_(image.eye),
@@ -25,7 +26,14 @@ Result<ReferenceView> ReferenceView::make(const config::Installation& installati
   const int height = optics::screen_pixels(screen.height, screen.pixels_per_metre);
   auto renderer = render::SceneRenderer::create(scene, width * supersample, height * supersample);
   if (!renderer) return Error{renderer.error()};
-  return ReferenceView(std::move(renderer).value(), installation, image, width, height, supersample);
+  std::optional<render::BoxReduce> reduce;
+  if (supersample > 1) {
+    auto made = render::BoxReduce::make(width, height, supersample);
+    if (!made) return Error{made.error()};
+    reduce = std::move(made).value();
+  }
+  return ReferenceView(std::move(renderer).value(), std::move(reduce), installation, image, width, height,
+                       supersample);
 }
 
 Result<image::FloatImage> ReferenceView::draw(const scene::SceneState& state, double fraction) const {
@@ -34,8 +42,8 @@ Result<image::FloatImage> ReferenceView::draw(const scene::SceneState& state, do
   auto frustum = geometry::off_axis_frustum(screen_->world(), eye, viewer.near, viewer.far);
   if (!frustum) return Error{frustum.error()};
   renderer_->draw(state, fraction, eye, frustum.value());
-  if (supersample_ == 1) return renderer_->read_rendered();
-  return image::box_downsample(renderer_->read_rendered(), supersample_);
+  if (!reduce_) return renderer_->read_rendered();
+  return reduce_->read(renderer_->rendered_framebuffer());
 }
 
 }  // namespace optique::tools

@@ -5,9 +5,11 @@
 // moments of a continuous, every-colour-at-once display.
 
 #include <memory>
+#include <optional>
 
 #include "config/installation.h"
 #include "image/image.h"
+#include "render/box_reduce.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
 #include "scene/state.h"
@@ -35,10 +37,12 @@ class ReferenceView {
   [[nodiscard]] int supersample() const { return supersample_; }
 
  private:
-  ReferenceView(std::unique_ptr<render::SceneRenderer> renderer, const config::Installation& installation,
-                const ScreenImage& image, int width, int height, int supersample);
+  ReferenceView(std::unique_ptr<render::SceneRenderer> renderer, std::optional<render::BoxReduce> reduce,
+                const config::Installation& installation, const ScreenImage& image, int width, int height,
+                int supersample);
 
   std::unique_ptr<render::SceneRenderer> renderer_;
+  std::optional<render::BoxReduce> reduce_;  // when supersampled: the samples averaged by GL
   const config::Viewer* viewer_;
   const config::Screen* screen_;
   config::Eye eye_;

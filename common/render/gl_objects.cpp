@@ -83,4 +83,14 @@ Result<Program> link_program(std::string_view vertex_source, std::string_view fr
   return Error{std::string("shader program does not link: ") + log};
 }
 
+image::FloatImage read_float(GLuint framebuffer, int width, int height, GLenum format, int channels) {
+  image::FloatImage image(width, height, channels);
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
+  glReadBuffer(format == GL_DEPTH_COMPONENT ? GL_NONE : GL_COLOR_ATTACHMENT0);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glReadPixels(0, 0, width, height, format, GL_FLOAT, image.pixels.data());
+  image::flip_rows(image);
+  return image;
+}
+
 }  // namespace optique::render::glo

@@ -3,13 +3,15 @@
 // array, shader or program name owned by one value, moved and never copied, and
 // given back to GL when the value goes (with its context current, as every GL
 // call needs). And the one way to build a program from GLSL sources, with the
-// driver's message when it does not compile or link.
+// driver's message when it does not compile or link, and the one way to read
+// a framebuffer back as floats.
 
 #include <epoxy/gl.h>
 
 #include <string_view>
 #include <utility>
 
+#include "image/image.h"
 #include "util/result.h"
 
 namespace optique::render::glo {
@@ -68,5 +70,9 @@ using Program = Object<detail::delete_program>;
 
 // Compiles and links; fails with the driver's log.
 [[nodiscard]] Result<Program> link_program(std::string_view vertex_source, std::string_view fragment_source);
+
+// `framebuffer`'s colour attachment 0 (or its depth, for GL_DEPTH_COMPONENT) as
+// floats, rows top first.
+[[nodiscard]] image::FloatImage read_float(GLuint framebuffer, int width, int height, GLenum format, int channels);
 
 }  // namespace optique::render::glo

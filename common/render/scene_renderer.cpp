@@ -812,20 +812,6 @@ void SceneRenderer::encode(unsigned texture, unsigned depth) {
   glFinish();
 }
 
-namespace {
-
-image::FloatImage read_float(GLuint framebuffer, int width, int height, GLenum format, int channels) {
-  image::FloatImage image(width, height, channels);
-  glBindFramebuffer(GL_READ_FRAMEBUFFER, framebuffer);
-  glReadBuffer(format == GL_DEPTH_COMPONENT ? GL_NONE : GL_COLOR_ATTACHMENT0);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
-  glReadPixels(0, 0, width, height, format, GL_FLOAT, image.pixels.data());
-  image::flip_rows(image);
-  return image;
-}
-
-}  // namespace
-
 image::FloatImage SceneRenderer::read_linear() const {
   const image::WordImage signal = read_signal();
   image::FloatImage normalized(signal.width, signal.height, signal.channels);
@@ -834,13 +820,13 @@ image::FloatImage SceneRenderer::read_linear() const {
 }
 
 image::FloatImage SceneRenderer::read_rendered() const {
-  image::FloatImage image = read_float(gl_->rendered_colour_framebuffer, gl_->width, gl_->height, GL_RGBA, 4);
+  image::FloatImage image = glo::read_float(gl_->rendered_colour_framebuffer, gl_->width, gl_->height, GL_RGBA, 4);
   for (std::size_t i = 3; i < image.pixels.size(); i += 4) image.pixels[i] = 1.0f;
   return image;
 }
 
 image::FloatImage SceneRenderer::read_depth() const {
-  return read_float(gl_->rendered_depth_framebuffer, gl_->width, gl_->height, GL_DEPTH_COMPONENT, 1);
+  return glo::read_float(gl_->rendered_depth_framebuffer, gl_->width, gl_->height, GL_DEPTH_COMPONENT, 1);
 }
 
 image::ByteImage SceneRenderer::read_encoded() const {
@@ -862,6 +848,7 @@ image::Image<std::uint16_t> SceneRenderer::read_signal() const {
 }
 
 unsigned SceneRenderer::output_framebuffer() const { return gl_->encoded_framebuffer.get(); }
+unsigned SceneRenderer::rendered_framebuffer() const { return gl_->rendered_colour_framebuffer; }
 int SceneRenderer::width() const { return gl_->output_width; }
 int SceneRenderer::height() const { return gl_->output_height; }
 

@@ -192,6 +192,8 @@ class SceneRenderer {
   // The rendered image before the output stage (opaque: the alpha that carries
   // depth inside is read as 1), and its depth (window z in [0, 1]).
   [[nodiscard]] image::FloatImage read_rendered() const;
+  // The framebuffer read_rendered reads (its colour: a single-sampled texture).
+  [[nodiscard]] unsigned rendered_framebuffer() const;
   [[nodiscard]] image::FloatImage read_depth() const;
 
  private:

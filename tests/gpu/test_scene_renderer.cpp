@@ -13,8 +13,10 @@
 #include <vector>
 
 #include "geometry/projection.h"
+#include "image/convert.h"
 #include "image/texture_decode.h"
 #include "optics/projector_model.h"
+#include "render/box_reduce.h"
 #include "render/gl_context.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
@@ -218,6 +220,51 @@ TEST_F(SceneRendererTest, OutputPassSendsTheSignalTheProjectorModelGives) {
     EXPECT_LT(lowest, 0.001) << c.name << ": the ramp should reach black";
     EXPECT_GT(highest, 0.99) << c.name << ": the ramp should reach white";
   }
+}
+
+// GL's box reduction of a supersampled render (render-reference, perceive's
+// ideal) is the CPU's box_downsample of the same pixels: every block, the right
+// way up, at a factor that is no power of two; a source of the wrong size is
+// refused, not read past.
+TEST_F(SceneRendererTest, BoxReductionByGlIsTheMeanOfEachBlock) {
+  constexpr int kTexels = 7;  // edges between texels fall inside the 3×3 blocks
+  scene::SceneDefinition scene;
+  scene.meshes.push_back(textured_quad());
+  scene::Texture texture{"varied", kTexels, kTexels, {}};
+  for (int i = 0; i < kTexels * kTexels; ++i) {
+    for (int c = 0; c < 3; ++c) texture.rgba.push_back(static_cast<std::uint8_t>((i * 37 + c * 91) % 256));
+    texture.rgba.push_back(255);
+  }
+  scene.textures.push_back(texture);
+  scene.materials.emplace_back(glm::vec3(1.0f), 0.0f, 1.0f, glm::vec3(0.0f), 0u);
+  scene.instances.push_back({0, 0, std::nullopt, glm::dmat4(1.0)});
+  only_ambient(scene);
+  auto renderer = SceneRenderer::create(scene, kSize, kSize);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  renderer.value()->draw(scene::SceneState{}, 0.0, kEye, view_of_unit_square());
+
+  auto reduce = BoxReduce::make(kSize / 3, kSize / 3, 3);
+  ASSERT_TRUE(reduce.ok()) << reduce.error();
+  auto by_gl = reduce.value().read(renderer.value()->rendered_framebuffer());
+  ASSERT_TRUE(by_gl.ok()) << by_gl.error();
+  const image::FloatImage by_cpu = image::box_downsample(renderer.value()->read_rendered(), 3);
+  ASSERT_EQ(by_gl.value().width, by_cpu.width);
+  ASSERT_EQ(by_gl.value().height, by_cpu.height);
+  float worst = 0.0f;
+  float spread = 0.0f;  // the blocks differ: a flipped or shifted read cannot match
+  for (std::size_t i = 0; i < by_cpu.pixels.size(); ++i) {
+    worst = std::max(worst, std::abs(by_gl.value().pixels[i] - by_cpu.pixels[i]));
+    spread = std::max(spread, std::abs(by_cpu.pixels[i] - by_cpu.pixels[0]));
+  }
+  EXPECT_LE(worst, 1e-6f);
+  EXPECT_GT(spread, 0.3f);
+
+  auto wrong = BoxReduce::make(kSize / 4, kSize / 4, 4);
+  ASSERT_TRUE(wrong.ok()) << wrong.error();
+  auto refused = wrong.value().read(renderer.value()->rendered_framebuffer());
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().find("was given 66×66"), std::string::npos) << refused.error();
+  EXPECT_FALSE(BoxReduce::make(0, 4, 2).ok());
 }
 
 TEST_F(SceneRendererTest, MaterialTextureOutOfRangeFailsCreate) {
