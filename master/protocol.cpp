@@ -40,6 +40,7 @@ MasterProtocol::MasterProtocol(const config::Installation& installation, const s
       slots_(installation.projectors.size()),
       authority_(scene.definition.objects, installation.viewer, installation.master.frame_rate,
                  LightSwitches::from_config(installation.scene)),
+      scene_server_(scene),
       light_plan_(installation, scene.definition),
       focus_(FocusSchedule::make(installation)) {
   frame_period_ = authority_.frame_period();
@@ -172,14 +173,14 @@ Actions MasterProtocol::message(PeerId peer, const wire::Envelope& message, cloc
         out.push_back(Close{peer, "asked for the scene's files after setting up"});
         break;
       }
-      on_scene_request(peer, session, message.scene_request(), now, out);
+      scene_server_.request(peer, slot_id(*session.slot), session.scene, message.scene_request(), now, out);
       break;
     case wire::Envelope::kSceneWait:
       if (session.phase != Phase::configuring) {
         out.push_back(Close{peer, "waited for the scene after setting up"});
         break;
       }
-      on_scene_wait(peer, session, message.scene_wait(), now, out);
+      scene_server_.wait(peer, slot_id(*session.slot), session.scene, message.scene_wait(), now, out);
       break;
     case wire::Envelope::kConfigured:
       if (session.phase != Phase::configuring) {
@@ -217,8 +218,8 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
                               Actions& out) {
   if (message.body_case() == wire::Envelope::kGoodbye) {
     // A node that cannot answer the challenge (it has no secret) says why.
-    out.push_back(Log{spdlog::level::warn, "a node at " + session.peer_text +
-                                               " left before its hello: " + message.goodbye().reason()});
+    out.push_back(Log{spdlog::level::warn,
+                      "a node at " + session.peer_text + " left before its hello: " + message.goodbye().reason()});
     session.refused = true;
     ++refused_connections_;
     out.push_back(Close{peer, "left before its hello"});
@@ -261,11 +262,11 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
     }
     // Everything from here on is sealed, refusals included: the node knows its
     // master by the first message that opens.
-    out.push_back(Protect{peer, net::derive_session_keys(
-                                    *settings_.secret, session.nonce,
-                                    std::span(reinterpret_cast<const std::uint8_t*>(node_nonce.data()),
-                                              node_nonce.size()),
-                                    hello.node_id(), message.protocol_version())});
+    out.push_back(Protect{
+        peer,
+        net::derive_session_keys(*settings_.secret, session.nonce,
+                                 std::span(reinterpret_cast<const std::uint8_t*>(node_nonce.data()), node_nonce.size()),
+                                 hello.node_id(), message.protocol_version())});
   }
   const std::optional<std::size_t> slot = installation_.find_projector(hello.node_id());
   if (!slot) {
@@ -290,9 +291,9 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
   out.push_back(SetMaxPayload{peer, config_.max_message_bytes});
   // Setting up a GL context and compiling shaders can take seconds on a loaded
   // machine; the node is silent meanwhile.
-  out.push_back(
-      SetDeadline{peer, configure_timeout(),
-                  "node did not finish configuring within " + std::to_string(configure_timeout().count()) + " s"});
+  out.push_back(SetDeadline{
+      peer, scene_server_.configure_timeout(),
+      "node did not finish configuring within " + std::to_string(scene_server_.configure_timeout().count()) + " s"});
   const LightShare* share = light_plan_.share(*slot);
   wire::Envelope envelope;
   *envelope.mutable_welcome() =
@@ -333,108 +334,6 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
                       nodes_up(), slots_.size())});
   if (state_ == RunState::starting && (nodes_up() == slots_.size() || (startup_passed_ && slots_configuring().empty())))
     start_frames(now, out);
-}
-
-// A node without a copy of the scene asks for its files chunk by chunk while it
-// sets up: each request that names a chunk of this scene is answered from the
-// bytes the master loaded (scene/gltf_source.h: what it hashed), and gives the
-// node another configure_timeout() to finish.
-void MasterProtocol::on_scene_request(PeerId peer, Session& session, const wire::SceneRequest& request,
-                                      clock::Nanos now, Actions& out) {
-  const scene::SceneManifest& manifest = scene_.manifest;
-  const std::string id = slot_id(*session.slot);
-  if (manifest.files.empty() || request.scene_sha256() != scene_.content_sha256) {
-    out.push_back(Close{peer, "asked for the files of another scene"});
-    return;
-  }
-  if (request.file() >= manifest.files.size() ||
-      request.chunk() >= manifest.files[request.file()].chunks(manifest.chunk_bytes)) {
-    out.push_back(Close{peer, "asked for chunk " + std::to_string(request.chunk()) + " of file " +
-                                  std::to_string(request.file()) + ", which the scene does not have"});
-    return;
-  }
-  const std::uint64_t total = manifest.total_bytes();
-  if (!session.scene) {
-    session.scene.emplace();
-    session.scene->started = now;
-    out.push_back(
-        Log{spdlog::level::info, fmt::format("sending the scene to '{}', which has no copy: {} file(s), {:.1f} MiB", id,
-                                             manifest.files.size(), static_cast<double>(total) / (1 << 20))});
-  }
-  SceneSending& sending = *session.scene;
-  const std::uint64_t offset = manifest.chunk_offset(request.chunk());
-  const std::uint64_t length = manifest.chunk_length(request.file(), request.chunk());
-  sending.bytes_asked += length;
-  if (sending.bytes_asked > kMostSceneRepeats * std::max<std::uint64_t>(total, manifest.chunk_bytes)) {
-    out.push_back(Close{peer, "asked for the scene " + std::to_string(kMostSceneRepeats) + " times over"});
-    return;
-  }
-  if (sending.sent.insert({request.file(), request.chunk()}).second) {
-    sending.bytes_new += length;
-  } else if (++sending.repeats <= kRepeatsLogged) {
-    // What a node asks for twice came spoilt (or not at all) the first time.
-    out.push_back(Log{spdlog::level::warn,
-                      fmt::format("'{}' asked again for chunk {} of '{}' of the scene (spoilt on the way?){}", id,
-                                  request.chunk(), manifest.files[request.file()].path,
-                                  sending.repeats == kRepeatsLogged ? "; further repeats are not logged" : "")});
-  }
-  wire::Envelope envelope;
-  auto& chunk = *envelope.mutable_scene_chunk();
-  chunk.set_file(request.file());
-  chunk.set_chunk(request.chunk());
-  chunk.set_data(scene_.files[request.file()]->data() + offset, length);
-  out.push_back(Send{peer, std::move(envelope)});
-  out.push_back(SetDeadline{peer, configure_timeout(),
-                            "node did not finish configuring within " + std::to_string(configure_timeout().count()) +
-                                " s of its last request for the scene"});
-  const int quarters = static_cast<int>(4 * sending.bytes_new / std::max<std::uint64_t>(total, 1));
-  if (quarters > sending.quarters_logged) {
-    sending.quarters_logged = quarters;
-    if (quarters == 4) {
-      out.push_back(Log{spdlog::level::info, fmt::format("sent the scene to '{}': {}", id,
-                                                         protocol::transfer_text(total, now - sending.started))});
-    } else if (total >= protocol::kSceneProgressBytes) {
-      out.push_back(Log{spdlog::level::info, fmt::format("sending the scene to '{}': {} %", id, 25 * quarters)});
-    }
-  }
-}
-
-// A node whose host has another node fetching the scene into the cache they
-// share waits for that copy: each word that it still waits gives it another
-// configure_timeout(), as a request would (the node gives up waiting, and
-// fetches, once the other copy stops growing), up to twice that in all: time
-// for a whole fetch at the rate configure_timeout() allows for.
-void MasterProtocol::on_scene_wait(PeerId peer, Session& session, const wire::SceneWait& wait, clock::Nanos now,
-                                   Actions& out) {
-  const scene::SceneManifest& manifest = scene_.manifest;
-  if (manifest.files.empty() || wait.scene_sha256() != scene_.content_sha256) {
-    out.push_back(Close{peer, "waited for another scene"});
-    return;
-  }
-  const std::chrono::seconds longest = 2 * configure_timeout();
-  if (session.waiting_since && now - *session.waiting_since > nanos(longest)) {
-    out.push_back(Close{peer, "waited for another node's copy of the scene for more than " +
-                                  std::to_string(longest.count()) + " s"});
-    return;
-  }
-  const std::uint64_t total = manifest.total_bytes();
-  if (!session.waiting_since) {
-    session.waiting_since = now;
-    out.push_back(Log{spdlog::level::info,
-                      fmt::format("'{}' waits for the copy of the scene another node of its host is fetching into "
-                                  "the cache they share ({:.1f} of {:.1f} MiB there)",
-                                  slot_id(*session.slot),
-                                  static_cast<double>(std::min(wait.bytes_there(), total)) / (1 << 20),
-                                  static_cast<double>(total) / (1 << 20))});
-  }
-  out.push_back(SetDeadline{peer, configure_timeout(),
-                            "node did not finish configuring within " + std::to_string(configure_timeout().count()) +
-                                " s of saying it waits for the scene"});
-}
-
-std::chrono::seconds MasterProtocol::configure_timeout() const {
-  const std::uint64_t bytes = scene_.manifest.total_bytes();
-  return kConfigureTimeout + std::chrono::seconds((bytes + kSceneBytesPerExtraSecond - 1) / kSceneBytesPerExtraSecond);
 }
 
 // The state as of the last frame begun; the next FrameBegin's delta applies to it.
@@ -510,10 +409,11 @@ Actions MasterProtocol::timer(Timer timer, clock::Nanos now) {
         startup_passed_ = true;
         std::string ids;
         for (const std::size_t slot : configuring) ids += (ids.empty() ? "" : ", ") + slot_id(slot);
-        out.push_back(Log{spdlog::level::warn,
-                          fmt::format("no node ready after {} ms; waiting for {} (connected, still configuring, "
-                                      "at most {} s each) before starting",
-                                      config_.startup_timeout.count(), ids, configure_timeout().count())});
+        out.push_back(
+            Log{spdlog::level::warn,
+                fmt::format("no node ready after {} ms; waiting for {} (connected, still configuring, "
+                            "at most {} s each) before starting",
+                            config_.startup_timeout.count(), ids, scene_server_.configure_timeout().count())});
         break;
       }
       {
@@ -604,8 +504,8 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   }
   if (all_behind()) {
     if (!begin_when_answered_) {
-      out.push_back(Log{spdlog::level::warn,
-                        fmt::format("frame {} waits: every node is still drawing an earlier frame", frame)});
+      out.push_back(
+          Log{spdlog::level::warn, fmt::format("frame {} waits: every node is still drawing an earlier frame", frame)});
     }
     begin_when_answered_ = true;
     return;
@@ -666,8 +566,8 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     // once it has answered.
     const bool behind = session.phase == Phase::out_of_barrier && session.drawing.has_value();
     if (session.phase == Phase::out_of_barrier && !behind) {
-      out.push_back(Log{spdlog::level::info,
-                        fmt::format("node '{}' is back in the barrier from frame {}", slot_id(i), frame)});
+      out.push_back(
+          Log{spdlog::level::info, fmt::format("node '{}' is back in the barrier from frame {}", slot_id(i), frame)});
       session.phase = Phase::in_barrier;
     }
     if (session.phase == Phase::joined) session.phase = Phase::in_barrier;
@@ -715,9 +615,9 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   barrier_allowance_ = nanos(config_.frame_timeout);
   for (const std::size_t slot : waited) {
     // At most the liveness timeout: a node drawing longer than that is gone anyway.
-    barrier_allowance_ =
-        std::max(barrier_allowance_, session_of(slot)->pace.allowance(nanos(config_.frame_timeout),
-                                                                      nanos(config_.liveness_timeout), captured));
+    barrier_allowance_ = std::max(
+        barrier_allowance_,
+        session_of(slot)->pace.allowance(nanos(config_.frame_timeout), nanos(config_.liveness_timeout), captured));
   }
   barrier_.begin(frame, std::move(waited));
   if (barrier_.complete()) {
@@ -751,12 +651,12 @@ void MasterProtocol::say_if_slow(Session& session, Actions& out) {
   const std::optional<clock::Nanos> usual = session.pace.typical();
   if (!usual || *usual <= frame_period_) return;
   session.said_slow = true;
-  out.push_back(Log{spdlog::level::warn,
-                    fmt::format("node '{}' draws a frame in {:.1f} ms, longer than the {:.1f} ms frame period: frames "
-                                "come at the rate it can draw (about {:.1f} Hz), not at {} Hz",
-                                slot_id(*session.slot), static_cast<double>(*usual) / 1e6,
-                                static_cast<double>(frame_period_) / 1e6, 1e9 / static_cast<double>(*usual),
-                                config_.frame_rate)});
+  out.push_back(Log{
+      spdlog::level::warn,
+      fmt::format("node '{}' draws a frame in {:.1f} ms, longer than the {:.1f} ms frame period: frames "
+                  "come at the rate it can draw (about {:.1f} Hz), not at {} Hz",
+                  slot_id(*session.slot), static_cast<double>(*usual) / 1e6, static_cast<double>(frame_period_) / 1e6,
+                  1e9 / static_cast<double>(*usual), config_.frame_rate)});
 }
 
 void MasterProtocol::on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now,

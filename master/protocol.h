@@ -24,14 +24,16 @@
 
 #include "clock/clock.h"
 #include "config/installation.h"
+#include "master/actions.h"
 #include "master/barrier.h"
 #include "master/exit_codes.h"
 #include "master/focus_schedule.h"
 #include "master/live_status.h"
-#include "master/render_pace.h"
 #include "master/operator_api.h"
+#include "master/render_pace.h"
 #include "master/run_recorder.h"
 #include "master/scene_authority.h"
+#include "master/scene_server.h"
 #include "master/stacked_groups.h"
 #include "master/viewer_head.h"
 #include "net/auth.h"
@@ -45,80 +47,6 @@ namespace optique::master {
 
 // The largest frame a peer may send before its hello is accepted.
 inline constexpr std::uint32_t kMaxHelloBytes = 4096;
-// How long a node may take to set itself up (GL context, scene) after the welcome,
-// or after the last chunk of the scene it asks for: this, and a second more for
-// every kSceneBytesPerExtraSecond of a glTF scene's files (which a node reads and
-// hashes once or twice while it sets up: 8 GiB is 158 s in all).
-inline constexpr std::chrono::seconds kConfigureTimeout{30};
-inline constexpr std::uint64_t kSceneBytesPerExtraSecond = 64u << 20;
-// A node that asks for more than this many times the scene's bytes is broken.
-inline constexpr std::uint64_t kMostSceneRepeats = 4;
-
-using PeerId = std::uint64_t;
-
-// The master's timers; arming one replaces its pending time.
-enum class Timer { startup, next_frame, barrier, last_presents, goodbye, heartbeat };
-
-// --- actions
-
-struct Send {
-  PeerId peer = 0;
-  wire::Envelope message;
-};
-struct Close {
-  PeerId peer = 0;
-  std::string reason;
-  bool after_sending = false;  // let what is queued (a refusal, a goodbye) go first
-};
-// A one-shot deadline on a connection: it closes with `reason` unless cancelled.
-struct SetDeadline {
-  PeerId peer = 0;
-  std::chrono::milliseconds after{0};
-  std::string reason;
-};
-struct CancelDeadline {
-  PeerId peer = 0;
-};
-struct SetLiveness {
-  PeerId peer = 0;
-  std::chrono::milliseconds timeout{0};
-  std::string reason;
-};
-struct SetMaxPayload {
-  PeerId peer = 0;
-  std::uint32_t bytes = 0;
-};
-// The node proved it holds the secret: from now on everything to it is sealed
-// with keys.to_node, and everything from it must open with keys.to_master.
-struct Protect {
-  PeerId peer = 0;
-  net::SessionKeys keys;
-};
-struct Arm {
-  Timer timer = Timer::startup;
-  clock::Nanos at = 0;  // monotonic
-};
-struct Disarm {
-  Timer timer = Timer::startup;
-};
-struct StopAccepting {};
-struct SignalLocalNodes {
-  int signal = 0;
-};
-// HeadShown (master/viewer_head.h): the head shown in a frame, for head.csv.
-// The run is over: write the outputs (report()) and end with this status.
-struct Finish {
-  int exit_code = kExitOk;
-};
-struct Log {
-  spdlog::level::level_enum level = spdlog::level::info;
-  std::string text;
-};
-
-using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Protect, Arm, Disarm,
-                            StopAccepting, SignalLocalNodes, HeadShown, Finish, Log>;
-using Actions = std::vector<Action>;
-
 struct RunSettings {
   std::uint64_t frames = 0;         // 0: until interrupted
   std::uint64_t capture_every = 0;  // ask nodes to capture every K-th frame (0: never)
@@ -131,18 +59,6 @@ struct RunSettings {
   // is computed: a barrier round is from then to the Swap, not the master's own
   // work on the frame. Unset (tests): the time of the event that began the frame.
   std::function<clock::Nanos()> send_clock;
-};
-
-// The scene's files going to a node that has no copy (a session's bookkeeping;
-// outside MasterProtocol so that it is a complete type where the session's
-// std::optional of it is used).
-struct SceneSending {
-  clock::Nanos started = 0;
-  std::uint64_t bytes_asked = 0;  // all chunks sent, repeats included
-  std::uint64_t bytes_new = 0;    // each chunk once
-  std::set<std::pair<std::uint32_t, std::uint64_t>> sent;
-  int quarters_logged = 0;
-  int repeats = 0;  // chunks asked for again
 };
 
 class MasterProtocol {
@@ -193,22 +109,19 @@ class MasterProtocol {
   enum class Phase { handshake, configuring, joined, in_barrier, out_of_barrier };
   enum class RunState { starting, running, draining, closing, done };
 
-  static constexpr int kRepeatsLogged = 10;
   struct Session {
     std::string peer_text;
     std::optional<std::size_t> slot;
     Phase phase = Phase::handshake;
     std::vector<std::uint8_t> nonce;  // of its challenge
     bool refused = false;             // said so in the log already
-    std::optional<SceneSending> scene;
+    SceneServed scene;                // its scene's files, if it has no copy
     // The frame it was last told to draw and has not answered yet: out of the
     // barrier, it is told to skip frames until it answers, then draws the
     // newest and is waited for again.
     std::optional<std::uint64_t> drawing;
     RenderPace pace;
     bool said_slow = false;  // logged once that it draws slower than the period
-    // Since when it waits for another node's copy of the scene (SceneWait).
-    std::optional<clock::Nanos> waiting_since;
   };
   struct Slot {
     std::optional<PeerId> peer;
@@ -217,9 +130,6 @@ class MasterProtocol {
 
   void on_hello(PeerId peer, Session& session, const wire::Envelope& message, clock::Nanos now, Actions& out);
   void on_configured(PeerId peer, Session& session, const wire::Configured& configured, clock::Nanos now, Actions& out);
-  void on_scene_request(PeerId peer, Session& session, const wire::SceneRequest& request, clock::Nanos now,
-                        Actions& out);
-  void on_scene_wait(PeerId peer, Session& session, const wire::SceneWait& wait, clock::Nanos now, Actions& out);
   void on_ready(Session& session, const wire::FrameReady& ready, clock::Nanos received, clock::Nanos now, Actions& out);
   // Whether every node that is up is behind (out of the barrier, still drawing
   // an earlier frame): then a frame would be shown by nobody, and the next one
@@ -254,7 +164,6 @@ class MasterProtocol {
   // The projectors whose node has said hello and is setting up (GL, scene, shaders).
   [[nodiscard]] std::vector<std::size_t> slots_configuring() const;
   [[nodiscard]] std::string slot_id(std::size_t slot) const;
-  [[nodiscard]] std::chrono::seconds configure_timeout() const;
   [[nodiscard]] Session* session_of(std::size_t slot);
   [[nodiscard]] const Session* session_of(std::size_t slot) const;
 
@@ -267,6 +176,7 @@ class MasterProtocol {
   std::map<PeerId, Session> sessions_;
   std::vector<Slot> slots_;
   SceneAuthority authority_;
+  SceneServer scene_server_;
   LightPlan light_plan_;
   std::optional<FocusSchedule> focus_;
   std::optional<ViewerHead> head_;  // viewer.tracking
@@ -282,8 +192,8 @@ class MasterProtocol {
   std::vector<std::size_t> presents_owed_;
   std::uint64_t presents_owed_frame_ = 0;
   clock::Nanos presents_grace_end_ = 0;
-  bool begin_when_presented_ = false;  // the next frame's time came while presents were owed
-  bool begin_when_answered_ = false;   // the next frame's time came while every node was behind
+  bool begin_when_presented_ = false;   // the next frame's time came while presents were owed
+  bool begin_when_answered_ = false;    // the next frame's time came while every node was behind
   clock::Nanos barrier_allowance_ = 0;  // how long the frame in the barrier is waited for
 
   std::uint64_t next_frame_ = 0;

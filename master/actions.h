@@ -1,0 +1,89 @@
+#pragma once
+// What the master's core (master/protocol.h) asks its shell (master/master.h) to
+// do, in order: send, close, set a connection's deadline, arm a timer, stop
+// accepting, signal the local nodes, record the head shown, finish, log. Apart
+// from the core, so that the units it dispatches to (master/scene_server.h)
+// answer in the same actions.
+
+#include <spdlog/common.h>
+
+#include <chrono>
+#include <cstdint>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "clock/clock.h"
+#include "master/exit_codes.h"
+#include "master/viewer_head.h"
+#include "net/session_seal.h"
+#include "optique/wire.pb.h"
+
+namespace optique::master {
+
+using PeerId = std::uint64_t;
+
+// The master's timers; arming one replaces its pending time.
+enum class Timer { startup, next_frame, barrier, last_presents, goodbye, heartbeat };
+
+// --- actions
+
+struct Send {
+  PeerId peer = 0;
+  wire::Envelope message;
+};
+struct Close {
+  PeerId peer = 0;
+  std::string reason;
+  bool after_sending = false;  // let what is queued (a refusal, a goodbye) go first
+};
+// A one-shot deadline on a connection: it closes with `reason` unless cancelled.
+struct SetDeadline {
+  PeerId peer = 0;
+  std::chrono::milliseconds after{0};
+  std::string reason;
+};
+struct CancelDeadline {
+  PeerId peer = 0;
+};
+struct SetLiveness {
+  PeerId peer = 0;
+  std::chrono::milliseconds timeout{0};
+  std::string reason;
+};
+struct SetMaxPayload {
+  PeerId peer = 0;
+  std::uint32_t bytes = 0;
+};
+// The node proved it holds the secret: from now on everything to it is sealed
+// with keys.to_node, and everything from it must open with keys.to_master.
+struct Protect {
+  PeerId peer = 0;
+  net::SessionKeys keys;
+};
+struct Arm {
+  Timer timer = Timer::startup;
+  clock::Nanos at = 0;  // monotonic
+};
+struct Disarm {
+  Timer timer = Timer::startup;
+};
+struct StopAccepting {};
+struct SignalLocalNodes {
+  int signal = 0;
+};
+// HeadShown (master/viewer_head.h): the head shown in a frame, for head.csv.
+// The run is over: write the outputs (report()) and end with this status.
+struct Finish {
+  int exit_code = kExitOk;
+};
+struct Log {
+  spdlog::level::level_enum level = spdlog::level::info;
+  std::string text;
+};
+
+using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Protect, Arm, Disarm,
+                            StopAccepting, SignalLocalNodes, HeadShown, Finish, Log>;
+using Actions = std::vector<Action>;
+
+}  // namespace optique::master
