@@ -35,7 +35,7 @@ void SceneServer::request(PeerId peer, const std::string& id, SceneServed& serve
         Log{spdlog::level::info, fmt::format("sending the scene to '{}', which has no copy: {} file(s), {:.1f} MiB", id,
                                              manifest.files.size(), static_cast<double>(total) / (1 << 20))});
   }
-  SceneServed::Sending& sending = *served.sending;
+  SceneSending& sending = *served.sending;
   const std::uint64_t offset = manifest.chunk_offset(request.chunk());
   const std::uint64_t length = manifest.chunk_length(request.file(), request.chunk());
   sending.bytes_asked += length;

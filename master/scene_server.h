@@ -30,18 +30,21 @@ inline constexpr std::uint64_t kSceneBytesPerExtraSecond = 64u << 20;
 // A node that asks for more than this many times the scene's bytes is broken.
 inline constexpr std::uint64_t kMostSceneRepeats = 4;
 
+// Sending one node the files (from its first request). Not nested in
+// SceneServed: clang does not take a nested struct's default member
+// initializers in the enclosing one's std::optional of it.
+struct SceneSending {
+  clock::Nanos started = 0;
+  std::uint64_t bytes_asked = 0;  // all chunks sent, repeats included
+  std::uint64_t bytes_new = 0;    // each chunk once
+  std::set<std::pair<std::uint32_t, std::uint64_t>> sent;
+  int quarters_logged = 0;
+  int repeats = 0;  // chunks asked for again
+};
+
 // What one node has been served: the bookkeeping a session keeps.
 struct SceneServed {
-  // Sending it the files (from its first request).
-  struct Sending {
-    clock::Nanos started = 0;
-    std::uint64_t bytes_asked = 0;  // all chunks sent, repeats included
-    std::uint64_t bytes_new = 0;    // each chunk once
-    std::set<std::pair<std::uint32_t, std::uint64_t>> sent;
-    int quarters_logged = 0;
-    int repeats = 0;  // chunks asked for again
-  };
-  std::optional<Sending> sending;
+  std::optional<SceneSending> sending;
   // Since when it waits for another node's copy of the scene (SceneWait).
   std::optional<clock::Nanos> waiting_since;
 };
