@@ -7,7 +7,10 @@
 // the local nodes, finish, log. Every rule — admission and authentication, the
 // frame loop and its barrier, stragglers, rejoining and resyncing, the lights'
 // shares, shutting down — lives here and is tested in microseconds
-// (tests/unit/test_master_protocol.cpp).
+// (tests/unit/test_master_protocol.cpp). By concern: the connections and the
+// timers in protocol.cpp, the frame loop in frame_loop.cpp, stopping and the
+// reports in run_control.cpp; serving the scene's files is a unit of its own
+// (master/scene_server.h), as is the tracked head (master/viewer_head.h).
 
 #include <spdlog/common.h>
 
@@ -147,6 +150,11 @@ class MasterProtocol {
 
   void start_frames(clock::Nanos now, Actions& out);
   void begin_frame(clock::Nanos now, Actions& out);
+  [[nodiscard]] wire::Envelope next_frame_begin(std::uint64_t frame, clock::Nanos display, bool captured,
+                                                clock::Nanos now, Actions& out);
+  [[nodiscard]] bool send_frame_begin(std::size_t slot, const wire::Envelope& envelope, clock::Nanos display,
+                                      Actions& out);
+  void wait_for(std::uint64_t frame, std::vector<std::size_t> waited, bool captured, clock::Nanos now, Actions& out);
   void on_barrier_timeout(clock::Nanos now, Actions& out);
   void swap(clock::Nanos now, Actions& out);
   void drain(const std::string& reason, clock::Nanos now, Actions& out);

@@ -3,6 +3,7 @@
 // each process reads its own monotonic clock, which a node maps to the master's
 // with an estimated offset (clock/offset_estimator.h).
 
+#include <chrono>
 #include <cstdint>
 
 namespace optique::clock {
@@ -12,6 +13,12 @@ using Nanos = std::int64_t;
 inline constexpr Nanos kNanosPerMicro = 1'000;
 inline constexpr Nanos kNanosPerMilli = 1'000'000;
 inline constexpr Nanos kNanosPerSecond = 1'000'000'000;
+
+// A std::chrono duration (a config's timeout) in Nanos.
+template <class Rep, class Period>
+[[nodiscard]] constexpr Nanos nanos(std::chrono::duration<Rep, Period> d) {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
+}
 
 // CLOCK_MONOTONIC in nanoseconds.
 [[nodiscard]] Nanos monotonic_now();

@@ -11,16 +11,13 @@
 namespace optique::tracking {
 namespace {
 
+using clock::nanos;
+
 // The reader's period in datagram(): a 60 Hz frame.
 constexpr Nanos kDefaultReadPeriod = clock::kNanosPerSecond / 60;
 
 Nanos seconds_to_nanos(double seconds) {
   return static_cast<Nanos>(std::llround(seconds * static_cast<double>(clock::kNanosPerSecond)));
-}
-
-template <class Duration>
-Nanos nanos(Duration d) {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
 }
 
 double smoothstep(double x) {
@@ -76,8 +73,9 @@ void HeadTracker::take_dtrack(const DTrackSample& sample, std::vector<std::strin
   const bool restarted = order == Order::restart;
   if (order == Order::outside || (!restarted && !predictor_.empty() && shows <= predictor_.newest_time())) {
     ++counts_.backwards;
-    say_once(said_backwards_, "tracker: ignored a frame out of the tracker's sequence (older than the last one taken, "
-                              "or further ahead than the time since could bring)",
+    say_once(said_backwards_,
+             "tracker: ignored a frame out of the tracker's sequence (older than the last one taken, "
+             "or further ahead than the time since could bring)",
              said);
     return;
   }
@@ -131,11 +129,13 @@ void HeadTracker::notice_start(Nanos now, std::vector<std::string>& said) {
     said.push_back("tracker: no sample in " + std::to_string(kQuietStart / clock::kNanosPerSecond) +
                    " s; listening for DTrack's output (body " + std::to_string(settings_.body) + ") on " +
                    settings_.listen + " port " + std::to_string(settings_.port) + " (UDP)" +
-                   (settings_.from.empty() ? "" : " from " + settings_.from) + "; the eyes rest where the config puts them");
+                   (settings_.from.empty() ? "" : " from " + settings_.from) +
+                   "; the eyes rest where the config puts them");
   }
   if (last_arrival_ && said_quiet_start_ && !said_first_sample_) {
     said_first_sample_ = true;
-    said.push_back("tracker: the first sample came " + std::to_string((*last_arrival_ - *first_now_) / clock::kNanosPerMilli) +
+    said.push_back("tracker: the first sample came " +
+                   std::to_string((*last_arrival_ - *first_now_) / clock::kNanosPerMilli) +
                    " ms after the first frame; tracking");
   }
 }
