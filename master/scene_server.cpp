@@ -86,7 +86,7 @@ void SceneServer::wait(PeerId peer, const std::string& id, SceneServed& served, 
     return;
   }
   const std::chrono::seconds longest = 2 * configure_timeout();
-  if (served.waiting_since && now - *served.waiting_since > std::chrono::nanoseconds(longest).count()) {
+  if (served.waiting_since && now - *served.waiting_since > clock::nanos(longest)) {
     out.push_back(Close{
         peer, "waited for another node's copy of the scene for more than " + std::to_string(longest.count()) + " s"});
     return;

@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <type_traits>
 
 namespace optique::clock {
 
@@ -14,9 +15,11 @@ inline constexpr Nanos kNanosPerMicro = 1'000;
 inline constexpr Nanos kNanosPerMilli = 1'000'000;
 inline constexpr Nanos kNanosPerSecond = 1'000'000'000;
 
-// A std::chrono duration (a config's timeout) in Nanos.
+// A std::chrono duration (a config's timeout) in Nanos: whole units only, so
+// that nothing is cut off unseen.
 template <class Rep, class Period>
 [[nodiscard]] constexpr Nanos nanos(std::chrono::duration<Rep, Period> d) {
+  static_assert(std::is_integral_v<Rep>, "clock::nanos takes a duration in whole units");
   return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
 }
 

@@ -31,6 +31,8 @@ class BoxReduce {
   int height_ = 0;
   int factor_ = 1;
   glo::Program program_;
+  GLint source_location_ = -1;
+  GLint factor_location_ = -1;
   glo::Texture reduced_;
   glo::Framebuffer framebuffer_;
   glo::VertexArray empty_vertex_array_;
