@@ -192,7 +192,7 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
         // Each of the frame's images (a stereo projector used as mono shows
         // two) emits during its own fields.
         const auto emit = [&](int image) {
-          const image::FloatImage emitted = pipeline.value()->renderer().read_linear();
+          const image::FloatImage emitted = pipeline.value()->renderer().output().read_linear();
           const optics::ProjectedImage placed{&geometry, &emitted};
           lights.push_back(optics::compose_screen({&placed, 1}, screen.width, screen.height, compose));
           if (projector->color_fields.fields.empty()) {
@@ -281,10 +281,10 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
       // whole screen, still background and all (PSNR_Y far higher than around
       // a moving object at the same speed).
       const std::string over =
-          options.velocity ? fmt::format("the whole screen, {}×{} px", result.box[2] - result.box[0],
-                                         result.box[3] - result.box[1])
-                           : fmt::format("'{}' and its motion, {}×{} px", options.object,
-                                         result.box[2] - result.box[0], result.box[3] - result.box[1]);
+          options.velocity
+              ? fmt::format("the whole screen, {}×{} px", result.box[2] - result.box[0], result.box[3] - result.box[1])
+              : fmt::format("'{}' and its motion, {}×{} px", options.object, result.box[2] - result.box[0],
+                            result.box[3] - result.box[1]);
       log.info(
           "screen '{}': the eye at ({:.1f}, {:.1f}) px/frame over {:.4f} s: colour fringes {:.2f} px (ideal "
           "{:.2f}), PSNR_Y {:.2f} dB against the ideal, over {} → {}",

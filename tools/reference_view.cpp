@@ -32,8 +32,7 @@ Result<ReferenceView> ReferenceView::make(const config::Installation& installati
     if (!made) return Error{made.error()};
     reduce = std::move(made).value();
   }
-  return ReferenceView(std::move(renderer).value(), std::move(reduce), installation, image, width, height,
-                       supersample);
+  return ReferenceView(std::move(renderer).value(), std::move(reduce), installation, image, width, height, supersample);
 }
 
 Result<image::FloatImage> ReferenceView::draw(const scene::SceneState& state, double fraction) const {
@@ -41,7 +40,7 @@ Result<image::FloatImage> ReferenceView::draw(const scene::SceneState& state, do
   const glm::dvec3 eye = viewer.eye_in(state, fraction, eye_);
   auto frustum = geometry::off_axis_frustum(screen_->world(), eye, viewer.near, viewer.far);
   if (!frustum) return Error{frustum.error()};
-  renderer_->draw(state, fraction, eye, frustum.value());
+  renderer_->draw(state, {fraction, eye, frustum.value()});
   if (!reduce_) return renderer_->read_rendered();
   return reduce_->read(renderer_->rendered_framebuffer());
 }

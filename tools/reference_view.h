@@ -30,7 +30,7 @@ class ReferenceView {
   // (objects and eyes that far on), linear RGBA at the screen's raster.
   [[nodiscard]] Result<image::FloatImage> draw(const scene::SceneState& state, double fraction) const;
   // One sample per pixel, what the projectors' signal would encode: for PNGs.
-  [[nodiscard]] image::ByteImage encoded() const { return renderer_->read_encoded(); }
+  [[nodiscard]] image::ByteImage encoded() const { return renderer_->output().read_encoded(); }
 
   [[nodiscard]] int width() const { return width_; }
   [[nodiscard]] int height() const { return height_; }

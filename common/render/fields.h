@@ -6,22 +6,18 @@
 #include <vector>
 
 #include <glm/mat4x4.hpp>
-#include <glm/vec3.hpp>
 
-#include "geometry/projection.h"
+#include "render/viewpoint.h"
 
 namespace optique::render {
 
 // One colour field's pass (config/color_fields.h): the channels it writes, and
-// the moment it shows — objects `fraction` of the way to their next pose, seen
-// from `eye` through `frustum`.
+// the moment it shows.
 struct FieldPass {
+  Viewpoint view;
   bool red = false;
   bool green = false;
   bool blue = false;
-  double fraction = 0.0;
-  glm::dvec3 eye{0.0};
-  geometry::Frustum frustum;
 };
 
 // One field of the frame: the channels it shows and its moment, in frame
@@ -63,7 +59,7 @@ inline constexpr int kMaxGatherFields = 3;
 // time and a frame later (each moment seen from where the eye is then), and the
 // fields gathered from that image.
 struct GatherFrame {
-  FieldPass seen;  // its channels are not used
+  Viewpoint seen;
   glm::dmat4 view_projection_now{1.0};
   glm::dmat4 view_projection_next{1.0};
   std::vector<GatherField> fields;  // shifts from seen.fraction

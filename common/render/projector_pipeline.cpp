@@ -54,7 +54,7 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
   OutputStage stage = view.value().output_stage(options.blend ? blend_weights(job) : image::FloatImage{}, role);
   stage.focus.inset = job.installation.depth_of_field && job.installation.depth_of_field->inset_radius > 0.0;
   stage.projector = optics::ProjectorModel(self.response);
-  if (auto output = renderer.value()->set_output(stage); !output) return Error{output.error()};
+  if (auto output = renderer.value()->output().set(stage); !output) return Error{output.error()};
   if (self.color_fields.needs_velocity()) {
     if (auto gather = renderer.value()->prepare_gather(); !gather) {
       return Error{"projector '" + self.id + "': " + gather.error()};
@@ -89,15 +89,15 @@ void ProjectorPipeline::set_focus(const protocol::Focus& focus) {
                                             viewer_.far);
   frame.gaze = focus.gaze;
   frame.inset_radius = depth_of_field_->inset_radius;
-  renderer_->set_focus(frame);
+  renderer_->output().set_focus(frame);
 }
 
 glm::dvec3 ProjectorPipeline::eye(const scene::SceneState& state, double fraction) const {
   return viewer_.eye_in(state, fraction, eye_);
 }
 
-Result<FieldPass> ProjectorPipeline::moment(const scene::SceneState& state, double fraction) const {
-  FieldPass pass;
+Result<Viewpoint> ProjectorPipeline::moment(const scene::SceneState& state, double fraction) const {
+  Viewpoint pass;
   pass.fraction = fraction;
   // A still viewer is exactly where it stands at every moment: mix() would
   // round it differently per fraction, and the fields would no longer share one
@@ -115,7 +115,7 @@ Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double frac
     renderer_->draw_black();
     return Error{seen.error()};
   }
-  renderer_->draw(state, fraction, seen.value().eye, seen.value().frustum, terms_);
+  renderer_->draw(state, seen.value(), terms_);
   return {};
 }
 
@@ -131,7 +131,7 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state, const
     // The second image's fields are built from what the first's were, at their
     // own moments; black after a first that could not be seen.
     for (int image = 1; image < images(); ++image) {
-      renderer_->hold_output();
+      renderer_->output().hold();
       if (result) result = draw_fields_between(state, image);
       if (drawn) drawn(image);
     }
@@ -139,7 +139,7 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state, const
   }
   Result<void> result;
   for (int image = 0; image < images(); ++image) {
-    if (image > 0) renderer_->hold_output();  // shown while this one is drawn
+    if (image > 0) renderer_->output().hold();  // shown while this one is drawn
     // A frame that cannot be seen is black in every image.
     if (result) result = draw_image(state, image);
     if (drawn) drawn(image);
@@ -149,8 +149,9 @@ Result<void> ProjectorPipeline::draw_frame(const scene::SceneState& state, const
 
 unsigned ProjectorPipeline::image_framebuffer(int image) const {
   assert(image >= 0 && image < images() && images() <= 2);
-  assert(images() == 1 || renderer_->held_framebuffer() != 0);  // a frame was drawn
-  return image + 1 < images() ? renderer_->held_framebuffer() : renderer_->output_framebuffer();
+  const OutputPass& output = renderer_->output();
+  assert(images() == 1 || output.held_framebuffer() != 0);  // a frame was drawn
+  return image + 1 < images() ? output.held_framebuffer() : output.framebuffer();
 }
 
 Result<void> ProjectorPipeline::draw_image(const scene::SceneState& state, int image) {
@@ -163,7 +164,7 @@ Result<void> ProjectorPipeline::draw_image(const scene::SceneState& state, int i
   auto passes = field_passes(state, image);
   if (!passes) return Error{passes.error()};
   if (!color_fields_.blurs()) {
-    (void)renderer_->draw_fields(state, passes.value(), terms_, still_once_);
+    renderer_->draw_fields(state, passes.value(), terms_, still_once_);
     return {};
   }
   // What is faster than the threshold gets motion blur over the image's time on
@@ -175,7 +176,7 @@ Result<void> ProjectorPipeline::draw_image(const scene::SceneState& state, int i
     return Error{blur.error()};
   }
   blur.value().fields.clear();
-  add(renderer_->draw_fields(state, passes.value(), terms_, still_once_, &blur.value()));
+  add(renderer_->gather().draw_fields_blurred(state, passes.value(), blur.value(), terms_, still_once_));
   return {};
 }
 
@@ -188,10 +189,8 @@ Result<std::vector<FieldPass>> ProjectorPipeline::field_passes(const scene::Scen
       renderer_->draw_black();
       return Error{pass.error()};
     }
-    pass.value().red = field.channel == config::Channel::red;
-    pass.value().green = field.channel == config::Channel::green;
-    pass.value().blue = field.channel == config::Channel::blue;
-    passes.push_back(pass.value());
+    passes.push_back({pass.value(), field.channel == config::Channel::red, field.channel == config::Channel::green,
+                      field.channel == config::Channel::blue});
   }
   return passes;
 }
@@ -208,11 +207,11 @@ Result<void> ProjectorPipeline::draw_fields_up_converted(const scene::SceneState
       renderer_->draw_black();
       return Error{pass.error()};
     }
-    key = pass.value();
+    key = FieldPass{pass.value(), true, true, true};
   }
   auto passes = field_passes(state, image);
   if (!passes) return Error{passes.error()};
-  renderer_->draw_fields_up_converted(state, key ? &*key : nullptr, passes.value(), terms_);
+  renderer_->up_conversion().draw_fields_up_converted(state, key ? &*key : nullptr, passes.value(), terms_);
   return {};
 }
 
@@ -240,8 +239,8 @@ Result<GatherFrame> ProjectorPipeline::gather_frame(const scene::SceneState& sta
   }
   GatherFrame frame;
   frame.seen = seen.value();
-  frame.view_projection_now = now.value().frustum.projection * now.value().frustum.view;
-  frame.view_projection_next = next.value().frustum.projection * next.value().frustum.view;
+  frame.view_projection_now = now.value().view_projection();
+  frame.view_projection_next = next.value().view_projection();
   for (const config::ColorField& field : color_fields_.fields) {
     if (field.image != image) continue;
     frame.fields.push_back({field.channel == config::Channel::red, field.channel == config::Channel::green,
@@ -269,8 +268,9 @@ Result<void> ProjectorPipeline::draw_gathered(const scene::SceneState& state, in
     return Error{frame.error()};
   }
   // The second image's fields from the render the first made.
-  add(image == 0 ? renderer_->draw_gathered(state, frame.value(), terms_)
-                 : renderer_->gather_again(frame.value().fields, frame.value().settings));
+  GatherPasses& gather = renderer_->gather();
+  add(image == 0 ? gather.draw_gathered(state, frame.value(), terms_)
+                 : gather.gather_again(frame.value().fields, frame.value().settings));
   return {};
 }
 
@@ -296,12 +296,13 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
   // The adaptive ratio's check: the frame between from kept key
   // plan.check_slot at `key`'s moment, against what was just drawn for it (or
   // kept key `against`).
-  const auto check = [&](const scene::SceneState& key, const auto& seen, std::optional<int> against) {
+  UpConversionPasses& up_passes = renderer_->up_conversion();
+  const auto check = [&](const scene::SceneState& key, const Viewpoint& seen, std::optional<int> against) {
     if (!plan.check_slot) return;
     up::BetweenFrame from;
     from.method = schedule_->settings().method;
     from.first = *plan.check_slot;
-    up_report_.checked_psnr = renderer_->check_between(key, 0.0, seen.eye, seen.frustum, from, terms_, against);
+    up_report_.checked_psnr = up_passes.check_between(key, seen, from, terms_, against);
     schedule_->checked(*up_report_.checked_psnr);
   };
   if (plan.band) {  // first: it draws through the image the frame's own then replaces
@@ -310,9 +311,7 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
     if (!seen) {
       schedule_->drop_band();  // its moment cannot be seen from here: another is begun later
     } else {
-      const geometry::Frustum& f = seen.value().frustum;
-      renderer_->draw_key_band(*band.state, 0.0, seen.value().eye, f, terms_, band.slot, band.index, band.count,
-                               band.bands);
+      up_passes.draw_key_band(*band.state, seen.value(), terms_, band.slot, band.index, band.count, band.bands);
       if (band.last()) check(*band.state, seen.value(), band.slot);
     }
   }
@@ -320,10 +319,9 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
     const scene::SceneState* key = plan.key_state;  // this frame's, or one sent ahead
     const auto seen = moment(*key, 0.0);
     if (!seen) return black(seen.error());
-    renderer_->draw(*key, 0.0, seen.value().eye, seen.value().frustum, terms_);
+    renderer_->draw(*key, seen.value(), terms_);
     check(*key, seen.value(), std::nullopt);
-    const geometry::Frustum& f = seen.value().frustum;
-    renderer_->keep_key(plan.key_slot, {*key, 0.0, f.projection * f.view});
+    up_passes.keep_key(plan.key_slot, {*key, 0.0, seen.value().view_projection()});
   }
   up_report_.ratio = schedule_->ratio();
   if (color_fields_.sequential()) {
@@ -336,18 +334,19 @@ Result<void> ProjectorPipeline::draw_up_converted(const scene::SceneState& state
     fields_between_ = plan.between;
     return draw_fields_between(state, 0);
   }
-  if (plan.shown_slot) renderer_->show_key(*plan.shown_slot);
+  if (plan.shown_slot) up_passes.show_key(*plan.shown_slot);
   if (!plan.between) return {};
   const auto seen = moment(state, 0.0);
   if (!seen) return black(seen.error());
-  up_report_.between = renderer_->draw_between(state, 0.0, seen.value().eye, seen.value().frustum, plan.frame, terms_);
+  up_report_.between = up_passes.draw_between(state, seen.value(), plan.frame, terms_);
   return {};
 }
 
 Result<void> ProjectorPipeline::draw_fields_between(const scene::SceneState& state, int image) {
   auto passes = field_passes(state, image);
   if (!passes) return Error{passes.error()};  // drawn black
-  const up::BetweenReport report = renderer_->draw_fields_between(state, passes.value(), fields_from_, terms_);
+  const up::BetweenReport report =
+      renderer_->up_conversion().draw_fields_between(state, passes.value(), fields_from_, terms_);
   // The frame's report: the image that left the most unseen.
   if (fields_between_ && (image == 0 || report.unseen_share > up_report_.between.unseen_share)) {
     up_report_.between = report;
@@ -357,39 +356,39 @@ Result<void> ProjectorPipeline::draw_fields_between(const scene::SceneState& sta
 
 void ProjectorPipeline::warm_up(const scene::SceneState& state) {
   const glm::dvec3 in_front = view_.bounds().at(0.5, 0.5) + view_.bounds().normal();
-  if (auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far)) {
-    renderer_->draw(state, 0.0, in_front, frustum.value());
-    if (schedule_) {  // the motion fields, each resolve and the check
-      const geometry::Frustum& f = frustum.value();
-      for (int slot = 0; slot < schedule_->slots(); ++slot) {
-        renderer_->keep_key(slot, {state, 0.0, f.projection * f.view});
-      }
-      (void)renderer_->check_between(state, 0.0, in_front, f, {}, terms_);
-      up::BetweenFrame frame;
-      frame.method = schedule_->settings().method;
-      for (bool two : {false, true}) {
-        frame.two_keys = two;
-        (void)renderer_->draw_between(state, 0.0, in_front, f, frame, terms_);
-      }
+  auto frustum = view_.frustum(in_front, viewer_.near, viewer_.far);
+  if (!frustum) return;
+  const Viewpoint seen{0.0, in_front, frustum.value()};
+  renderer_->draw(state, seen);
+  if (schedule_) {  // the motion fields, each resolve and the check
+    UpConversionPasses& up_passes = renderer_->up_conversion();
+    for (int slot = 0; slot < schedule_->slots(); ++slot) {
+      up_passes.keep_key(slot, {state, 0.0, seen.view_projection()});
     }
-    if (color_fields_.up_converts()) {  // one field at the render's moment, one built from it
-      FieldPass key{true, true, true, 0.0, in_front, frustum.value()};
-      FieldPass other = key;
-      other.fraction = 0.5;
-      other.green = other.blue = false;
-      (void)renderer_->draw_fields_up_converted(state, &key, {&other, 1});
+    (void)up_passes.check_between(state, seen, {}, terms_);
+    up::BetweenFrame frame;
+    frame.method = schedule_->settings().method;
+    for (bool two : {false, true}) {
+      frame.two_keys = two;
+      (void)up_passes.draw_between(state, seen, frame, terms_);
     }
-    if (color_fields_.needs_velocity()) {
-      // The velocity program and the tile passes too (the field pass itself
-      // first runs when something moves).
-      GatherFrame frame;
-      frame.seen.eye = in_front;
-      frame.seen.frustum = frustum.value();
-      frame.view_projection_now = frustum.value().projection * frustum.value().view;
-      frame.view_projection_next = frame.view_projection_now;
-      frame.fields.push_back({true, true, true, 0.0});
-      (void)renderer_->draw_gathered(state, frame);
-    }
+  }
+  if (color_fields_.up_converts()) {  // one field at the render's moment, one built from it
+    const FieldPass key{seen, true, true, true};
+    FieldPass other = key;
+    other.view.fraction = 0.5;
+    other.green = other.blue = false;
+    renderer_->up_conversion().draw_fields_up_converted(state, &key, {&other, 1});
+  }
+  if (color_fields_.needs_velocity()) {
+    // The velocity program and the tile passes too (the field pass itself
+    // first runs when something moves).
+    GatherFrame frame;
+    frame.seen = seen;
+    frame.view_projection_now = seen.view_projection();
+    frame.view_projection_next = frame.view_projection_now;
+    frame.fields.push_back({true, true, true, 0.0});
+    (void)renderer_->gather().draw_gathered(state, frame);
   }
 }
 

@@ -125,7 +125,7 @@ class ProjectorPipeline {
                     optics::ProjectorModel model);
   // Where the scene is seen from `fraction` of a frame after the display time:
   // this projector's eye then, and its frustum through the screen.
-  [[nodiscard]] Result<FieldPass> moment(const scene::SceneState& state, double fraction) const;
+  [[nodiscard]] Result<Viewpoint> moment(const scene::SceneState& state, double fraction) const;
   [[nodiscard]] Result<void> draw_image(const scene::SceneState& state, int image);
   // When the gather's one render shows the scene, frame periods from the display time.
   [[nodiscard]] double gather_moment() const;

@@ -85,8 +85,8 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
 
 GlRenderer::ReadBack GlRenderer::read_back() const {
   const render::SceneRenderer& renderer = pipeline_->renderer();
-  return {renderer.read_linear(), deep_signal_ ? image::ByteImage{} : renderer.read_encoded(),
-          deep_signal_ ? renderer.read_signal() : image::WordImage{}};
+  return {renderer.output().read_linear(), deep_signal_ ? image::ByteImage{} : renderer.output().read_encoded(),
+          deep_signal_ ? renderer.output().read_signal() : image::WordImage{}};
 }
 
 std::string GlRenderer::description() const {
@@ -162,11 +162,11 @@ void GlRenderer::present(int image) {
   const unsigned framebuffer = pipeline_->image_framebuffer(image);
   const render::SceneRenderer& renderer = pipeline_->renderer();
   if (!read_back_shown_ || image != 0) {  // a window's read-back: of the frame's first image
-    context_->present(framebuffer, renderer.width(), renderer.height());
+    context_->present(framebuffer, renderer.output().width(), renderer.output().height());
     return;
   }
   image::ByteImage shown;
-  context_->present(framebuffer, renderer.width(), renderer.height(), &shown);
+  context_->present(framebuffer, renderer.output().width(), renderer.output().height(), &shown);
   captures_->submit_shown(*read_back_shown_, std::move(shown));
   read_back_shown_.reset();
 }
@@ -176,7 +176,7 @@ void GlRenderer::show_black() {
   read_back_shown_.reset();  // black is not the captured frame
   render::SceneRenderer& renderer = pipeline_->renderer();
   renderer.draw_black();
-  context_->present(renderer.output_framebuffer(), renderer.width(), renderer.height());
+  context_->present(renderer.output().framebuffer(), renderer.output().width(), renderer.output().height());
 }
 
 }  // namespace optique::node

@@ -240,8 +240,10 @@ int main(int argc, char** argv) {
   app.option("--config", config_path, "stacked group whose first projector every identical node copies");
   app.option("--auto-config", auto_config_path, "mixed stacked group with lights \"auto\"");
   app.option("--out", out, "folder for lighting.md, lighting.csv and lighting.png");
-  app.option("--frames", frames, "measured frames per run (1 s of animation apart)", optique::bench::Bounds::more_than_zero());
-  app.option("--repeats", repeats, "runs; times are medians per run, tables their median and min–max", optique::bench::Bounds::more_than_zero());
+  app.option("--frames", frames, "measured frames per run (1 s of animation apart)",
+             optique::bench::Bounds::more_than_zero());
+  app.option("--repeats", repeats, "runs; times are medians per run, tables their median and min–max",
+             optique::bench::Bounds::more_than_zero());
   if (const std::optional<int> status = app.parse(argc, argv)) return *status;
 
   try {
@@ -364,7 +366,7 @@ int main(int argc, char** argv) {
           // still holds this frame.
           const Stack& full = full_of(s);
           const image::FloatImage full_rendered = full.nodes.front().renderer().read_rendered();
-          const image::FloatImage full_linear = full.nodes.front().renderer().read_linear();
+          const image::FloatImage full_linear = full.nodes.front().renderer().output().read_linear();
           // Where the full render is brighter than one projector can show, one
           // clips and several clip less: a matter of headroom, not of the split
           // or of 8-bit steps, so the comparisons leave those pixels out.
@@ -381,10 +383,10 @@ int main(int argc, char** argv) {
             const Stack& stack = stacks[i];
             if (stack.mixed) continue;
             image::FloatImage sum_rendered = stack.nodes.front().renderer().read_rendered();
-            image::FloatImage sum_linear = stack.nodes.front().renderer().read_linear();
+            image::FloatImage sum_linear = stack.nodes.front().renderer().output().read_linear();
             for (std::size_t n = 1; n < stack.nodes.size(); ++n) {
               add(sum_rendered, stack.nodes[n].renderer().read_rendered());
-              add(sum_linear, stack.nodes[n].renderer().read_linear());
+              add(sum_linear, stack.nodes[n].renderer().output().read_linear());
             }
             Accuracy a;
             a.split_max_abs = max_abs_rgb(sum_rendered, full_rendered, everywhere);
@@ -428,8 +430,8 @@ int main(int argc, char** argv) {
       const RunTimes times = run_times(stack);
       for (std::size_t n = 0; n < stack.nodes.size(); ++n) {
         const double t = median(times.node[n]);
-        const double pixels =
-            static_cast<double>(stack.nodes[n].renderer().width()) * stack.nodes[n].renderer().height();
+        const double pixels = static_cast<double>(stack.nodes[n].renderer().output().width()) *
+                              stack.nodes[n].renderer().output().height();
         const double a = pixels / t;
         const double b = pixels * units(stack.scene, stack.nodes[n].share) / t;
         saa += a * a;

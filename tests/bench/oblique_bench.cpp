@@ -45,7 +45,7 @@ constexpr int kSupersample = 4;
 struct Method {
   std::unique_ptr<render::ProjectorPipeline> pipeline;
   [[nodiscard]] const render::ProjectorView& view() const { return pipeline->view(); }
-  [[nodiscard]] image::FloatImage light() const { return pipeline->renderer().read_linear(); }
+  [[nodiscard]] image::FloatImage light() const { return pipeline->renderer().output().read_linear(); }
 };
 
 Method make_method(config::ProjectorJob job, const scene::SceneDefinition& scene, render::RenderMethod how,

@@ -50,7 +50,7 @@ std::vector<double> frame_times(const Case& c, int frames) {
       state.objects[object.id] = {object.pose_at(t), object.pose_at(t + 1.0 / 60.0)};
     }
     const clock::Nanos start = clock::monotonic_now();
-    renderer.value()->draw(state, 0.0, eye, frustum);
+    renderer.value()->draw(state, {0.0, eye, frustum});
     const clock::Nanos end = clock::monotonic_now();
     if (k >= 0) times.push_back(static_cast<double>(end - start) / 1e6);
   }

@@ -58,7 +58,7 @@ class FieldGather : public ::testing::Test {
     const auto drawn = pipeline.value()->draw_frame(state_at(frame));
     EXPECT_TRUE(drawn) << (drawn ? "" : drawn.error());
     if (report) *report = pipeline.value()->gather_report();
-    return pipeline.value()->renderer().read_linear();
+    return pipeline.value()->renderer().output().read_linear();
   }
 
   testing::GlInstallation gl_;
@@ -278,7 +278,7 @@ TEST_F(FieldGather, ASurfacePassingByTheEyeGivesAFiniteFrame) {
   ASSERT_TRUE(pipeline) << pipeline.error();
   ASSERT_TRUE(pipeline.value()->draw_frame(state));
   const render::GatherReport& report = pipeline.value()->gather_report();
-  const image::FloatImage image = pipeline.value()->renderer().read_linear();
+  const image::FloatImage image = pipeline.value()->renderer().output().read_linear();
   std::size_t finite = 0;
   float brightest = 0.0f;
   for (const float v : image.pixels) {
@@ -401,7 +401,7 @@ class FieldsBetweenKeyFrames : public FieldGather {
                                              return found == sent.end() ? nullptr : &found->second;
                                            }};
         const auto drawn = pipeline.value()->draw_frame(
-            state_at(n), [&](int) { images.push_back(pipeline.value()->renderer().read_linear()); }, &display);
+            state_at(n), [&](int) { images.push_back(pipeline.value()->renderer().output().read_linear()); }, &display);
         EXPECT_TRUE(drawn) << (drawn ? "" : drawn.error());
         if (kinds) *kinds += std::string(up::to_string(pipeline.value()->up_report().kind)).substr(0, 1);
       }

@@ -215,7 +215,7 @@ TEST_F(FieldRendering, EachOfTwoImagesShowsItsOwnThreeFields) {
   const auto drawn = pipeline.value()->draw_frame(state_at(kFrame), [&](int image) {
     EXPECT_EQ(image, static_cast<int>(images.size()));
     images.push_back(pipeline.value()->renderer().read_rendered());
-    signals.push_back(pipeline.value()->renderer().read_encoded());
+    signals.push_back(pipeline.value()->renderer().output().read_encoded());
   });
   ASSERT_TRUE(drawn) << drawn.error();
   ASSERT_EQ(images.size(), 2u);

@@ -91,8 +91,8 @@ class SceneRendererTest : public ::testing::Test {
   void expect_checker(const scene::SceneDefinition& scene) {
     auto renderer = SceneRenderer::create(scene, kSize, kSize);
     ASSERT_TRUE(renderer.ok()) << renderer.error();
-    renderer.value()->draw(scene::SceneState{}, 0.0, kEye, view_of_unit_square());
-    const image::FloatImage image = renderer.value()->read_linear();  // top row first
+    renderer.value()->draw(scene::SceneState{}, {0.0, kEye, view_of_unit_square()});
+    const image::FloatImage image = renderer.value()->output().read_linear();  // top row first
     ASSERT_EQ(image.width, kSize);
     ASSERT_EQ(image.height, kSize);
     struct Quadrant {
@@ -132,7 +132,7 @@ TEST_F(SceneRendererTest, BaseColourFactorMultipliesTheTexture) {
   only_ambient(scene);
   auto renderer = SceneRenderer::create(scene, kSize, kSize);
   ASSERT_TRUE(renderer.ok()) << renderer.error();
-  renderer.value()->draw(scene::SceneState{}, 0.0, kEye, view_of_unit_square());
+  renderer.value()->draw(scene::SceneState{}, {0.0, kEye, view_of_unit_square()});
   const auto image = renderer.value()->read_rendered();
   EXPECT_NEAR(image.at(kSize / 2, kSize / 2, 0), 0.5f, kTolerance);
   EXPECT_NEAR(image.at(kSize / 2, kSize / 2, 1), 0.25f, kTolerance);
@@ -192,10 +192,10 @@ TEST_F(SceneRendererTest, OutputPassSendsTheSignalTheProjectorModelGives) {
   for (const Case& c : cases) {
     OutputStage stage;
     stage.projector = optics::ProjectorModel(c.response);
-    ASSERT_TRUE(renderer.set_output(stage).ok()) << c.name;
-    renderer.draw(scene::SceneState{}, 0.0, kEye, view_of_unit_square());
+    ASSERT_TRUE(renderer.output().set(stage).ok()) << c.name;
+    renderer.draw(scene::SceneState{}, {0.0, kEye, view_of_unit_square()});
     const image::FloatImage light = renderer.read_rendered();
-    const image::WordImage signal = renderer.read_signal();
+    const image::WordImage signal = renderer.output().read_signal();
     ASSERT_EQ(signal.width, light.width);
     ASSERT_EQ(signal.height, light.height);
     const optics::ProjectorModel& model = stage.projector;
@@ -241,7 +241,7 @@ TEST_F(SceneRendererTest, BoxReductionByGlIsTheMeanOfEachBlock) {
   only_ambient(scene);
   auto renderer = SceneRenderer::create(scene, kSize, kSize);
   ASSERT_TRUE(renderer.ok()) << renderer.error();
-  renderer.value()->draw(scene::SceneState{}, 0.0, kEye, view_of_unit_square());
+  renderer.value()->draw(scene::SceneState{}, {0.0, kEye, view_of_unit_square()});
 
   auto reduce = BoxReduce::make(kSize / 3, kSize / 3, 3);
   ASSERT_TRUE(reduce.ok()) << reduce.error();

@@ -50,7 +50,7 @@ class StackedLighting : public ::testing::Test {
     if (share != nullptr) pipeline.value()->set_share(*share);
     const auto drawn = pipeline.value()->draw(state_);
     EXPECT_TRUE(drawn) << (drawn ? "" : drawn.error());
-    return {pipeline.value()->renderer().read_rendered(), pipeline.value()->renderer().read_linear()};
+    return {pipeline.value()->renderer().read_rendered(), pipeline.value()->renderer().output().read_linear()};
   }
 
   testing::GlInstallation gl_;

@@ -61,9 +61,9 @@ TEST(TrackedEyes, TheStereoAxisTurnsWithTheHead) {
 
   const auto parallax = [](render::ProjectorPipeline& l, render::ProjectorPipeline& r, const scene::SceneState& state) {
     EXPECT_TRUE(l.draw_frame(state));
-    const glm::dvec2 from_left = mean_place(l.renderer().read_linear());
+    const glm::dvec2 from_left = mean_place(l.renderer().output().read_linear());
     EXPECT_TRUE(r.draw_frame(state));
-    return mean_place(r.renderer().read_linear()) - from_left;
+    return mean_place(r.renderer().output().read_linear()) - from_left;
   };
   const glm::dvec2 upright = parallax(*left.value(), *right.value(), facing);
   const glm::dvec2 tilted = parallax(*left.value(), *right.value(), rolled);

@@ -131,20 +131,20 @@ class UpConversion : public ::testing::Test {
 
   // The full render of a state (linear light, before the output stage).
   image::FloatImage full(const scene::SceneState& state) {
-    renderer_->draw(state, 0.0, kEye, view());
+    renderer_->draw(state, {0.0, kEye, view()});
     return renderer_->read_rendered();
   }
 
   // Draws `state` and keeps it as key `slot`.
   void key(int slot, const scene::SceneState& state) {
     const geometry::Frustum f = view();
-    renderer_->draw(state, 0.0, kEye, f);
-    renderer_->keep_key(slot, {state, 0.0, f.projection * f.view});
+    renderer_->draw(state, {0.0, kEye, f});
+    renderer_->up_conversion().keep_key(slot, {state, 0.0, f.projection * f.view});
   }
 
   image::FloatImage between(const scene::SceneState& state, const up::BetweenFrame& frame,
                             up::BetweenReport* report = nullptr) {
-    const up::BetweenReport r = renderer_->draw_between(state, 0.0, kEye, view(), frame);
+    const up::BetweenReport r = renderer_->up_conversion().draw_between(state, {0.0, kEye, view()}, frame);
     if (report) *report = r;
     return renderer_->read_rendered();
   }
@@ -333,8 +333,8 @@ TEST_F(UpConversion, BetweenTwoKeyFramesNothingIsUnseen) {
 // taken (its edges only unseen); three frames on, all of it is shaded anew.
 TEST_F(UpConversion, ASurfaceTurnedFurtherThanTheLimitIsShadedAnew) {
   const Motion spinning = [](double t) {
-    return scene::Pose{glm::dvec3(0.0, 0.0, 0.1), glm::angleAxis(glm::radians(10.0 + 10.0 * 60.0 * t),
-                                                                 glm::dvec3(0, 1, 0))};
+    return scene::Pose{glm::dvec3(0.0, 0.0, 0.1),
+                       glm::angleAxis(glm::radians(10.0 + 10.0 * 60.0 * t), glm::dvec3(0, 1, 0))};
   };
   make(squares(false));
   key(0, state_at(spinning, 0));

@@ -209,9 +209,9 @@ Result<FocalFrame> Pair::frame(double b, const ExactDepth& exact) {
   draw_plain();
   f.rendered = plain_->renderer().read_rendered();
   draw_focus(b);
-  f.focus = focus_->renderer().read_linear();
+  f.focus = focus_->renderer().output().read_linear();
   draw_defocus(b);
-  f.defocus = defocus_->renderer().read_linear();
+  f.defocus = defocus_->renderer().output().read_linear();
   if (exact.depth.width != f.rendered.width || exact.depth.height != f.rendered.height) {
     return Error{"the exact depth map is not the rendered image's size"};
   }
@@ -265,7 +265,7 @@ Result<Precision> measure_precision(const PairSetup& setup, const ExactDepth& ex
         return Error{"the exact depth map is not the rendered image's size"};
       }
     }
-    const image::FloatImage focus = renderer.read_linear();
+    const image::FloatImage focus = renderer.output().read_linear();
     const bool first = b == focal_depths.front();
     for (int y = 0; y < depth.height; ++y) {
       for (int x = 0; x < depth.width; ++x) {

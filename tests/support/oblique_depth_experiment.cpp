@@ -355,7 +355,7 @@ Result<Count> Experiment::measure(const Projector& projector, double delta, Meth
   const int width = projector.placement.width;
   const int height = projector.placement.height;
   auto& renderer = renderers_[{delta, static_cast<int>(format)}];
-  if (!renderer || renderer->width() != width || renderer->height() != height) {
+  if (!renderer || renderer->output().width() != width || renderer->output().height() != height) {
     auto created = render::SceneRenderer::create(layer_scene(inst_, delta), width, height, format);
     if (!created) return Error{created.error()};
     renderer = std::move(created).value();
@@ -372,7 +372,7 @@ Result<Count> Experiment::measure(const Projector& projector, double delta, Meth
     const geometry::ObliqueProjection drawn{ours.bounds, model.a, model.scale};
     frustum.value().projection = drawn.matrix() * frustum.value().projection;
   }
-  renderer->draw(scene::SceneState{}, 0.0, inst_.eye, frustum.value());
+  renderer->draw(scene::SceneState{}, {0.0, inst_.eye, frustum.value()});
   const image::FloatImage image = renderer->read_rendered();  // top row first, as projector pixels
 
   // The wall point of a pixel centre (x, y may be one outside the image).

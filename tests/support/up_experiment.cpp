@@ -60,7 +60,7 @@ std::string installation_json(const StageScene& scene, const Run& run, int width
 }
 
 image::FloatImage displayed(const render::SceneRenderer& renderer) {
-  const image::ByteImage signal = renderer.read_encoded();
+  const image::ByteImage signal = renderer.output().read_encoded();
   image::FloatImage out(signal.width, signal.height, signal.channels);
   for (std::size_t i = 0; i < signal.pixels.size(); ++i) out.pixels[i] = signal.pixels[i] / 255.0f;
   return out;
@@ -206,9 +206,8 @@ Result<SceneResult> measure(const StageScene& stage, const Run& run, int frames,
   // Once started, as steady_max_ms: a wall runs for hours, and the first key
   // frames drawn at once are paid once (24 frames at ratio 2, 3, 4 or 6 leave
   // whole cycles of the schedule).
-  const std::size_t start = all_ms.size() > static_cast<std::size_t>(2 * run.ratio)
-                                ? static_cast<std::size_t>(2 * run.ratio)
-                                : 0;
+  const std::size_t start =
+      all_ms.size() > static_cast<std::size_t>(2 * run.ratio) ? static_cast<std::size_t>(2 * run.ratio) : 0;
   double sum = 0.0;
   for (std::size_t i = start; i < all_ms.size(); ++i) sum += all_ms[i];
   result.per_display_frame_ms = all_ms.empty() ? 0.0 : sum / static_cast<double>(all_ms.size() - start);

@@ -1,0 +1,279 @@
+#include "render/scene_pass.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <string>
+
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/mat3x3.hpp>
+
+#include "render/shaders.h"
+#include "up/between.h"
+
+namespace optique::render {
+namespace {
+
+// What a scene program writes besides the geometry: shaded colour; or that
+// and each fragment's velocity (the gather); or only where each fragment was
+// in one key frame or two (the up-conversion's motion field; from one, it
+// writes one target: 6 ms instead of 11 on llvmpipe at 1280×720).
+enum class SceneOutput { colour, velocity, key_frame, key_frames };
+
+// Its sources come without a #version line, so that the choice goes first.
+Result<glo::Program> scene_program(SceneOutput output, ScenePass::Uniforms& uniforms) {
+  const std::string head = std::string("#version 450 core\n") +
+                           (output != SceneOutput::colour ? "#define VELOCITY 1\n" : "") +
+                           (output == SceneOutput::key_frame ? "#define ONE_END 1\n" : "");
+  const bool field = output == SceneOutput::key_frame || output == SceneOutput::key_frames;
+  const std::string_view fragment = field ? shaders::motion_field_frag : shaders::scene_frag;
+  auto program = glo::link_program(head + std::string(shaders::scene_vert), head + std::string(fragment));
+  if (!program) return Error{program.error()};
+  const GLuint p = program.value().get();
+  const auto at = [p](const char* name) { return glGetUniformLocation(p, name); };
+  uniforms = {at("model_view_projection"),
+              at("model"),
+              at("normal_matrix"),
+              at("eye"),
+              at("base_colour_factor"),
+              at("has_base_colour_texture"),
+              at("metallic"),
+              at("roughness"),
+              at("emissive"),
+              at("ambient"),
+              at("light_count"),
+              at("model_view_projection_0"),
+              at("model_view_projection_1"),
+              at("half_size"),
+              at("size"),
+              at("normal_matrix_0"),
+              at("normal_matrix_1"),
+              at("most_turn_cosine")};
+  return program;
+}
+
+// Textures: sRGB colour (decoded to linear when sampled), linear alpha; mipmapped,
+// trilinear, repeating. Rows go up as they are stored, top row first: that row
+// is t = 0, which is where glTF's v = 0 (the image's top) is, so glTF uvs
+// sample the texture unchanged.
+Result<glo::Texture> upload_texture(const scene::Texture& texture) {
+  if (texture.width <= 0 || texture.height <= 0 ||
+      texture.rgba.size() != static_cast<std::size_t>(texture.width) * static_cast<std::size_t>(texture.height) * 4) {
+    return Error{"texture '" + texture.name + "' has no or the wrong number of texels"};
+  }
+  glo::Texture made = glo::make_texture();
+  const GLuint name = made.get();
+  int levels = 1;
+  for (int side = std::max(texture.width, texture.height); side > 1; side /= 2) ++levels;
+  glTextureStorage2D(name, levels, GL_SRGB8_ALPHA8, texture.width, texture.height);
+  glTextureSubImage2D(name, 0, 0, 0, texture.width, texture.height, GL_RGBA, GL_UNSIGNED_BYTE, texture.rgba.data());
+  glGenerateTextureMipmap(name);
+  glTextureParameteri(name, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+  glTextureParameteri(name, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glTextureParameteri(name, GL_TEXTURE_WRAP_S, GL_REPEAT);
+  glTextureParameteri(name, GL_TEXTURE_WRAP_T, GL_REPEAT);
+  return made;
+}
+
+}  // namespace
+
+Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
+  ScenePass pass;
+  auto program = scene_program(SceneOutput::colour, pass.colour_uniforms_);
+  if (!program) return Error{program.error()};
+  pass.colour_program_ = std::move(program).value();
+
+  // All meshes in one vertex and one index buffer.
+  std::vector<scene::Vertex> vertices;
+  std::vector<std::uint32_t> indices;
+  for (const auto& mesh : scene.meshes) {
+    pass.meshes_.push_back(
+        {static_cast<GLsizei>(mesh.indices.size()), indices.size(), static_cast<GLint>(vertices.size())});
+    vertices.insert(vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
+    indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
+  }
+  pass.vertex_array_ = glo::make_vertex_array();
+  pass.vertex_buffer_ = glo::make_buffer();
+  pass.index_buffer_ = glo::make_buffer();
+  const GLuint array = pass.vertex_array_.get();
+  glNamedBufferStorage(pass.vertex_buffer_.get(),
+                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, vertices.size()) * sizeof(scene::Vertex)),
+                       vertices.empty() ? nullptr : vertices.data(), 0);
+  glNamedBufferStorage(pass.index_buffer_.get(),
+                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, indices.size()) * sizeof(std::uint32_t)),
+                       indices.empty() ? nullptr : indices.data(), 0);
+  glVertexArrayVertexBuffer(array, 0, pass.vertex_buffer_.get(), 0, sizeof(scene::Vertex));
+  glVertexArrayElementBuffer(array, pass.index_buffer_.get());
+  const auto attribute = [array](GLuint index, GLint size, std::size_t offset) {
+    glEnableVertexArrayAttrib(array, index);
+    glVertexArrayAttribFormat(array, index, size, GL_FLOAT, GL_FALSE, static_cast<GLuint>(offset));
+    glVertexArrayAttribBinding(array, index, 0);
+  };
+  attribute(0, 3, offsetof(scene::Vertex, position));
+  attribute(1, 3, offsetof(scene::Vertex, normal));
+  attribute(2, 2, offsetof(scene::Vertex, uv));
+
+  for (const auto& texture : scene.textures) {
+    auto uploaded = upload_texture(texture);
+    if (!uploaded) return Error{uploaded.error()};
+    pass.textures_.push_back(std::move(uploaded).value());
+  }
+  for (const auto& material : scene.materials) {
+    if (material.base_colour_texture && *material.base_colour_texture >= scene.textures.size()) {
+      return Error{"a material's base colour texture " + std::to_string(*material.base_colour_texture) +
+                   " is out of range (" + std::to_string(scene.textures.size()) + " textures)"};
+    }
+  }
+
+  for (const auto& light : scene.lights) {
+    pass.all_lights_.emplace_back(glm::vec3(light.position), 1.0f);
+    pass.all_lights_.emplace_back(light.colour * light.intensity, 0.0f);
+  }
+  pass.light_buffer_ = glo::make_buffer();
+  glNamedBufferStorage(pass.light_buffer_.get(),
+                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, pass.all_lights_.size()) * sizeof(glm::vec4)),
+                       nullptr, GL_DYNAMIC_STORAGE_BIT);
+
+  pass.materials_ = scene.materials;
+  pass.instances_ = scene.instances;
+  pass.ambient_ = scene.ambient;
+  pass.background_ = scene.background;
+  pass.set_all_lights();
+  return pass;
+}
+
+Result<void> ScenePass::prepare_velocity() {
+  if (velocity_program_) return {};
+  auto program = scene_program(SceneOutput::velocity, velocity_uniforms_);
+  if (!program) return Error{program.error()};
+  velocity_program_ = std::move(program).value();
+  return {};
+}
+
+Result<void> ScenePass::prepare_motion_field() {
+  if (key_frames_program_[0]) return {};
+  std::array<glo::Program, 2> programs;
+  std::array<Uniforms, 2> uniforms{};
+  for (int keys = 1; keys <= 2; ++keys) {
+    auto program = scene_program(keys == 1 ? SceneOutput::key_frame : SceneOutput::key_frames, uniforms[keys - 1]);
+    if (!program) return Error{"the up-conversion's motion field: " + program.error()};
+    programs[keys - 1] = std::move(program).value();
+  }
+  key_frames_program_ = std::move(programs);
+  key_frames_uniforms_ = uniforms;
+  return {};
+}
+
+void ScenePass::set_lights(std::span<const std::uint32_t> lights) {
+  assert(std::all_of(lights.begin(), lights.end(),
+                     [&](std::uint32_t i) { return 2 * static_cast<std::size_t>(i) + 1 < all_lights_.size(); }));
+  chosen_lights_.assign(lights.begin(), lights.end());
+  upload_shining_lights({});
+}
+
+void ScenePass::set_all_lights() {
+  std::vector<std::uint32_t> all(all_lights_.size() / 2);
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
+  set_lights(all);
+}
+
+void ScenePass::upload_shining_lights(const std::set<std::uint32_t>& off) {
+  std::vector<std::uint32_t> shining;
+  for (std::uint32_t i : chosen_lights_) {
+    if (!off.contains(i)) shining.push_back(i);
+  }
+  if (shining == uploaded_lights_ && light_count_ == static_cast<int>(shining.size())) return;
+  std::vector<glm::vec4> data;
+  for (std::uint32_t i : shining) {
+    data.push_back(all_lights_[2 * i]);
+    data.push_back(all_lights_[2 * i + 1]);
+  }
+  if (!data.empty()) {
+    glNamedBufferSubData(light_buffer_.get(), 0, static_cast<GLsizeiptr>(data.size() * sizeof(glm::vec4)), data.data());
+  }
+  light_count_ = static_cast<int>(shining.size());
+  uploaded_lights_ = std::move(shining);
+}
+
+bool ScenePass::anything_still() const {
+  return std::any_of(instances_.begin(), instances_.end(), [](const scene::Instance& i) { return !i.object; });
+}
+
+void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, const LightTerms& terms, int width,
+                     int height, Objects which, const Motion* motion) {
+  upload_shining_lights(state.lights_off);
+  const int keys = motion ? motion->key_frames : 0;
+  const bool key_frames = keys > 0;
+  assert(keys >= 0 && keys <= 2);
+  assert(!motion || (key_frames ? key_frames_program_[0] : velocity_program_));  // prepared first
+  const int field = std::max(keys - 1, 0);
+  glUseProgram(key_frames ? key_frames_program_[field].get()
+               : motion   ? velocity_program_.get()
+                          : colour_program_.get());
+  glBindVertexArray(vertex_array_.get());
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, light_buffer_.get());
+  const Uniforms& u = key_frames ? key_frames_uniforms_[field] : motion ? velocity_uniforms_ : colour_uniforms_;
+  if (motion) glUniform2f(u.half_size, 0.5f * static_cast<float>(width), 0.5f * static_cast<float>(height));
+  if (key_frames) {
+    glUniform2f(u.size, static_cast<float>(width), static_cast<float>(height));
+    glUniform1f(u.most_turn_cosine, static_cast<float>(std::cos(up::kMostTurn)));
+  }
+  const glm::dvec3& eye = view.eye;
+  glUniform3f(u.eye, static_cast<float>(eye.x), static_cast<float>(eye.y), static_cast<float>(eye.z));
+  const glm::vec3 ambient = terms.ambient ? ambient_ : glm::vec3(0.0f);
+  glUniform3fv(u.ambient, 1, glm::value_ptr(ambient));
+  glUniform1i(u.light_count, light_count_);
+  const glm::dmat4 view_projection = view.view_projection();
+
+  for (const auto& instance : instances_) {
+    if ((which == Objects::still && instance.object) || (which == Objects::moving && !instance.object)) continue;
+    glm::dmat4 model = instance.transform;
+    if (instance.object) {
+      const auto found = state.objects.find(*instance.object);
+      if (found == state.objects.end()) continue;  // not in the state (yet): nothing to place
+      model = scene::model_matrix(scene::interpolate(found->second, view.fraction)) * instance.transform;
+    }
+    // Products in double, then to float: keeps precision for large worlds.
+    const glm::mat4 mvp(view_projection * model);
+    const glm::mat4 model_f(model);
+    const glm::mat3 normal_matrix(glm::transpose(glm::inverse(glm::dmat3(model))));
+    glUniformMatrix4fv(u.model_view_projection, 1, GL_FALSE, glm::value_ptr(mvp));
+    if (motion) {
+      // Where this instance is at the motion's two ends; an object not in the
+      // scene then projects to w = 0: no place.
+      const GLint locations[2] = {u.model_view_projection_now, u.model_view_projection_next};
+      const GLint normal_locations[2] = {u.normal_matrix_now, u.normal_matrix_next};
+      for (int e = 0; e < (keys == 1 ? 1 : 2); ++e) {
+        const MotionEnd& end = motion->ends[e];
+        glm::dmat4 then = instance.transform;
+        bool there = true;
+        if (instance.object) {
+          const auto found = end.state->objects.find(*instance.object);
+          there = found != end.state->objects.end();
+          if (there) then = scene::model_matrix(scene::interpolate(found->second, end.fraction)) * instance.transform;
+        }
+        const glm::mat4 clip(there ? end.view_projection * then : glm::dmat4(0.0));
+        glUniformMatrix4fv(locations[e], 1, GL_FALSE, glm::value_ptr(clip));
+        if (key_frames) {
+          const glm::mat3 normals(glm::transpose(glm::inverse(glm::dmat3(then))));
+          glUniformMatrix3fv(normal_locations[e], 1, GL_FALSE, glm::value_ptr(normals));
+        }
+      }
+    }
+    glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(model_f));
+    glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
+    const scene::Material& m = materials_[instance.material];
+    glUniform3fv(u.base_colour, 1, glm::value_ptr(m.base_colour));
+    glUniform1i(u.has_base_colour_texture, m.base_colour_texture ? 1 : 0);
+    if (m.base_colour_texture) glBindTextureUnit(1, textures_[*m.base_colour_texture].get());  // unit 0: encode
+    glUniform1f(u.metallic, m.metallic);
+    glUniform1f(u.roughness, m.roughness);
+    const glm::vec3 emissive = terms.emissive ? m.emissive : glm::vec3(0.0f);
+    glUniform3fv(u.emissive, 1, glm::value_ptr(emissive));
+    const MeshRange& mesh = meshes_[instance.mesh];
+    glDrawElementsBaseVertex(GL_TRIANGLES, mesh.count, GL_UNSIGNED_INT,
+                             reinterpret_cast<const void*>(mesh.first_index * sizeof(std::uint32_t)), mesh.base_vertex);
+  }
+}
+
+}  // namespace optique::render

@@ -1,0 +1,113 @@
+#pragma once
+// Internal to render (scene_renderer.h is the public door): the scene on the
+// GPU and the programs that draw it. Its meshes, textures, materials and
+// lights uploaded once; drawn for a moment and a viewpoint into whatever
+// framebuffer is bound (render/linear_target.h), writing shaded colour, or also
+// each fragment's velocity (the gather), or where each fragment was in kept key
+// frames (up-conversion's motion field).
+
+#include <array>
+#include <cstdint>
+#include <set>
+#include <span>
+#include <vector>
+
+#include <epoxy/gl.h>
+#include <glm/mat4x4.hpp>
+#include <glm/vec3.hpp>
+
+#include "render/gl_objects.h"
+#include "render/viewpoint.h"
+#include "scene/definition.h"
+#include "scene/state.h"
+#include "util/result.h"
+
+namespace optique::render {
+
+// Which of the scene's instances a draw takes: all, those on no animated
+// object, or those on one.
+enum class Objects { all, still, moving };
+
+// Where each drawn surface point also is at two other moments: in `state`,
+// objects `fraction` of the way to their next pose, seen through
+// `view_projection`. An object missing from that state has no place then.
+struct MotionEnd {
+  const scene::SceneState* state = nullptr;
+  double fraction = 0.0;
+  glm::dmat4 view_projection{1.0};
+};
+
+// Each fragment's screen velocity between the two ends (the gather's program
+// and target, key_frames 0), or its place in the key_frames (1 or 2) key
+// frames at the first ends (the up-conversion's motion field).
+struct Motion {
+  MotionEnd ends[2];
+  int key_frames = 0;
+};
+
+class ScenePass {
+ public:
+  // Uploads the scene's static content and builds the colour program; fails
+  // with the driver's message, or when a texture or material is malformed.
+  [[nodiscard]] static Result<ScenePass> create(const scene::SceneDefinition& scene);
+  // The gather's program (velocity beside colour); once.
+  [[nodiscard]] Result<void> prepare_velocity();
+  // Up-conversion's motion-field programs (from one key frame, from two); once.
+  [[nodiscard]] Result<void> prepare_motion_field();
+
+  // Draws only these of the scene's point lights (indices), less those the
+  // drawn state has switched off. Asserts that each exists.
+  void set_lights(std::span<const std::uint32_t> lights);
+  void set_all_lights();
+
+  // The scene at `view`'s moment from its place into the bound framebuffer of
+  // `width` × `height` pixels; with `motion`, through the program that writes
+  // it (prepared first).
+  void draw(const scene::SceneState& state, const Viewpoint& view, const LightTerms& terms, int width, int height,
+            Objects which = Objects::all, const Motion* motion = nullptr);
+
+  [[nodiscard]] bool anything_still() const;  // an instance on no animated object
+  [[nodiscard]] const glm::vec3& background() const { return background_; }
+
+  // The uniforms of one program (scene_pass.cpp).
+  struct Uniforms {
+    GLint model_view_projection, model, normal_matrix, eye, base_colour, has_base_colour_texture, metallic, roughness,
+        emissive, ambient, light_count;
+    GLint model_view_projection_now, model_view_projection_next, half_size;  // velocity only
+    GLint size, normal_matrix_now, normal_matrix_next, most_turn_cosine;     // motion field only
+  };
+
+ private:
+  ScenePass() = default;
+  void upload_shining_lights(const std::set<std::uint32_t>& off);
+
+  struct MeshRange {
+    GLsizei count = 0;
+    std::size_t first_index = 0;
+    GLint base_vertex = 0;
+  };
+  glo::Program colour_program_;
+  Uniforms colour_uniforms_{};
+  glo::Program velocity_program_;  // prepare_velocity
+  Uniforms velocity_uniforms_{};
+  // prepare_motion_field: one per number of key frames, [0] from one, [1] from two.
+  std::array<glo::Program, 2> key_frames_program_;
+  std::array<Uniforms, 2> key_frames_uniforms_{};
+
+  glo::VertexArray vertex_array_;
+  glo::Buffer vertex_buffer_;
+  glo::Buffer index_buffer_;
+  glo::Buffer light_buffer_;
+  std::vector<glo::Texture> textures_;  // by index in the scene's textures
+  std::vector<MeshRange> meshes_;
+  std::vector<scene::Material> materials_;
+  std::vector<scene::Instance> instances_;
+  glm::vec3 ambient_{0.0f};
+  glm::vec3 background_{0.0f};
+  std::vector<glm::vec4> all_lights_;           // position, radiance: two per light
+  std::vector<std::uint32_t> chosen_lights_;    // set_lights
+  std::vector<std::uint32_t> uploaded_lights_;  // those of them that shine, in the light buffer
+  int light_count_ = 0;
+};
+
+}  // namespace optique::render
