@@ -1,12 +1,14 @@
 #pragma once
 // What the master's core (master/protocol.h) asks its shell (master/master.h) to
 // do, in order: send, close, set a connection's deadline, arm a timer, stop
-// accepting, signal the local nodes, record the head shown, finish, log. Apart
+// accepting, signal the local nodes, record the head shown and the frames
+// finalized, finish, log. Apart
 // from the core, so that the units it dispatches to (master/scene_server.h)
 // answer in the same actions.
 
 #include <spdlog/common.h>
 
+#include <array>
 #include <chrono>
 #include <cstdint>
 #include <string>
@@ -15,6 +17,7 @@
 
 #include "clock/clock.h"
 #include "master/exit_codes.h"
+#include "master/frame_rows.h"
 #include "master/viewer_head.h"
 #include "net/session_seal.h"
 #include "optique/wire.pb.h"
@@ -23,8 +26,11 @@ namespace optique::master {
 
 using PeerId = std::uint64_t;
 
-// The master's timers; arming one replaces its pending time.
+// The master's timers, listed once: arming one replaces its pending time.
 enum class Timer { startup, next_frame, barrier, last_presents, goodbye, heartbeat };
+inline constexpr std::array kTimers{Timer::startup,       Timer::next_frame, Timer::barrier,
+                                    Timer::last_presents, Timer::goodbye,    Timer::heartbeat};
+static_assert(static_cast<std::size_t>(kTimers.back()) + 1 == kTimers.size(), "every Timer in kTimers, in order");
 
 // --- actions
 
@@ -73,6 +79,7 @@ struct SignalLocalNodes {
   int signal = 0;
 };
 // HeadShown (master/viewer_head.h): the head shown in a frame, for head.csv.
+// FrameRows (master/frame_rows.h): frames finalized, for frames.csv.
 // The run is over: write the outputs (report()) and end with this status.
 struct Finish {
   int exit_code = kExitOk;
@@ -83,7 +90,7 @@ struct Log {
 };
 
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Protect, Arm, Disarm,
-                            StopAccepting, SignalLocalNodes, HeadShown, Finish, Log>;
+                            StopAccepting, SignalLocalNodes, HeadShown, FrameRows, Finish, Log>;
 using Actions = std::vector<Action>;
 
 }  // namespace optique::master

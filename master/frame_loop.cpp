@@ -63,9 +63,6 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   const bool captured = settings_.capture_every != 0 && frame % settings_.capture_every == 0;
   const wire::Envelope envelope = next_frame_begin(frame, display, captured, now, out);
 
-  // The record of the frame before last is written out now, before the send is
-  // stamped: a CSV row is not part of the barrier round.
-  if (frame > 1) recorder_.finalize_before(frame - 1);  // the previous frame may still get Presented
   const clock::Nanos begin_sent = settings_.send_clock ? settings_.send_clock() : now;
   std::vector<std::size_t> sent;
   std::vector<std::size_t> waited;
@@ -76,6 +73,11 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     if (session_of(i)->phase == Phase::in_barrier) waited.push_back(i);
   }
   recorder_.frame_begun(frame, begin_sent, sent);
+  // The record of the frame before last is complete (the previous frame may
+  // still get Presented); its rows go after the sends, out of the barrier round.
+  if (frame > 1) {
+    if (auto rows = recorder_.finalize(frame - 1); !rows.empty()) out.push_back(FrameRows{std::move(rows)});
+  }
   next_frame_ = frame + 1;
   ready_for_swap_.clear();
   wait_for(frame, std::move(waited), captured, now, out);
@@ -236,7 +238,7 @@ void MasterProtocol::on_ready(Session& session, const wire::FrameReady& ready, c
     say_if_slow(session, out);
   }
   if (ready.frame_id() + 1 == next_frame_ && ready.state_hash() != current_hash_) {
-    recorder_.hash_mismatch(slot);
+    recorder_.node_event(slot, NodeEvent::hash_mismatch);
     out.push_back(Log{spdlog::level::warn,
                       fmt::format("node '{}' reports state hash {:016x} for frame {}, master has {:016x}: sending it "
                                   "a fresh snapshot",
@@ -269,7 +271,7 @@ void MasterProtocol::on_barrier_timeout(clock::Nanos now, Actions& out) {
   if (!barrier_.active()) return;
   const bool drop = config_.straggler_policy == config::StragglerPolicy::drop;
   for (std::size_t slot : barrier_.waiting_for()) {
-    recorder_.node_missed_barrier(slot);
+    recorder_.node_event(slot, NodeEvent::missed_barrier);
     if (Session* session = session_of(slot)) session->phase = Phase::out_of_barrier;
     out.push_back(Log{spdlog::level::warn,
                       fmt::format("node '{}' was not ready for frame {} within {} ms: taken out of the barrier; {}",

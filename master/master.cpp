@@ -76,9 +76,9 @@ Result<void> Master::listen_to_tracker(const config::Tracking& tracking, double 
   tracker_socket_.non_blocking(true, ec);
   // The read budget is per frame.
   const auto period = static_cast<clock::Nanos>(1e9 / std::max(frame_rate, 1.0));
-  tracker_receiver_ = std::make_unique<TrackerReceiver>(
-      tracker_socket_.native_handle(), tracking::DTrackReader(tracking, period),
-      [this] { asio::post(io_, [this] { take_tracker_input(); }); });
+  tracker_receiver_ =
+      std::make_unique<TrackerReceiver>(tracker_socket_.native_handle(), tracking::DTrackReader(tracking, period),
+                                        [this] { asio::post(io_, [this] { take_tracker_input(); }); });
   return {};
 }
 
@@ -99,8 +99,9 @@ Result<void> Master::start() {
     const auto csv_path = std::filesystem::path(options_.out_dir) / "frames.csv";
     csv_.open(csv_path);
     if (!csv_) return Error{"cannot write " + csv_path.string()};
+    csv_ << frames_csv_header();
   }
-  recorder_.emplace(ids, csv_.is_open() ? &csv_ : nullptr);
+  recorder_.emplace(ids);
   // A replay (up to millions of samples) is moved, not copied, into the protocol.
   const std::size_t replay_samples = options_.run.replay.size();
   std::vector<tracking::ReplaySample> replay = std::move(options_.run.replay);
@@ -316,6 +317,9 @@ void Master::carry_out(Action& action) {
                  [&](HeadShown& a) {
                    if (head_csv_.is_open()) head_csv_ << head_csv_row(a);
                  },
+                 [&](FrameRows& a) {
+                   if (csv_.is_open()) csv_ << frames_csv(a.rows);
+                 },
                  [&](Finish& a) { finish(a.exit_code); },
                  [&](Log& a) { log_.log(a.level, "{}", a.text); },
              },
@@ -369,21 +373,22 @@ void Master::update_status() {
   if (!status_.enabled()) return;
   const clock::Nanos now = clock::monotonic_now();
   if (now - last_status_ < 250 * clock::kNanosPerMilli) return;
-  const std::uint64_t frame = protocol_->next_frame();
+  const MasterProtocol::Progress progress = protocol_->progress();
+  const std::uint64_t frame = progress.next_frame;
   const double rate = last_status_ == 0
                           ? 0.0
                           : static_cast<double>(frame - status_frame_) * 1e9 / static_cast<double>(now - last_status_);
   last_status_ = now;
   status_frame_ = frame;
   const std::string total = options_.run.frames ? std::to_string(options_.run.frames) : std::string("-");
-  const double shown_by_all =
-      100.0 * shown_by_all_share(recorder_->frames_finalized(), recorder_->frames_with_missing_node());
+  const RunTotals& totals = recorder_->totals();
+  const double shown_by_all = 100.0 * shown_by_all_share(totals.frames_finalized, totals.frames_with_missing_node);
   char line[240];
   std::snprintf(line, sizeof line,
                 "frame %llu/%s  %.1f of %g Hz  nodes %zu/%zu  shown by all %.1f %%  skew %.0f us  missing %llu",
-                static_cast<unsigned long long>(frame), total.c_str(), rate, options_.config.installation.master.frame_rate,
-                protocol_->nodes_up(), protocol_->projectors(), shown_by_all, recorder_->last_present_skew_us(),
-                static_cast<unsigned long long>(recorder_->frames_with_missing_node()));
+                static_cast<unsigned long long>(frame), total.c_str(), rate,
+                options_.config.installation.master.frame_rate, progress.nodes_up, progress.projectors, shown_by_all,
+                totals.last_present_skew_us, static_cast<unsigned long long>(totals.frames_with_missing_node));
   status_.show(line);
 }
 
@@ -417,7 +422,13 @@ void Master::finish(int exit_code) {
 
 void Master::write_outputs() {
   if (options_.out_dir.empty()) return;
-  if (head_csv_.is_open()) head_csv_.flush();
+  for (std::ofstream* csv : {&csv_, &head_csv_}) {
+    if (csv->is_open()) csv->flush();
+  }
+  if (csv_.is_open() && !csv_) {
+    log_.error("cannot write {}", (std::filesystem::path(options_.out_dir) / "frames.csv").string());
+    exit_code_ = kExitFailed;
+  }
   report::RunReport report = protocol_->report();
   report.set_config_file(options_.config.path);
   report.set_config_sha256(options_.config.sha256);

@@ -102,8 +102,8 @@ class Master {
   asio::steady_timer accept_retry_timer_;
   bool accept_failing_ = false;
   asio::signal_set signals_;
-  std::array<std::unique_ptr<asio::steady_timer>, 6> timers_;  // one per Timer
-  std::array<std::uint64_t, 6> timer_generations_{};           // each arm or disarm: the one pending
+  std::array<std::unique_ptr<asio::steady_timer>, kTimers.size()> timers_;  // one per Timer
+  std::array<std::uint64_t, kTimers.size()> timer_generations_{};           // each arm or disarm: the one pending
   asio::steady_timer housekeeping_timer_;
   std::map<PeerId, std::shared_ptr<net::Connection>> connections_;
   PeerId next_peer_ = 1;

@@ -317,7 +317,7 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
   // waited for as long as the warm-up took, twice over.
   if (configured.warm_up_ns() > 0) session.pace.add(configured.warm_up_ns());
   session.pace.set_capture(configured.capture_ns());
-  recorder_.node_joined(*session.slot);
+  recorder_.node_event(*session.slot, NodeEvent::joined);
   rebalance_lights(true);
   out.push_back(
       Log{spdlog::level::info,

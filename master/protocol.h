@@ -97,11 +97,13 @@ class MasterProtocol {
   // as a first interrupt, the run finishes in order.
   [[nodiscard]] Actions operator_command(OperatorCommand command, const std::string& from, clock::Nanos now);
 
-  // For the status line and the outputs.
-  [[nodiscard]] std::uint64_t next_frame() const { return next_frame_; }
-  [[nodiscard]] std::size_t nodes_up() const;
-  [[nodiscard]] std::size_t projectors() const { return slots_.size(); }
-  [[nodiscard]] bool done() const { return state_ == RunState::done; }
+  // For the status line: the frame to begin next, and the nodes up of the projectors.
+  struct Progress {
+    std::uint64_t next_frame = 0;
+    std::size_t nodes_up = 0;
+    std::size_t projectors = 0;
+  };
+  [[nodiscard]] Progress progress() const { return {next_frame_, nodes_up(), slots_.size()}; }
   [[nodiscard]] bool running() const { return state_ == RunState::running; }
   // The run's summary (after Finish: every frame finalized).
   [[nodiscard]] report::RunReport report() const;
@@ -109,6 +111,7 @@ class MasterProtocol {
   [[nodiscard]] LiveStatus live(clock::Nanos now) const;
 
  private:
+  [[nodiscard]] std::size_t nodes_up() const;
   enum class Phase { handshake, configuring, joined, in_barrier, out_of_barrier };
   enum class RunState { starting, running, draining, closing, done };
 

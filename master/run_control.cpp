@@ -65,11 +65,8 @@ void MasterProtocol::finish_if_all_gone(Actions& out) {
 void MasterProtocol::finish(Actions& out) {
   if (state_ == RunState::done) return;
   state_ = RunState::done;
-  for (Timer t :
-       {Timer::startup, Timer::next_frame, Timer::barrier, Timer::last_presents, Timer::goodbye, Timer::heartbeat}) {
-    out.push_back(Disarm{t});
-  }
-  recorder_.finalize_all();
+  for (Timer t : kTimers) out.push_back(Disarm{t});
+  if (auto rows = recorder_.finalize(); !rows.empty()) out.push_back(FrameRows{std::move(rows)});
   const report::RunReport summary = report();
   out.push_back(Log{spdlog::level::info, summary_line(summary)});
   if (exit_code_ == kExitOk) {
@@ -110,12 +107,13 @@ LiveStatus MasterProtocol::live(clock::Nanos now) const {
   status.next_frame = next_frame_;
   status.frames_target = settings_.frames;
   status.target_rate_hz = config_.frame_rate;
-  status.frames_finalized = recorder_.frames_finalized();
-  status.frames_with_missing_node = recorder_.frames_with_missing_node();
-  status.frames_incoherent = recorder_.frames_incoherent();
-  status.frames_dropped = recorder_.frames_dropped();
-  status.skew_us_sum = recorder_.present_skew_us_sum();
-  status.skew_count = recorder_.present_skew_count();
+  const RunTotals& totals = recorder_.totals();
+  status.frames_finalized = totals.frames_finalized;
+  status.frames_with_missing_node = totals.frames_with_missing_node;
+  status.frames_incoherent = totals.frames_incoherent;
+  status.frames_dropped = totals.frames_dropped;
+  status.skew_us_sum = totals.present_skew_us_sum;
+  status.skew_count = totals.present_skew_count;
   status.nodes_up = nodes_up();
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     LiveNode node;

@@ -19,10 +19,7 @@ bool plausible(const report::ClockReport& clock, std::optional<clock::Nanos> tru
 
 }  // namespace
 
-RunRecorder::RunRecorder(std::vector<std::string> node_ids, std::ostream* csv)
-    : ids_(std::move(node_ids)), csv_(csv), totals_(ids_.size()) {
-  if (csv_ != nullptr) *csv_ << "frame_id,node,begin_sent_ns,ready_received_ns,swap_sent_ns,presented_ns\n";
-}
+RunRecorder::RunRecorder(std::vector<std::string> node_ids) : ids_(std::move(node_ids)), totals_(ids_.size()) {}
 
 RunRecorder::FrameRecord* RunRecorder::find(std::uint64_t frame) {
   for (auto& record : open_) {
@@ -108,13 +105,24 @@ void RunRecorder::clock_estimated(std::uint64_t frame, std::size_t node, const r
   }
 }
 
-void RunRecorder::frame_dropped(std::uint64_t) { ++frames_dropped_; }
+void RunRecorder::frame_dropped(std::uint64_t) { ++run_.frames_dropped; }
 
-void RunRecorder::node_joined(std::size_t node) { totals_[node].counts.joins += 1; }
-void RunRecorder::node_missed_barrier(std::size_t node) { totals_[node].counts.barrier_misses += 1; }
-void RunRecorder::hash_mismatch(std::size_t node) { totals_[node].counts.hash_mismatches += 1; }
+void RunRecorder::node_event(std::size_t node, NodeEvent event) {
+  NodeCounts& counts = totals_[node].counts;
+  switch (event) {
+    case NodeEvent::joined:
+      counts.joins += 1;
+      break;
+    case NodeEvent::missed_barrier:
+      counts.barrier_misses += 1;
+      break;
+    case NodeEvent::hash_mismatch:
+      counts.hash_mismatches += 1;
+      break;
+  }
+}
 
-void RunRecorder::finalize(const FrameRecord& record) {
+void RunRecorder::finalize(const FrameRecord& record, std::vector<FrameRow>& rows) {
   clock::Nanos earliest = 0;
   clock::Nanos latest = 0;
   std::size_t presented = 0;
@@ -134,49 +142,41 @@ void RunRecorder::finalize(const FrameRecord& record) {
     } else if (f.swapped) {
       incoherent = true;  // told to show this frame, never said it did
     }
-    if (csv_ != nullptr && f.begun) {
-      *csv_ << record.id << ',' << ids_[n] << ',' << record.begin_sent << ',';
-      if (f.ready != 0) *csv_ << f.ready;
-      *csv_ << ',';
-      if (f.swapped) *csv_ << record.swap_sent;
-      *csv_ << ',';
-      if (f.presented != 0) *csv_ << f.presented;
-      *csv_ << '\n';
+    if (f.begun) {
+      const auto given = [](clock::Nanos t) { return t != 0 ? std::optional(t) : std::nullopt; };
+      rows.push_back({record.id, ids_[n], record.begin_sent, given(f.ready),
+                      f.swapped ? std::optional(record.swap_sent) : std::nullopt, given(f.presented)});
     }
   }
   if (presented >= 2) {  // skew is between nodes: one node alone has none
     // In double: present times come from the network and may be anything.
-    last_skew_us_ = (static_cast<double>(latest) - static_cast<double>(earliest)) / 1e3;
-    present_skew_us_.add(last_skew_us_);
-    skew_us_sum_ += last_skew_us_;
-    recent.skew_us = last_skew_us_;
+    const double skew_us = (static_cast<double>(latest) - static_cast<double>(earliest)) / 1e3;
+    present_skew_us_.add(skew_us);
+    run_.last_present_skew_us = skew_us;
+    run_.present_skew_us_sum += skew_us;
+    run_.present_skew_count = present_skew_us_.count();
+    recent.skew_us = skew_us;
   }
   recent_.push_back(std::move(recent));
   if (recent_.size() > kRecentFrames) recent_.pop_front();
-  if (presented < record.nodes.size()) ++frames_missing_;
-  if (presented == 0) ++frames_shown_by_none_;
-  if (incoherent) ++frames_incoherent_;
-  ++frames_finalized_;
+  if (presented < record.nodes.size()) ++run_.frames_with_missing_node;
+  if (presented == 0) ++run_.frames_shown_by_none;
+  if (incoherent) ++run_.frames_incoherent;
+  ++run_.frames_finalized;
 }
 
-void RunRecorder::finalize_before(std::uint64_t frame) {
-  while (!open_.empty() && open_.front().id < frame) {
-    finalize(open_.front());
+std::vector<FrameRow> RunRecorder::finalize(std::optional<std::uint64_t> before) {
+  std::vector<FrameRow> rows;
+  while (!open_.empty() && (!before || open_.front().id < *before)) {
+    finalize(open_.front(), rows);
     open_.pop_front();
   }
-}
-
-void RunRecorder::finalize_all() {
-  while (!open_.empty()) {
-    finalize(open_.front());
-    open_.pop_front();
-  }
-  if (csv_ != nullptr) csv_->flush();
+  return rows;
 }
 
 report::RunReport RunRecorder::report() const {
   report::RunReport r;
-  r.set_frames(frames_finalized_);
+  r.set_frames(run_.frames_finalized);
   r.set_nodes_configured(static_cast<std::uint32_t>(ids_.size()));
   for (std::size_t n = 0; n < ids_.size(); ++n) {
     const NodeTotals& t = totals_[n];
@@ -210,12 +210,12 @@ report::RunReport RunRecorder::report() const {
   auto& sync = *r.mutable_sync();
   *sync.mutable_barrier_round_us() = barrier_round_us_.summary();
   *sync.mutable_present_skew_us() = present_skew_us_.summary();
-  sync.set_frames_with_missing_node(frames_missing_);
-  sync.set_frames_incoherent(frames_incoherent_);
-  sync.set_frames_dropped(frames_dropped_);
-  sync.set_frames_shown_by_none(frames_shown_by_none_);
-  if (frames_finalized_ > 1 && last_begin_ > first_begin_) {
-    sync.set_achieved_frame_rate(static_cast<double>(frames_finalized_ - 1) * 1e9 /
+  sync.set_frames_with_missing_node(run_.frames_with_missing_node);
+  sync.set_frames_incoherent(run_.frames_incoherent);
+  sync.set_frames_dropped(run_.frames_dropped);
+  sync.set_frames_shown_by_none(run_.frames_shown_by_none);
+  if (run_.frames_finalized > 1 && last_begin_ > first_begin_) {
+    sync.set_achieved_frame_rate(static_cast<double>(run_.frames_finalized - 1) * 1e9 /
                                  static_cast<double>(last_begin_ - first_begin_));
   }
   return r;

@@ -1,17 +1,18 @@
 #pragma once
-// What happened to every frame on every node, in master-clock nanoseconds: streamed
-// to frames.csv as frames complete, and folded into the run.json summary.
+// What happened to every frame on every node, in master-clock nanoseconds:
+// handed over as frames.csv rows as frames complete (master/frame_rows.h), and
+// folded into the run.json summary. Writes no file.
 
 #include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <map>
 #include <optional>
-#include <ostream>
 #include <string>
 #include <vector>
 
 #include "clock/clock.h"
+#include "master/frame_rows.h"
 #include "metrics/distribution.h"
 #include "optique/report.pb.h"
 #include "optique/wire.pb.h"
@@ -58,11 +59,27 @@ struct NodeCounts {
   report::ClockReport clock;       // the latest estimate in bounds
 };
 
+// The run's totals over the finalized frames, cheap to read at any time.
+struct RunTotals {
+  std::uint64_t frames_finalized = 0;
+  std::uint64_t frames_with_missing_node = 0;
+  std::uint64_t frames_incoherent = 0;
+  std::uint64_t frames_dropped = 0;
+  std::uint64_t frames_shown_by_none = 0;
+  // Present skew of the most recently finalized frame that two or more nodes
+  // presented, for the status line.
+  double last_present_skew_us = 0.0;
+  // Over every finalized frame that two or more nodes presented.
+  double present_skew_us_sum = 0.0;
+  std::uint64_t present_skew_count = 0;
+};
+
+// What happened to a node, counted in its NodeCounts.
+enum class NodeEvent { joined, missed_barrier, hash_mismatch };
+
 class RunRecorder {
  public:
-  // `csv` may be null (no --out); otherwise it receives the header now and a row
-  // per (frame, node) as frames are finalized.
-  RunRecorder(std::vector<std::string> node_ids, std::ostream* csv);
+  explicit RunRecorder(std::vector<std::string> node_ids);
 
   void frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
   // `drawn_as`: how a node that up-converts drew it (key frame, between…). A
@@ -84,30 +101,18 @@ class RunRecorder {
   // The straggler policy "drop": no node was told to show `frame`.
   void frame_dropped(std::uint64_t frame);
 
-  void node_joined(std::size_t node);
-  void node_missed_barrier(std::size_t node);
-  void hash_mismatch(std::size_t node);
+  void node_event(std::size_t node, NodeEvent event);
 
-  // Frames older than `frame` can no longer change: write and summarize them.
-  void finalize_before(std::uint64_t frame);
-  void finalize_all();
+  // Frames older than `before` (every frame without) can no longer change:
+  // summarized, and their frames.csv rows returned.
+  [[nodiscard]] std::vector<FrameRow> finalize(std::optional<std::uint64_t> before = std::nullopt);
 
   // Summary of the finalized frames.
   [[nodiscard]] report::RunReport report() const;
 
-  [[nodiscard]] std::uint64_t frames_finalized() const { return frames_finalized_; }
-  // Present skew of the most recently finalized frame that two or more nodes
-  // presented, for the status line.
-  [[nodiscard]] double last_present_skew_us() const { return last_skew_us_; }
-  [[nodiscard]] std::uint64_t frames_with_missing_node() const { return frames_missing_; }
-  [[nodiscard]] std::uint64_t frames_incoherent() const { return frames_incoherent_; }
-  [[nodiscard]] std::uint64_t frames_dropped() const { return frames_dropped_; }
-  [[nodiscard]] std::uint64_t frames_shown_by_none() const { return frames_shown_by_none_; }
+  [[nodiscard]] const RunTotals& totals() const { return run_; }
   [[nodiscard]] const std::deque<RecentFrame>& recent() const { return recent_; }
   [[nodiscard]] const NodeCounts& node_counts(std::size_t node) const { return totals_.at(node).counts; }
-  // Over every finalized frame that two or more nodes presented.
-  [[nodiscard]] double present_skew_us_sum() const { return skew_us_sum_; }
-  [[nodiscard]] std::uint64_t present_skew_count() const { return present_skew_us_.count(); }
 
  private:
   struct NodeFrame {
@@ -137,23 +142,16 @@ class RunRecorder {
   };
 
   FrameRecord* find(std::uint64_t frame);
-  void finalize(const FrameRecord& record);
+  void finalize(const FrameRecord& record, std::vector<FrameRow>& rows);
 
   std::vector<std::string> ids_;
-  std::ostream* csv_;
   std::deque<FrameRecord> open_;
   std::vector<NodeTotals> totals_;
   metrics::Reservoir barrier_round_us_;
   metrics::Reservoir present_skew_us_;
-  std::uint64_t frames_finalized_ = 0;
-  std::uint64_t frames_missing_ = 0;
-  std::uint64_t frames_incoherent_ = 0;
-  std::uint64_t frames_dropped_ = 0;
-  std::uint64_t frames_shown_by_none_ = 0;
+  RunTotals run_;
   clock::Nanos first_begin_ = 0;
   clock::Nanos last_begin_ = 0;
-  double last_skew_us_ = 0.0;
-  double skew_us_sum_ = 0.0;
   std::deque<RecentFrame> recent_;
 };
 

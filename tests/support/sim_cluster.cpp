@@ -48,7 +48,7 @@ SimCluster::SimCluster(const master::RunConfig& run, master::RunSettings setting
   const config::Installation& installation = run.config.installation;
   std::vector<std::string> ids;
   for (const config::Projector& p : installation.projectors) ids.push_back(p.id);
-  recorder_ = std::make_unique<master::RunRecorder>(ids, nullptr);
+  recorder_ = std::make_unique<master::RunRecorder>(ids);
   master_ = std::make_unique<master::MasterProtocol>(installation, run.scene, std::move(settings), *recorder_);
   for (std::size_t i = 0; i < ids.size(); ++i) {
     node::NodeSettings s;
@@ -234,6 +234,7 @@ void SimCluster::master_actions(master::Actions actions) {
                    [&](master::StopAccepting&) { accepting_ = false; },
                    [&](master::SignalLocalNodes&) {},
                    [&](master::HeadShown&) {},
+                   [&](master::FrameRows&) {},
                    [&](master::Finish& a) { finished_ = a.exit_code; },
                    [&](master::Log&) {},
                },
@@ -278,10 +279,13 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
               link->node_liveness = std::chrono::nanoseconds(a.timeout).count();
               link->node_heard = now_;
             },
-            [&](node::Configure&) { node_actions(i, n.protocol.answer(node::Configured{{}, "sim", {}}, now_)); },
+            [&](node::Configure&) {
+              node_actions(i, n.protocol.answer(node::Configured{{}, "sim", {}}, now_));
+            },
             [&](node::Render& a) {
               n.last_rendered = a.frame.frame_id;
-              node_actions(i, n.protocol.answer(node::FrameRendered{a.frame.frame_id, clock::kNanosPerMilli, {}}, now_));
+              node_actions(i,
+                           n.protocol.answer(node::FrameRendered{a.frame.frame_id, clock::kNanosPerMilli, {}}, now_));
             },
             [&](node::Skip&) {},
             [&](node::Protect&) {},

@@ -139,7 +139,7 @@ TEST(LiveStatus, MetricsAreWellFormedPrometheusText) {
 // quantile with no sample, which Prometheus writes so).
 TEST(LiveStatus, AbsurdReportsReachNeitherTheMetricsNorTheJson) {
   constexpr clock::Nanos kHuge = std::numeric_limits<clock::Nanos>::max();
-  RunRecorder recorder({"left", "right"}, nullptr);
+  RunRecorder recorder({"left", "right"});
   recorder.frame_begun(1, 1000 * kMs, {0, 1});
   recorder.ready(1, 0, 1001 * kMs, kHuge);
   recorder.ready(1, 1, 1001 * kMs, 2 * kMs);
@@ -154,7 +154,7 @@ TEST(LiveStatus, AbsurdReportsReachNeitherTheMetricsNorTheJson) {
   recorder.clock_estimated(1, 0, clock, std::nullopt);
   clock.set_drift_ppm(std::numeric_limits<double>::infinity());
   recorder.clock_estimated(1, 1, clock, std::nullopt);
-  recorder.finalize_all();
+  (void)recorder.finalize();
 
   LiveStatus s = two_nodes();
   for (std::size_t n = 0; n < 2; ++n) s.nodes[n].counts = recorder.node_counts(n);
@@ -177,8 +177,7 @@ TEST(LiveStatus, AbsurdReportsReachNeitherTheMetricsNorTheJson) {
   }
   EXPECT_GT(node_samples, 20u);
   EXPECT_NE(text.find("optique_node_out_of_range_total{projector=\"left\"} 3\n"), std::string::npos) << text;
-  EXPECT_NE(text.find("optique_node_out_of_range_total{projector=\"right \\\"quoted\\\"\"} 1\n"),
-            std::string::npos)
+  EXPECT_NE(text.find("optique_node_out_of_range_total{projector=\"right \\\"quoted\\\"\"} 1\n"), std::string::npos)
       << text;
   EXPECT_NE(text.find("optique_node_render_seconds_count{projector=\"left\"} 0\n"), std::string::npos) << text;
 
@@ -210,8 +209,7 @@ TEST(LiveStatus, OddTextStaysInsideItsJsonStringAndItsMetricsLabel) {
   EXPECT_EQ(json_text.find('\x1b'), std::string::npos);
   const auto doc = nlohmann::json::parse(json_text);
   EXPECT_EQ(doc["nodes"][0]["id"], "new\nline \\ back");
-  EXPECT_EQ(doc["warnings"][0]["text"].get<std::string>().rfind("</script><script>alert(1)</script>\n\x1b[31m", 0),
-            0u);
+  EXPECT_EQ(doc["warnings"][0]["text"].get<std::string>().rfind("</script><script>alert(1)</script>\n\x1b[31m", 0), 0u);
   const std::string text = status_metrics(s);
   EXPECT_NE(text.find("optique_node_up{projector=\"new\\nline \\\\ back\"} 1\n"), std::string::npos) << text;
   std::istringstream lines(text);

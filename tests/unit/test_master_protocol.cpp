@@ -61,7 +61,7 @@ class MasterTest : public ::testing::Test {
     if (change) change(run_.config.installation);
     std::vector<std::string> ids;
     for (const auto& p : run_.config.installation.projectors) ids.push_back(p.id);
-    recorder_.emplace(ids, nullptr);
+    recorder_.emplace(ids);
     master_.emplace(run_.config.installation, run_.scene, std::move(settings), *recorder_);
     (void)master_->start(now_);
   }
@@ -223,7 +223,8 @@ TEST_F(MasterTest, TheSharedSecretIsChecked) {
 
   (void)master_->accepted(2, "10.0.0.8:5000", false, nonce_, now_);
   wire::Envelope wrong = with_nonce;
-  const auto bad = net::hello_mac(net::Secret{std::vector<std::uint8_t>(32, 8)}, both, "top-left", net::kProtocolVersion);
+  const auto bad =
+      net::hello_mac(net::Secret{std::vector<std::uint8_t>(32, 8)}, both, "top-left", net::kProtocolVersion);
   wrong.mutable_hello()->set_nonce_mac(bad.data(), bad.size());
   Actions a = master_->message(2, wrong, now_);
   EXPECT_TRUE(logged(a, "authentication failed"));
@@ -275,7 +276,7 @@ TEST_F(MasterTest, AGoodHelloGetsItsJobAndTheStateOnceConfigured) {
   const auto resync = sent_to(a, 1, wire::Envelope::kResync);
   ASSERT_EQ(resync.size(), 1u);
   EXPECT_EQ(resync.front().resync().next_frame_id(), 0u);
-  EXPECT_EQ(master_->nodes_up(), 1u);
+  EXPECT_EQ(master_->progress().nodes_up, 1u);
   EXPECT_FALSE(master_->running()) << "it waits for the other three";
 }
 
@@ -435,7 +436,7 @@ TEST_F(MasterTest, ANodeThatInterpolatesGetsTheSceneAheadAndItsKeyFramesAreRepor
   (void)drawn(2, wire::DRAWN_KEY);
   (void)drawn(3, wire::DRAWN_KEY);
   (void)drawn(4, wire::DRAWN_FULL);
-  recorder_->finalize_all();
+  (void)recorder_->finalize();
   const report::RunReport report = recorder_->report();
   EXPECT_FALSE(report.nodes(0).has_up_conversion());
   ASSERT_TRUE(report.nodes(1).has_up_conversion());
@@ -636,7 +637,7 @@ TEST_F(MasterTest, ANodeThatLeavesIsNotWaitedForAndMayRejoin) {
   const auto resync = sent_to(a, 9, wire::Envelope::kResync);
   ASSERT_EQ(resync.size(), 1u);
   EXPECT_EQ(resync.front().resync().next_frame_id(), 2u);
-  EXPECT_EQ(master_->nodes_up(), 4u);
+  EXPECT_EQ(master_->progress().nodes_up, 4u);
 }
 
 // The operator pauses: the frame under way finishes and no other begins; the
@@ -761,7 +762,8 @@ TEST_F(MasterTest, ARunSucceedsOnlyWhenEnoughWasShown) {
     SCOPED_TRACE(min_presented ? "min_presented 0.5" : "by default");
     RunSettings settings;
     settings.frames = 2;
-    load("powerwall-2x2.json", [&](config::Installation& i) { i.master.min_presented = min_presented; }, settings);
+    load(
+        "powerwall-2x2.json", [&](config::Installation& i) { i.master.min_presented = min_presented; }, settings);
     Actions a = join_all();
     std::uint64_t hash = hash_of(a, 1);
     for (PeerId p = 1; p <= 4; ++p) (void)ready(p, 0, hash);
@@ -779,8 +781,9 @@ TEST_F(MasterTest, ARunSucceedsOnlyWhenEnoughWasShown) {
     ASSERT_NE(first<Finish>(a), nullptr);
     if (min_presented) {
       EXPECT_EQ(first<Finish>(a)->exit_code, kExitTooFewShown);
-      EXPECT_TRUE(logged(a, "the run failed: 0.0 % of the 2 frames were shown by every projector, less than "
-                            "master.min_presented (50.0 %)"));
+      EXPECT_TRUE(logged(a,
+                         "the run failed: 0.0 % of the 2 frames were shown by every projector, less than "
+                         "master.min_presented (50.0 %)"));
     } else {
       EXPECT_EQ(first<Finish>(a)->exit_code, kExitOk) << "frames were shown, by some";
     }

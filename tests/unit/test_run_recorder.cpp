@@ -1,5 +1,5 @@
 // Per-frame, per-node timing records, frames.csv and the run summary:
-// master/run_recorder.h.
+// master/run_recorder.h, master/frame_rows.h.
 
 #include <gtest/gtest.h>
 
@@ -30,8 +30,8 @@ std::vector<std::string> lines_of(const std::string& text) {
 //   frame 2: both ready, swapped, presented 70 µs apart (b first); round 400 µs.
 void feed_three_frames(RunRecorder& r) {
   const std::vector<std::size_t> both{0, 1};
-  r.node_joined(0);
-  r.node_joined(1);
+  r.node_event(0, NodeEvent::joined);
+  r.node_event(1, NodeEvent::joined);
 
   r.frame_begun(0, 1'000'000'000, both);
   r.ready(0, 0, 1'000'300'000, 250'000);
@@ -54,17 +54,13 @@ void feed_three_frames(RunRecorder& r) {
   r.presented(2, 1, 1'035'000'000, 2);
 }
 
-TEST(RunRecorder, CsvHeaderIsWrittenOnConstruction) {
-  std::ostringstream csv;
-  RunRecorder r({"a", "b"}, &csv);
-  EXPECT_EQ(csv.str(), std::string(kHeader) + "\n");
-}
+TEST(RunRecorder, CsvHeaderNamesTheColumns) { EXPECT_EQ(frames_csv_header(), std::string(kHeader) + "\n"); }
 
 TEST(RunRecorder, CsvHasOneRowPerFrameAndNode) {
-  std::ostringstream csv;
-  RunRecorder r({"a", "b"}, &csv);
+  std::string csv = frames_csv_header();
+  RunRecorder r({"a", "b"});
   feed_three_frames(r);
-  r.finalize_all();
+  csv += frames_csv(r.finalize());
   const std::vector<std::string> expected{
       kHeader,
       "0,a,1000000000,1000300000,1000600000,1002000000",
@@ -74,36 +70,36 @@ TEST(RunRecorder, CsvHasOneRowPerFrameAndNode) {
       "2,a,1033333333,1033500000,1033733333,1035070000",
       "2,b,1033333333,1033700000,1033733333,1035000000",
   };
-  EXPECT_EQ(lines_of(csv.str()), expected);
-  EXPECT_EQ(r.frames_finalized(), 3u);
+  EXPECT_EQ(lines_of(csv), expected);
+  EXPECT_EQ(r.totals().frames_finalized, 3u);
 }
 
 TEST(RunRecorder, FinalizeBeforeStreamsOnlyOlderFrames) {
-  std::ostringstream csv;
-  RunRecorder r({"a", "b"}, &csv);
+  std::string csv = frames_csv_header();
+  RunRecorder r({"a", "b"});
   feed_three_frames(r);
-  r.finalize_before(2);
-  EXPECT_EQ(r.frames_finalized(), 2u);
-  auto lines = lines_of(csv.str());
+  csv += frames_csv(r.finalize(2));
+  EXPECT_EQ(r.totals().frames_finalized, 2u);
+  auto lines = lines_of(csv);
   ASSERT_EQ(lines.size(), 5u);  // header + frames 0 and 1
   EXPECT_EQ(lines.back().rfind("1,b,", 0), 0u) << lines.back();
   // Frame 1 had one present, so no skew: the last skew is still frame 0's.
-  EXPECT_NEAR(r.last_present_skew_us(), 30.0, kTolUs);
-  EXPECT_EQ(r.frames_with_missing_node(), 1u);
+  EXPECT_NEAR(r.totals().last_present_skew_us, 30.0, kTolUs);
+  EXPECT_EQ(r.totals().frames_with_missing_node, 1u);
 
-  r.finalize_before(2);  // again: nothing new
-  EXPECT_EQ(lines_of(csv.str()).size(), 5u);
+  csv += frames_csv(r.finalize(2));  // again: nothing new
+  EXPECT_EQ(lines_of(csv).size(), 5u);
 
-  r.finalize_all();
-  EXPECT_EQ(r.frames_finalized(), 3u);
-  EXPECT_EQ(lines_of(csv.str()).size(), 7u);
-  EXPECT_NEAR(r.last_present_skew_us(), 70.0, kTolUs);
+  csv += frames_csv(r.finalize());
+  EXPECT_EQ(r.totals().frames_finalized, 3u);
+  EXPECT_EQ(lines_of(csv).size(), 7u);
+  EXPECT_NEAR(r.totals().last_present_skew_us, 70.0, kTolUs);
 }
 
 TEST(RunRecorder, ReportSummarizesTheFrames) {
-  RunRecorder r({"a", "b"}, nullptr);
+  RunRecorder r({"a", "b"});
   feed_three_frames(r);
-  r.finalize_all();
+  (void)r.finalize();
   const report::RunReport rep = r.report();
   EXPECT_EQ(rep.frames(), 3u);
   EXPECT_EQ(rep.nodes_configured(), 2u);
@@ -149,9 +145,9 @@ TEST(RunRecorder, ReportSummarizesTheFrames) {
 }
 
 TEST(RunRecorder, ReportCoversOnlyFinalizedFrames) {
-  RunRecorder r({"a", "b"}, nullptr);
+  RunRecorder r({"a", "b"});
   feed_three_frames(r);
-  r.finalize_before(1);  // frame 0 only
+  (void)r.finalize(1);  // frame 0 only
   const report::RunReport rep = r.report();
   EXPECT_EQ(rep.frames(), 1u);
   EXPECT_EQ(rep.sync().present_skew_us().count(), 1u);
@@ -161,15 +157,15 @@ TEST(RunRecorder, ReportCoversOnlyFinalizedFrames) {
 }
 
 TEST(RunRecorder, NodeNotBegunHasNoRowAndCountsAsMissing) {
-  std::ostringstream csv;
-  RunRecorder r({"a", "b"}, &csv);
+  std::string csv = frames_csv_header();
+  RunRecorder r({"a", "b"});
   r.frame_begun(5, 2'000'000'000, {0});  // b is not connected
   r.ready(5, 0, 2'000'100'000, 90'000);
   r.swapped(5, 2'000'150'000, {0});
   r.presented(5, 0, 2'001'000'000, 5);
-  r.finalize_all();
+  csv += frames_csv(r.finalize());
   const std::vector<std::string> expected{kHeader, "5,a,2000000000,2000100000,2000150000,2001000000"};
-  EXPECT_EQ(lines_of(csv.str()), expected);
+  EXPECT_EQ(lines_of(csv), expected);
   const report::RunReport rep = r.report();
   EXPECT_EQ(rep.sync().frames_with_missing_node(), 1u);
   EXPECT_EQ(rep.sync().frames_incoherent(), 0u);  // b was never told to swap
@@ -177,18 +173,18 @@ TEST(RunRecorder, NodeNotBegunHasNoRowAndCountsAsMissing) {
 }
 
 TEST(RunRecorder, NodeThatMissedTheBarrierHasEmptyCells) {
-  std::ostringstream csv;
-  RunRecorder r({"a", "b"}, &csv);
+  std::string csv = frames_csv_header();
+  RunRecorder r({"a", "b"});
   r.frame_begun(9, 3'000'000'000, {0, 1});
   r.ready(9, 0, 3'000'100'000, 90'000);
-  r.node_missed_barrier(1);
+  r.node_event(1, NodeEvent::missed_barrier);
   r.swapped(9, 3'500'000'000, {0});     // swapped without b
   r.presented(9, 1, 3'500'900'000, 9);  // b was not told to swap: ignored
   r.presented(9, 0, 3'501'000'000, 9);
-  r.finalize_all();
+  csv += frames_csv(r.finalize());
   const std::vector<std::string> expected{kHeader, "9,a,3000000000,3000100000,3500000000,3501000000",
                                           "9,b,3000000000,,,"};
-  EXPECT_EQ(lines_of(csv.str()), expected);
+  EXPECT_EQ(lines_of(csv), expected);
   const report::RunReport rep = r.report();
   EXPECT_EQ(rep.nodes(1).barrier_misses(), 1u);
   EXPECT_EQ(rep.nodes(1).frames_presented(), 0u);
@@ -199,7 +195,7 @@ TEST(RunRecorder, NodeThatMissedTheBarrierHasEmptyCells) {
 }
 
 TEST(RunRecorder, DuplicateAndUnknownEventsAreIgnored) {
-  RunRecorder r({"a"}, nullptr);
+  RunRecorder r({"a"});
   r.frame_begun(1, 1'000, {0});
   r.ready(1, 0, 2'000, 500);
   r.ready(1, 0, 2'500, 700);  // duplicate FrameReady
@@ -208,9 +204,9 @@ TEST(RunRecorder, DuplicateAndUnknownEventsAreIgnored) {
   r.presented(1, 0, 4'000, 1);
   r.presented(1, 0, 4'500, 1);  // duplicate Presented
   r.presented(8, 0, 4'600, 8);  // unknown frame
-  r.hash_mismatch(0);
-  r.hash_mismatch(0);
-  r.finalize_all();
+  r.node_event(0, NodeEvent::hash_mismatch);
+  r.node_event(0, NodeEvent::hash_mismatch);
+  (void)r.finalize();
   const report::RunReport rep = r.report();
   EXPECT_EQ(rep.nodes(0).frames_rendered(), 1u);
   EXPECT_EQ(rep.nodes(0).frames_presented(), 1u);
@@ -226,12 +222,12 @@ constexpr clock::Nanos kHuge = std::numeric_limits<clock::Nanos>::max();
 constexpr clock::Nanos kHugeNegative = std::numeric_limits<clock::Nanos>::min();
 
 TEST(RunRecorder, AbsurdRenderTimesAreCountedNotRecorded) {
-  RunRecorder r({"a", "b", "c"}, nullptr);
+  RunRecorder r({"a", "b", "c"});
   r.frame_begun(1, 1'000'000'000, {0, 1, 2});
   r.ready(1, 0, 1'000'100'000, kHuge, wire::DRAWN_KEY);
   r.ready(1, 1, 1'000'100'000, -5);
   r.ready(1, 2, 1'000'100'000, kLongestRender);  // a minute: slow, not absurd
-  r.finalize_all();
+  (void)r.finalize();
   const report::RunReport rep = r.report();
   for (int n = 0; n < 2; ++n) {
     EXPECT_EQ(rep.nodes(n).frames_rendered(), 1u) << "it did say it was ready";
@@ -249,8 +245,8 @@ TEST(RunRecorder, AbsurdRenderTimesAreCountedNotRecorded) {
 }
 
 TEST(RunRecorder, PresentTimesFarFromTheSwapAreCountedNotRecorded) {
-  std::ostringstream csv;
-  RunRecorder r({"a", "b", "c", "d"}, &csv);
+  std::string csv = frames_csv_header();
+  RunRecorder r({"a", "b", "c", "d"});
   const clock::Nanos swap = 2'000'000'000;
   r.frame_begun(3, 1'990'000'000, {0, 1, 2, 3});
   r.swapped(3, swap, {0, 1, 2, 3});
@@ -259,7 +255,7 @@ TEST(RunRecorder, PresentTimesFarFromTheSwapAreCountedNotRecorded) {
   r.presented(3, 2, swap + kFarthestPresent + 1, 3);
   r.presented(3, 3, swap - kFarthestPresent, 3);  // at the bound: recorded
   r.presented(3, 2, swap + 1'000'000, 3);         // then a plausible one: taken
-  r.finalize_all();
+  csv += frames_csv(r.finalize());
   const report::RunReport rep = r.report();
   EXPECT_EQ(rep.nodes(0).frames_presented(), 0u);
   EXPECT_EQ(rep.nodes(0).out_of_range(), 1u);
@@ -270,14 +266,14 @@ TEST(RunRecorder, PresentTimesFarFromTheSwapAreCountedNotRecorded) {
   // Skew between the two in bounds only: 61 s, not 2^64 ns.
   EXPECT_NEAR(rep.sync().present_skew_us().max(), 60e6 + 1e3, kTolUs);
   EXPECT_EQ(rep.sync().frames_incoherent(), 1u) << "a and b were told to swap and said nothing usable";
-  const auto lines = lines_of(csv.str());
+  const auto lines = lines_of(csv);
   ASSERT_EQ(lines.size(), 5u);
   EXPECT_EQ(lines[1], "3,a,1990000000,,2000000000,");
   EXPECT_EQ(lines[2], "3,b,1990000000,,2000000000,");
 }
 
 TEST(RunRecorder, ImplausibleClockEstimatesAreCountedAndThePreviousKept) {
-  RunRecorder r({"a"}, nullptr);
+  RunRecorder r({"a"});
   report::ClockReport good;
   good.set_offset_ns(-50'000'000);
   good.set_drift_ppm(12.5);
@@ -318,8 +314,8 @@ TEST(RunRecorder, ImplausibleClockEstimatesAreCountedAndThePreviousKept) {
 }
 
 TEST(RunRecorder, EmptyRunReport) {
-  RunRecorder r({"a", "b", "c"}, nullptr);
-  r.finalize_all();
+  RunRecorder r({"a", "b", "c"});
+  (void)r.finalize();
   const report::RunReport rep = r.report();
   EXPECT_EQ(rep.frames(), 0u);
   EXPECT_EQ(rep.nodes_configured(), 3u);
