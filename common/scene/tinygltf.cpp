@@ -1,0 +1,3 @@
+// TinyGLTF's implementation, compiled once (scene/tinygltf.h).
+#define TINYGLTF_IMPLEMENTATION
+#include "scene/tinygltf.h"
