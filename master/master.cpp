@@ -11,6 +11,7 @@
 #include "master/report_json.h"
 #include "master/run_verdict.h"
 #include "net/stamped_receive.h"
+#include "util/join.h"
 #include "util/overloaded.h"
 
 namespace optique::master {
@@ -131,9 +132,7 @@ Result<void> Master::start() {
   }
   port_ = acceptor_.local_endpoint().port();
   if (auto written = write_port_file(options_.port_file, port_, "port file"); !written) return written;
-  std::string id_list;
-  for (const auto& id : ids) id_list += (id_list.empty() ? "" : ", ") + id;
-  log_.info("listening on {}:{}; waiting for {} node(s): {}", settings.listen, port_, ids.size(), id_list);
+  log_.info("listening on {}:{}; waiting for {} node(s): {}", settings.listen, port_, ids.size(), util::joined(ids));
   if (tracking && tracking->source == config::TrackingSource::dtrack) {
     if (auto listening = listen_to_tracker(*tracking, settings.frame_rate); !listening) return listening;
   } else if (tracking) {

@@ -8,6 +8,7 @@
 #include "net/envelope.h"
 #include "protocol/scene_fetch.h"
 #include "protocol/welcome.h"
+#include "util/join.h"
 
 namespace optique::master {
 
@@ -266,8 +267,7 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
   }
   const std::optional<std::size_t> slot = installation_.find_projector(hello.node_id());
   if (!slot) {
-    std::string known;
-    for (const config::Projector& p : installation_.projectors) known += (known.empty() ? "" : ", ") + p.id;
+    const std::string known = util::joined(installation_.projectors, [](const config::Projector& p) { return p.id; });
     refuse(peer, session, hello.node_id(),
            "unknown projector id '" + hello.node_id() + "' (this installation has: " + known + ")", false, out);
     return;
@@ -403,8 +403,7 @@ Actions MasterProtocol::timer(Timer timer, clock::Nanos now) {
         // machine, or with a large scene, that takes longer than the timeout.
         // Their own configure deadline bounds the wait.
         startup_passed_ = true;
-        std::string ids;
-        for (const std::size_t slot : configuring) ids += (ids.empty() ? "" : ", ") + slot_id(slot);
+        const std::string ids = util::joined(configuring, [&](std::size_t slot) { return slot_id(slot); });
         out.push_back(
             Log{spdlog::level::warn,
                 fmt::format("no node ready after {} ms; waiting for {} (connected, still configuring, "
@@ -413,13 +412,13 @@ Actions MasterProtocol::timer(Timer timer, clock::Nanos now) {
         break;
       }
       {
-        std::string missing;
+        std::vector<std::string> missing;
         for (std::size_t i = 0; i < slots_.size(); ++i) {
-          if (!slots_[i].peer) missing += (missing.empty() ? "" : ", ") + slot_id(i);
+          if (!slots_[i].peer) missing.push_back(slot_id(i));
         }
         out.push_back(Log{spdlog::level::warn,
                           fmt::format("starting without {} (not connected after {} ms); they join when they come",
-                                      missing, config_.startup_timeout.count())});
+                                      util::joined(missing), config_.startup_timeout.count())});
       }
       start_frames(now, out);
       break;

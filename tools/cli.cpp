@@ -18,6 +18,7 @@
 #include "tools/compose.h"
 #include "tools/perceive.h"
 #include "tools/render_reference.h"
+#include "util/join.h"
 
 namespace optique::tools {
 namespace {
@@ -43,8 +44,7 @@ int check_config(const std::vector<std::string>& files) {
     std::cout << summarize(loaded.value().config);
     const scene::LoadedScene& scene = loaded.value().scene;
     if (!scene.manifest.files.empty()) {
-      std::string names;
-      for (const auto& f : scene.manifest.files) names += (names.empty() ? "" : ", ") + f.path;
+      const std::string names = util::joined(scene.manifest.files, [](const auto& f) { return f.path; });
       std::cout << "  scene files: " << scene.manifest.files.size() << " (" << names << "), "
                 << fmt::format("{:.1f}", static_cast<double>(scene.manifest.total_bytes()) / (1 << 20))
                 << " MiB, identity " << scene.content_sha256.substr(0, 12)

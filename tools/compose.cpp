@@ -11,6 +11,7 @@
 #include "optics/defocus.h"
 #include "optics/projector_model.h"
 #include "tools/screen_images.h"
+#include "util/join.h"
 
 namespace optique::tools {
 namespace {
@@ -130,8 +131,7 @@ Result<ComposeSummary> compose_frame(const config::LoadedConfig& config, std::ui
     }
     composed.exr_path = image::frame_path(folder, frame, "exr");
     composed.png_path = image::frame_path(folder, frame, "png");
-    std::string names;
-    for (const std::string& id : composed.projectors) names += (names.empty() ? "" : ", ") + id;
+    const std::string names = util::joined(composed.projectors);
     log.info("screen '{}' ({}): {}×{} px from {} projector(s) [{}], {}×{} subsamples, {:.1f}% lit → {}", screen.id,
              config::to_string(group.eye), composed.width, composed.height, composed.projectors.size(), names,
              composed.subsamples, composed.subsamples, 100.0 * composed.covered, composed.png_path);

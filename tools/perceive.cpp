@@ -22,6 +22,7 @@
 #include "render/projector_pipeline.h"
 #include "tools/reference_view.h"
 #include "tools/screen_images.h"
+#include "util/join.h"
 
 namespace optique::tools {
 namespace {
@@ -110,8 +111,7 @@ Result<std::vector<PerceivedScreen>> perceive(const config::LoadedConfig& config
     const auto found = std::find_if(scene.objects.begin(), scene.objects.end(),
                                     [&](const scene::AnimatedObject& o) { return o.name == options.object; });
     if (found == scene.objects.end()) {
-      std::string names;
-      for (const auto& o : scene.objects) names += (names.empty() ? "" : ", ") + o.name;
+      const std::string names = util::joined(scene.objects, [](const scene::AnimatedObject& o) { return o.name; });
       return Error{"--track: the scene has no object '" + options.object +
                    "' (its moving objects: " + (names.empty() ? "none" : names) + ")" +
                    (options.object.find(',') != std::string::npos

@@ -10,6 +10,7 @@
 #include "calib/point_checks.h"
 #include "calib/refine.h"
 #include "util/finite.h"
+#include "util/join.h"
 
 namespace optique::calib {
 namespace {
@@ -58,10 +59,9 @@ double rms_over(const glm::dmat3& h, std::span<const geometry::Correspondence> p
 }
 
 std::string outlier_list(std::span<const Outlier> outliers) {
-  std::string text;
-  for (std::size_t k = 0; k < outliers.size() && k < kNamedOutliers; ++k) {
-    text += fmt::format("{}points[{}] {:.3g} px", k == 0 ? "" : ", ", outliers[k].index, outliers[k].residual_px);
-  }
+  std::string text = util::joined(outliers.first(std::min(outliers.size(), kNamedOutliers)), [](const Outlier& o) {
+    return fmt::format("points[{}] {:.3g} px", o.index, o.residual_px);
+  });
   if (outliers.size() > kNamedOutliers) text += fmt::format(" and {} more", outliers.size() - kNamedOutliers);
   return text;
 }

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "calib/screen_frame.h"
+#include "util/join.h"
 
 namespace optique::calib {
 namespace {
@@ -54,8 +55,7 @@ Result<void> only_keys(const json& object, std::initializer_list<const char*> al
     // Not a structured binding: clang 14 (the sanitizer build) cannot capture one.
     const std::string& key = item.key();
     if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return key == a; })) {
-      std::string names;
-      for (const char* a : allowed) names += fmt::format("{}\"{}\"", names.empty() ? "" : ", ", a);
+      const std::string names = util::joined(allowed, [](const char* a) { return fmt::format("\"{}\"", a); });
       return Error{
           fmt::format("{}: unknown field \"{}\" (expected {})", field.empty() ? "top level" : field, key, names)};
     }

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "util/join.h"
 #include "util/number_text.h"
 
 namespace optique::config {
@@ -181,9 +182,8 @@ ColorFields parse_color_fields(const schema::ColorFields& c, const std::string& 
     const auto preset =
         std::find_if(presets().begin(), presets().end(), [&](const Preset& p) { return p.name == c.preset(); });
     if (preset == presets().end()) {
-      std::string names;
-      for (const std::string& n : color_field_presets()) names += (names.empty() ? "" : ", ") + n;
-      problems.push_back({path + ".preset", "unknown preset '" + c.preset() + "' (presets are: " + names + ")"});
+      problems.push_back({path + ".preset", "unknown preset '" + c.preset() +
+                                                "' (presets are: " + util::joined(color_field_presets()) + ")"});
       return out;
     }
     out.fields = preset->fields;

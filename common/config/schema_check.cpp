@@ -1,4 +1,5 @@
 #include "config/schema_check.h"
+#include "util/join.h"
 
 #include <algorithm>
 #include <cmath>
@@ -139,8 +140,7 @@ class Checker {
   void one_value(const FieldDescriptor& field, const Json& value, const std::string& path) {
     switch (field.cpp_type()) {
       case FieldDescriptor::CPPTYPE_INT32:
-        integer(value, path, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max(),
-                false);
+        integer(value, path, std::numeric_limits<std::int32_t>::min(), std::numeric_limits<std::int32_t>::max(), false);
         break;
       case FieldDescriptor::CPPTYPE_UINT32:
         integer(value, path, 0.0, std::numeric_limits<std::uint32_t>::max(), false);
@@ -172,11 +172,10 @@ class Checker {
         break;
       case FieldDescriptor::CPPTYPE_ENUM:
         if (value.is_string() && field.enum_type()->FindValueByName(value.get<std::string>()) == nullptr) {
-          std::string names;
-          for (int i = 0; i < field.enum_type()->value_count(); ++i) {
-            names += (names.empty() ? "" : ", ") + field.enum_type()->value(i)->name();
-          }
-          fail(path, "unknown value " + shown(value) + " (one of: " + names + ")");
+          std::vector<std::string> names;
+          for (int i = 0; i < field.enum_type()->value_count(); ++i)
+            names.push_back(field.enum_type()->value(i)->name());
+          fail(path, "unknown value " + shown(value) + " (one of: " + util::joined(names) + ")");
         } else if (!value.is_string() && !value.is_number_integer()) {
           fail(path, "expected one of the names in quotes (got " + kind_of(value) + ")");
         }

@@ -13,6 +13,7 @@
 #include "config/tracking.h"
 #include "config/up_conversion.h"
 #include "scene/builtin.h"
+#include "util/join.h"
 #include "util/number_text.h"
 
 namespace optique::config {
@@ -63,13 +64,10 @@ class Checker {
 
   void one_of(const std::string& path, const std::string& value, std::initializer_list<const char*> allowed) {
     if (value.empty()) return;  // the default applies
-    std::string list;
     for (const char* a : allowed) {
       if (value == a) return;
-      list += list.empty() ? "" : ", ";
-      list += a;
     }
-    fail(path, "unknown value '" + value + "' (expected one of: " + list + ")");
+    fail(path, "unknown value '" + value + "' (expected one of: " + util::joined(allowed) + ")");
   }
 
  private:
@@ -318,8 +316,7 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
     if (p.screen().empty()) {
       check.fail(at + ".screen", "must name the screen this projector lights");
     } else if (screen == nullptr && every_screen_named(inst)) {
-      std::string known;
-      for (const schema::Screen& s : inst.screens()) known += (known.empty() ? "" : ", ") + s.id();
+      const std::string known = util::joined(inst.screens(), [](const schema::Screen& s) { return s.id(); });
       check.fail(at + ".screen", "unknown screen '" + p.screen() + "' (screens are: " + known + ")");
     }
     if (p.has_region()) check_region(check, at + ".region", p.region(), screen);
@@ -351,9 +348,8 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
           preset_rate && std::abs(*preset_rate - rate) > 0.01) {
         check.fail(at + ".color_fields.preset",
                    "'" + p.color_fields().preset() + "' is the field timing of a " + number_text(*preset_rate) +
-                       " Hz projector, but master.frame_rate is " + number_text(rate) +
-                       " Hz: each field would last " + number_text(*preset_rate / rate) +
-                       " times as long (set master.frame_rate, or give the fields)");
+                       " Hz projector, but master.frame_rate is " + number_text(rate) + " Hz: each field would last " +
+                       number_text(*preset_rate / rate) + " times as long (set master.frame_rate, or give the fields)");
       }
     }
     // Interpolation draws key frames from the scene sent ahead; a live tracked
@@ -422,8 +418,8 @@ void check_master(Checker& check, const schema::MasterSettings& m) {
   }
   if (m.has_min_presented() && check.finite("master.min_presented", m.min_presented()) &&
       (m.min_presented() < 0.0 || m.min_presented() > 1.0)) {
-    check.fail("master.min_presented", "is a share of the frames, 0 to 1 (got " + number_text(m.min_presented()) +
-                                           "; 0.9 means 90 %)");
+    check.fail("master.min_presented",
+               "is a share of the frames, 0 to 1 (got " + number_text(m.min_presented()) + "; 0.9 means 90 %)");
   }
   if (m.max_message_bytes() != 0 && m.max_message_bytes() < 1024) {
     check.fail("master.max_message_bytes", "must be at least 1024 (got " + std::to_string(m.max_message_bytes()) + ")");
@@ -512,9 +508,8 @@ void check_scene(Checker& check, const schema::Scene& s, const std::string& conf
     return;
   }
   if (builtin && !scene::is_builtin_scene(s.builtin())) {
-    std::string known;
-    for (const auto& name : scene::builtin_scene_names()) known += (known.empty() ? "" : ", ") + std::string(name);
-    check.fail("scene.builtin", "unknown scene '" + s.builtin() + "' (built-in scenes are: " + known + ")");
+    check.fail("scene.builtin", "unknown scene '" + s.builtin() +
+                                    "' (built-in scenes are: " + util::joined(scene::builtin_scene_names()) + ")");
   }
   check_light_switches(check, s);
   if (gltf && scope == Scope::installation) {

@@ -26,8 +26,8 @@
 #include <vector>
 
 #include "scene/definition.h"
-#include "scene/manifest.h"
 #include "scene/image_decoder.h"
+#include "scene/manifest.h"
 #include "util/result.h"
 
 namespace optique::scene {

@@ -1,6 +1,7 @@
 // The loader's materials: glTF's metallic-roughness factors, emissive (and its
 // strength), and base colour textures through the caller's ImageDecoder.
 #include "scene/gltf_loader.h"
+#include "util/join.h"
 
 #include <algorithm>
 #include <cmath>
@@ -69,9 +70,7 @@ Material Loader::convert_material(std::size_t index) {
   if (source.occlusionTexture.index >= 0) textures.emplace_back("occlusionTexture");
   if (source.emissiveTexture.index >= 0) textures.emplace_back("emissiveTexture");
   if (!textures.empty()) {
-    std::string list;
-    for (const auto& name : textures) list += (list.empty() ? "" : ", ") + name;
-    warn(label + ": only base colour textures are supported; ignored " + list);
+    warn(label + ": only base colour textures are supported; ignored " + util::joined(textures));
   }
   if (!source.alphaMode.empty() && source.alphaMode != "OPAQUE") {
     warn(label + ": alphaMode " + source.alphaMode + " is ignored; drawn opaque");

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/relative_path.h"
+#include "util/join.h"
 #include "util/message_text.h"
 
 namespace optique::scene {
@@ -243,12 +244,9 @@ Result<GltfSource> read_gltf_source(const std::string& path, const std::vector<s
       }
     }
     if (!unsupported.empty()) {
-      std::string list;
-      for (const auto& extension : unsupported) list += (list.empty() ? "" : ", ") + extension;
-      std::string supported;
-      for (const auto& extension : supported_required) supported += (supported.empty() ? "" : ", ") + extension;
       return Error{path + ": requires " + (unsupported.size() == 1 ? "an extension" : "extensions") +
-                   " that optique cannot draw: " + list + " (it reads " + supported + ")"};
+                   " that optique cannot draw: " + util::joined(unsupported) + " (it reads " +
+                   util::joined(supported_required) + ")"};
     }
   }
 

@@ -4,6 +4,7 @@
 #include <cassert>
 
 #include "tracking/dtrack.h"
+#include "util/join.h"
 
 namespace optique::tracking {
 
@@ -44,7 +45,8 @@ void DTrackReader::read(std::string_view bytes, Nanos arrival, std::string_view 
   if (!from_.empty() && sender != from_) {
     ++counts.other_sender;
     say_once(said_other_sender_,
-             "tracker: ignored datagrams from " + std::string(sender) + ": viewer.tracking.from is " + from_, into.said);
+             "tracker: ignored datagrams from " + std::string(sender) + ": viewer.tracking.from is " + from_,
+             into.said);
     return;
   }
   enter_period(static_cast<std::uint64_t>(std::max<Nanos>(arrival, 0) / period_));
@@ -54,7 +56,8 @@ void DTrackReader::read(std::string_view bytes, Nanos arrival, std::string_view 
     ++counts.flood;
     say_once(said_flood_,
              "tracker: datagrams from " + who + " come faster than " +
-                 std::to_string(clock::kNanosPerSecond / kFloodInterval) + " a second; the extra ones are dropped unread",
+                 std::to_string(clock::kNanosPerSecond / kFloodInterval) +
+                 " a second; the extra ones are dropped unread",
              into.said);
     return;
   }
@@ -84,8 +87,7 @@ void DTrackReader::read(std::string_view bytes, Nanos arrival, std::string_view 
   const auto body = std::find_if(f.bodies.begin(), f.bodies.end(), [&](const DTrackBody& b) { return b.id == body_; });
   if (body == f.bodies.end()) {
     ++counts.without_body;
-    std::string seen;
-    for (const DTrackBody& b : f.bodies) seen += (seen.empty() ? "" : ", ") + std::to_string(b.id);
+    const std::string seen = util::joined(f.bodies, [](const DTrackBody& b) { return std::to_string(b.id); });
     say_once(said_without_body_,
              "tracker: a frame without body " + std::to_string(body_) +
                  (seen.empty() ? " (no body tracked)" : " (bodies " + seen + ")"),
