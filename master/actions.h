@@ -1,5 +1,5 @@
 #pragma once
-// What the master's core (master/protocol.h) asks its shell (master/master.h) to
+// What the master's core (master/protocol.h) asks its shell (master/app/master.h) to
 // do, in order: send, close, set a connection's deadline, arm a timer, stop
 // accepting, signal the local nodes, record the head shown and the frames
 // finalized, finish, log. Apart

@@ -2,7 +2,7 @@
 // The master's side of the protocol, without sockets, timers or processes: it
 // takes events (a connection accepted, a message, a connection closed, a timer
 // due, a local node's exit, an interrupt) with the time they happened, and
-// answers with actions for its shell (master/master.h) to carry out, in order:
+// answers with actions for its shell (master/app/master.h) to carry out, in order:
 // send, close, set a connection's deadline, arm a timer, stop accepting, signal
 // the local nodes, finish, log. Every rule — admission and authentication, the
 // frame loop and its barrier, stragglers, rejoining and resyncing, the lights'
@@ -32,7 +32,7 @@
 #include "master/exit_codes.h"
 #include "master/focus_schedule.h"
 #include "master/live_status.h"
-#include "master/operator_api.h"
+#include "master/operator_command.h"
 #include "master/render_pace.h"
 #include "master/run_recorder.h"
 #include "master/scene_authority.h"
@@ -89,7 +89,7 @@ class MasterProtocol {
   // second stops at once.
   [[nodiscard]] Actions interrupted(const std::string& signal_name, clock::Nanos now);
   // What the head tracker's datagrams brought (viewer.tracking with source
-  // dtrack), read and parsed off the frame loop (master/tracker_receiver.h).
+  // dtrack), read and parsed off the frame loop (master/app/tracker_receiver.h).
   [[nodiscard]] Actions tracker_input(tracking::TrackerInput input);
   // The operator's page asked (`from`: who, for the log). Pause: no frame
   // begins after the one under way, whose picture stays on every projector;

@@ -41,7 +41,7 @@ class ViewerHead {
              std::vector<tracking::ReplaySample> replay);
 
   void start(clock::Nanos now);
-  // What the tracker's reader brought (master/tracker_receiver.h); what it has
+  // What the tracker's reader brought (master/app/tracker_receiver.h); what it has
   // to say goes to `said`.
   void input(tracking::TrackerInput input, std::vector<std::string>& said);
   // The frame's head: a replay fed up to `now`, a loss noticed (said), the head

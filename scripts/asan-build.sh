@@ -3,7 +3,7 @@
 # libFuzzer targets share it, so CI compiles the code under test once for both
 # (a separate fuzz build took 315 s of a 2-core machine), and clang compiles it
 # under the sanitizers in about two thirds of gcc's time (gltf.cpp 36 -> 26 s,
-# master/cli.cpp 37 -> 24 s).
+# master/app/cli.cpp 37 -> 24 s).
 #
 # Flags, and why:
 #  -O1: the sanitizers' own docs recommend it (usable speed, exact stacks);

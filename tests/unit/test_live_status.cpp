@@ -11,8 +11,8 @@
 #include <sstream>
 
 #include "master/live_status.h"
-#include "master/status_json.h"
-#include "master/status_metrics.h"
+#include "master/status/status_json.h"
+#include "master/status/status_metrics.h"
 
 namespace optique::master {
 namespace {

@@ -1,14 +1,14 @@
 // The status server's answers, decided without a network: which path gives
 // what, which method is allowed, and who may read or control; and the page's
-// Content-Security-Policy (master/page_policy.h).
+// Content-Security-Policy (master/status/page_policy.h).
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 
-#include "master/operator_api.h"
-#include "master/page_policy.h"
-#include "master/status_metrics.h"
+#include "master/status/operator_api.h"
+#include "master/status/page_policy.h"
+#include "master/status/status_metrics.h"
 
 namespace optique::master {
 namespace {
@@ -76,9 +76,10 @@ TEST(OperatorApi, OpenReadsRefuseAForeignHost) {
   rebound.authorization = "Bearer " + kToken;
   EXPECT_EQ(route(rebound, kBeyondLoopback, texts).response.status, 200u) << "with the token, any name";
   // Names that begin or end like this machine's are not it.
-  for (const char* host : {"localhost.attacker.example", "localhost.attacker.example:7480", "127.0.0.1.attacker.example",
-                           "attacker.localhost.example", "localhostx", "[::1].attacker.example", "[::1]x:7480",
-                           "attacker.example:localhost", "localhost:7480@attacker.example"}) {
+  for (const char* host :
+       {"localhost.attacker.example", "localhost.attacker.example:7480", "127.0.0.1.attacker.example",
+        "attacker.localhost.example", "localhostx", "[::1].attacker.example", "[::1]x:7480",
+        "attacker.example:localhost", "localhost:7480@attacker.example"}) {
     http::Request foreign = request(http::Method::get, "/status.json");
     foreign.host = host;
     EXPECT_EQ(route(foreign, kLoopback, texts).response.status, 403u) << host;

@@ -15,14 +15,12 @@
 #include <string>
 
 #include "http/message.h"
+#include "master/operator_command.h"
 
 namespace optique::master {
 
-enum class OperatorCommand { pause, resume, stop };
-[[nodiscard]] std::string_view to_string(OperatorCommand command);
-
 // What is served: the page and its Content-Security-Policy (set once,
-// master/page_policy.h), and the latest status (null until the first is
+// master/status/page_policy.h), and the latest status (null until the first is
 // published).
 struct StatusTexts {
   std::shared_ptr<const std::string> page;

@@ -1,4 +1,4 @@
-#include "master/operator_api.h"
+#include "master/status/operator_api.h"
 
 #include <openssl/crypto.h>
 
@@ -7,7 +7,7 @@
 #include <cctype>
 
 #include "config/address.h"
-#include "master/status_metrics.h"
+#include "master/status/status_metrics.h"
 
 namespace optique::master {
 namespace {
@@ -90,18 +90,6 @@ constexpr std::array<Control, 3> kControls{{{"/control/pause", OperatorCommand::
                                             {"/control/stop", OperatorCommand::stop}}};
 
 }  // namespace
-
-std::string_view to_string(OperatorCommand command) {
-  switch (command) {
-    case OperatorCommand::pause:
-      return "pause";
-    case OperatorCommand::resume:
-      return "resume";
-    case OperatorCommand::stop:
-      return "stop";
-  }
-  return "unknown";
-}
 
 void StatusBoard::set(StatusTexts texts) {
   const std::lock_guard lock(mutex_);

@@ -1,4 +1,4 @@
-#include "master/local_launcher.h"
+#include "master/app/local_launcher.h"
 
 #include <fcntl.h>
 #include <sys/prctl.h>

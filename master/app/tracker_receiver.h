@@ -51,10 +51,10 @@ class TrackerReceiver {
   tracking::DTrackReader reader_;  // the receive thread's
   std::function<void()> ready_;
   std::mutex mutex_;
-  tracking::TrackerInput waiting_;  // guarded by mutex_
-  bool announced_ = false;          // guarded by mutex_: ready_ called, not yet taken
-  clock::Nanos last_announced_ = 0; // the receive thread's
-  bool error_said_ = false;         // the receive thread's
+  tracking::TrackerInput waiting_;   // guarded by mutex_
+  bool announced_ = false;           // guarded by mutex_: ready_ called, not yet taken
+  clock::Nanos last_announced_ = 0;  // the receive thread's
+  bool error_said_ = false;          // the receive thread's
   std::thread thread_;
 };
 

@@ -1,7 +1,7 @@
 #pragma once
 // The master's status server, as its shell runs it: http::Server on a thread of
 // its own (clients never delay the frame loop), answering by route()
-// (master/operator_api.h) from what the frame loop last published. Commands
+// (master/status/operator_api.h) from what the frame loop last published. Commands
 // from the page are handed to `on_command` on the server's thread; the master
 // posts them to its own.
 
@@ -17,7 +17,7 @@
 #include "config/installation.h"
 #include "http/server.h"
 #include "master/live_status.h"
-#include "master/operator_api.h"
+#include "master/status/operator_api.h"
 #include "util/result.h"
 
 namespace optique::master {

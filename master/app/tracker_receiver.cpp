@@ -1,4 +1,4 @@
-#include "master/tracker_receiver.h"
+#include "master/app/tracker_receiver.h"
 
 #include <poll.h>
 #include <sys/eventfd.h>

@@ -21,13 +21,13 @@
 #include <vector>
 
 #include "config/load.h"
+#include "master/app/local_launcher.h"
+#include "master/app/status_line.h"
+#include "master/app/tracker_receiver.h"
 #include "master/exit_codes.h"
-#include "master/local_launcher.h"
 #include "master/protocol.h"
 #include "master/run_recorder.h"
-#include "master/status_line.h"
-#include "master/status_service.h"
-#include "master/tracker_receiver.h"
+#include "master/status/status_service.h"
 #include "net/auth.h"
 #include "net/connection.h"
 #include "scene/load_scene.h"

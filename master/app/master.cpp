@@ -1,4 +1,4 @@
-#include "master/master.h"
+#include "master/app/master.h"
 
 #include <boost/asio/post.hpp>
 

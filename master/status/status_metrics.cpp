@@ -1,4 +1,4 @@
-#include "master/status_metrics.h"
+#include "master/status/status_metrics.h"
 
 #include <fmt/format.h>
 
@@ -162,7 +162,8 @@ std::string status_metrics(const LiveStatus& s) {
   w.single("optique_status_requests_total", "counter", "Requests this status server answered.", s.clients.requests);
   w.single("optique_status_refused_total", "counter",
            "Connections this status server closed: busy, too many from one address, too slow, too large, not HTTP "
-           "or an event stream behind.", s.clients.refused);
+           "or an event stream behind.",
+           s.clients.refused);
   return w.take();
 }
 

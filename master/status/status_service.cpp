@@ -1,8 +1,8 @@
-#include "master/status_service.h"
+#include "master/status/status_service.h"
 
-#include "master/page_policy.h"
-#include "master/status_json.h"
-#include "master/status_metrics.h"
+#include "master/status/page_policy.h"
+#include "master/status/status_json.h"
+#include "master/status/status_metrics.h"
 #include "operator_page.h"
 
 namespace optique::master {

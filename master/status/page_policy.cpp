@@ -1,4 +1,4 @@
-#include "master/page_policy.h"
+#include "master/status/page_policy.h"
 
 #include <openssl/evp.h>
 
@@ -23,7 +23,8 @@ std::string element_hashes(std::string_view html, std::string_view tag) {
     std::vector<unsigned char> base64(4 * ((digest.size() + 2) / 3) + 1);
     const int length = EVP_EncodeBlock(base64.data(), reinterpret_cast<const unsigned char*>(digest.data()),
                                        static_cast<int>(digest.size()));
-    sources += " 'sha256-" + std::string(reinterpret_cast<const char*>(base64.data()), static_cast<std::size_t>(length)) + "'";
+    sources +=
+        " 'sha256-" + std::string(reinterpret_cast<const char*>(base64.data()), static_cast<std::size_t>(length)) + "'";
     at = end + close.size();
   }
   return sources.empty() ? " 'none'" : sources;

@@ -1,4 +1,4 @@
-#include "master/status_line.h"
+#include "master/app/status_line.h"
 
 namespace optique::master {
 

@@ -1,4 +1,4 @@
-#include "master/cli.h"
+#include "master/app/cli.h"
 
 #include <unistd.h>
 
@@ -13,7 +13,7 @@
 #include <spdlog/sinks/sink.h>
 
 #include "log/logger.h"
-#include "master/master.h"
+#include "master/app/master.h"
 #include "master/run_config.h"
 #include "master/shared_secret.h"
 #include "util/program.h"

@@ -1,7 +1,7 @@
 #include <exception>
 #include <iostream>
 
-#include "master/cli.h"
+#include "master/app/cli.h"
 
 int main(int argc, char** argv) {
   try {

@@ -1,4 +1,4 @@
-#include "master/status_json.h"
+#include "master/status/status_json.h"
 
 #include <nlohmann/json.hpp>
 
