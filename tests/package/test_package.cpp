@@ -36,6 +36,7 @@ TEST(Package, CmakeInstallPutsTheProgramsConfigsAndDocsUnderThePrefix) {
   EXPECT_TRUE(fs::exists(prefix + "/share/optique/configs/cave-tracked.json"));
   EXPECT_TRUE(fs::exists(prefix + "/share/optique/configs/assets/head-walk.csv")) << "configs keep their assets";
   EXPECT_TRUE(fs::exists(prefix + "/share/doc/optique/README.md"));
+  EXPECT_TRUE(fs::exists(prefix + "/share/doc/optique/docs/deploying.md")) << "the README's guides beside it";
   EXPECT_FALSE(fs::exists(prefix + "/lib/systemd")) << "the units only with --component service";
   // The installed master runs the installed tools.
   const std::string log = dir + "/check.log";
@@ -53,9 +54,8 @@ TEST(Package, CmakeInstallPutsTheProgramsConfigsAndDocsUnderThePrefix) {
 TEST(Package, TheServiceComponentFollowsThePrefix) {
   const std::string dir = make_temp_dir("optique-service");
   const std::string prefix = dir + "/local";
-  ASSERT_EQ(run({"/usr/bin/cmake", "--install", kBuild, "--prefix", prefix, "--component", "service"},
-                dir + "/local.log"),
-            0)
+  ASSERT_EQ(
+      run({"/usr/bin/cmake", "--install", kBuild, "--prefix", prefix, "--component", "service"}, dir + "/local.log"), 0)
       << read_file(dir + "/local.log");
   const std::string master = read_file(prefix + "/lib/systemd/system/optique-master.service");
   EXPECT_NE(master.find("\nExecStart=" + prefix + "/bin/optique-master "), std::string::npos) << master;
@@ -96,8 +96,8 @@ TEST(Package, TheDebianPackageHoldsEverythingAndRunsFromAnExtractedCopy) {
   for (const char* path :
        {"./usr/bin/optique-master", "./usr/bin/optique-node", "./usr/bin/optique-node-gl", "./usr/bin/optique-tools",
         "./usr/share/optique/configs/powerwall-2x2.json", "./usr/share/doc/optique/README.md",
-        "./usr/lib/systemd/system/optique-master.service", "./usr/lib/systemd/system/optique-node@.service",
-        "./etc/optique/master.env", "./etc/optique/node.env"}) {
+        "./usr/share/doc/optique/docs/deploying.md", "./usr/lib/systemd/system/optique-master.service",
+        "./usr/lib/systemd/system/optique-node@.service", "./etc/optique/master.env", "./etc/optique/node.env"}) {
     EXPECT_NE(contents.find(std::string(path) + "\n"), std::string::npos) << path << " not in\n" << contents;
   }
   ASSERT_EQ(run({"/usr/bin/dpkg-deb", "--field", deb, "Depends"}, dir + "/depends.txt"), 0);
