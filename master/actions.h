@@ -26,11 +26,20 @@ namespace optique::master {
 
 using PeerId = std::uint64_t;
 
-// The master's timers, listed once: arming one replaces its pending time.
+// The master's timers, listed once: arming one replaces its pending time. A
+// timer added to the enum is added to kTimers too (the shell has one
+// steady_timer per entry, indexed by the enum's value).
 enum class Timer { startup, next_frame, barrier, last_presents, goodbye, heartbeat };
 inline constexpr std::array kTimers{Timer::startup,       Timer::next_frame, Timer::barrier,
                                     Timer::last_presents, Timer::goodbye,    Timer::heartbeat};
-static_assert(static_cast<std::size_t>(kTimers.back()) + 1 == kTimers.size(), "every Timer in kTimers, in order");
+// Each entry at its enum value: no timer twice, none out of order.
+[[nodiscard]] constexpr bool timers_in_order() {
+  for (std::size_t i = 0; i < kTimers.size(); ++i) {
+    if (static_cast<std::size_t>(kTimers[i]) != i) return false;
+  }
+  return true;
+}
+static_assert(timers_in_order(), "kTimers lists every Timer once, in the enum's order");
 
 // --- actions
 

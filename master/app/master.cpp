@@ -2,6 +2,7 @@
 
 #include <boost/asio/post.hpp>
 
+#include <cassert>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
@@ -303,8 +304,8 @@ void Master::carry_out(Action& action) {
                  },
                  [&](Arm& a) { arm(a.timer, a.at); },
                  [&](Disarm& a) {
-                   ++timer_generations_[static_cast<std::size_t>(a.timer)];
-                   timers_[static_cast<std::size_t>(a.timer)]->cancel();
+                   ++timer_generations_[timer_slot(a.timer)];
+                   timers_[timer_slot(a.timer)]->cancel();
                  },
                  [&](StopAccepting&) {
                    boost::system::error_code ignored;
@@ -325,14 +326,20 @@ void Master::carry_out(Action& action) {
              action);
 }
 
+std::size_t Master::timer_slot(Timer timer) {
+  const auto slot = static_cast<std::size_t>(timer);
+  assert(slot < kTimers.size());  // every Timer is in kTimers (master/actions.h)
+  return slot;
+}
+
 void Master::arm(Timer timer, clock::Nanos at) {
-  asio::steady_timer& t = *timers_[static_cast<std::size_t>(timer)];
+  asio::steady_timer& t = *timers_[timer_slot(timer)];
   t.expires_after(std::chrono::nanoseconds(std::max<clock::Nanos>(0, at - clock::monotonic_now())));
   // A timer that expired before it was disarmed or armed again still runs its
   // handler, with success: the generation tells it that it is stale.
-  const std::uint64_t generation = ++timer_generations_[static_cast<std::size_t>(timer)];
+  const std::uint64_t generation = ++timer_generations_[timer_slot(timer)];
   t.async_wait([this, timer, generation](const boost::system::error_code& error) {
-    if (error || generation != timer_generations_[static_cast<std::size_t>(timer)]) return;
+    if (error || generation != timer_generations_[timer_slot(timer)]) return;
     carry_out(protocol_->timer(timer, clock::monotonic_now()));
   });
 }

@@ -76,6 +76,7 @@ class Master {
   void carry_out(Actions actions);
   void carry_out(Action& action);
   void arm(Timer timer, clock::Nanos at);
+  [[nodiscard]] static std::size_t timer_slot(Timer timer);  // its steady_timer's index
   void housekeeping();
   void on_signal(int signal);
   void update_status();
