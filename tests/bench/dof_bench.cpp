@@ -31,6 +31,7 @@
 #include "image/compare.h"
 #include "image/convert.h"
 #include "image/image_io.h"
+#include "number_text.h"
 #include "render/gl_context.h"
 #include "render/gl_objects.h"
 #include "shaders.h"
@@ -145,14 +146,10 @@ class Gather {
   render::glo::VertexArray vertex_array_;
 };
 
-std::string fixed(double v, int decimals) {
-  if (std::isinf(v)) return "∞";
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", decimals, v);
-  return text;
-}
+// Its tables say ∞ for a PSNR of equal images.
+std::string cell(double v, int decimals) { return bench::fixed(v, decimals, "∞"); }
 
-std::string signed_ms(double v) { return (v < 0.0 ? "−" : "+") + fixed(std::abs(v), 2) + " ms"; }
+std::string signed_ms(double v) { return (v < 0.0 ? "−" : "+") + cell(std::abs(v), 2) + " ms"; }
 
 std::string sci(double v) {
   char text[64];
@@ -321,7 +318,7 @@ int main(int argc, char** argv) {
       row.exact_gather = psnr(exact_gathered, f.ideal, all);
       row.exact_gather_away = psnr(exact_gathered, f.ideal, away);
       rows.push_back(row);
-      const std::string bs = fixed(b, 3);
+      const std::string bs = cell(b, 3);
       for (const auto& [method, all_db, away_db] :
            {std::tuple{"all-in-focus", f.scores.sharp, f.scores.sharp_away},
             std::tuple{"pair-16bit", f.scores.pair, f.scores.pair_away},
@@ -349,7 +346,7 @@ int main(int argc, char** argv) {
         o.sharp = psnr(f.rendered, f.ideal, in);
         o.pair = psnr(f.composite, f.ideal, in);
         objects.push_back(o);
-        const std::string subject = "object-at-" + fixed(depth, 2) + "m";
+        const std::string subject = "object-at-" + cell(depth, 2) + "m";
         put("object", b, subject, "", "coc", o.coc);
         put("object", b, subject, "all-in-focus", "psnr_luma_db", o.sharp);
         put("object", b, subject, "pair-16bit", "psnr_luma_db", o.pair);
@@ -360,9 +357,9 @@ int main(int argc, char** argv) {
         shown_ideal = f.ideal;
         shown_gather = gathered;
       }
-      std::cout << "b " << bs << " m: all-in-focus " << fixed(f.scores.sharp_away, 2) << ", pair "
-                << fixed(f.scores.pair_away, 2) << " (8-bit " << fixed(row.pair8_away, 2) << "), gather "
-                << fixed(row.gather_away, 2) << ", disc-weight gather " << fixed(row.exact_gather_away, 2)
+      std::cout << "b " << bs << " m: all-in-focus " << cell(f.scores.sharp_away, 2) << ", pair "
+                << cell(f.scores.pair_away, 2) << " (8-bit " << cell(row.pair8_away, 2) << "), gather "
+                << cell(row.gather_away, 2) << ", disc-weight gather " << cell(row.exact_gather_away, 2)
                 << " dB (away from focus)" << std::endl;
     }
 
@@ -393,12 +390,12 @@ int main(int argc, char** argv) {
       worst_buffer = std::max(worst_buffer, q.buffer_max);
       worst_output = std::max(worst_output, q.output_max);
       worst_output_vs_cpu = std::max(worst_output_vs_cpu, q.output_vs_buffer_max);
-      precision_table << "| " << fixed(c.near, 2) << " / " << fixed(c.far, 0) << " | " << fixed(c.far / c.near, 0)
-                      << " | " << c.name << " | " << q.counted << " (" << q.excluded << ") | "
-                      << fixed(q.window_steps_max, 2) << " | " << sci(q.buffer_max) << " / " << sci(q.buffer_mean)
-                      << " | " << sci(q.output_max) << " / " << sci(q.output_mean) << " (" << q.output_counted << ") | "
+      precision_table << "| " << cell(c.near, 2) << " / " << cell(c.far, 0) << " | " << cell(c.far / c.near, 0) << " | "
+                      << c.name << " | " << q.counted << " (" << q.excluded << ") | " << cell(q.window_steps_max, 2)
+                      << " | " << sci(q.buffer_max) << " / " << sci(q.buffer_mean) << " | " << sci(q.output_max)
+                      << " / " << sci(q.output_mean) << " (" << q.output_counted << ") | "
                       << sci(q.output_vs_buffer_max) << " |\n";
-      const std::string subject = "near-" + fixed(c.near, 2) + "-far-" + fixed(c.far, 0);
+      const std::string subject = "near-" + cell(c.near, 2) + "-far-" + cell(c.far, 0);
       put("precision", 0.0, subject, c.name, "window_steps_max", q.window_steps_max);
       put("precision", 0.0, subject, c.name, "coc_buffer_max", q.buffer_max);
       put("precision", 0.0, subject, c.name, "coc_buffer_mean", q.buffer_mean);
@@ -474,7 +471,7 @@ int main(int argc, char** argv) {
     };
     const double full_ms = timing[kFull].median;
     std::ostringstream timing_table;
-    timing_table << "| method (" << width << "×" << height << ", c_max " << fixed(setup.c_max, 1)
+    timing_table << "| method (" << width << "×" << height << ", c_max " << cell(setup.c_max, 1)
                  << " px) | ms per frame | over the full render | PSNR vs ideal, away from focus: mean / worst over "
                     "the sweep (dB) |\n|---|---:|---:|---:|\n";
     auto timing_row = [&](const std::string& what, const Spread& s, const std::string& psnr_text) {
@@ -482,19 +479,19 @@ int main(int argc, char** argv) {
                    << (s.median == full_ms ? "—" : signed_ms(s.median - full_ms)) << " | " << psnr_text << " |\n";
     };
     timing_row("full render alone (all-in-focus)", timing[kFull],
-               fixed(mean_of([](const Row& r) { return r.scores16.sharp_away; }), 2) + " / " +
-                   fixed(min_of([](const Row& r) { return r.scores16.sharp_away; }), 2));
+               cell(mean_of([](const Row& r) { return r.scores16.sharp_away; }), 2) + " / " +
+                   cell(min_of([](const Row& r) { return r.scores16.sharp_away; }), 2));
     timing_row("focus node: render + output pass with (1 − c_r)", timing[kFocus], "");
     timing_row("defocus node: render + output pass with c_r", timing[kDefocus], "");
     timing_row("**pair** (each frame the slower node: two machines in parallel)", timing[kMethods],
-               fixed(mean_of([](const Row& r) { return r.scores16.pair_away; }), 2) + " / " +
-                   fixed(min_of([](const Row& r) { return r.scores16.pair_away; }), 2));
+               cell(mean_of([](const Row& r) { return r.scores16.pair_away; }), 2) + " / " +
+                   cell(min_of([](const Row& r) { return r.scores16.pair_away; }), 2));
     timing_row(
         "**gather DOF** on one node: render + gather pass (" + std::to_string(2 * gather.reach() + 1) + "² taps)",
         timing[kGather],
-        fixed(mean_of([](const Row& r) { return r.gather_away; }), 2) + " / " +
-            fixed(min_of([](const Row& r) { return r.gather_away; }), 2) + " (normalized); disc weights " +
-            fixed(min_of([](const Row& r) { return r.exact_gather_away; }), 1) + " at worst");
+        cell(mean_of([](const Row& r) { return r.gather_away; }), 2) + " / " +
+            cell(min_of([](const Row& r) { return r.gather_away; }), 2) + " (normalized); disc weights " +
+            cell(min_of([](const Row& r) { return r.exact_gather_away; }), 1) + " at worst");
 
     std::ostringstream psnr_table;
     psnr_table << "| b (m) | pixels away from focus | all-in-focus | pair 16-bit | pair 8-bit | gather (normalized) | "
@@ -507,12 +504,12 @@ int main(int argc, char** argv) {
         least_margin = margin;
         least_margin_b = r.b;
       }
-      psnr_table << "| " << fixed(r.b, 3) << " | " << r.scores16.away_pixels << " | " << fixed(r.scores16.sharp, 2)
-                 << " / " << fixed(r.scores16.sharp_away, 2) << " | " << fixed(r.scores16.pair, 2) << " / "
-                 << fixed(r.scores16.pair_away, 2) << " | " << fixed(r.pair8, 2) << " / " << fixed(r.pair8_away, 2)
-                 << " | " << fixed(r.gather, 2) << " / " << fixed(r.gather_away, 2) << " | " << fixed(r.exact_gather, 1)
-                 << " / " << fixed(r.exact_gather_away, 1) << " | " << fixed(r.scores16.pair - r.scores16.sharp, 2)
-                 << " / " << fixed(margin, 2) << " |\n";
+      psnr_table << "| " << cell(r.b, 3) << " | " << r.scores16.away_pixels << " | " << cell(r.scores16.sharp, 2)
+                 << " / " << cell(r.scores16.sharp_away, 2) << " | " << cell(r.scores16.pair, 2) << " / "
+                 << cell(r.scores16.pair_away, 2) << " | " << cell(r.pair8, 2) << " / " << cell(r.pair8_away, 2)
+                 << " | " << cell(r.gather, 2) << " / " << cell(r.gather_away, 2) << " | " << cell(r.exact_gather, 1)
+                 << " / " << cell(r.exact_gather_away, 1) << " | " << cell(r.scores16.pair - r.scores16.sharp, 2)
+                 << " / " << cell(margin, 2) << " |\n";
     }
 
     // The pair's gain on each object, by the object's c_r. Below a radius of half a
@@ -545,12 +542,12 @@ int main(int argc, char** argv) {
         gains.push_back(o.pair - o.sharp);
       }
       Bin bin{bins[i], std::min(bins[i + 1], 1.0), static_cast<int>(gains.size())};
-      object_table << "| " << fixed(bin.low, 4) << " – " << fixed(bin.high, 4) << " | " << bin.cases << " | ";
+      object_table << "| " << cell(bin.low, 4) << " – " << cell(bin.high, 4) << " | " << bin.cases << " | ";
       if (gains.empty()) {
         object_table << " | | | | |\n";
         continue;
       }
-      object_table << fixed(spread(sharp).median, 2) << " | " << fixed(spread(paired).median, 2) << " | ";
+      object_table << cell(spread(sharp).median, 2) << " | " << cell(spread(paired).median, 2) << " | ";
       if (i == 0) {
         object_table << "(ideal ≈ all-in-focus) | | |\n";
         continue;
@@ -561,7 +558,7 @@ int main(int argc, char** argv) {
       bin.least_gain = *std::min_element(gains.begin(), gains.end());
       bin.most_gain = *std::max_element(gains.begin(), gains.end());
       gain_bins.push_back(bin);
-      object_table << fixed(bin.mean_gain, 2) << " | " << fixed(bin.least_gain, 2) << " | " << fixed(bin.most_gain, 2)
+      object_table << cell(bin.mean_gain, 2) << " | " << cell(bin.least_gain, 2) << " | " << cell(bin.most_gain, 2)
                    << " |\n";
     }
 
@@ -621,8 +618,7 @@ int main(int argc, char** argv) {
     for (const Row& r : rows) {
       max_8bit_loss = std::max(max_8bit_loss, std::abs(r.scores16.pair_away - r.pair8_away));
       max_gather_loss = std::max(max_gather_loss, r.scores16.pair_away - r.gather_away);
-      if (r.gather_away < r.scores16.pair_away)
-        gather_worse_at += (gather_worse_at.empty() ? "" : ", ") + fixed(r.b, 2);
+      if (r.gather_away < r.scores16.pair_away) gather_worse_at += (gather_worse_at.empty() ? "" : ", ") + cell(r.b, 2);
     }
     Bin low_bin;  // c_r from ½ / c_max to 0.125
     if (!gain_bins.empty()) low_bin = gain_bins.front();
@@ -640,11 +636,11 @@ int main(int argc, char** argv) {
           "costs beside a computational DOF.\n\n"
        << "**Setup.** `configs/dof-pair.json`: the depth-stack scene (five 0.3 m slabs at eye depths ";
     for (std::size_t i = 0; i < setup.object_depths.size(); ++i) {
-      md << (i == 0 ? "" : ", ") << fixed(setup.object_depths[i], 1);
+      md << (i == 0 ? "" : ", ") << cell(setup.object_depths[i], 1);
     }
     md << " m over a black background), the viewer's eye 2 m before a 3.2 × 1.8 m screen, two aligned " << width << "×"
        << height << " projectors (projector pixels = screen pixels), c_r from near " << setup.range.near << " m to far "
-       << setup.range.far << " m, c_max = " << fixed(setup.c_max, 1) << " px, frustum near/far " << setup.frustum_near
+       << setup.range.far << " m, c_max = " << cell(setup.c_max, 1) << " px, frustum near/far " << setup.frustum_near
        << " / " << setup.frustum_far
        << " m (the viewer's defaults). Both nodes are SceneRenderers set up as `GlRenderer::configure` sets up a "
           "focus/defocus projector (single pass, the projector's output stage with its share); the projectors' "
@@ -663,7 +659,7 @@ int main(int argc, char** argv) {
           "so its time is GPU work only.\n\n"
        << "**Metric.** PSNR of Rec. 601 luma against the ideal, peak 1 (the projector's white). The scene is dim "
           "(brightest pixel "
-       << fixed(brightest, 3)
+       << cell(brightest, 3)
        << "), so absolute values are high; differences between methods at the same b are ratios of squared error "
           "and do not depend on the peak. *All pixels*, and *away from focus*: pixels whose exact c_r > "
        << kAwayFromFocus
@@ -693,20 +689,20 @@ int main(int argc, char** argv) {
           "object and b against the object's c_r](dof.png)\n\n"
           "The disc-weight gather is the ideal to float rounding and is left out of the plot. `dof-images.png`, "
           "top row, at b = "
-       << fixed(shown_b, 2) << " m, the " << tile_w << "×" << tile_h
-       << " pixels around the objects, full resolution, brightened ×" << fixed(gain, 1)
+       << cell(shown_b, 2) << " m, the " << tile_w << "×" << tile_h
+       << " pixels around the objects, full resolution, brightened ×" << cell(gain, 1)
        << ": all-in-focus, the pair on the screen (16-bit), the ideal, the normalized gather. Bottom row: each "
           "one's difference from the ideal, ×"
-       << fixed(kErrorGain * gain, 0) << " (none under the ideal).\n\n![the images at b = " << fixed(shown_b, 2)
+       << cell(kErrorGain * gain, 0) << " (none under the ideal).\n\n![the images at b = " << cell(shown_b, 2)
        << " m and their differences from the ideal](dof-images.png)\n\n"
        << "## Findings\n\n"
        << "- **The pair against all-in-focus.** Away from focus the pair is "
        << (least_margin > 0.0 ? "closer to the ideal at every b of the sweep, by "
                               : "not closer to the ideal at every b of the sweep: the difference is ")
-       << fixed(least_margin, 2) << " dB at least (b = " << fixed(least_margin_b, 3) << " m) and "
-       << fixed(mean_of([](const Row& r) { return r.scores16.pair_away - r.scores16.sharp_away; }), 2)
-       << " dB on average. At the worst b every object's c_r lies between " << fixed(worst_b_coc_low, 2) << " and "
-       << fixed(worst_b_coc_high, 2)
+       << cell(least_margin, 2) << " dB at least (b = " << cell(least_margin_b, 3) << " m) and "
+       << cell(mean_of([](const Row& r) { return r.scores16.pair_away - r.scores16.sharp_away; }), 2)
+       << " dB on average. At the worst b every object's c_r lies between " << cell(worst_b_coc_low, 2) << " and "
+       << cell(worst_b_coc_high, 2)
        << ": the gain grows with c_r (table above), and that b has no object where the pair gains much. So the "
           "margin is clear but not large everywhere: "
        << (least_margin >= 3.0 ? "it stays above 3 dB." : "it does not reach 3 dB at every b.") << "\n"
@@ -715,36 +711,36 @@ int main(int argc, char** argv) {
           "move the same light off the pixel's centre, but the pair's is a sharp core with a faint wide skirt. "
           "For small c_r that is little different from the sharp image, so it gains little over it. Below "
           "c_r = ½ / c_max = "
-       << fixed(sharp_limit, 4)
+       << cell(sharp_limit, 4)
        << " the ideal is the sharp image (a circle under half a pixel), while the pair's skirt is still c_max "
           "wide: there the pair can only lose. Just above it the ideal's circle is barely over half a pixel and "
           "the pair still mostly loses: objects at c_r "
-       << fixed(sharp_limit, 4) << "–0.125 gain " << fixed(low_bin.mean_gain, 2) << " dB on average (from "
-       << fixed(low_bin.least_gain, 1) << " to " << fixed(low_bin.most_gain, 1)
+       << cell(sharp_limit, 4) << "–0.125 gain " << cell(low_bin.mean_gain, 2) << " dB on average (from "
+       << cell(low_bin.least_gain, 1) << " to " << cell(low_bin.most_gain, 1)
        << "). Such pixels count as away from focus (c_r > " << kAwayFromFocus
        << "); in this scene they are few beside the background's. Towards c_r = 1 the pair becomes the largest blur "
           "itself and approaches the "
           "ideal.\n"
-       << "- **Bit depth.** The pair with 8-bit projectors is within " << fixed(max_8bit_loss, 2)
+       << "- **Bit depth.** The pair with 8-bit projectors is within " << cell(max_8bit_loss, 2)
        << " dB of the 16-bit pair at every b: the method's error, not quantization, sets the PSNR here (the sum "
           "of two 8-bit projectors also has more levels than one).\n"
        << "- **Gather DOF.** With the reference's own disc weights the gather is the ideal (PSNR over "
-       << fixed(min_of([](const Row& r) { return r.exact_gather_away; }), 0)
+       << cell(min_of([](const Row& r) { return r.exact_gather_away; }), 0)
        << " dB: float rounding), so at this resolution a computational DOF can be exact. Normalized by the shares "
           "a pixel receives, it is wrong wherever those do not add to 1, i.e. where the circle changes abruptly "
           "across an edge: a sharp object's edge pixels also receive the blurred background's shares and are "
           "darkened (the rings in the bottom row), and a blurred object's edge pixels receive only part of a "
           "full share, are brightened back and keep a sharp silhouette instead of spreading. The latter makes it "
           "worse than the pair where blurred objects lie before a sharp background (b = "
-       << gather_worse_at << " m, by up to " << fixed(max_gather_loss, 1) << " dB).\n"
+       << gather_worse_at << " m, by up to " << cell(max_gather_loss, 1) << " dB).\n"
        << "- **Cost.** The output pass with the mask changes the focus node's frame time by "
        << signed_ms(timing[kFocus].median - full_ms) << " and the defocus node's by "
        << signed_ms(timing[kDefocus].median - full_ms) << " against the full render alone (whose runs spread over "
-       << fixed(timing[kFull].low, 2) << "–" << fixed(timing[kFull].high, 2)
+       << cell(timing[kFull].low, 2) << "–" << cell(timing[kFull].high, 2)
        << " ms): one depth fetch and the mask's arithmetic per pixel, in a pass every node runs anyway. The blur "
           "itself is done by the defocused projector's optics, so the pair's frame costs one node's render plus "
           "that mask, on two machines and two projectors. The gather costs "
-       << fixed(timing[kGather].median - full_ms, 1) << " ms more (" << fixed(timing[kGather].median / full_ms, 1)
+       << cell(timing[kGather].median - full_ms, 1) << " ms more (" << cell(timing[kGather].median / full_ms, 1)
        << "× the full render) for its " << 2 * gather.reach() + 1 << "² taps per pixel, work that grows with c_max². "
        << (software ? "These are llvmpipe times (the CPU rasterizes, on a shared machine); a GPU is far faster at "
                       "both, but the ratio of work per pixel, one depth fetch against "
@@ -754,7 +750,7 @@ int main(int argc, char** argv) {
        << " of c_r of the exact depth at far/near = 10⁴ (near 0.01 m), against an 8-bit step of 1/255 = "
        << sci(buffer_bound_8bit)
        << ": it does not matter, and no fix is needed. It is k·|Δz′| with k = (1/n − 1/f)/(1/near − 1/far) = "
-       << fixed(k_precise, 0)
+       << cell(k_precise, 0)
        << " at near 0.01 m and |Δz′| about one step of 2⁻²⁴ (the column above), i.e. about 10⁻⁵. 24-bit and 32F "
           "give the same numbers: with the standard mapping, depth beyond a few near distances lies in z′ ∈ "
           "[0.5, 1), where a float's spacing is 2⁻²⁴ like 24-bit fixed point's, and the vertex stage's float "

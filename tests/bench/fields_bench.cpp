@@ -27,6 +27,7 @@
 #include "master/run_config.h"
 #include "master/scene_authority.h"
 #include "metrics/distribution.h"
+#include "number_text.h"
 #include "render/gl_context.h"
 #include "render/projector_pipeline.h"
 #include "spread.h"
@@ -119,11 +120,7 @@ render::PipelineOptions options_for(const Method& m) {
   return options;
 }
 
-std::string fixed(double value, int decimals) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*f", decimals, value);
-  return text;
-}
+using bench::fixed;
 
 }  // namespace
 

@@ -42,6 +42,7 @@
 #include "master/light_share.h"
 #include "master/scene_authority.h"
 #include "master/stacked_groups.h"
+#include "number_text.h"
 #include "render/gl_context.h"
 #include "render/projector_pipeline.h"
 #include "scene/builtin.h"
@@ -185,11 +186,7 @@ std::string cell(const std::vector<double>& values, int decimals) {
   return bench::cell(s, decimals);
 }
 
-std::string fixed(double value, int decimals) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*f", decimals, value);
-  return text;
-}
+using bench::fixed;
 
 std::string scientific(double value) {
   char text[32];

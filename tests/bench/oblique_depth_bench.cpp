@@ -23,6 +23,7 @@
 #include "bench_options.h"
 #include "draw_plot.h"
 #include "image/image_io.h"
+#include "number_text.h"
 #include "oblique_depth_experiment.h"
 #include "render/gl_context.h"
 #include "util/join.h"
@@ -98,11 +99,7 @@ const std::vector<Tile> kTiles{
     {"askew-close", 36, 1e-4, kOurs24, "ours, same frame and δ, 24-bit"},
 };
 
-std::string fixed(double v, int decimals) {
-  char text[64];
-  std::snprintf(text, sizeof text, "%.*f", decimals, v);
-  return text;
-}
+using bench::fixed;
 
 std::string delta_text(double delta) {
   if (delta >= 1e-2) return "1 cm";

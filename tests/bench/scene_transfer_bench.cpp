@@ -14,9 +14,9 @@
 
 #include <arpa/inet.h>
 #include <netinet/in.h>
+#include <spdlog/sinks/null_sink.h>
 #include <sys/socket.h>
 #include <unistd.h>
-#include <spdlog/sinks/null_sink.h>
 
 #include <algorithm>
 #include <chrono>
@@ -82,13 +82,6 @@ std::string make_config(const fs::path& dir, const std::string& gltf) {
   const fs::path path = dir / "config.json";
   std::ofstream(path) << config.dump(1);
   return path.string();
-}
-
-std::string read_whole(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::string bytes(fs::file_size(path), '\0');
-  in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  return bytes;
 }
 
 // The SHA-256 of a file read back in 1 MiB pieces, as node::SceneCache checks one.
@@ -184,7 +177,7 @@ int run(const std::string& out, std::size_t mib, int runs) {
   const scene::SceneManifest& manifest = loaded.value().manifest;
   const std::string identity = loaded.value().content_sha256;
   const std::uint64_t total = manifest.total_bytes();
-  const std::string bytes = read_whole(fs::path(gltf).parent_path() / "big.bin");
+  const std::string bytes = optique::testing::read_file(fs::path(gltf).parent_path() / "big.bin");
   std::cout << "scene: " << manifest.files.size() << " files, " << total / double(1 << 20) << " MiB\n";
 
   std::vector<Measured> rows;
@@ -274,7 +267,7 @@ int run(const std::string& out, std::size_t mib, int runs) {
      << "- **cached copy checked**: what a restarted node does instead of fetching: every file's SHA-256 (the rate "
      << "is the scene's size over that time).\n";
   md.close();
-  std::cout << read_whole(fs::path(out) / "scene-transfer.md");
+  std::cout << optique::testing::read_file(fs::path(out) / "scene-transfer.md");
   (void)draw_plot(out, "scene-transfer");
   return 0;
 }
@@ -283,7 +276,8 @@ int run(const std::string& out, std::size_t mib, int runs) {
 }  // namespace optique::bench
 
 int main(int argc, char** argv) {
-  optique::bench::BenchOptions app{"optique-bench-scene-transfer: a large scene from the master to a node with an empty cache"};
+  optique::bench::BenchOptions app{
+      "optique-bench-scene-transfer: a large scene from the master to a node with an empty cache"};
   std::string out = "docs/bench";
   std::size_t mib = 200;
   int runs = 5;

@@ -27,6 +27,7 @@
 #include "image/compare.h"
 #include "image/convert.h"
 #include "image/image_io.h"
+#include "number_text.h"
 #include "render/gl_context.h"
 #include "spread.h"
 #include "up_experiment.h"
@@ -57,12 +58,7 @@ struct Row {
   SceneResult result;
 };
 
-std::string fixed(double value, int decimals) {
-  if (!std::isfinite(value)) return "—";
-  char text[32];
-  std::snprintf(text, sizeof text, "%.*f", decimals, value);
-  return text;
-}
+std::string cell(double value, int decimals) { return bench::fixed(value, decimals, "—"); }
 
 // Chooses each scene's framing: the screen width and display rate whose
 // average baseline lands nearest the paper's (what paper_scenes() holds).
@@ -219,7 +215,7 @@ int main(int argc, char** argv) {
            << over_runs(mine, [](const SceneResult& s) { return s.per_display_frame_ms / s.full_ms; }) << " | "
            << over_runs(mine, [](const SceneResult& s) { return s.steady_max_ms; }) << " | "
            << over_runs(mine, [](const SceneResult& s) { return s.steady_max_ms / s.full_ms; }) << " | "
-           << fixed(first.mean_between_psnr, 2) << " | " << fixed(100.0 * first.block_share[0], 1) << " % |\n";
+           << cell(first.mean_between_psnr, 2) << " | " << cell(100.0 * first.block_share[0], 1) << " % |\n";
       }
     }
     md << "\n";
@@ -283,13 +279,12 @@ int main(int argc, char** argv) {
     const SceneResult& es = of(scene.name, extrapolated_spread).front()->result;
     hardest_rows.push_back(&i_row);
     const FrameResult& hardest = i.frames[i.hardest];
-    md << "| " << scene.name << " | " << fixed(scene.screen_width, 2) << " m, " << fixed(scene.frame_rate, 0)
-       << " Hz | " << fixed(a.mean_between_psnr, 2) << " (" << fixed(scene.paper_average, 2) << ") | "
-       << fixed(i.mean_between_psnr, 2) << " (" << fixed(scene.paper_motion, 2) << ") | "
-       << fixed(e.mean_between_psnr, 2) << " | " << fixed(is.mean_between_psnr, 2) << ", "
-       << fixed(es.mean_between_psnr, 2) << " | " << fixed(100.0 * a.block_share[0], 1) << " % → "
-       << fixed(100.0 * i.block_share[0], 1) << " % | " << hardest.frame << ": " << fixed(hardest.psnr_y, 1) << " dB | "
-       << fixed(100.0 * i.mean_shaded_anew, 1) << " % |\n";
+    md << "| " << scene.name << " | " << cell(scene.screen_width, 2) << " m, " << cell(scene.frame_rate, 0) << " Hz | "
+       << cell(a.mean_between_psnr, 2) << " (" << cell(scene.paper_average, 2) << ") | " << cell(i.mean_between_psnr, 2)
+       << " (" << cell(scene.paper_motion, 2) << ") | " << cell(e.mean_between_psnr, 2) << " | "
+       << cell(is.mean_between_psnr, 2) << ", " << cell(es.mean_between_psnr, 2) << " | "
+       << cell(100.0 * a.block_share[0], 1) << " % → " << cell(100.0 * i.block_share[0], 1) << " % | " << hardest.frame
+       << ": " << cell(hardest.psnr_y, 1) << " dB | " << cell(100.0 * i.mean_shaded_anew, 1) << " % |\n";
     sum_average += a.mean_between_psnr;
     sum_interpolated += i.mean_between_psnr;
     sum_extrapolated += e.mean_between_psnr;
@@ -297,10 +292,10 @@ int main(int argc, char** argv) {
     sum_spread[1] += es.mean_between_psnr;
   }
   const double n = static_cast<double>(scenes.size());
-  md << "| **mean** | | " << fixed(sum_average / n, 2) << " (21.72) | " << fixed(sum_interpolated / n, 2)
-     << " (33.10) | " << fixed(sum_extrapolated / n, 2) << " | " << fixed(sum_spread[0] / n, 2) << ", "
-     << fixed(sum_spread[1] / n, 2) << " | | | |\n\n"
-     << "Interpolation gains " << fixed((sum_interpolated - sum_average) / n, 1)
+  md << "| **mean** | | " << cell(sum_average / n, 2) << " (21.72) | " << cell(sum_interpolated / n, 2) << " (33.10) | "
+     << cell(sum_extrapolated / n, 2) << " | " << cell(sum_spread[0] / n, 2) << ", " << cell(sum_spread[1] / n, 2)
+     << " | | | |\n\n"
+     << "Interpolation gains " << cell((sum_interpolated - sum_average) / n, 1)
      << " dB over the average (the paper: 11.4). Where a fast turn leaves most of the surface turned by\n"
         "more than 20° since the key frames, most of it is shaded anew: the error stays low and the frame\n"
         "costs nearly a full render (below). `upconversion-hardest.png`: for each scene, its hardest frame\n"

@@ -1,8 +1,8 @@
 // render-reference with a supersample factor: the same raster, each pixel the
 // average of S × S samples. Needs GL (headless; llvmpipe in CI): label `gpu`.
 
-#include "image/texture_decode.h"
 #include "config/installation_scene.h"
+#include "image/texture_decode.h"
 #include "tools/render_reference.h"
 
 #include <gtest/gtest.h>
@@ -17,6 +17,7 @@
 #include "image/frame_files.h"
 #include "image/image_io.h"
 #include "optics/compose.h"
+#include "scratch.h"
 
 namespace optique::tools {
 namespace {
@@ -37,8 +38,8 @@ struct References {
 References render_references(const config::LoadedConfig& config, const scene::LoadedScene& scene, std::uint64_t frame,
                              int supersample) {
   References out;
-  std::string dir = (fs::temp_directory_path() / "optique-reference-XXXXXX").string();
-  EXPECT_NE(mkdtemp(dir.data()), nullptr);
+  const optique::testing::ScratchDir scratch("optique-reference");
+  const std::string dir = scratch.string();
   spdlog::logger log("reference", std::make_shared<spdlog::sinks::null_sink_mt>());
   ReferenceOptions options;
   options.supersample = supersample;
@@ -54,7 +55,6 @@ References render_references(const config::LoadedConfig& config, const scene::Lo
       out.images[entry.path().filename().string()] = {std::move(linear).value(), std::move(encoded).value()};
     }
   }
-  fs::remove_all(dir, ec);
   return out;
 }
 

@@ -143,11 +143,6 @@ std::vector<fs::path> copies_in(const std::string& cache) {
   return copies;
 }
 
-std::string read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 TEST(SceneTransfer, ANodeWithAnEmptyCacheFetchesTheSceneAndARestartedOneDoesNot) {
   const std::string dir = make_temp_dir("optique-transfer");
   const std::string config = torus_config(dir, torus_scene(dir), "127.0.0.1", false);
@@ -163,7 +158,7 @@ TEST(SceneTransfer, ANodeWithAnEmptyCacheFetchesTheSceneAndARestartedOneDoesNot)
   // The copy, under the scene's identity, holds the files as they are.
   const std::vector<fs::path> copies = copies_in(cache);
   ASSERT_EQ(copies.size(), 1u);
-  EXPECT_EQ(read_bytes(copies[0] / "torus.png"), read_bytes(kTorus + "torus.png"));
+  EXPECT_EQ(read_file(copies[0] / "torus.png"), read_file(kTorus + "torus.png"));
 
   const ClusterOutcome restarted = run(config, cache, "127.0.0.1");
   EXPECT_EQ(restarted.master_status, 0) << restarted.master_log;
@@ -178,7 +173,7 @@ TEST(SceneTransfer, TheMasterSendsTheFilesAsItLoadedThemNotAsTheyAreLater) {
   const std::string gltf = torus_scene(dir);
   const std::string config = torus_config(dir, gltf, "127.0.0.1", false);
   const std::string cache = dir + "/cache";
-  const std::string png = read_bytes(kTorus + "torus.png");
+  const std::string png = read_file(kTorus + "torus.png");
   // Once the master has loaded the scene, a byte of its texture changes on disk
   // (inside the file: a master that read it again would send other bytes).
   const ClusterOutcome fetched = run(config, cache, "127.0.0.1", {}, false, [&] {
@@ -190,7 +185,7 @@ TEST(SceneTransfer, TheMasterSendsTheFilesAsItLoadedThemNotAsTheyAreLater) {
   EXPECT_EQ(fetched.node_status, 0) << fetched.node_log;
   const std::vector<fs::path> copies = copies_in(cache);
   ASSERT_EQ(copies.size(), 1u);
-  EXPECT_EQ(read_bytes(copies[0] / "torus.png"), png);
+  EXPECT_EQ(read_file(copies[0] / "torus.png"), png);
 }
 
 TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
@@ -221,7 +216,7 @@ TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
   EXPECT_TRUE(contains(master.output(), "node 'wall' joined")) << master.output();
   const std::vector<fs::path> copies = copies_in(cache);
   ASSERT_EQ(copies.size(), 1u);
-  EXPECT_EQ(read_bytes(copies[0] / "big.bin"), read_bytes(fs::path(dir) / "scene/big.bin"));
+  EXPECT_EQ(read_file(copies[0] / "big.bin"), read_file(fs::path(dir) / "scene/big.bin"));
 }
 
 // Two nodes of one host sharing one cache fetch the scene once: the first
@@ -251,9 +246,9 @@ TEST(SceneTransfer, TwoNodesOfOneHostSharingACacheFetchTheSceneOnce) {
   ASSERT_FALSE(port.empty()) << master.output();
   FaultProxy proxy(static_cast<std::uint16_t>(std::stoi(port)));
   proxy.set_delay(300ms, 0us);
-  Process first({node_binary(), "--master", "127.0.0.1:" + std::to_string(proxy.port()), "--id", "wall",
-                 "--cache-dir", cache},
-                dir + "/first.log");
+  Process first(
+      {node_binary(), "--master", "127.0.0.1:" + std::to_string(proxy.port()), "--id", "wall", "--cache-dir", cache},
+      dir + "/first.log");
   ASSERT_TRUE(first.wait_for_output("fetching the scene", scaled(10s))) << first.output();
   Process second({node_binary(), "--master", "127.0.0.1:" + port, "--id", "wall-b", "--cache-dir", cache},
                  dir + "/second.log");

@@ -86,21 +86,6 @@ std::chrono::milliseconds scaled(std::chrono::milliseconds bound) {
   return std::chrono::milliseconds(static_cast<std::int64_t>(static_cast<double>(bound.count()) * timing_scale()));
 }
 
-std::string make_temp_dir(const std::string& prefix) {
-  std::random_device device;
-  const auto dir = std::filesystem::temp_directory_path() /
-                   (prefix + "-" + std::to_string(getpid()) + "-" + std::to_string(device()));
-  std::filesystem::create_directories(dir);
-  return dir.string();
-}
-
-std::string read_file(const std::string& path) {
-  std::ifstream in(path);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
-
 bool wait_for_file(const std::string& path, std::chrono::milliseconds timeout) {
   return poll_until(
       [&] {

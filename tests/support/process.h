@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "scratch.h"
+
 namespace optique::testing {
 
 class Process {
@@ -36,9 +38,6 @@ class Process {
   std::optional<int> status_;
 };
 
-// A fresh empty folder under the system temp dir.
-[[nodiscard]] std::string make_temp_dir(const std::string& prefix);
-[[nodiscard]] std::string read_file(const std::string& path);
 // Checks `done` every 10 ms until it holds (true) or the timeout passes (false).
 [[nodiscard]] bool poll_until(const std::function<bool()>& done, std::chrono::milliseconds timeout);
 // Polls until `path` exists and is non-empty, or the timeout passes.

@@ -15,6 +15,7 @@
 #include "keystoned_wall.h"
 #include "optics/blend.h"
 #include "optics/compose.h"
+#include "scratch.h"
 #include "tools/screen_images.h"
 
 namespace optique::tools {
@@ -23,13 +24,6 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr std::uint64_t kFrame = 7;
-
-std::string make_temp_dir() {
-  std::string pattern = (fs::temp_directory_path() / "optique-compose-XXXXXX").string();
-  const char* made = mkdtemp(pattern.data());
-  EXPECT_NE(made, nullptr);
-  return pattern;
-}
 
 void add_homography(schema::Projector& p, const glm::dmat3& h) {
   for (double v : geometry::homography_rows(h)) p.add_homography(v);
@@ -104,17 +98,14 @@ void write_captures(const config::LoadedConfig& loaded, const std::string& captu
 
 struct Fixture {
   config::LoadedConfig config = installation();
-  std::string dir = make_temp_dir();
+  optique::testing::ScratchDir scratch{"optique-compose"};
+  std::string dir = scratch.string();
   std::string captures = dir + "/nodes";
   std::string out = dir + "/out";
   std::ostringstream log_text;
   spdlog::logger log{"compose", std::make_shared<spdlog::sinks::ostream_sink_mt>(log_text)};
 
   Fixture() { write_captures(config, captures); }
-  ~Fixture() {
-    std::error_code ec;
-    fs::remove_all(dir, ec);
-  }
   std::string capture(const std::string& projector) const {
     return image::frame_path(captures + "/" + projector, kFrame, "png");  // the signal, as the simulator reads it
   }

@@ -30,6 +30,7 @@
 #include "image/texture_decode.h"
 #include "scene/gltf.h"
 #include "scene/manifest.h"
+#include "scratch.h"
 #include "util/sha256.h"
 
 namespace optique::scene {
@@ -45,39 +46,15 @@ const std::string kData = OPTIQUE_SOURCE_DIR "/tests/data/gltf/";
 // The textured torus as obj2gltf and gltf-pipeline write it (scripts/make-gltf-assets.sh).
 const std::string kTorus = OPTIQUE_SOURCE_DIR "/configs/assets/torus/";
 
-// A fresh directory under the system's temporary one, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    std::string pattern = (fs::temp_directory_path() / "optique-gltf-XXXXXX").string();
-    const char* made = mkdtemp(pattern.data());
-    EXPECT_NE(made, nullptr);
-    path_ = pattern;
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  [[nodiscard]] std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
-};
-
-std::string read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using TempDir = optique::testing::ScratchDir;
+using optique::testing::read_file;
 
 void write_bytes(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
   out << bytes;
 }
 
-json read_json(const std::string& path) { return json::parse(read_bytes(path)); }
+json read_json(const std::string& path) { return json::parse(read_file(path)); }
 
 void write_json(const std::string& path, const json& doc) { write_bytes(path, doc.dump(1)); }
 
@@ -291,13 +268,13 @@ TEST(Gltf, HashIsStableAndFollowsTheBytes) {
   // The identity is the manifest's: one file, the glTF itself.
   ASSERT_EQ(first.manifest.files.size(), 1u);
   EXPECT_EQ(first.manifest.files[0].path, "animated-cubes.gltf");
-  EXPECT_EQ(first.manifest.files[0].sha256, util::sha256_raw(read_bytes(kCubes)));
+  EXPECT_EQ(first.manifest.files[0].sha256, util::sha256_raw(read_file(kCubes)));
   EXPECT_EQ(first.content_sha256, manifest_sha256(first.manifest));
   ASSERT_EQ(first.files.size(), 1u);
-  EXPECT_EQ(*first.files[0], read_bytes(kCubes));
+  EXPECT_EQ(*first.files[0], read_file(kCubes));
 
   TempDir dir;
-  std::string bytes = read_bytes(kCubes);
+  std::string bytes = read_file(kCubes);
   const auto where = bytes.find("\"roughnessFactor\": 0.4");
   ASSERT_NE(where, std::string::npos);
   bytes[where + std::string("\"roughnessFactor\": 0.").size()] = '3';
@@ -314,10 +291,10 @@ TEST(Gltf, HashCoversSideBuffers) {
   const auto original = load_ok(dir.file("quad.gltf"));
   ASSERT_EQ(original.manifest.files.size(), 2u);
   EXPECT_EQ(original.manifest.files[1].path, "quad.bin");
-  EXPECT_EQ(original.manifest.files[1].sha256, util::sha256_raw(read_bytes(kData + "quad.bin")));
+  EXPECT_EQ(original.manifest.files[1].sha256, util::sha256_raw(read_file(kData + "quad.bin")));
   EXPECT_EQ(original.content_sha256, manifest_sha256(original.manifest));
 
-  std::string bin = read_bytes(dir.file("quad.bin"));
+  std::string bin = read_file(dir.file("quad.bin"));
   bin[0] = static_cast<char>(bin[0] ^ 0x01);  // a tiny change to the first x coordinate
   write_bytes(dir.file("quad.bin"), bin);
   const auto changed = load_ok(dir.file("quad.gltf"));
@@ -362,7 +339,7 @@ TEST(Gltf, BinaryGltfWithInterleavedVertices) {
   EXPECT_FLOAT_EQ(scene.lights[0].intensity, 0.5f);
   EXPECT_EQ(scene.lights[0].colour, glm::vec3(1.0f));
   ASSERT_EQ(loaded.manifest.files.size(), 1u);
-  EXPECT_EQ(loaded.manifest.files[0].sha256, util::sha256_raw(read_bytes(kData + "triangle.glb")));
+  EXPECT_EQ(loaded.manifest.files[0].sha256, util::sha256_raw(read_file(kData + "triangle.glb")));
 }
 
 TEST(Gltf, CubicSplineAndStepInterpolation) {
@@ -527,7 +504,7 @@ TEST(Gltf, OtherTexCoordSetsAndTexturesAreIgnoredWithWarnings) {
 
 // The torus's texture as decoded from its PNG.
 Texture torus_texture() {
-  const std::string png = read_bytes(kTorus + "torus.png");
+  const std::string png = read_file(kTorus + "torus.png");
   auto decoded = image::decode_texture(std::span(reinterpret_cast<const std::uint8_t*>(png.data()), png.size()), "");
   EXPECT_TRUE(decoded.ok());
   return decoded.ok() ? decoded.value() : Texture{};
@@ -567,11 +544,11 @@ TEST(Gltf, TorusWithItsBufferAndTextureBesideIt) {
   EXPECT_EQ(loaded.manifest.files[0].path, "torus.gltf");
   EXPECT_EQ(loaded.manifest.files[1].path, "torus.bin");
   EXPECT_EQ(loaded.manifest.files[2].path, "torus.png");
-  EXPECT_EQ(loaded.manifest.files[2].sha256, util::sha256_raw(read_bytes(kTorus + "torus.png")));
+  EXPECT_EQ(loaded.manifest.files[2].sha256, util::sha256_raw(read_file(kTorus + "torus.png")));
   // The texture is part of the identity: another image, another scene.
   TempDir dir;
   for (const char* name : {"torus.gltf", "torus.bin", "torus.png"}) fs::copy_file(kTorus + name, dir.file(name));
-  std::string png = read_bytes(dir.file("torus.png"));
+  std::string png = read_file(dir.file("torus.png"));
   png.back() = static_cast<char>(png.back() ^ 1);  // the IEND chunk's CRC: still decodes
   write_bytes(dir.file("torus.png"), png);
   const auto changed = load_gltf(dir.file("torus.gltf"), {});
@@ -639,7 +616,7 @@ TEST(Gltf, AFileNameThatIsNotUtf8IsRefusedBeforeAnyNodeWouldBe) {
 
 TEST(Gltf, CorruptDracoDataIsRefusedNamingThePrimitive) {
   TempDir dir;
-  std::string glb = read_bytes(kTorus + "torus-draco.glb");
+  std::string glb = read_file(kTorus + "torus-draco.glb");
   // The binary chunk follows the JSON chunk: break the compressed mesh's start.
   const std::size_t json_length = static_cast<unsigned char>(glb[12]) | static_cast<unsigned char>(glb[13]) << 8;
   const std::size_t binary = 20 + json_length + 8;
@@ -710,7 +687,7 @@ TEST(Gltf, EveryMissingFileIsNamedAtOnce) {
 TEST(Gltf, ATruncatedBufferIsRefused) {
   TempDir dir;
   const auto path = torus_variant(dir, [](json&) {});
-  write_bytes(dir.file("torus.bin"), read_bytes(dir.file("torus.bin")).substr(0, 1000));
+  write_bytes(dir.file("torus.bin"), read_file(dir.file("torus.bin")).substr(0, 1000));
   expect_error(path, {"buffer 0 'torus.bin' is truncated: 1000 bytes where its byteLength says 184352"});
 }
 
@@ -727,7 +704,7 @@ TEST(Gltf, ABufferViewPastItsBufferIsRefused) {
 
 TEST(Gltf, ATruncatedGlbIsRefused) {
   TempDir dir;
-  const std::string glb = read_bytes(kTorus + "torus.glb");
+  const std::string glb = read_file(kTorus + "torus.glb");
   write_bytes(dir.file("cut.glb"), glb.substr(0, glb.size() / 2));
   expect_error(dir.file("cut.glb"), {"malformed GLB", "truncated"});
 }
@@ -737,7 +714,7 @@ TEST(Gltf, ATruncatedGlbIsRefused) {
 // shorter than the buffer's byteLength.
 TEST(Gltf, AGlbChunkPastTheEndOrShorterThanItsBufferIsRefused) {
   TempDir dir;
-  const std::string glb = read_bytes(kTorus + "torus.glb");
+  const std::string glb = read_file(kTorus + "torus.glb");
   const auto u32 = [](const std::string& bytes, std::size_t at) {
     return static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at])) |
            static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[at + 1])) << 8 |
@@ -754,7 +731,8 @@ TEST(Gltf, AGlbChunkPastTheEndOrShorterThanItsBufferIsRefused) {
   std::string over = glb;
   put(over, bin, u32(glb, bin) + 4);
   write_bytes(dir.file("over.glb"), over);
-  expect_error(dir.file("over.glb"), {"malformed GLB", "a chunk at byte " + std::to_string(bin) + " runs past the end"});
+  expect_error(dir.file("over.glb"),
+               {"malformed GLB", "a chunk at byte " + std::to_string(bin) + " runs past the end"});
 
   std::string shorter = glb.substr(0, glb.size() - 8);
   put(shorter, 8, static_cast<std::uint32_t>(shorter.size()));
@@ -784,7 +762,7 @@ TEST(Gltf, MissingFile) { expect_error(kData + "no-such.gltf", {"no such file"})
 TEST(Gltf, MalformedJson) {
   TempDir dir;
   const std::string path = dir.file("broken.gltf");
-  const std::string bytes = read_bytes(kCubes);
+  const std::string bytes = read_file(kCubes);
   write_bytes(path, bytes.substr(0, bytes.size() / 2));
   expect_error(path, {"malformed glTF"});
 }

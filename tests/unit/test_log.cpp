@@ -17,6 +17,7 @@
 #include <sstream>
 
 #include "log/escape.h"
+#include "scratch.h"
 
 namespace optique::log {
 namespace {
@@ -28,10 +29,18 @@ const std::string kEscaped = "node 'evil\\nFAKE [error] line' \\x1b[31mred\\x1b[
 
 TEST(Log, EveryControlCharacterAndInvalidUtf8IsEscaped) {
   EXPECT_EQ(escape_for_log(kHostile), kEscaped);
-  EXPECT_EQ(escape_for_log("a\rb\tc\x7f" "d"), "a\\rb\\tc\\x7fd");
+  EXPECT_EQ(escape_for_log("a\rb\tc\x7f"
+                           "d"),
+            "a\\rb\\tc\\x7fd");
   EXPECT_EQ(escape_for_log(std::string("nul\0x", 5)), "nul\\x00x");
-  EXPECT_EQ(escape_for_log("c1 \xc2\x9b" "31m"), "c1 \\u009b31m") << "C1 CSI, encoded as UTF-8";
-  EXPECT_EQ(escape_for_log("raw \x9b" "31m"), "raw \\x9b31m") << "C1 as a lone byte: not UTF-8";
+  EXPECT_EQ(escape_for_log("c1 \xc2\x9b"
+                           "31m"),
+            "c1 \\u009b31m")
+      << "C1 CSI, encoded as UTF-8";
+  EXPECT_EQ(escape_for_log("raw \x9b"
+                           "31m"),
+            "raw \\x9b31m")
+      << "C1 as a lone byte: not UTF-8";
   EXPECT_EQ(escape_for_log("over \xc0\x8a long"), "over \\xc0\\x8a long") << "an overlong newline";
   EXPECT_EQ(escape_for_log("cut \xe2\x82"), "cut \\xe2\\x82");
   EXPECT_EQ(escape_for_log("sep \xe2\x80\xa8 rtl \xe2\x80\xae"), "sep \\u2028 rtl \\u202e");
@@ -42,20 +51,12 @@ TEST(Log, EveryControlCharacterAndInvalidUtf8IsEscaped) {
 
 class LoggerTest : public ::testing::Test {
  protected:
-  LoggerTest() {
-    std::string pattern = (fs::temp_directory_path() / "optique-log-XXXXXX").string();
-    EXPECT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  ~LoggerTest() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
   static std::string read(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
     return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   }
-  fs::path dir_;
+  optique::testing::ScratchDir scratch_{"optique-log"};
+  fs::path dir_ = scratch_.path();
 };
 
 TEST_F(LoggerTest, AHostileMessageIsOneLineOfEscapesInEverySink) {

@@ -14,6 +14,7 @@
 
 #include "actions.h"
 #include "config/load.h"
+#include "envelopes.h"
 #include "master/run_config.h"
 #include "net/envelope.h"
 #include "protocol/welcome.h"
@@ -44,11 +45,7 @@ const clock::Nanos* armed(const Actions& actions, Timer timer) {
   return nullptr;
 }
 
-wire::Envelope envelope() {
-  wire::Envelope e;
-  e.set_protocol_version(net::kProtocolVersion);
-  return e;
-}
+using testing::envelope;
 
 // A master over a shipped config (changed by `change`), with nodes joined by hand.
 class MasterTest : public ::testing::Test {

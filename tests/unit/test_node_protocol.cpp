@@ -9,6 +9,7 @@
 
 #include "actions.h"
 #include "config/load.h"
+#include "envelopes.h"
 #include "net/auth.h"
 #include "protocol/welcome.h"
 #include "scene/manifest.h"
@@ -34,11 +35,7 @@ std::vector<wire::Envelope> sent(const Actions& actions, wire::Envelope::BodyCas
 
 bool logged(const Actions& actions, const std::string& fragment) { return testing::logged<Log>(actions, fragment); }
 
-wire::Envelope envelope() {
-  wire::Envelope e;
-  e.set_protocol_version(net::kProtocolVersion);
-  return e;
-}
+using testing::envelope;
 
 config::Installation wall() {
   auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-2x2.json");
@@ -148,8 +145,8 @@ TEST_F(NodeTest, HandshakeAnswersTheChallengeWithItsMacAndJoinsOnTheState) {
   // Everything after the hello is sealed, each way with its own key.
   const Protect* protect = first<Protect>(a);
   ASSERT_NE(protect, nullptr);
-  const net::SessionKeys keys = net::derive_session_keys(
-      *s.secret, std::span(both).first(32), own, "bottom-left", net::kProtocolVersion);
+  const net::SessionKeys keys =
+      net::derive_session_keys(*s.secret, std::span(both).first(32), own, "bottom-left", net::kProtocolVersion);
   EXPECT_EQ(protect->send, keys.to_master);
   EXPECT_EQ(protect->receive, keys.to_node);
   // A second challenge is a broken master.

@@ -16,8 +16,8 @@
 #include <unistd.h>
 
 #include <cerrno>
-#include <csignal>
 #include <chrono>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -27,6 +27,7 @@
 #include <variant>
 
 #include "scene/manifest.h"
+#include "scratch.h"
 
 namespace optique::node {
 namespace {
@@ -35,16 +36,6 @@ namespace fs = std::filesystem;
 
 class SceneCacheTest : public ::testing::Test {
  protected:
-  SceneCacheTest() {
-    std::string pattern = (fs::temp_directory_path() / "optique-cache-XXXXXX").string();
-    EXPECT_NE(mkdtemp(pattern.data()), nullptr);
-    dir_ = pattern;
-  }
-  ~SceneCacheTest() override {
-    std::error_code ignored;
-    fs::remove_all(dir_, ignored);
-  }
-
   // Writes chunks of the scene through `cache` as a fetch would; all of them
   // unless `only` names one (file, chunk).
   void write_chunks(SceneCache& cache, std::optional<std::pair<std::uint32_t, std::uint64_t>> only = {}) {
@@ -108,7 +99,8 @@ class SceneCacheTest : public ::testing::Test {
 
   std::ostringstream log_text_;
   spdlog::logger log_{"node", std::make_shared<spdlog::sinks::ostream_sink_st>(log_text_)};
-  fs::path dir_;
+  optique::testing::ScratchDir scratch_{"optique-cache"};
+  fs::path dir_ = scratch_.path();
   std::string gltf_ = R"({"asset":{"version":"2.0"}})";
   std::string bin_ = std::string(10000, '\x61');
   scene::SceneManifest files_{
@@ -156,8 +148,7 @@ TEST_F(SceneCacheTest, ACopyWithAFileMissingSaysWhich) {
   SceneCache restarted(dir_, log_);
   EXPECT_FALSE(restarted.find(files_, sha_).has_value());
   const std::string logged = log_text_.str();
-  EXPECT_NE(logged.find((dir_ / "scenes" / sha_ / "s.gltf").string() + ": No such file"), std::string::npos)
-      << logged;
+  EXPECT_NE(logged.find((dir_ / "scenes" / sha_ / "s.gltf").string() + ": No such file"), std::string::npos) << logged;
 }
 
 TEST_F(SceneCacheTest, ACopyMissingChunksIsNotPutInPlace) {

@@ -21,6 +21,7 @@
 #include "scene/manifest.h"
 #include "scene/meshes.h"
 #include "scene/relative_path.h"
+#include "scratch.h"
 #include "util/sha256.h"
 
 namespace optique::scene {
@@ -133,8 +134,9 @@ TEST(Manifest, APeersManifestIsCheckedBeforeAnythingIsFetched) {
   refused(m, "larger than the 1000 bytes", limits);
   {
     // Every file within the limit, all of them together not.
-    SceneManifest two{4096, {describe_file("s.gltf", std::string(600, '{'), 4096),
-                             describe_file("a.bin", std::string(600, 'a'), 4096)}};
+    SceneManifest two{
+        4096,
+        {describe_file("s.gltf", std::string(600, '{'), 4096), describe_file("a.bin", std::string(600, 'a'), 4096)}};
     refused(two, "larger than the 1000 bytes", limits);
   }
   refused(m, "1 chunk digests for 2 chunks", {100000, 10});
@@ -188,10 +190,7 @@ TEST(DefaultLights, AnEmptySceneAndAViewerAtTheCentreStillGetFiniteLights) {
 
 // --- the shipped glTF assets, as the Khronos validator saw them
 
-std::string read_bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+using optique::testing::read_file;
 
 TEST(ShippedAssets, EveryGltfAssetPassedTheKhronosValidatorAsItIsNow) {
   const fs::path root = OPTIQUE_SOURCE_DIR;
@@ -216,10 +215,10 @@ TEST(ShippedAssets, EveryGltfAssetPassedTheKhronosValidatorAsItIsNow) {
     const nlohmann::json& report = found->second;
     EXPECT_EQ(report.at("errors").get<int>(), 0) << report.dump();
     EXPECT_EQ(report.at("warnings").get<int>(), 0) << report.dump();
-    EXPECT_EQ(report.at("sha256").get<std::string>(), util::sha256_hex(read_bytes(root / asset)))
+    EXPECT_EQ(report.at("sha256").get<std::string>(), util::sha256_hex(read_file(root / asset)))
         << "changed since it was validated: run scripts/make-gltf-assets.sh";
     for (const auto& [uri, digest] : report.at("resources").items()) {
-      EXPECT_EQ(digest.get<std::string>(), util::sha256_hex(read_bytes((root / asset).parent_path() / uri)))
+      EXPECT_EQ(digest.get<std::string>(), util::sha256_hex(read_file((root / asset).parent_path() / uri)))
           << uri << " changed since it was validated: run scripts/make-gltf-assets.sh";
     }
   }
