@@ -3,43 +3,16 @@
 #include <algorithm>
 #include <cassert>
 
+#include "config/names.h"
 #include "scene/scripted_path.h"
 
 namespace optique::config {
 
-std::string_view to_string(Eye eye) {
-  switch (eye) {
-    case Eye::left:
-      return "left";
-    case Eye::right:
-      return "right";
-    case Eye::mono:
-      break;
-  }
-  return "mono";
-}
-
-std::string_view to_string(RenderMethod method) {
-  return method == RenderMethod::two_pass ? "two-pass" : "single-pass";
-}
-
-std::string_view to_string(ContentRole role) {
-  switch (role) {
-    case ContentRole::lights:
-      return "lights";
-    case ContentRole::focus:
-      return "focus";
-    case ContentRole::defocus:
-      return "defocus";
-    case ContentRole::full:
-      break;
-  }
-  return "full";
-}
-
-std::string_view to_string(StragglerPolicy policy) { return policy == StragglerPolicy::drop ? "drop" : "present"; }
-
-std::string_view to_string(OutputKind kind) { return kind == OutputKind::window ? "window" : "headless"; }
+std::string_view to_string(Eye eye) { return name_of(kEyeNames, eye); }
+std::string_view to_string(RenderMethod method) { return name_of(kRenderMethodNames, method); }
+std::string_view to_string(ContentRole role) { return name_of(kContentRoleNames, role); }
+std::string_view to_string(StragglerPolicy policy) { return name_of(kStragglerPolicyNames, policy); }
+std::string_view to_string(OutputKind kind) { return name_of(kOutputKindNames, kind); }
 
 geometry::WorldRect Screen::world(const geometry::ScreenRect& part) const {
   geometry::WorldRect rect;

@@ -8,6 +8,7 @@
 
 #include "config/calibration_file.h"
 #include "config/light_list.h"
+#include "config/names.h"
 #include "config/response.h"
 #include "scene/load_scene.h"
 
@@ -31,6 +32,14 @@ glm::dmat3 matrix3(const google::protobuf::RepeatedField<double>& nine) {
   return geometry::homography_from_rows(std::span<const double, 9>(nine.data(), 9));
 }
 
+// A name validate() accepted.
+template <class E, std::size_t N>
+E checked_name(const std::array<Named<E>, N>& table, std::string_view name) {
+  const std::optional<E> value = from_name(table, name);
+  assert(value);
+  return value.value_or(table.front().value);
+}
+
 template <class T>
 T or_default(T value, T fallback) {
   return value == T{} ? fallback : value;
@@ -52,11 +61,7 @@ Screen build_screen(const schema::Screen& s) {
 
 Content build_content(const schema::Content& c) {
   Content content;
-  const std::string& role = c.role();
-  content.role = role == "lights"    ? ContentRole::lights
-                 : role == "focus"   ? ContentRole::focus
-                 : role == "defocus" ? ContentRole::defocus
-                                     : ContentRole::full;
+  content.role = checked_name(kContentRoleNames, c.role());
   if (content.role == ContentRole::lights) {
     content.automatic = c.lights() == "auto";
     if (!content.automatic) {
@@ -80,11 +85,11 @@ Projector build_projector(const schema::Projector& p, const std::vector<Screen>&
   const auto screen = std::find_if(screens.begin(), screens.end(), [&](const Screen& s) { return s.id == p.screen(); });
   assert(screen != screens.end());
   projector.screen = static_cast<std::size_t>(screen - screens.begin());
-  projector.eye = p.eye() == "left" ? Eye::left : p.eye() == "right" ? Eye::right : Eye::mono;
-  projector.output.kind = p.output().kind() == "window" ? OutputKind::window : OutputKind::headless;
+  projector.eye = checked_name(kEyeNames, p.eye());
+  projector.output.kind = checked_name(kOutputKindNames, p.output().kind());
   projector.output.monitor = p.output().monitor();
   projector.output.fullscreen = p.output().fullscreen();
-  projector.rendering = p.rendering() == "two-pass" ? RenderMethod::two_pass : RenderMethod::single_pass;
+  projector.rendering = checked_name(kRenderMethodNames, p.rendering());
   projector.blend_ramp = p.blend_ramp();
   auto response = parse_response(p);
   assert(response);
@@ -210,7 +215,7 @@ MasterSettings build_master(const schema::MasterSettings& m) {
   master.max_message_bytes = or_default(m.max_message_bytes(), defaults::kMaxMessageBytes);
   master.secret_file = m.secret_file();
   master.max_pending_connections = or_default(m.max_pending_connections(), defaults::kMaxPendingConnections);
-  master.straggler_policy = m.straggler_policy() == "drop" ? StragglerPolicy::drop : StragglerPolicy::present;
+  master.straggler_policy = checked_name(kStragglerPolicyNames, m.straggler_policy());
   if (m.has_min_presented()) master.min_presented = m.min_presented();
   if (m.has_status()) {
     const schema::StatusServer& st = m.status();

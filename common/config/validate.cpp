@@ -9,6 +9,7 @@
 #include "config/color_fields.h"
 #include "config/defaults.h"
 #include "config/light_list.h"
+#include "config/names.h"
 #include "config/response.h"
 #include "config/tracking.h"
 #include "config/up_conversion.h"
@@ -62,12 +63,11 @@ class Checker {
     return ok;
   }
 
-  void one_of(const std::string& path, const std::string& value, std::initializer_list<const char*> allowed) {
-    if (value.empty()) return;  // the default applies
-    for (const char* a : allowed) {
-      if (value == a) return;
-    }
-    fail(path, "unknown value '" + value + "' (expected one of: " + util::joined(allowed) + ")");
+  // A name of `table` (config/names.h), or empty: the default applies.
+  template <class E, std::size_t N>
+  void one_of(const std::string& path, const std::string& value, const std::array<Named<E>, N>& table) {
+    if (from_name(table, value)) return;
+    fail(path, "unknown value '" + value + "' (expected one of: " + util::joined(names_of(table)) + ")");
   }
 
  private:
@@ -175,8 +175,9 @@ void check_geometry_source(Checker& check, const std::string& at, const schema::
 }
 
 void check_content(Checker& check, const std::string& at, const schema::Content& c) {
-  check.one_of(at + ".role", c.role(), {"full", "lights", "focus", "defocus"});
-  const bool lights = c.role() == "lights";
+  check.one_of(at + ".role", c.role(), kContentRoleNames);
+  const std::optional<ContentRole> role = from_name(kContentRoleNames, c.role());
+  const bool lights = role == ContentRole::lights;
   if (lights && c.lights().empty()) {
     check.fail(at + ".lights",
                "role 'lights' needs its lights: indices and ranges of the scene's lights (\"0-6\", "
@@ -188,7 +189,7 @@ void check_content(Checker& check, const std::string& at, const schema::Content&
   if (!lights && !c.lights().empty()) check.fail(at + ".lights", "only a projector of role 'lights' takes lights");
   if (!lights && c.ambient()) check.fail(at + ".ambient", "only a projector of role 'lights' takes ambient");
   check.non_negative(at + ".blur_radius", c.blur_radius());
-  if (c.role() != "defocus" && c.blur_radius() != 0.0) {
+  if (role != ContentRole::defocus && c.blur_radius() != 0.0) {
     check.fail(at + ".blur_radius", "only a projector of role 'defocus' has a blur radius");
   }
 }
@@ -199,18 +200,20 @@ void check_content(Checker& check, const std::string& at, const schema::Content&
 void check_stacked_pairs(Checker& check, const schema::Installation& inst) {
   for (int i = 0; i < inst.projectors_size(); ++i) {
     const schema::Projector& p = inst.projectors(i);
-    const std::string& role = p.content().role();
-    if (role != "focus" && role != "defocus") continue;
-    const std::string wanted = role == "focus" ? "defocus" : "focus";
+    const std::optional<ContentRole> role = from_name(kContentRoleNames, p.content().role());
+    if (role != ContentRole::focus && role != ContentRole::defocus) continue;
+    const ContentRole wanted = role == ContentRole::focus ? ContentRole::defocus : ContentRole::focus;
     bool partnered = false;
     for (const schema::Projector& other : inst.projectors()) {
-      partnered = partnered || (other.content().role() == wanted && other.screen() == p.screen() &&
-                                (other.eye().empty() ? "mono" : other.eye()) == (p.eye().empty() ? "mono" : p.eye()));
+      partnered = partnered ||
+                  (from_name(kContentRoleNames, other.content().role()) == wanted && other.screen() == p.screen() &&
+                   from_name(kEyeNames, other.eye()) == from_name(kEyeNames, p.eye()));
     }
     if (!partnered) {
       check.fail("projectors[" + std::to_string(i) + "].content.role",
-                 "a '" + role + "' projector needs a '" + wanted + "' partner on screen '" + p.screen() +
-                     "' for the same eye, and '" + p.id() + "' has none: the pair shows depth of field together");
+                 "a '" + std::string(to_string(*role)) + "' projector needs a '" + std::string(to_string(wanted)) +
+                     "' partner on screen '" + p.screen() + "' for the same eye, and '" + p.id() +
+                     "' has none: the pair shows depth of field together");
     }
   }
 }
@@ -228,7 +231,8 @@ void check_depth_range(Checker& check, const schema::DepthOfField& d) {
 void check_depth_of_field(Checker& check, const schema::Installation& inst) {
   bool needed = false;
   for (const schema::Projector& p : inst.projectors()) {
-    needed = needed || p.content().role() == "focus" || p.content().role() == "defocus";
+    const std::optional<ContentRole> role = from_name(kContentRoleNames, p.content().role());
+    needed = needed || role == ContentRole::focus || role == ContentRole::defocus;
   }
   const schema::DepthOfField& d = inst.depth_of_field();
   const bool given = inst.has_depth_of_field();
@@ -321,9 +325,9 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
     }
     if (p.has_region()) check_region(check, at + ".region", p.region(), screen);
     check_geometry_source(check, at, p, config_dir);
-    check.one_of(at + ".output.kind", p.output().kind(), {"headless", "window"});
-    check.one_of(at + ".eye", p.eye(), {"mono", "left", "right"});
-    check.one_of(at + ".rendering", p.rendering(), {"single-pass", "two-pass"});
+    check.one_of(at + ".output.kind", p.output().kind(), kOutputKindNames);
+    check.one_of(at + ".eye", p.eye(), kEyeNames);
+    check.one_of(at + ".rendering", p.rendering(), kRenderMethodNames);
     check.non_negative(at + ".blend_ramp", p.blend_ramp());
     if (auto model = parse_response(p); !model) {
       // The model's messages start with the field ("response.table[3]: …").
@@ -411,7 +415,7 @@ void check_master(Checker& check, const schema::MasterSettings& m) {
     check.fail("master.frame_rate",
                "must be in (0, 1000] Hz, or 0 for the default (got " + number_text(m.frame_rate()) + ")");
   }
-  if (!m.straggler_policy().empty() && m.straggler_policy() != "present" && m.straggler_policy() != "drop") {
+  if (!from_name(kStragglerPolicyNames, m.straggler_policy())) {
     check.fail("master.straggler_policy", "unknown policy '" + m.straggler_policy() +
                                               "' (\"present\": the frame without the late node, or "
                                               "\"drop\": the frame everywhere)");
