@@ -43,7 +43,7 @@
 #include "net/session_seal.h"
 #include "optique/report.pb.h"
 #include "optique/wire.pb.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "tracking/head_tracker.h"
 
 namespace optique::master {

@@ -1,5 +1,5 @@
 #include "master/run_config.h"
-#include "config/installation_scene.h"
+#include "scene_load/installation_scene.h"
 
 #include "master/light_switches.h"
 #include "master/shared_secret.h"

@@ -9,7 +9,7 @@
 
 #include "config/load.h"
 #include "scene/image_decoder.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "tracking/replay.h"
 #include "util/result.h"
 

@@ -12,7 +12,7 @@ SceneServer::SceneServer(const scene::LoadedScene& scene) : scene_(scene) {}
 
 // A node without a copy of the scene asks for its files chunk by chunk while it
 // sets up: each request that names a chunk of this scene is answered from the
-// bytes the master loaded (scene/gltf_source.h: what it hashed), and gives the
+// bytes the master loaded (scene_load/gltf_source.h: what it hashed), and gives the
 // node another configure_timeout() to finish.
 void SceneServer::request(PeerId peer, const std::string& id, SceneServed& served, const wire::SceneRequest& request,
                           clock::Nanos now, Actions& out) const {

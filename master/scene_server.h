@@ -17,7 +17,7 @@
 #include "clock/clock.h"
 #include "master/actions.h"
 #include "optique/wire.pb.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 
 namespace optique::master {
 

@@ -20,7 +20,7 @@
 
 #include "config/load.h"
 #include "image/image.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "util/result.h"
 
 namespace optique::tools {

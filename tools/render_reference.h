@@ -10,7 +10,7 @@
 #include <spdlog/logger.h>
 
 #include "config/load.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "util/result.h"
 
 namespace optique::tools {

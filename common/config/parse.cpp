@@ -6,11 +6,11 @@
 
 #include <glm/matrix.hpp>
 
+#include "config/asset_path.h"
 #include "config/calibration_file.h"
 #include "config/light_list.h"
 #include "config/names.h"
 #include "config/response.h"
-#include "scene/load_scene.h"
 
 namespace optique::config {
 namespace {
@@ -192,7 +192,7 @@ Viewer build_viewer(const schema::Viewer& v, const std::string& config_dir) {
   if (v.has_tracking()) {
     std::vector<Problem> problems;  // none: validated
     viewer.tracking = parse_tracking(v.tracking(), "viewer.tracking", problems);
-    if (!viewer.tracking->file.empty()) viewer.tracking->file = scene::resolve_asset(viewer.tracking->file, config_dir);
+    if (!viewer.tracking->file.empty()) viewer.tracking->file = resolve_asset(viewer.tracking->file, config_dir);
   }
   return viewer;
 }
@@ -231,7 +231,7 @@ MasterSettings build_master(const schema::MasterSettings& m) {
 SceneSource build_scene(const schema::Scene& s, const std::string& config_dir) {
   SceneSource scene;
   scene.builtin = s.builtin();
-  if (!s.gltf().empty()) scene.gltf = scene::resolve_asset(s.gltf(), config_dir);
+  if (!s.gltf().empty()) scene.gltf = resolve_asset(s.gltf(), config_dir);
   for (const schema::LightSwitch& entry : s.light_switches()) {
     auto off = parse_light_list(entry.off());
     auto on = parse_light_list(entry.on());

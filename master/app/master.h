@@ -30,7 +30,7 @@
 #include "master/status/status_service.h"
 #include "net/auth.h"
 #include "net/connection.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "util/result.h"
 
 namespace optique::master {

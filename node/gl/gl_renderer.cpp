@@ -1,9 +1,9 @@
 #include "node/gl/gl_renderer.h"
 
-#include "config/installation_scene.h"
+#include "scene_load/installation_scene.h"
 #include "config/to_schema.h"
 #include "image/texture_decode.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 
 namespace optique::node {
 

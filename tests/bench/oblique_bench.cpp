@@ -19,7 +19,7 @@
 
 #include "bench_options.h"
 #include "clock/clock.h"
-#include "config/installation_scene.h"
+#include "scene_load/installation_scene.h"
 #include "config/job.h"
 #include "config/load.h"
 #include "draw_plot.h"
@@ -30,7 +30,7 @@
 #include "metrics/distribution.h"
 #include "render/gl_context.h"
 #include "render/projector_pipeline.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "spread.h"
 
 namespace {

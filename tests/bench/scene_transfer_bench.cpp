@@ -36,7 +36,7 @@
 #include "external_master.h"
 #include "node/scene_cache.h"
 #include "process.h"
-#include "scene/gltf.h"
+#include "scene_load/gltf.h"
 #include "spread.h"
 #include "util/sha256.h"
 

@@ -12,12 +12,12 @@
 
 #include <glm/geometric.hpp>
 
-#include "config/installation_scene.h"
+#include "scene_load/installation_scene.h"
 #include "config/load.h"
 #include "config/parse.h"
 #include "image/compare.h"
 #include "image/texture_decode.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "scene/raycast.h"
 
 namespace optique::bench::dof {

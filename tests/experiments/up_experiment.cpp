@@ -7,14 +7,14 @@
 #include <map>
 #include <sstream>
 
-#include "config/installation_scene.h"
+#include "scene_load/installation_scene.h"
 #include "config/job.h"
 #include "config/load.h"
 #include "image/texture_decode.h"
 #include "master/light_switches.h"
 #include "master/scene_authority.h"
 #include "render/projector_pipeline.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 
 namespace optique::bench::upconv {
 namespace {

@@ -1,7 +1,7 @@
 // render-reference with a supersample factor: the same raster, each pixel the
 // average of S × S samples. Needs GL (headless; llvmpipe in CI): label `gpu`.
 
-#include "config/installation_scene.h"
+#include "scene_load/installation_scene.h"
 #include "image/texture_decode.h"
 #include "tools/render_reference.h"
 

@@ -20,7 +20,7 @@
 #include "render/gl_context.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
-#include "scene/gltf.h"
+#include "scene_load/gltf.h"
 #include "scene/state.h"
 
 namespace optique::render {

@@ -1,8 +1,8 @@
 #include "gl_installation.h"
-#include "config/installation_scene.h"
+#include "scene_load/installation_scene.h"
 
 #include "image/texture_decode.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 
 namespace optique::testing {
 

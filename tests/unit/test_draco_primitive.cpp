@@ -1,9 +1,9 @@
-// A Draco-compressed primitive (scene/draco_primitive.h) from bytes Draco's own
+// A Draco-compressed primitive (scene_load/draco_primitive.h) from bytes Draco's own
 // encoder wrote: a triangle decodes to its points, and one whose stored index
 // names a point the mesh does not have is refused (Draco's sequential format
 // stores indices as plain bytes, and its decoder takes them as they are).
 
-#include "scene/draco_primitive.h"
+#include "scene_load/draco_primitive.h"
 
 #include <gtest/gtest.h>
 

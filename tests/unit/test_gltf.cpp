@@ -1,4 +1,4 @@
-// glTF scenes (common/scene/gltf.h): the shipped animated-cubes asset loads into
+// glTF scenes (common/scene_load/gltf.h): the shipped animated-cubes asset loads into
 // the meshes, instances, lights and animated objects it describes, with poses that
 // match hand-computed values, loop, and are pure functions of time; the content
 // hash covers the file and every file it references; base colour textures are
@@ -28,7 +28,7 @@
 #include <nlohmann/json.hpp>
 
 #include "image/texture_decode.h"
-#include "scene/gltf.h"
+#include "scene_load/gltf.h"
 #include "scene/manifest.h"
 #include "scratch.h"
 #include "util/sha256.h"

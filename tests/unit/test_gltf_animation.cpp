@@ -1,4 +1,4 @@
-// A glTF animation evaluated at any time: scene/gltf_animation.h.
+// A glTF animation evaluated at any time: scene_load/gltf_animation.h.
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "scene/definition.h"
-#include "scene/gltf_animation.h"
+#include "scene_load/gltf_animation.h"
 
 namespace optique::scene::gltf {
 namespace {

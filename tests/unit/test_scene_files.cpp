@@ -17,7 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "scene/default_lights.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "scene/manifest.h"
 #include "scene/meshes.h"
 #include "scene/relative_path.h"

@@ -1,4 +1,4 @@
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 
 #include <fmt/format.h>
 
@@ -6,15 +6,9 @@
 
 #include "scene/builtin.h"
 #include "scene/default_lights.h"
-#include "scene/gltf.h"
+#include "scene_load/gltf.h"
 
 namespace optique::scene {
-
-std::string resolve_asset(const std::string& path, const std::string& config_dir) {
-  const std::filesystem::path asset(path);
-  if (asset.is_absolute()) return asset.lexically_normal().string();
-  return std::filesystem::absolute(std::filesystem::path(config_dir) / asset).lexically_normal().string();
-}
 
 Result<LoadedScene> load_scene(const std::string& builtin, const std::string& path, const ImageDecoder& decode,
                                const glm::dvec3& viewer) {
@@ -39,8 +33,8 @@ Result<LoadedScene> load_scene(const std::string& builtin, const std::string& pa
   if (loaded.definition.lights.empty()) {
     loaded.notes.push_back(path + ": " + add_default_lights(loaded.definition, viewer));
   } else {
-    loaded.notes.push_back(fmt::format("{}: lit by the file's {} point light(s)", path,
-                                       loaded.definition.lights.size()));
+    loaded.notes.push_back(
+        fmt::format("{}: lit by the file's {} point light(s)", path, loaded.definition.lights.size()));
   }
   return loaded;
 }

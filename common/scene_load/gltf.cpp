@@ -1,4 +1,4 @@
-#include "scene/gltf.h"
+#include "scene_load/gltf.h"
 
 #include <exception>
 #include <optional>
@@ -6,11 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "scene/draco_primitive.h"
-#include "scene/gltf_error.h"
-#include "scene/gltf_loader.h"
-#include "scene/gltf_source.h"
-#include "scene/tinygltf.h"
+#include "scene_load/draco_primitive.h"
+#include "scene_load/gltf_error.h"
+#include "scene_load/gltf_loader.h"
+#include "scene_load/gltf_source.h"
+#include "scene_load/tinygltf.h"
 #include "util/message_text.h"
 
 namespace optique::scene {
@@ -22,7 +22,7 @@ const std::vector<std::string> kSupportedRequiredExtensions{"KHR_lights_punctual
                                                             kDracoExtension};
 
 // ---------------------------------------------------------------------------
-// File access for tinygltf: only the files scene/gltf_source.h read, by the
+// File access for tinygltf: only the files scene_load/gltf_source.h read, by the
 // names it gave their buffers (source_file_name) in the folder kSourceFolder.
 
 std::optional<std::size_t> source_index(const std::string& path, const GltfSource& source) {

@@ -1,4 +1,4 @@
-#include "scene/gltf_loader.h"
+#include "scene_load/gltf_loader.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,6 +1,6 @@
 // The loader's materials: glTF's metallic-roughness factors, emissive (and its
 // strength), and base colour textures through the caller's ImageDecoder.
-#include "scene/gltf_loader.h"
+#include "scene_load/gltf_loader.h"
 #include "util/join.h"
 
 #include <algorithm>

@@ -1,4 +1,4 @@
-#include "scene/gltf_source.h"
+#include "scene_load/gltf_source.h"
 
 #include <algorithm>
 #include <cerrno>

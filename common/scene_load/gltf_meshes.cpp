@@ -1,11 +1,11 @@
 // The loader's meshes: a glTF mesh's primitives (triangles, from accessors or
 // Draco) into the scene's meshes, each with its material.
-#include "scene/gltf_loader.h"
+#include "scene_load/gltf_loader.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "scene/draco_primitive.h"
+#include "scene_load/draco_primitive.h"
 #include "util/finite.h"
 
 namespace optique::scene {

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "scene/tinygltf.h"
+#include "scene_load/tinygltf.h"
 
 namespace optique::scene {
 

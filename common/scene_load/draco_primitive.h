@@ -14,9 +14,9 @@ namespace optique::scene {
 
 struct DracoPrimitive {
   std::size_t points = 0;
-  std::vector<double> positions;  // 3 a point
-  std::vector<double> normals;    // 3 a point, when asked for
-  std::vector<double> uvs;        // 2 a point, when asked for
+  std::vector<double> positions;       // 3 a point
+  std::vector<double> normals;         // 3 a point, when asked for
+  std::vector<double> uvs;             // 2 a point, when asked for
   std::vector<std::uint32_t> indices;  // 3 a triangle, each below `points`
 };
 

@@ -1,4 +1,4 @@
-#include "config/installation_scene.h"
+#include "scene_load/installation_scene.h"
 
 namespace optique::config {
 

@@ -2,7 +2,7 @@
 // The scene an installation names, built in or from a glTF file, loaded the same
 // way by the master (to animate it and to send its files to nodes that lack
 // them) and by every node (to draw it). The installation's own entry point is
-// config::load_scene (config/installation_scene.h).
+// config::load_scene (scene_load/installation_scene.h).
 
 #include <memory>
 #include <string>
@@ -23,13 +23,9 @@ struct LoadedScene {
   std::string content_sha256;  // the glTF's identity (its manifest's SHA-256); empty for built-in scenes
   SceneManifest manifest;      // the glTF's files; none for built-in scenes
   std::vector<std::shared_ptr<const std::string>> files;  // their bytes, as manifest.files
-  std::vector<std::string> warnings;  // what the file asked for that is left out or changed
-  std::vector<std::string> notes;     // what was done that is no fault: how a glTF is lit
+  std::vector<std::string> warnings;                      // what the file asked for that is left out or changed
+  std::vector<std::string> notes;                         // what was done that is no fault: how a glTF is lit
 };
-
-// A glTF path relative to `config_dir` becomes absolute, so nodes started
-// elsewhere load the same file.
-[[nodiscard]] std::string resolve_asset(const std::string& path, const std::string& config_dir);
 
 // The built-in scene `builtin`, or else the glTF file at `gltf` (absolute, or
 // relative to the working folder); `decode` reads its images (empty: none are

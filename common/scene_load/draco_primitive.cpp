@@ -1,4 +1,4 @@
-#include "scene/draco_primitive.h"
+#include "scene_load/draco_primitive.h"
 
 #include <draco/compression/decode.h>
 #include <draco/mesh/mesh.h>
@@ -48,7 +48,8 @@ Result<DracoPrimitive> decode_draco_primitive(std::string_view bytes, int positi
   if (type.value() != draco::TRIANGULAR_MESH) return Error{"the compressed data is not a triangle mesh"};
   draco::Decoder decoder;
   auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
-  if (!decoded.ok()) return Error{"the compressed data cannot be decoded (" + decoded.status().error_msg_string() + ")"};
+  if (!decoded.ok())
+    return Error{"the compressed data cannot be decoded (" + decoded.status().error_msg_string() + ")"};
   const std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
   if (!mesh) return Error{"the compressed data cannot be decoded"};
 
@@ -71,8 +72,9 @@ Result<DracoPrimitive> decode_draco_primitive(std::string_view bytes, int positi
   for (draco::FaceIndex face(0); face < mesh->num_faces(); ++face) {
     for (int corner = 0; corner < 3; ++corner) {
       const std::uint32_t point = mesh->face(face)[corner].value();
-      if (point >= out.points) return Error{"a compressed triangle names point " + std::to_string(point) + " of " +
-                                            std::to_string(out.points)};
+      if (point >= out.points)
+        return Error{"a compressed triangle names point " + std::to_string(point) + " of " +
+                     std::to_string(out.points)};
       out.indices.push_back(point);
     }
   }

@@ -3,7 +3,7 @@
 // parts, each a file: the file checked whole, its animations read and its node
 // hierarchy walked (gltf_loader.cpp), meshes and Draco (gltf_meshes.cpp),
 // materials and their base colour textures (gltf_materials.cpp); the binary
-// data through GltfAccessors, animated poses through scene/gltf_animation.h.
+// data through GltfAccessors, animated poses through scene_load/gltf_animation.h.
 // Throws GltfError when the file is wrong.
 
 #include <cstddef>
@@ -16,12 +16,12 @@
 #include <glm/mat4x4.hpp>
 
 #include "scene/definition.h"
-#include "scene/gltf_accessors.h"
-#include "scene/gltf_animation.h"
-#include "scene/gltf_error.h"
-#include "scene/gltf_source.h"
 #include "scene/image_decoder.h"
-#include "scene/tinygltf.h"
+#include "scene_load/gltf_accessors.h"
+#include "scene_load/gltf_animation.h"
+#include "scene_load/gltf_error.h"
+#include "scene_load/gltf_source.h"
+#include "scene_load/tinygltf.h"
 
 namespace optique::scene {
 

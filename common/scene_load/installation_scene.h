@@ -6,7 +6,7 @@
 
 #include "config/installation.h"
 #include "scene/image_decoder.h"
-#include "scene/load_scene.h"
+#include "scene_load/load_scene.h"
 #include "util/result.h"
 
 namespace optique::config {
@@ -14,8 +14,7 @@ namespace optique::config {
 // The scene `installation` names: built in, or its glTF file — read from
 // `gltf_path` instead when given (a node's copy of the master's files) — lit
 // from where the viewer's eyes rest (at t = 0) when the file brings no lights.
-[[nodiscard]] Result<scene::LoadedScene> load_scene(const Installation& installation,
-                                                    const scene::ImageDecoder& decode,
+[[nodiscard]] Result<scene::LoadedScene> load_scene(const Installation& installation, const scene::ImageDecoder& decode,
                                                     const std::string& gltf_path = {});
 
 }  // namespace optique::config

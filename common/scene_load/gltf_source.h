@@ -1,6 +1,6 @@
 #pragma once
 // A glTF file and every file it references, read and checked before tinygltf
-// parses anything (scene/gltf.cpp then builds the scene from it):
+// parses anything (scene_load/gltf.cpp then builds the scene from it):
 // - required extensions that optique cannot draw are refused first, all named
 //   in one message;
 // - each buffer and image URI that is not a data: URI must name a file inside

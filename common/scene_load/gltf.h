@@ -5,7 +5,7 @@
 // base colour texture, embedded or in a file beside the glTF), the default
 // scene's node hierarchy, TRS animations and KHR_lights_punctual point lights.
 // The file and what it references are read and checked first
-// (scene/gltf_source.h: files outside the glTF's folder, missing or truncated
+// (scene_load/gltf_source.h: files outside the glTF's folder, missing or truncated
 // files and unsupported required extensions are refused by name). Whatever the
 // file uses that we cannot draw either fails the load with a message naming the
 // feature (skins, morph targets, points and lines) or, where drawing without it

@@ -1,4 +1,4 @@
-#include "scene/gltf_animation.h"
+#include "scene_load/gltf_animation.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,10 +1,10 @@
-#include "scene/gltf_accessors.h"
+#include "scene_load/gltf_accessors.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 
-#include "scene/gltf_error.h"
+#include "scene_load/gltf_error.h"
 
 namespace optique::scene {
 

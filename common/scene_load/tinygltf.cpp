@@ -1,0 +1,3 @@
+// TinyGLTF's implementation, compiled once (scene_load/tinygltf.h).
+#define TINYGLTF_IMPLEMENTATION
+#include "scene_load/tinygltf.h"
