@@ -73,11 +73,6 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     if (session_of(i)->phase == Phase::in_barrier) waited.push_back(i);
   }
   recorder_.frame_begun(frame, begin_sent, sent);
-  // The record of the frame before last is complete (the previous frame may
-  // still get Presented); its rows go after the sends, out of the barrier round.
-  if (frame > 1) {
-    if (auto rows = recorder_.finalize(frame - 1); !rows.empty()) out.push_back(FrameRows{std::move(rows)});
-  }
   next_frame_ = frame + 1;
   ready_for_swap_.clear();
   wait_for(frame, std::move(waited), captured, now, out);
@@ -305,6 +300,12 @@ void MasterProtocol::swap(clock::Nanos now, Actions& out) {
   presents_grace_end_ = swap.present_deadline_ns() + frame_period_;
   recorder_.swapped(frame, sent, ready_for_swap_);
   ready_for_swap_.clear();
+  // The record of the frame before last is complete (the last one may still get
+  // Presented). Its rows are written after the Swap has gone: not inside a
+  // barrier round (FrameBegin to Swap), where the write would hold up the Swap.
+  if (frame > 1) {
+    if (auto rows = recorder_.finalize(frame - 1); !rows.empty()) out.push_back(FrameRows{std::move(rows)});
+  }
   if (state_ == RunState::draining) {
     wait_for_last_presents(true, now, out);
     return;

@@ -30,6 +30,15 @@ Texture make_storage(GLenum format, int width, int height, int samples) {
   return texture;
 }
 
+Texture make_exact_texture(GLenum format, int width, int height) {
+  Texture texture = make_storage(format, width, height);
+  glTextureParameteri(texture.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+  glTextureParameteri(texture.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+  glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+  glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+  return texture;
+}
+
 Buffer make_buffer() {
   GLuint name = 0;
   glCreateBuffers(1, &name);

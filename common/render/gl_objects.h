@@ -64,6 +64,8 @@ using Program = Object<detail::delete_program>;
 // locations, as every multisampled target here: they share framebuffers) when
 // `samples` > 1.
 [[nodiscard]] Texture make_storage(GLenum format, int width, int height, int samples = 1);
+// A single-sample texture read texel by texel (nearest, clamped).
+[[nodiscard]] Texture make_exact_texture(GLenum format, int width, int height);
 [[nodiscard]] Buffer make_buffer();
 [[nodiscard]] Framebuffer make_framebuffer();
 [[nodiscard]] VertexArray make_vertex_array();

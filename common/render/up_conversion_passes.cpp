@@ -22,7 +22,7 @@ UpConversionPasses::~UpConversionPasses() = default;
 
 void UpConversionPasses::keep_key(int slot, up::KeyView view) {
   const LinearTarget& linear = parts_.linear;
-  converter_->keep(slot, linear.colour(), linear.depth(), linear.multisample_depth(), std::move(view));
+  converter_->keys().keep(slot, linear.colour(), linear.depth(), linear.multisample_depth(), std::move(view));
 }
 
 up::BetweenReport UpConversionPasses::build_between(const scene::SceneState& state, const Viewpoint& view,
@@ -31,8 +31,8 @@ up::BetweenReport UpConversionPasses::build_between(const scene::SceneState& sta
   const bool motion = frame.method == up::BetweenMethod::motion;
   if (motion) {
     converter.begin_motion_field(frame.two_keys);
-    const up::KeyView& first = converter.key(frame.first);
-    const up::KeyView& second = converter.key(frame.two_keys ? frame.second : frame.first);
+    const up::KeyView& first = converter.keys().view(frame.first);
+    const up::KeyView& second = converter.keys().view(frame.two_keys ? frame.second : frame.first);
     const Motion field{{{&first.state, first.fraction, first.view_projection},
                         {&second.state, second.fraction, second.view_projection}},
                        frame.two_keys ? 2 : 1};
@@ -56,7 +56,7 @@ up::BetweenReport UpConversionPasses::draw_between(const scene::SceneState& stat
   const bool motion = frame.method == up::BetweenMethod::motion;
   // The average has no depth of its own: the first key frame's (the linear
   // depth may hold bands of a key frame being drawn).
-  if (!motion) converter.restore_depth(frame.first, linear.depth());
+  if (!motion) converter.keys().restore_depth(frame.first, linear.depth());
   parts_.rendered_colour = converter.output_framebuffer();
   parts_.rendered_depth = motion ? converter.output_framebuffer() : linear.framebuffer();
   parts_.output.encode(converter.output(), motion ? converter.depth() : linear.depth());
@@ -68,7 +68,7 @@ double UpConversionPasses::check_between(const scene::SceneState& state, const V
                                          std::optional<int> against_slot) {
   (void)build_between(state, view, frame, terms);
   UpConverter& converter = *converter_;
-  return converter.psnr_y_against(against_slot ? converter.key_colour(*against_slot) : parts_.linear.colour());
+  return converter.psnr_y_against(against_slot ? converter.keys().colour(*against_slot) : parts_.linear.colour());
 }
 
 void UpConversionPasses::draw_key_band(const scene::SceneState& state, const Viewpoint& view, const LightTerms& terms,
@@ -85,8 +85,8 @@ void UpConversionPasses::draw_key_band(const scene::SceneState& state, const Vie
   glScissor(0, first_row, width, rows);
   parts_.draw_linear(state, view, terms);
   glDisable(GL_SCISSOR_TEST);
-  converter_->keep_rows(slot, linear.colour(), linear.depth(), linear.multisample_depth(),
-                        {state, view.fraction, view.view_projection()}, first_row, rows);
+  converter_->keys().keep_rows(slot, linear.colour(), linear.depth(), linear.multisample_depth(),
+                               {state, view.fraction, view.view_projection()}, first_row, rows);
 }
 
 void UpConversionPasses::draw_fields_up_converted(const scene::SceneState& state, const FieldPass* key,
@@ -131,7 +131,7 @@ up::BetweenReport UpConversionPasses::build_fields(const scene::SceneState& stat
 void UpConversionPasses::show_key(int slot) {
   // Back where a draw leaves an image: SceneRenderer::read_rendered and
   // read_depth find it.
-  converter_->restore(slot, parts_.linear.colour(), parts_.linear.depth());
+  converter_->keys().restore(slot, parts_.linear.colour(), parts_.linear.depth());
   parts_.rendered_is_linear();
   parts_.encode();
 }

@@ -16,16 +16,6 @@ constexpr std::string_view kVersion = "#version 450 core\n";
 constexpr int kErrorBlock = 16;  // pixels per side summed by one texel of the check
 constexpr GLenum kBothKeys[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};  // the motion field's targets
 
-// A single-sample texture read texel by texel.
-glo::Texture exact_texture(GLenum format, int width, int height) {
-  glo::Texture texture = glo::make_storage(format, width, height);
-  glTextureParameteri(texture.get(), GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-  glTextureParameteri(texture.get(), GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-  glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-  glTextureParameteri(texture.get(), GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-  return texture;
-}
-
 }  // namespace
 
 UpConverter::~UpConverter() {
@@ -62,44 +52,23 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   if (!channels) return Error{"the up-conversion's colour fields: " + channels.error()};
   u->channels_program_ = std::move(channels).value();
   glProgramUniform1i(u->error_program_.get(), glGetUniformLocation(u->error_program_.get(), "block"), kErrorBlock);
-  u->error_sums_ =
-      exact_texture(GL_RGBA32F, (width + kErrorBlock - 1) / kErrorBlock, (height + kErrorBlock - 1) / kErrorBlock);
+  u->error_sums_ = glo::make_exact_texture(GL_RGBA32F, (width + kErrorBlock - 1) / kErrorBlock,
+                                           (height + kErrorBlock - 1) / kErrorBlock);
   u->error_framebuffer_ = glo::make_framebuffer();
   glNamedFramebufferTexture(u->error_framebuffer_.get(), GL_COLOR_ATTACHMENT0, u->error_sums_.get(), 0);
 
   for (std::size_t k = 0; k < u->motion_.size(); ++k) {
     // Key-frame pixels in pixels, window depth at float precision: a depth
     // tolerance of a few 1e-6 must be representable. Read texel by texel.
-    u->motion_[k] =
-        samples > 1 ? glo::make_storage(GL_RGBA32F, width, height, samples) : exact_texture(GL_RGBA32F, width, height);
+    u->motion_[k] = samples > 1 ? glo::make_storage(GL_RGBA32F, width, height, samples)
+                                : glo::make_exact_texture(GL_RGBA32F, width, height);
   }
-  for (int k = 0; k < slots; ++k) {  // a key frame drawn in bands needs a third
-    u->key_colour_[k] = exact_texture(GL_RGBA32F, width, height);
-    // Multisampled, bilinear where all four pixels around a point saw its
-    // surface (the resolve's one fetch); texel by texel elsewhere.
-    glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(u->key_colour_[k].get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    u->key_depth_[k] = exact_texture(depth_format, width, height);
-    if (samples > 1) {
-      u->key_range_[k] = exact_texture(GL_RG32F, width, height);
-      u->key_range_framebuffer_[k] = glo::make_framebuffer();
-      glNamedFramebufferTexture(u->key_range_framebuffer_[k].get(), GL_COLOR_ATTACHMENT0, u->key_range_[k].get(), 0);
-      if (glCheckNamedFramebufferStatus(u->key_range_framebuffer_[k].get(), GL_FRAMEBUFFER) !=
-          GL_FRAMEBUFFER_COMPLETE) {
-        return Error{"this GL driver cannot draw the up-conversion's key depth range (RG32F)"};
-      }
-    }
-  }
-  if (samples > 1) {
-    auto range =
-        glo::link_program(shaders::fullscreen_vert, std::string(kVersion) + std::string(shaders::key_depth_range_frag));
-    if (!range) return Error{"the up-conversion's key depth range: " + range.error()};
-    u->range_program_ = std::move(range).value();
-    glProgramUniform1i(u->range_program_.get(), glGetUniformLocation(u->range_program_.get(), "samples"), samples);
-  }
+  auto keys = KeyFrames::create(width, height, depth_format, slots, samples);
+  if (!keys) return Error{keys.error()};
+  u->keys_.emplace(std::move(keys).value());
   const GLenum depth_stencil = depth_format == GL_DEPTH_COMPONENT24 ? GL_DEPTH24_STENCIL8 : GL_DEPTH32F_STENCIL8;
-  u->depth_stencil_ = exact_texture(depth_stencil, width, height);
-  u->output_ = exact_texture(GL_RGBA32F, width, height);
+  u->depth_stencil_ = glo::make_exact_texture(depth_stencil, width, height);
+  u->output_ = glo::make_exact_texture(GL_RGBA32F, width, height);
   // Read by the output pass like the linear image: bilinear for a two-pass warp.
   glTextureParameteri(u->output_.get(), GL_TEXTURE_MIN_FILTER, GL_LINEAR);
   glTextureParameteri(u->output_.get(), GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -141,63 +110,6 @@ Result<std::unique_ptr<UpConverter>> UpConverter::create(int width, int height, 
   return u;
 }
 
-namespace {
-
-void copy(GLuint from, GLuint to, int width, int height, int first_row = 0) {
-  glCopyImageSubData(from, GL_TEXTURE_2D, 0, 0, first_row, 0, to, GL_TEXTURE_2D, 0, 0, first_row, 0, width, height, 1);
-}
-
-}  // namespace
-
-void UpConverter::keep(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view) {
-  keep_rows(slot, colour, depth, sample_depth, std::move(view), 0, height_);
-}
-
-void UpConverter::keep_rows(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view, int first_row,
-                            int rows) {
-  assert(slot >= 0 && slot < slots_);
-  assert(first_row >= 0 && rows >= 0 && first_row + rows <= height_);
-  assert((samples_ > 1) == (sample_depth != 0));
-  if (rows > 0) {
-    copy(colour, key_colour_[slot].get(), width_, rows, first_row);
-    copy(depth, key_depth_[slot].get(), width_, rows, first_row);
-    if (samples_ > 1) {
-      glBindFramebuffer(GL_FRAMEBUFFER, key_range_framebuffer_[slot].get());
-      glViewport(0, 0, width_, height_);
-      glEnable(GL_SCISSOR_TEST);
-      glScissor(0, first_row, width_, rows);
-      glDisable(GL_DEPTH_TEST);
-      glUseProgram(range_program_.get());
-      glBindTextureUnit(0, sample_depth);
-      glBindVertexArray(empty_vertex_array_.get());
-      glDrawArrays(GL_TRIANGLES, 0, 3);
-      glDisable(GL_SCISSOR_TEST);
-    }
-  }
-  key_view_[slot] = std::move(view);
-}
-
-GLuint UpConverter::key_colour(int slot) const {
-  assert(slot >= 0 && slot < slots_);
-  return key_colour_[slot].get();
-}
-
-void UpConverter::restore(int slot, GLuint colour, GLuint depth) const {
-  assert(slot >= 0 && slot < slots_);
-  copy(key_colour_[slot].get(), colour, width_, height_);
-  restore_depth(slot, depth);
-}
-
-void UpConverter::restore_depth(int slot, GLuint depth) const {
-  assert(slot >= 0 && slot < slots_);
-  copy(key_depth_[slot].get(), depth, width_, height_);
-}
-
-const up::KeyView& UpConverter::key(int slot) const {
-  assert(slot >= 0 && slot < slots_);
-  return key_view_[slot];
-}
-
 void UpConverter::begin_motion_field(bool from_two) {
   const GLuint fb = motion_framebuffer_.get();
   glNamedFramebufferDrawBuffers(fb, from_two ? 2 : 1, kBothKeys);
@@ -227,7 +139,7 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
     // What no key frame saw keeps the first key frame's pixel (the resolve
     // leaves it): drawn into every sample.
     glUseProgram(channels_program_.get());
-    glBindTextureUnit(0, key_colour_[frame.first].get());
+    glBindTextureUnit(0, keys_->colour(frame.first));
     glDrawArrays(GL_TRIANGLES, 0, 3);
   }
   glUseProgram(resolve_programs_[r].get());
@@ -237,10 +149,10 @@ up::BetweenReport UpConverter::resolve(const up::BetweenFrame& frame, const glm:
   assert(!frame.two_keys || (frame.second >= 0 && frame.second < slots_ && frame.second != frame.first));
   for (int k = 0; k < 2; ++k) {  // the first key frame as key 0
     const int slot = k == 0 || !frame.two_keys ? frame.first : frame.second;
-    glBindTextureUnit(static_cast<GLuint>(k), key_colour_[slot].get());
+    glBindTextureUnit(static_cast<GLuint>(k), keys_->colour(slot));
     // Multisampled, the depth range (glsl/key_depth_range.frag.glsl); with one
     // sample the key colour's alpha is its depth.
-    if (samples_ > 1) glBindTextureUnit(static_cast<GLuint>(2 + k), key_range_[slot].get());
+    if (samples_ > 1) glBindTextureUnit(static_cast<GLuint>(2 + k), keys_->range(slot));
     glBindTextureUnit(static_cast<GLuint>(4 + k), motion_[k].get());  // the motion field's, in that order
   }
   if (averages) {

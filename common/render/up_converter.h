@@ -12,10 +12,12 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include <epoxy/gl.h>
 
 #include "render/gl_objects.h"
+#include "render/key_frames.h"
 #include "up/between.h"
 #include "util/result.h"
 
@@ -32,18 +34,9 @@ class UpConverter {
   UpConverter(const UpConverter&) = delete;
   UpConverter& operator=(const UpConverter&) = delete;
 
-  // Copies a drawn image (RGBA32F, its alpha the window depth as the scene's
-  // program writes it) and its depth into key slot `slot`;
-  // multisampled, `sample_depth` is its depth per sample (before the resolve:
-  // which pixels hold more than one surface).
-  void keep(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view);
-  // Only `rows` rows from `first_row` (a band of a key frame drawn in bands).
-  void keep_rows(int slot, GLuint colour, GLuint depth, GLuint sample_depth, up::KeyView view, int first_row, int rows);
-  [[nodiscard]] const up::KeyView& key(int slot) const;
-  [[nodiscard]] GLuint key_colour(int slot) const;
-  // And back: key `slot`'s colour and depth into these.
-  void restore(int slot, GLuint colour, GLuint depth) const;
-  void restore_depth(int slot, GLuint depth) const;  // the depth alone
+  // The kept key frames the frames between are built from.
+  [[nodiscard]] KeyFrames& keys() { return *keys_; }
+  [[nodiscard]] const KeyFrames& keys() const { return *keys_; }
 
   // The motion field's target: where each pixel's surface was in each key frame
   // (attachment 0, and 1 `from_two` key frames) over the frame's own depth and
@@ -81,13 +74,7 @@ class UpConverter {
   int height_ = 0;
   int slots_ = 2;
   int samples_ = 1;
-  std::array<glo::Texture, up::kKeySlots> key_colour_;
-  std::array<glo::Texture, up::kKeySlots> key_depth_;
-  std::array<up::KeyView, up::kKeySlots> key_view_;
-  // Multisampled: each key frame's nearest and farthest sample depth per pixel.
-  std::array<glo::Texture, up::kKeySlots> key_range_;
-  std::array<glo::Framebuffer, up::kKeySlots> key_range_framebuffer_;
-  glo::Program range_program_;
+  std::optional<KeyFrames> keys_;  // made by create()
   // Where each pixel (sample) was in the first and the second key frame.
   std::array<glo::Texture, 2> motion_;
   glo::Texture depth_stencil_;  // output()'s; the motion field's too with one sample
