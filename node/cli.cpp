@@ -59,17 +59,18 @@ int run_cli(int argc, char** argv, const GlRendererFactory& make_gl) {
                  "run with real-time priority (SCHED_FIFO, as chrt -f) where permitted; 0: normal priority")
       ->check(CLI::Range(0, 99));
   // Test hooks, hidden from --help.
-  app.add_option("--protocol-version", options.protocol.protocol_version, "speak this protocol version")->group("");
+  app.add_option("--protocol-version", options.protocol.faults.protocol_version, "speak this protocol version")
+      ->group("");
   app.add_option("--clock-offset-ns", clock_offset_ns, "skew this node's clock")->group("");
   app.add_option("--clock-drift-ppm", clock_drift_ppm, "make this node's clock drift")->group("");
   std::int64_t present_spin_us = options.present_spin.count();
   app.add_option("--present-spin-us", present_spin_us, "spin this long before each present deadline")
       ->check(CLI::Range(std::int64_t{0}, std::int64_t{5000}))
       ->group("");
-  app.add_option("--corrupt-state-at-frame", options.protocol.corrupt_state_at_frame,
+  app.add_option("--corrupt-state-at-frame", options.protocol.faults.corrupt_state_at_frame,
                  "nudge the scene state at this frame")
       ->group("");
-  app.add_option("--lag-frames", options.protocol.lag_frames, "show the content of this many frames ago")
+  app.add_option("--lag-frames", options.protocol.faults.lag_frames, "show the content of this many frames ago")
       ->check(CLI::Range(0u, 100u))
       ->group("");
 

@@ -264,7 +264,7 @@ void NodeProtocol::on_challenge(const wire::Envelope& message, Actions& out) {
     return;
   }
   wire::Envelope hello;
-  hello.set_protocol_version(settings_.protocol_version);
+  hello.set_protocol_version(settings_.faults.protocol_version);
   hello.mutable_hello()->set_node_id(settings_.id);
   hello.mutable_hello()->add_capabilities("render");
   std::optional<net::SessionKeys> keys;
@@ -272,11 +272,11 @@ void NodeProtocol::on_challenge(const wire::Envelope& message, Actions& out) {
     const std::string& theirs = challenge.nonce();
     std::vector<std::uint8_t> both(theirs.begin(), theirs.end());
     both.insert(both.end(), nonce_.begin(), nonce_.end());
-    const auto mac = net::hello_mac(*settings_.secret, both, settings_.id, settings_.protocol_version);
+    const auto mac = net::hello_mac(*settings_.secret, both, settings_.id, settings_.faults.protocol_version);
     hello.mutable_hello()->set_nonce_mac(mac.data(), mac.size());
     hello.mutable_hello()->set_node_nonce(nonce_.data(), nonce_.size());
     keys = net::derive_session_keys(*settings_.secret, std::span(both).first(net::kNonceBytes), nonce_, settings_.id,
-                                    settings_.protocol_version);
+                                    settings_.faults.protocol_version);
   }
   out.push_back(Send{std::move(hello)});
   if (keys) out.push_back(Protect{keys->to_master, keys->to_node});
@@ -338,16 +338,15 @@ void NodeProtocol::on_configured(const Configured& answer, Actions& out) {
     if (!part.empty()) drawing += "; " + part;
   }
   log(out, spdlog::level::info,
-      fmt::format("driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}{}{}", p.id, p.width,
-                  p.height, job_->job.screen().id, config::to_string(p.eye), static_cast<double>(frame_period_) / 1e6,
-                  answer.renderer,
-                  warm_up.frame > 0 ? fmt::format("; warm-up frame {:.1f} ms{}", static_cast<double>(warm_up.frame) / 1e6,
-                                                  warm_up.capture > 0
-                                                      ? fmt::format(", {:.1f} ms more when captured",
-                                                                    static_cast<double>(warm_up.capture) / 1e6)
-                                                      : "")
-                                    : "",
-                  drawing));
+      fmt::format(
+          "driving '{}': {}×{} px on screen '{}', eye {}, frame period {:.3f} ms; {}{}{}", p.id, p.width, p.height,
+          job_->job.screen().id, config::to_string(p.eye), static_cast<double>(frame_period_) / 1e6, answer.renderer,
+          warm_up.frame > 0 ? fmt::format("; warm-up frame {:.1f} ms{}", static_cast<double>(warm_up.frame) / 1e6,
+                                          warm_up.capture > 0 ? fmt::format(", {:.1f} ms more when captured",
+                                                                            static_cast<double>(warm_up.capture) / 1e6)
+                                                              : "")
+                            : "",
+          drawing));
 }
 
 void NodeProtocol::on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out) {
@@ -396,7 +395,7 @@ void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos no
     out.push_back(Close{"cannot apply frame " + std::to_string(begin.frame_id()) + ": " + applied.error()});
     return;
   }
-  if (settings_.corrupt_state_at_frame != 0 && begin.frame_id() == settings_.corrupt_state_at_frame) {
+  if (settings_.faults.corrupt_state_at_frame != 0 && begin.frame_id() == settings_.faults.corrupt_state_at_frame) {
     state_.eye_now.x += 1e-3;
   }
   last_hash_ = scene::state_hash(state_);
@@ -415,12 +414,12 @@ void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos no
   // scene sent ahead apply at once: they are how this node draws, not content).
   const protocol::FrameMessage* shown = &frame;
   const scene::SceneState* shown_state = &state_;
-  if (settings_.lag_frames > 0) {
+  if (settings_.faults.lag_frames > 0) {
     protocol::FrameMessage kept = frame;
     kept.lights.reset();
     kept.ahead.reset();
     past_frames_.push_back({std::move(kept), state_});
-    while (past_frames_.size() > settings_.lag_frames + 1) past_frames_.pop_front();
+    while (past_frames_.size() > settings_.faults.lag_frames + 1) past_frames_.pop_front();
     shown = &past_frames_.front().frame;
     shown_state = &past_frames_.front().state;
   }

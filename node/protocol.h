@@ -37,19 +37,27 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitRefused = 2;   // refused by the master, or bad command line
 inline constexpr int kExitNoMaster = 3;  // gave up reaching the master
 
+// Faults a test asks a node to show, so that the master's handling of them can
+// be seen: all off by default, set only by hidden command-line options. They
+// stay in the core, where the state they spoil is: the unit tests and the
+// simulated cluster drive the core without a shell, and see the same faults.
+struct NodeFaults {
+  std::uint32_t protocol_version = net::kProtocolVersion;  // speak another version
+  // Show the content of this many frames ago, as a node out of step with its
+  // stacked partners would (reported in Presented.content_frame_id).
+  std::uint32_t lag_frames = 0;
+  // Nudge the scene state at this frame, as a bit flip or a bug would, to see
+  // the master notice and repair it (0: never).
+  std::uint64_t corrupt_state_at_frame = 0;
+};
+
 struct NodeSettings {
   std::string master;  // HOST:PORT, for messages
   std::string id;
-  std::chrono::milliseconds give_up_after{10000};          // master unreachable this long: stop
-  std::uint32_t protocol_version = net::kProtocolVersion;  // test hook: speak another version
-  std::optional<net::Secret> secret;                       // proves to the master this node belongs
-  clock::LocalClock clock;                                 // test hook: a skewed clock
-  // Test hook: show the content of this many frames ago, as a node out of step
-  // with its stacked partners would (reported in Presented.content_frame_id).
-  std::uint32_t lag_frames = 0;
-  // Test hook: nudge the scene state at this frame, as a bit flip or a bug would,
-  // to see the master notice and repair it (0: never).
-  std::uint64_t corrupt_state_at_frame = 0;
+  std::chrono::milliseconds give_up_after{10000};  // master unreachable this long: stop
+  std::optional<net::Secret> secret;               // proves to the master this node belongs
+  clock::LocalClock clock;                         // a skewed clock, in tests
+  NodeFaults faults;
   // When the master is lost: show black (a frozen wall looks like a fault in the
   // show), or keep the last frame.
   bool hold_last_frame = false;
@@ -158,8 +166,8 @@ struct FinishScene {};
 // reconnect, or in the next node to fetch the scene.
 struct AbandonScene {};
 
-using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, Protect, SetLiveness, Configure, Render, Skip, PresentAt,
-                            Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log, PrepareScene,
+using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, Protect, SetLiveness, Configure, Render, Skip,
+                            PresentAt, Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log, PrepareScene,
                             RecheckScene, StoreSceneChunk, FinishScene, AbandonScene>;
 using Actions = std::vector<Action>;
 
@@ -327,7 +335,7 @@ class NodeProtocol {
   // Waiting for another node of this host to fetch the scene into the cache.
   struct SceneWaiting {
     clock::Nanos since = 0;
-    clock::Nanos grew_at = 0;  // when its copy last grew
+    clock::Nanos grew_at = 0;             // when its copy last grew
     std::optional<clock::Nanos> told_at;  // when the master was last told
     std::uint64_t bytes = 0;
   };

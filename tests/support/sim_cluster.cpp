@@ -54,7 +54,7 @@ SimCluster::SimCluster(const master::RunConfig& run, master::RunSettings setting
     node::NodeSettings s;
     s.master = "sim:7400";
     s.id = ids[i];
-    if (i == 0) s.corrupt_state_at_frame = corrupt_frame;
+    if (i == 0) s.faults.corrupt_state_at_frame = corrupt_frame;
     nodes_.push_back(std::make_unique<SimNode>(std::move(s)));
   }
 }

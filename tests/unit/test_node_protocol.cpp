@@ -574,7 +574,7 @@ TEST_F(NodeTest, LosingTheMasterShowsBlackAndReconnectsWithBackoffThenGivesUp) {
 
 TEST_F(NodeTest, ALaggingNodeShowsAnOlderFramesContent) {
   NodeSettings s = settings();
-  s.lag_frames = 2;
+  s.faults.lag_frames = 2;
   NodeProtocol node(s);
   join(node);
   for (std::uint64_t frame = 0; frame < 4; ++frame) {
