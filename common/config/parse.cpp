@@ -76,7 +76,8 @@ Content build_content(const schema::Content& c) {
 }
 
 // Everything but the geometry, which needs the other projectors (camera views).
-Projector build_projector(const schema::Projector& p, const std::vector<Screen>& screens) {
+Projector build_projector(const schema::Projector& p, const std::vector<Screen>& screens,
+                          const CheckedSections& sections, std::size_t index) {
   Projector projector;
   projector.id = p.id();
   projector.host = p.host().empty() ? "localhost" : p.host();
@@ -91,20 +92,11 @@ Projector build_projector(const schema::Projector& p, const std::vector<Screen>&
   projector.output.fullscreen = p.output().fullscreen();
   projector.rendering = checked_name(kRenderMethodNames, p.rendering());
   projector.blend_ramp = p.blend_ramp();
-  auto response = parse_response(p);
-  assert(response);
-  if (response) projector.response = std::move(response).value();
+  // Built by the check already.
+  projector.response = sections.responses.at(index);
   projector.content = build_content(p.content());
-  if (p.has_color_fields()) {
-    std::vector<Problem> problems;
-    projector.color_fields = parse_color_fields(p.color_fields(), "color_fields", problems);
-    assert(problems.empty());
-  }
-  if (p.has_up_conversion()) {
-    std::vector<Problem> problems;
-    projector.up_conversion = parse_up_conversion(p.up_conversion(), "up_conversion", problems);
-    assert(problems.empty());
-  }
+  projector.color_fields = sections.color_fields.at(index);
+  projector.up_conversion = sections.up_conversion.at(index);
   if (p.has_camera()) projector.camera = CameraView{p.camera().camera(), matrix3(p.camera().homography())};
   return projector;
 }
@@ -178,7 +170,7 @@ void resolve_geometry(const schema::Installation& inst, Installation& out, const
   }
 }
 
-Viewer build_viewer(const schema::Viewer& v, const std::string& config_dir) {
+Viewer build_viewer(const schema::Viewer& v, const std::string& config_dir, const CheckedSections& sections) {
   Viewer viewer;
   if (v.path().empty()) {
     viewer.path.push_back({0.0, vec3(v.eye())});
@@ -190,8 +182,8 @@ Viewer build_viewer(const schema::Viewer& v, const std::string& config_dir) {
   viewer.far = or_default(v.far(), defaults::kFar);
   if (!v.head_right().empty()) viewer.head_right = glm::normalize(vec3(v.head_right()));
   if (v.has_tracking()) {
-    std::vector<Problem> problems;  // none: validated
-    viewer.tracking = parse_tracking(v.tracking(), "viewer.tracking", problems);
+    assert(sections.tracking);  // built by the check
+    viewer.tracking = sections.tracking;
     if (!viewer.tracking->file.empty()) viewer.tracking->file = resolve_asset(viewer.tracking->file, config_dir);
   }
   return viewer;
@@ -270,14 +262,17 @@ std::optional<DepthOfField> build_depth_of_field(const schema::Installation& ins
 
 Result<Installation> build(const schema::Installation& inst, const std::string& config_dir, const std::string& origin,
                            Scope scope) {
-  if (auto problems = validate(inst, config_dir, scope); !problems.empty()) {
+  CheckedSections sections;
+  if (auto problems = validate(inst, config_dir, scope, sections); !problems.empty()) {
     return Error{describe_problems(problems, origin)};
   }
   Installation out;
   out.name = inst.name();
   for (const schema::Screen& s : inst.screens()) out.screens.push_back(build_screen(s));
-  for (const schema::Projector& p : inst.projectors()) out.projectors.push_back(build_projector(p, out.screens));
-  out.viewer = build_viewer(inst.viewer(), config_dir);
+  for (std::size_t i = 0; i < static_cast<std::size_t>(inst.projectors_size()); ++i) {
+    out.projectors.push_back(build_projector(inst.projectors(static_cast<int>(i)), out.screens, sections, i));
+  }
+  out.viewer = build_viewer(inst.viewer(), config_dir, sections);
   out.master = build_master(inst.master());
   out.scene = build_scene(inst.scene(), config_dir);
   out.depth_of_field = build_depth_of_field(inst, out);

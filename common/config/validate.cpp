@@ -297,7 +297,8 @@ void check_depth_of_field(Checker& check, const schema::Installation& inst) {
   }
 }
 
-void check_projectors(Checker& check, const schema::Installation& inst, const std::string& config_dir, Scope scope) {
+void check_projectors(Checker& check, const schema::Installation& inst, const std::string& config_dir, Scope scope,
+                      CheckedSections& sections) {
   if (inst.projectors().empty()) check.fail("projectors", "at least one projector is needed");
   std::set<std::string> ids;
   constexpr std::uint32_t kMaxPixels = 16384;
@@ -334,6 +335,9 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
       const std::string& e = model.error();
       const auto colon = e.find(": ");
       check.fail(at + "." + e.substr(0, colon), colon == std::string::npos ? e : e.substr(colon + 2));
+      sections.responses.emplace_back();
+    } else {
+      sections.responses.push_back(std::move(model).value());
     }
     check_content(check, at + ".content", p.content());
     const std::size_t problems_before = check.problems().size();
@@ -344,6 +348,8 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
     if (check.problems().size() == problems_before) {  // each well formed: together?
       if (auto problem = up_conversion_with_fields(up, fields)) check.fail(at + "." + problem->path, problem->message);
     }
+    sections.color_fields.push_back(fields);
+    sections.up_conversion.push_back(up);
     // A preset's field times are shares of its projector's frame: at another
     // frame rate every field would last longer or shorter than the projector's.
     const double rate = inst.master().frame_rate() > 0.0 ? inst.master().frame_rate() : defaults::kFrameRate;
@@ -368,7 +374,7 @@ void check_projectors(Checker& check, const schema::Installation& inst, const st
   if (scope == Scope::installation) check_stacked_pairs(check, inst);
 }
 
-void check_viewer(Checker& check, const schema::Viewer& v) {
+void check_viewer(Checker& check, const schema::Viewer& v, CheckedSections& sections) {
   const bool has_eye = !v.eye().empty();
   const bool has_path = !v.path().empty();
   if (has_eye == has_path) {
@@ -401,7 +407,7 @@ void check_viewer(Checker& check, const schema::Viewer& v) {
   if (v.eye_separation() > 1.0)
     check.fail("viewer.eye_separation",
                "is in metres; " + number_text(v.eye_separation()) + " m is not an eye separation");
-  if (v.has_tracking()) (void)parse_tracking(v.tracking(), "viewer.tracking", check.problems());
+  if (v.has_tracking()) sections.tracking = parse_tracking(v.tracking(), "viewer.tracking", check.problems());
 }
 
 void check_master(Checker& check, const schema::MasterSettings& m) {
@@ -533,12 +539,19 @@ std::string describe_problems(const std::vector<Problem>& problems, const std::s
 }
 
 std::vector<Problem> validate(const schema::Installation& installation, const std::string& config_dir, Scope scope) {
+  CheckedSections ignored;
+  return validate(installation, config_dir, scope, ignored);
+}
+
+std::vector<Problem> validate(const schema::Installation& installation, const std::string& config_dir, Scope scope,
+                              CheckedSections& sections) {
+  sections = {};
   std::vector<Problem> problems;
   Checker check(problems);
   std::set<std::string> screen_ids;
   check_screens(check, installation, screen_ids);
-  check_projectors(check, installation, config_dir, scope);
-  check_viewer(check, installation.viewer());
+  check_projectors(check, installation, config_dir, scope, sections);
+  check_viewer(check, installation.viewer(), sections);
   check_master(check, installation.master());
   check_scene(check, installation.scene(), config_dir, scope);
   if (scope == Scope::installation) {

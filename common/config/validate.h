@@ -8,7 +8,11 @@
 #include <string>
 #include <vector>
 
+#include "config/color_fields.h"
 #include "config/problem.h"
+#include "config/response.h"
+#include "config/tracking.h"
+#include "config/up_conversion.h"
 #include "optique/config.pb.h"
 
 namespace optique::config {
@@ -25,5 +29,18 @@ enum class Scope { installation, job };
 // `config_dir` resolves relative asset paths (the glTF scene, calibration files).
 [[nodiscard]] std::vector<Problem> validate(const schema::Installation& installation, const std::string& config_dir,
                                             Scope scope = Scope::installation);
+
+// The sections the check builds to check them (a projector's response, colour
+// fields and up-conversion, the viewer's tracking), kept for the build
+// (config/parse.cpp), which takes them instead of building them again. Each is
+// whole where no problem names it.
+struct CheckedSections {
+  std::vector<ProjectorResponse> responses;  // one per projector
+  std::vector<ColorFields> color_fields;
+  std::vector<UpConversion> up_conversion;
+  std::optional<Tracking> tracking;
+};
+[[nodiscard]] std::vector<Problem> validate(const schema::Installation& installation, const std::string& config_dir,
+                                            Scope scope, CheckedSections& sections);
 
 }  // namespace optique::config
