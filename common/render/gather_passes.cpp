@@ -39,9 +39,7 @@ GatherReport GatherPasses::draw_fields_blurred(const scene::SceneState& state, s
   // what is too fast to follow, laid over them.
   gather_->keep(parts_.linear.colour());
   draw_with_motion(state, blur, terms);
-  const GatherReport report = gather_->gather(parts_.linear.colour(), {}, blur.settings);
-  parts_.output.encode(gather_->output(), parts_.linear.depth());
-  return report;
+  return gather_again({}, blur.settings);  // no fields: the blur alone, over what keep() put aside
 }
 
 void GatherPasses::draw_with_motion(const scene::SceneState& state, const GatherFrame& frame, const LightTerms& terms) {
