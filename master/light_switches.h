@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "config/installation.h"
-#include "config/validate.h"
+#include "config/problem.h"
 #include "optique/config.pb.h"
 
 namespace optique::master {

@@ -14,7 +14,7 @@
 #include <glm/vec3.hpp>
 
 #include "config/installation.h"
-#include "config/validate.h"
+#include "config/problem.h"
 #include "master/light_share.h"
 #include "optique/config.pb.h"
 #include "scene/definition.h"

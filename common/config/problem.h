@@ -3,6 +3,7 @@
 // all of them at once, so a user can fix a file in one go.
 
 #include <string>
+#include <vector>
 
 namespace optique::config {
 
@@ -10,5 +11,8 @@ struct Problem {
   std::string path;     // e.g. "projectors[2].region.width"
   std::string message;  // e.g. "must be > 0 (got -1)"
 };
+
+// One line per problem: "ORIGIN: PATH: MESSAGE".
+[[nodiscard]] std::string describe_problems(const std::vector<Problem>& problems, const std::string& origin);
 
 }  // namespace optique::config

@@ -10,7 +10,7 @@
 #include <nlohmann/json_fwd.hpp>
 #include <vector>
 
-#include "config/validate.h"
+#include "config/problem.h"
 
 namespace optique::config {
 

@@ -40,7 +40,7 @@ Result<std::unique_ptr<ProjectorPipeline>> ProjectorPipeline::make(const config:
                                                                    const scene::SceneDefinition& scene,
                                                                    const PipelineOptions& options) {
   const config::Projector& self = job.self();
-  // The config refuses these (config/validate.cpp); a job built otherwise too.
+  // The config refuses these (config/projectors.cpp); a job built otherwise too.
   if (auto problem = config::up_conversion_with_fields(self.up_conversion, self.color_fields)) {
     return Error{"projector '" + self.id + "': " + problem->path + ": " + problem->message};
   }

@@ -1,4 +1,4 @@
-// Installation files: common/config/load.h, parse.h, validate.h and to_schema.h.
+// Installation files: common/config/load.h, parse.h and to_schema.h.
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,6 @@
 #include "config/load.h"
 #include "config/parse.h"
 #include "config/to_schema.h"
-#include "config/validate.h"
 #include "geometry/homography.h"
 
 namespace optique::config {

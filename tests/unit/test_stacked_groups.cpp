@@ -1,5 +1,5 @@
 // Stacked groups: the checks check-config makes on lights and focus pairs
-// (master/stacked_groups.h, common/config/validate.cpp) and the light plan.
+// (master/stacked_groups.h, common/config/across.cpp) and the light plan.
 
 #include "master/stacked_groups.h"
 
@@ -9,7 +9,7 @@
 #include <string>
 
 #include "config/load.h"
-#include "config/validate.h"
+#include "config/problem.h"
 #include "master/scene_authority.h"
 #include "scene/builtin.h"
 
@@ -116,6 +116,16 @@ TEST(StackedGroups, AFocusOrDefocusProjectorNeedsItsPartner) {
   ASSERT_FALSE(refused);
   EXPECT_NE(refused.error().find("depth_of_field: focus/defocus projectors need the focal depth"), std::string::npos)
       << refused.error();
+}
+
+// A depth of field relates to the projectors: set where no pair shows it, it is
+// a mistake (a copied block, a role changed), said at the section, and alone.
+TEST(StackedGroups, ADepthOfFieldWithoutAFocusPairIsRefused) {
+  std::string json = stacked(R"({"role": "full"})", R"({"role": "full"})", R"({"role": "full"})");
+  json.insert(json.find("\"viewer\""), R"("depth_of_field": {"focal_depth": 2.0}, )");
+  auto installation = config::parse_installation(json, "dof.json", ::testing::TempDir());
+  ASSERT_FALSE(installation);
+  EXPECT_EQ(installation.error(), "dof.json: depth_of_field: set, but no projector has role 'focus' or 'defocus'");
 }
 
 TEST(LightPlan, AutomaticGroupsShareAmongTheNodesThatAreUp) {

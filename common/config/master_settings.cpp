@@ -1,0 +1,93 @@
+// The master's settings: where it listens, the frame rate and every timeout,
+// the straggler policy, the operator's status server.
+#include <algorithm>
+
+#include "config/address.h"
+#include "config/sections.h"
+#include "util/number_text.h"
+
+namespace optique::config {
+namespace {
+
+template <class T>
+T or_default(T value, T fallback) {
+  return value == T{} ? fallback : value;
+}
+
+std::optional<StatusServer> parse_status(const schema::MasterSettings& m, Checker& check) {
+  if (!m.has_status()) return std::nullopt;
+  const schema::StatusServer& st = m.status();
+  if (!st.listen().empty() && !is_ip_address(st.listen())) {
+    check.fail("master.status.listen", "'" + st.listen() + "' is not an IPv4 or IPv6 address");
+  } else if (!st.listen().empty() && !is_loopback_address(st.listen()) && m.secret_file().empty()) {
+    check.fail("master.status.listen",
+               "'" + st.listen() +
+                   "' is reached from other machines, so the status needs a bearer token, derived from the "
+                   "shared secret: set master.secret_file (or listen on 127.0.0.1)");
+  }
+  if (st.port() > 65535) check.fail("master.status.port", "must be 0..65535 (got " + std::to_string(st.port()) + ")");
+  if (st.max_connections() > 100000) {
+    check.fail("master.status.max_connections",
+               "must be at most 100000 (got " + std::to_string(st.max_connections()) + ")");
+  }
+  StatusServer status;
+  if (!st.listen().empty()) status.listen = st.listen();
+  if (st.has_port()) status.port = static_cast<std::uint16_t>(st.port());
+  status.max_connections = or_default(st.max_connections(), defaults::kStatusMaxConnections);
+  return status;
+}
+
+}  // namespace
+
+MasterSettings parse_master(const schema::MasterSettings& m, Checker& check) {
+  using std::chrono::milliseconds;
+  using util::number_text;
+  MasterSettings master;
+  if (!m.listen().empty()) {
+    if (!is_ip_address(m.listen())) check.fail("master.listen", "'" + m.listen() + "' is not an IPv4 or IPv6 address");
+    master.listen = m.listen();
+  }
+  if (m.port() > 65535) check.fail("master.port", "must be 0..65535 (got " + std::to_string(m.port()) + ")");
+  master.port = static_cast<std::uint16_t>(m.port());
+  if (check.finite("master.frame_rate", m.frame_rate()) && (m.frame_rate() < 0.0 || m.frame_rate() > 1000.0)) {
+    check.fail("master.frame_rate",
+               "must be in (0, 1000] Hz, or 0 for the default (got " + number_text(m.frame_rate()) + ")");
+  }
+  master.frame_rate = or_default(m.frame_rate(), defaults::kFrameRate);
+  if (const auto policy = from_name(kStragglerPolicyNames, m.straggler_policy())) {
+    master.straggler_policy = *policy;
+  } else {
+    check.fail("master.straggler_policy", "unknown policy '" + m.straggler_policy() +
+                                              "' (\"present\": the frame without the late node, or "
+                                              "\"drop\": the frame everywhere)");
+  }
+  if (m.has_min_presented() && check.finite("master.min_presented", m.min_presented()) &&
+      (m.min_presented() < 0.0 || m.min_presented() > 1.0)) {
+    check.fail("master.min_presented",
+               "is a share of the frames, 0 to 1 (got " + number_text(m.min_presented()) + "; 0.9 means 90 %)");
+  }
+  if (m.has_min_presented()) master.min_presented = m.min_presented();
+  if (m.max_message_bytes() != 0 && m.max_message_bytes() < 1024) {
+    check.fail("master.max_message_bytes", "must be at least 1024 (got " + std::to_string(m.max_message_bytes()) + ")");
+  }
+  master.max_message_bytes = or_default(m.max_message_bytes(), defaults::kMaxMessageBytes);
+  master.status = parse_status(m, check);
+  master.frame_timeout = milliseconds(or_default(m.frame_timeout_ms(), defaults::kFrameTimeoutMs));
+  master.startup_timeout = milliseconds(or_default(m.startup_timeout_ms(), defaults::kStartupTimeoutMs));
+  master.handshake_timeout = milliseconds(or_default(m.handshake_timeout_ms(), defaults::kHandshakeTimeoutMs));
+  master.heartbeat = milliseconds(or_default(m.heartbeat_ms(), defaults::kHeartbeatMs));
+  const std::uint32_t heartbeat = or_default(m.heartbeat_ms(), defaults::kHeartbeatMs);
+  if (m.liveness_timeout_ms() != 0 && m.liveness_timeout_ms() <= 2 * heartbeat) {
+    check.fail("master.liveness_timeout_ms", "must be more than twice heartbeat_ms (" + std::to_string(heartbeat) +
+                                                 " ms), or peers are dropped between heartbeats");
+  }
+  // Three heartbeats, or the floor if that is longer.
+  master.liveness_timeout =
+      milliseconds(or_default(m.liveness_timeout_ms(), std::max(defaults::kMinLivenessTimeoutMs, 3 * heartbeat)));
+  master.present_lead = std::chrono::microseconds(or_default(m.present_lead_us(), defaults::kPresentLeadUs));
+  master.secret_file = m.secret_file();
+  master.max_pending_connections = or_default(m.max_pending_connections(), defaults::kMaxPendingConnections);
+  return master;
+}
+
+}  // namespace optique::config
