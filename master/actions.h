@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "clock/clock.h"
-#include "master/exit_codes.h"
+#include "master/run/exit_codes.h"
 #include "master/frame_rows.h"
 #include "master/viewer_head.h"
 #include "net/session_seal.h"

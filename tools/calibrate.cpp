@@ -10,7 +10,7 @@
 #include <ostream>
 
 #include "calib/calibrate_points.h"
-#include "master/exit_codes.h"
+#include "master/run/exit_codes.h"
 
 namespace optique::tools {
 

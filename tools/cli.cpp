@@ -11,8 +11,8 @@
 
 #include "image/texture_decode.h"
 #include "log/logger.h"
-#include "master/exit_codes.h"
-#include "master/run_config.h"
+#include "master/run/exit_codes.h"
+#include "master/run/run_config.h"
 #include "tools/calibrate.h"
 #include "tools/check_config.h"
 #include "tools/compose.h"

@@ -15,7 +15,7 @@
 #include "image/compare.h"
 #include "image/convert.h"
 #include "image/frame_files.h"
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 #include "optics/compose.h"
 #include "optics/perceive.h"
 #include "render/gl_context.h"

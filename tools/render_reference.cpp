@@ -6,7 +6,7 @@
 #include "geometry/projection.h"
 #include "image/convert.h"
 #include "image/frame_files.h"
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 #include "optics/compose.h"
 #include "render/gl_context.h"
 #include "render/scene_renderer.h"

@@ -14,8 +14,8 @@
 
 #include "log/logger.h"
 #include "master/app/master.h"
-#include "master/run_config.h"
-#include "master/shared_secret.h"
+#include "master/run/run_config.h"
+#include "master/run/shared_secret.h"
 #include "util/program.h"
 
 namespace optique::master {

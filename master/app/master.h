@@ -24,7 +24,7 @@
 #include "master/app/local_launcher.h"
 #include "master/app/status_line.h"
 #include "master/app/tracker_receiver.h"
-#include "master/exit_codes.h"
+#include "master/run/exit_codes.h"
 #include "master/protocol.h"
 #include "master/run_recorder.h"
 #include "master/status/status_service.h"

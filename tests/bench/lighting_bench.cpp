@@ -39,9 +39,9 @@
 #include "draw_plot.h"
 #include "image/compare.h"
 #include "image/image_io.h"
-#include "master/light_share.h"
-#include "master/scene_authority.h"
-#include "master/stacked_groups.h"
+#include "master/run/light_share.h"
+#include "master/run/scene_authority.h"
+#include "master/run/stacked_groups.h"
 #include "number_text.h"
 #include "render/gl_context.h"
 #include "render/projector_pipeline.h"
@@ -56,7 +56,7 @@ using namespace optique;
 constexpr std::array<int, 3> kLightCounts{20, 50, 100};
 constexpr int kMaxNodes = 4;
 
-// The master's cost model (master/stacked_groups.h); main() checks that
+// The master's cost model (master/run/stacked_groups.h); main() checks that
 // share_lights with it gives what automatic_shares gives.
 using master::kAmbientCost;
 using master::kBaseCost;
@@ -299,7 +299,7 @@ int main(int argc, char** argv) {
           master::share_lights(costs[s], mixed_pixels, kBaseCost, kAmbientCost);
       for (std::size_t k = 0; k < copied.size(); ++k) {
         if (copied[k].lights != automatic[k].lights || copied[k].ambient != automatic[k].ambient) {
-          throw std::runtime_error("the bench's copy of the cost model no longer matches master/stacked_groups.cpp");
+          throw std::runtime_error("the bench's copy of the cost model no longer matches master/run/stacked_groups.cpp");
         }
       }
       for (int k = 1; k < frames; ++k) {

@@ -26,7 +26,7 @@
 #include "image/compare.h"
 #include "image/convert.h"
 #include "image/texture_decode.h"
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 #include "metrics/distribution.h"
 #include "render/gl_context.h"
 #include "render/projector_pipeline.h"

@@ -11,8 +11,8 @@
 #include "config/job.h"
 #include "config/load.h"
 #include "image/texture_decode.h"
-#include "master/light_switches.h"
-#include "master/scene_authority.h"
+#include "master/run/light_switches.h"
+#include "master/run/scene_authority.h"
 #include "render/projector_pipeline.h"
 #include "scene_load/load_scene.h"
 

@@ -7,7 +7,7 @@
 
 #include "config/load.h"
 #include "fuzz_bodies.h"
-#include "master/run_config.h"
+#include "master/run/run_config.h"
 #include "node/protocol.h"
 #include "protocol/welcome.h"
 #include "sim_cluster.h"

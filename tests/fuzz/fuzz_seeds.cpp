@@ -7,7 +7,7 @@
 #include <string_view>
 
 #include "fuzz_bodies.h"
-#include "master/run_config.h"
+#include "master/run/run_config.h"
 #include "net/envelope.h"
 #include "net/framing.h"
 #include "protocol/welcome.h"

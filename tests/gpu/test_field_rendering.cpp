@@ -17,7 +17,7 @@
 #include "config/job.h"
 #include "geometry/homography.h"
 #include "gl_installation.h"
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 #include "render/projector_pipeline.h"
 #include "scene/builtin.h"
 

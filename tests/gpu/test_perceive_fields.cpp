@@ -15,7 +15,7 @@
 
 #include "image/compare.h"
 #include "image/texture_decode.h"
-#include "master/run_config.h"
+#include "master/run/run_config.h"
 #include "process.h"
 #include "tools/perceive.h"
 

@@ -12,7 +12,7 @@
 #include "config/job.h"
 #include "config/load.h"
 #include "gl_installation.h"
-#include "master/stacked_groups.h"
+#include "master/run/stacked_groups.h"
 #include "optics/projector_model.h"
 #include "render/projector_pipeline.h"
 

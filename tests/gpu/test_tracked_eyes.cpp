@@ -14,7 +14,7 @@
 #include "config/job.h"
 #include "gl_installation.h"
 #include "image/image.h"
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 #include "render/projector_pipeline.h"
 
 namespace optique {

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "master/protocol.h"
-#include "master/run_config.h"
+#include "master/run/run_config.h"
 #include "master/run_recorder.h"
 #include "node/protocol.h"
 

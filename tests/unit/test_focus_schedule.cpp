@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "config/load.h"
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 #include "scene/builtin.h"
 
 namespace optique::master {

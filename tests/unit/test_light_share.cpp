@@ -1,4 +1,4 @@
-// The automatic light split (master/light_share.h) and the coverage estimate it
+// The automatic light split (master/run/light_share.h) and the coverage estimate it
 // runs on (common/scene/light_coverage.h): every light in exactly one share, the
 // ambient in exactly one, modelled times balanced.
 
@@ -12,8 +12,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "master/light_share.h"
-#include "master/scene_authority.h"
+#include "master/run/light_share.h"
+#include "master/run/scene_authority.h"
 #include "scene/builtin.h"
 #include "scene/light_coverage.h"
 #include "scene/meshes.h"

@@ -1,8 +1,8 @@
-// Lights switched on and off over a show (master/light_switches.h, checked as the
+// Lights switched on and off over a show (master/run/light_switches.h, checked as the
 // config is read and again against the scene): what check-config refuses, and
 // which lights are off when.
 
-#include "master/light_switches.h"
+#include "master/run/light_switches.h"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // as events in and actions out.
 
 #include "master/protocol.h"
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include "actions.h"
 #include "config/load.h"
 #include "envelopes.h"
-#include "master/run_config.h"
+#include "master/run/run_config.h"
 #include "net/envelope.h"
 #include "protocol/welcome.h"
 

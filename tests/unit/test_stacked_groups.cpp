@@ -1,7 +1,7 @@
 // Stacked groups: the checks check-config makes on lights and focus pairs
-// (master/stacked_groups.h, common/config/across.cpp) and the light plan.
+// (master/run/stacked_groups.h, common/config/across.cpp) and the light plan.
 
-#include "master/stacked_groups.h"
+#include "master/run/stacked_groups.h"
 
 #include <gtest/gtest.h>
 
@@ -10,7 +10,7 @@
 
 #include "config/load.h"
 #include "config/problem.h"
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 #include "scene/builtin.h"
 
 namespace optique::master {

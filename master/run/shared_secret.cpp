@@ -1,4 +1,4 @@
-#include "master/shared_secret.h"
+#include "master/run/shared_secret.h"
 
 #include <filesystem>
 

@@ -1,4 +1,4 @@
-#include "master/light_switches.h"
+#include "master/run/light_switches.h"
 
 #include <algorithm>
 #include <cassert>

@@ -1,4 +1,4 @@
-#include "master/light_share.h"
+#include "master/run/light_share.h"
 
 #include <algorithm>
 #include <cassert>

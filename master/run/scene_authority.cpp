@@ -1,4 +1,4 @@
-#include "master/scene_authority.h"
+#include "master/run/scene_authority.h"
 
 namespace optique::master {
 

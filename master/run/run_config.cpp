@@ -1,9 +1,9 @@
-#include "master/run_config.h"
+#include "master/run/run_config.h"
 #include "scene_load/installation_scene.h"
 
-#include "master/light_switches.h"
-#include "master/shared_secret.h"
-#include "master/stacked_groups.h"
+#include "master/run/light_switches.h"
+#include "master/run/shared_secret.h"
+#include "master/run/stacked_groups.h"
 
 namespace optique::master {
 

@@ -15,7 +15,7 @@
 
 #include "config/installation.h"
 #include "config/problem.h"
-#include "master/light_share.h"
+#include "master/run/light_share.h"
 #include "optique/config.pb.h"
 #include "scene/definition.h"
 #include "scene/state.h"

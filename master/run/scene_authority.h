@@ -7,7 +7,7 @@
 
 #include "clock/clock.h"
 #include "config/installation.h"
-#include "master/light_switches.h"
+#include "master/run/light_switches.h"
 #include "scene/definition.h"
 #include "scene/state.h"
 

@@ -1,4 +1,4 @@
-#include "master/stacked_groups.h"
+#include "master/run/stacked_groups.h"
 
 #include <algorithm>
 #include <cassert>
