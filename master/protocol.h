@@ -29,15 +29,15 @@
 #include "config/installation.h"
 #include "master/actions.h"
 #include "master/barrier.h"
-#include "master/run/exit_codes.h"
 #include "master/focus_schedule.h"
 #include "master/live_status.h"
 #include "master/operator_command.h"
 #include "master/render_pace.h"
-#include "master/run_recorder.h"
+#include "master/run/exit_codes.h"
 #include "master/run/scene_authority.h"
-#include "master/scene_server.h"
 #include "master/run/stacked_groups.h"
+#include "master/run_recorder.h"
+#include "master/scene_server.h"
 #include "master/viewer_head.h"
 #include "net/auth.h"
 #include "net/session_seal.h"
@@ -97,14 +97,17 @@ class MasterProtocol {
   // as a first interrupt, the run finishes in order.
   [[nodiscard]] Actions operator_command(OperatorCommand command, const std::string& from, clock::Nanos now);
 
-  // For the status line: the frame to begin next, and the nodes up of the projectors.
+  // For the status line and tests: the frame to begin next, the nodes up of the
+  // projectors, whether frames are running.
   struct Progress {
     std::uint64_t next_frame = 0;
     std::size_t nodes_up = 0;
     std::size_t projectors = 0;
+    bool running = false;  // frames have started and the run is not draining
   };
-  [[nodiscard]] Progress progress() const { return {next_frame_, nodes_up(), slots_.size()}; }
-  [[nodiscard]] bool running() const { return state_ == RunState::running; }
+  [[nodiscard]] Progress progress() const {
+    return {next_frame_, nodes_up(), slots_.size(), state_ == RunState::running};
+  }
   // The run's summary (after Finish: every frame finalized).
   [[nodiscard]] report::RunReport report() const;
   // What the operator sees now; the shell adds uptime, warnings and clients.

@@ -12,26 +12,20 @@ double linear_to_srgb(double l) { return l <= 0.0031308 ? l * 12.92 : 1.055 * st
 
 }  // namespace
 
-ProjectorModel::ProjectorModel(const config::ProjectorResponse& response)
-    : curve_(response.curve),
-      gamma_(response.gamma),
-      table_(response.table),
-      bits_(response.bits),
-      black_level_(response.black_level),
-      brightness_(response.brightness) {}
+ProjectorModel::ProjectorModel(const config::ProjectorResponse& response) : response_(response) {}
 
 double ProjectorModel::response(double signal) const {
   const double v = std::clamp(signal, 0.0, 1.0);
-  switch (curve_) {
+  switch (response_.curve) {
     case Curve::srgb:
       return srgb_to_linear(v);
     case Curve::gamma:
-      return std::pow(v, gamma_);
+      return std::pow(v, response_.gamma);
     case Curve::table: {
-      const double at = v * static_cast<double>(table_.size() - 1);
-      const auto i = std::min(static_cast<std::size_t>(at), table_.size() - 2);
+      const double at = v * static_cast<double>(response_.table.size() - 1);
+      const auto i = std::min(static_cast<std::size_t>(at), response_.table.size() - 2);
       const double f = at - static_cast<double>(i);
-      return table_[i] + f * (table_[i + 1] - table_[i]);
+      return response_.table[i] + f * (response_.table[i + 1] - response_.table[i]);
     }
   }
   return v;
@@ -39,21 +33,21 @@ double ProjectorModel::response(double signal) const {
 
 double ProjectorModel::inverse_response(double light) const {
   const double l = std::clamp(light, 0.0, 1.0);
-  switch (curve_) {
+  switch (response_.curve) {
     case Curve::srgb:
       return std::clamp(linear_to_srgb(l), 0.0, 1.0);
     case Curve::gamma:
-      return std::pow(l, 1.0 / gamma_);
+      return std::pow(l, 1.0 / response_.gamma);
     case Curve::table: {
       // The first segment that reaches l; a flat segment maps to its start, so
       // the smallest signal giving that light is sent.
-      const auto upper = std::lower_bound(table_.begin(), table_.end(), l);
-      if (upper == table_.begin()) return 0.0;
-      const auto i = static_cast<std::size_t>(upper - table_.begin()) - 1;
-      const double a = table_[i];
-      const double b = table_[i + 1];
+      const auto upper = std::lower_bound(response_.table.begin(), response_.table.end(), l);
+      if (upper == response_.table.begin()) return 0.0;
+      const auto i = static_cast<std::size_t>(upper - response_.table.begin()) - 1;
+      const double a = response_.table[i];
+      const double b = response_.table[i + 1];
       const double f = b > a ? (l - a) / (b - a) : 0.0;
-      return (static_cast<double>(i) + f) / static_cast<double>(table_.size() - 1);
+      return (static_cast<double>(i) + f) / static_cast<double>(response_.table.size() - 1);
     }
   }
   return l;
@@ -65,7 +59,7 @@ double ProjectorModel::quantize(double signal) const {
 }
 
 double ProjectorModel::emitted(double signal) const {
-  return brightness_ * (black_level_ + (1.0 - black_level_) * response(signal));
+  return response_.brightness * (response_.black_level + (1.0 - response_.black_level) * response(signal));
 }
 
 double ProjectorModel::signal_for(double light) const {

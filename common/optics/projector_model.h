@@ -44,26 +44,18 @@ class ProjectorModel {
   [[nodiscard]] double signal_for(double light) const;
 
   // Light at signal 0 (brightness · black level) and at full signal.
-  [[nodiscard]] double black() const { return brightness_ * black_level_; }
-  [[nodiscard]] double white() const { return brightness_; }
+  [[nodiscard]] double black() const { return response_.brightness * response_.black_level; }
+  [[nodiscard]] double white() const { return response_.brightness; }
   // The most light it can add above its black.
-  [[nodiscard]] double headroom() const { return brightness_ * (1.0 - black_level_); }
+  [[nodiscard]] double headroom() const { return response_.brightness * (1.0 - response_.black_level); }
 
-  [[nodiscard]] Curve curve() const { return curve_; }
-  [[nodiscard]] double gamma() const { return gamma_; }
-  [[nodiscard]] const std::vector<double>& table() const { return table_; }
-  [[nodiscard]] int bits() const { return bits_; }
-  [[nodiscard]] int levels() const { return (1 << bits_) - 1; }  // the largest code
-  [[nodiscard]] double black_level() const { return black_level_; }
-  [[nodiscard]] double brightness() const { return brightness_; }
+  [[nodiscard]] int levels() const { return (1 << response_.bits) - 1; }  // the largest code
+  // The response as the config states it (curve, gamma, table, bits, black
+  // level, brightness), for the output pass that does the same in GLSL.
+  [[nodiscard]] const config::ProjectorResponse& settings() const { return response_; }
 
  private:
-  Curve curve_ = Curve::srgb;
-  double gamma_ = 2.2;
-  std::vector<double> table_;
-  int bits_ = 8;
-  double black_level_ = 0.0;
-  double brightness_ = 1.0;
+  config::ProjectorResponse response_;  // its defaults: sRGB, 8 bits, no black, brightness 1
 };
 
 // The light a projector emits for a captured signal image (values in [0, 1] as

@@ -15,7 +15,7 @@ namespace {
 // built with (the enums' values are the shader's numbers).
 std::string output_stage_defines(const OutputStage& stage) {
   return "#version 450 core\n#define WARP " + std::to_string(stage.projector_to_user ? 1 : 0) + "\n#define CURVE " +
-         std::to_string(static_cast<int>(stage.projector.curve())) + "\n#define SHARE " +
+         std::to_string(static_cast<int>(stage.projector.settings().curve)) + "\n#define SHARE " +
          std::to_string(static_cast<int>(stage.focus.role)) + "\n#define INSET " +
          std::to_string(stage.focus.inset ? 1 : 0) + "\n#define WEIGHTS " +
          std::to_string(stage.weights.empty() ? 0 : 1) + "\n";
@@ -68,14 +68,14 @@ Result<void> OutputPass::set(const OutputStage& stage) {
 
   projector_ = stage.projector;
   const optics::ProjectorModel& model = stage.projector;
-  glProgramUniform1f(program, uniform("gamma"), static_cast<float>(model.gamma()));
-  glProgramUniform1i(program, uniform("table_size"), static_cast<int>(model.table().size()));
+  glProgramUniform1f(program, uniform("gamma"), static_cast<float>(model.settings().gamma));
+  glProgramUniform1i(program, uniform("table_size"), static_cast<int>(model.settings().table.size()));
   glProgramUniform1f(program, uniform("levels"), static_cast<float>(model.levels()));
-  glProgramUniform1f(program, uniform("black_level"), static_cast<float>(model.black_level()));
-  glProgramUniform1f(program, uniform("brightness"), static_cast<float>(model.brightness()));
+  glProgramUniform1f(program, uniform("black_level"), static_cast<float>(model.settings().black_level));
+  glProgramUniform1f(program, uniform("brightness"), static_cast<float>(model.settings().brightness));
   {
     // A texture even when there is no table: every bound sampler needs one.
-    std::vector<float> table(model.table().begin(), model.table().end());
+    std::vector<float> table(model.settings().table.begin(), model.settings().table.end());
     if (table.empty()) table = {0.0f, 1.0f};
     response_table_ = glo::make_texture();
     glTextureStorage2D(response_table_.get(), 1, GL_R32F, static_cast<GLsizei>(table.size()), 1);
@@ -97,7 +97,7 @@ Result<void> OutputPass::set(const OutputStage& stage) {
   held_colour_ = {};
   encoded_colour_ = glo::make_texture();
   // The signal at the projector's depth: 8 bits, or 16 to hold up to 16.
-  glTextureStorage2D(encoded_colour_.get(), 1, model.bits() <= 8 ? GL_RGBA8 : GL_RGBA16, width, height);
+  glTextureStorage2D(encoded_colour_.get(), 1, model.settings().bits <= 8 ? GL_RGBA8 : GL_RGBA16, width, height);
   encoded_framebuffer_ = glo::make_framebuffer();
   glNamedFramebufferTexture(encoded_framebuffer_.get(), GL_COLOR_ATTACHMENT0, encoded_colour_.get(), 0);
   if (!stage.weights.empty()) {

@@ -54,7 +54,7 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   if (!pipeline) return Error{pipeline.error()};
   pipeline_ = std::move(pipeline).value();
   if (node.lights) pipeline_->set_share(*node.lights);
-  deep_signal_ = pipeline_->projector_model().bits() > 8;
+  deep_signal_ = pipeline_->projector_model().settings().bits > 8;
   gathers_ = projector.color_fields.gathers();
   // Every animated object where it starts: the warm-up runs the programs the
   // first frame runs.

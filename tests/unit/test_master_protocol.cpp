@@ -274,13 +274,13 @@ TEST_F(MasterTest, AGoodHelloGetsItsJobAndTheStateOnceConfigured) {
   ASSERT_EQ(resync.size(), 1u);
   EXPECT_EQ(resync.front().resync().next_frame_id(), 0u);
   EXPECT_EQ(master_->progress().nodes_up, 1u);
-  EXPECT_FALSE(master_->running()) << "it waits for the other three";
+  EXPECT_FALSE(master_->progress().running) << "it waits for the other three";
 }
 
 TEST_F(MasterTest, FramesStartWhenAllAreUpAndSwapWhenAllAreReady) {
   load("powerwall-2x2.json");
   Actions a = join_all();
-  ASSERT_TRUE(master_->running());
+  ASSERT_TRUE(master_->progress().running);
   const std::uint64_t hash = hash_of(a, 1);
   for (PeerId p = 1; p <= 4; ++p) ASSERT_EQ(sent_to(a, p, wire::Envelope::kFrameBegin).size(), 1u);
   ASSERT_NE(armed(a, Timer::barrier), nullptr);
@@ -406,7 +406,7 @@ TEST_F(MasterTest, ANodeThatInterpolatesGetsTheSceneAheadAndItsKeyFramesAreRepor
                                         config::kDefaultMinPsnr, true};
   });
   Actions a = join_all();
-  ASSERT_TRUE(master_->running());
+  ASSERT_TRUE(master_->progress().running);
   const auto begin_of = [&](PeerId p) { return sent_to(a, p, wire::Envelope::kFrameBegin).front().frame_begin(); };
   EXPECT_FALSE(begin_of(1).has_ahead());
   EXPECT_FALSE(begin_of(3).has_ahead()) << "extrapolation needs nothing ahead";
@@ -815,11 +815,11 @@ TEST_F(StartupTest, NodesStillConfiguringAtTheStartupTimeoutAreWaitedFor) {
   EXPECT_EQ(first<Finish>(a), nullptr);
   EXPECT_FALSE(logged(a, "no node connected"));
   EXPECT_TRUE(logged(a, "no node ready after 10000 ms; waiting for bottom-left, top-left"));
-  EXPECT_FALSE(master_->running());
+  EXPECT_FALSE(master_->progress().running);
   a = configured(2);
-  EXPECT_FALSE(master_->running()) << "bottom-left is still configuring";
+  EXPECT_FALSE(master_->progress().running) << "bottom-left is still configuring";
   a = configured(1);  // the last one configuring is ready: start, without the two that never came
-  EXPECT_TRUE(master_->running());
+  EXPECT_TRUE(master_->progress().running);
   EXPECT_TRUE(logged(a, "starting frames at 60 Hz with 2/4 node(s)"));
   EXPECT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u);
   EXPECT_EQ(sent_to(a, 2, wire::Envelope::kFrameBegin).size(), 1u);
@@ -828,9 +828,9 @@ TEST_F(StartupTest, NodesStillConfiguringAtTheStartupTimeoutAreWaitedFor) {
 TEST_F(StartupTest, AConfiguringNodeLeavingAfterTheStartupTimeoutStartsTheOthers) {
   (void)two_configuring_at_the_timeout();
   (void)configured(1);
-  EXPECT_FALSE(master_->running());
+  EXPECT_FALSE(master_->progress().running);
   const Actions a = master_->closed(2, "node did not finish configuring within 30 s", now_ + 30'000 * kMs);
-  EXPECT_TRUE(master_->running());
+  EXPECT_TRUE(master_->progress().running);
   EXPECT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u);
 }
 
@@ -852,7 +852,7 @@ TEST_F(MasterTest, SomeNodesAfterTheStartupTimeoutStartWithoutTheRest) {
   (void)configured(1);
   const Actions a = master_->timer(Timer::startup, now_ + 10'000 * kMs);
   EXPECT_TRUE(logged(a, "starting without bottom-right, top-left, top-right"));
-  EXPECT_TRUE(master_->running());
+  EXPECT_TRUE(master_->progress().running);
   EXPECT_EQ(sent_to(a, 1, wire::Envelope::kFrameBegin).size(), 1u);
 }
 

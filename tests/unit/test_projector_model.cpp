@@ -22,7 +22,7 @@ std::string error_of(const schema::Projector& projector) {
 
 TEST(ProjectorModel, DefaultIsEightBitSrgbWithoutBlack) {
   const ProjectorModel model;
-  EXPECT_EQ(model.bits(), 8);
+  EXPECT_EQ(model.settings().bits, 8);
   EXPECT_EQ(model.levels(), 255);
   EXPECT_EQ(model.black(), 0.0);
   EXPECT_NEAR(model.response(0.5), 0.2140, 1e-4);  // sRGB 128/255 ≈ 0.2158; 0.5 → 0.2140
@@ -89,7 +89,7 @@ TEST(ProjectorModel, MeasuredTableIsInvertedWhereItIsFlatAndSteep) {
   for (const double v : {0.0, 0.0, 0.05, 0.2, 0.2, 0.6, 1.0}) p.mutable_response()->add_table(v);
   p.mutable_response()->set_bits(16);
   const ProjectorModel model = model_of(p);
-  EXPECT_EQ(model.curve(), ProjectorModel::Curve::table);
+  EXPECT_EQ(model.settings().curve, ProjectorModel::Curve::table);
   EXPECT_DOUBLE_EQ(model.response(0.5), 0.2);  // signal 0.5 = table index 3
   EXPECT_NEAR(model.response(0.75), 0.4, 1e-12);
   for (double light = 0.0; light <= 1.0; light += 0.013) {
