@@ -1,0 +1,301 @@
+#include "master/session/live_scene.h"
+
+#include <cmath>
+
+#include <glm/gtc/quaternion.hpp>
+
+#include "util/number_text.h"
+
+namespace optique::master {
+namespace {
+
+using util::number_text;
+
+constexpr std::size_t kMaxIdLength = 64;
+constexpr double kMaxPosition = 1e6;  // metres from the origin: a world larger than any room, short of float trouble
+constexpr double kMinScale = 1e-4;
+constexpr double kMaxScale = 1e4;
+constexpr double kMaxEmissive = 1e3;
+
+// What is wrong, at a field relative to the edit ("transform.scale[1]").
+struct Wrong {
+  std::string field;
+  std::string reason;
+};
+using Check = std::optional<Wrong>;
+
+Check id_problem(const std::string& field, const std::string& id) {
+  if (id.empty()) return Wrong{field, "is needed"};
+  if (id.size() > kMaxIdLength) {
+    return Wrong{field,
+                 "is " + std::to_string(id.size()) + " characters long; at most " + std::to_string(kMaxIdLength)};
+  }
+  for (char c : id) {
+    const bool ok =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+    if (!ok) return Wrong{field, "may only use letters, digits, '-', '_' and '.'"};
+  }
+  return std::nullopt;
+}
+
+Check numbers_problem(const std::string& field, const google::protobuf::RepeatedField<double>& v, double low,
+                      double high) {
+  for (int i = 0; i < v.size(); ++i) {
+    if (!std::isfinite(v[i]) || v[i] < low || v[i] > high) {
+      return Wrong{field + "[" + std::to_string(i) + "]",
+                   "must be in [" + number_text(low) + ", " + number_text(high) + "] (got " + number_text(v[i]) + ")"};
+    }
+  }
+  return std::nullopt;
+}
+
+Check count_problem(const std::string& field, int got, std::initializer_list<int> allowed, const char* what) {
+  for (int n : allowed) {
+    if (got == n) return std::nullopt;
+  }
+  return Wrong{field, std::string("must be ") + what + " (got " + std::to_string(got) + " numbers)"};
+}
+
+// What the transform gives, over `pose`.
+Check read_transform(const session::Transform& t, scene::Pose& pose) {
+  if (!t.position().empty()) {
+    if (auto wrong = count_problem("transform.position", t.position_size(), {3}, "[x, y, z]")) return wrong;
+    if (auto wrong = numbers_problem("transform.position", t.position(), -kMaxPosition, kMaxPosition)) return wrong;
+    pose.position = {t.position(0), t.position(1), t.position(2)};
+  }
+  if (!t.rotation().empty()) {
+    if (auto wrong = count_problem("transform.rotation", t.rotation_size(), {4}, "a quaternion [w, x, y, z]")) {
+      return wrong;
+    }
+    if (auto wrong = numbers_problem("transform.rotation", t.rotation(), -1e6, 1e6)) return wrong;
+    const glm::dquat q(t.rotation(0), t.rotation(1), t.rotation(2), t.rotation(3));
+    const double length = glm::length(q);
+    if (!(length > 1e-9)) return Wrong{"transform.rotation", "has length 0: it is no rotation"};
+    pose.rotation = q / length;
+  }
+  if (!t.scale().empty()) {
+    if (auto wrong = count_problem("transform.scale", t.scale_size(), {1, 3}, "[x, y, z] or [s]")) return wrong;
+    if (auto wrong = numbers_problem("transform.scale", t.scale(), kMinScale, kMaxScale)) return wrong;
+    pose.scale = t.scale_size() == 1 ? glm::dvec3(t.scale(0)) : glm::dvec3(t.scale(0), t.scale(1), t.scale(2));
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+// One transaction's edits, applied to the scene as they come, with what each
+// instance was before its first change, to put back if a later edit fails.
+class LiveScene::Edits {
+ public:
+  explicit Edits(LiveScene& scene) : scene_(scene) {}
+
+  // Applies one edit; what is wrong is named from the edit ("create.asset").
+  Check apply(const session::Edit& edit) {
+    const auto named = [](const char* kind, Check wrong) -> Check {
+      if (wrong) wrong->field = std::string(kind) + "." + wrong->field;
+      return wrong;
+    };
+    switch (edit.edit_case()) {
+      case session::Edit::kCreate:
+        return named("create", create(edit.create()));
+      case session::Edit::kTransform:
+        return named("transform", transform(edit.transform()));
+      case session::Edit::kParent:
+        return named("parent", parent(edit.parent()));
+      case session::Edit::kVisible:
+        return named("visible", visible(edit.visible()));
+      case session::Edit::kRemove:
+        return named("remove", remove(edit.remove()));
+      case session::Edit::kFactors:
+        return named("factors", factors(edit.factors()));
+      case session::Edit::EDIT_NOT_SET:
+        break;
+    }
+    return Wrong{"", "is empty or of a kind this master does not know"};
+  }
+
+  // Puts every changed instance back as it was, the last change first.
+  void undo() {
+    for (auto it = before_.rbegin(); it != before_.rend(); ++it) scene_.put(it->first, it->second);
+    before_.clear();
+  }
+
+ private:
+  void put(const std::string& id, std::optional<Instance> instance) {
+    if (touched_.insert(id).second) {
+      const auto now = scene_.instances_.find(id);
+      before_.emplace_back(id, now == scene_.instances_.end() ? std::nullopt : std::optional<Instance>(now->second));
+    }
+    scene_.put(id, std::move(instance));
+  }
+
+  // The instance `id` names (at `field`), or why there is none.
+  Check existing(const std::string& field, const std::string& id, const Instance*& instance) const {
+    if (auto wrong = id_problem(field, id)) return wrong;
+    const auto found = scene_.instances_.find(id);
+    if (found == scene_.instances_.end()) return Wrong{field, "no instance '" + id + "'"};
+    instance = &found->second;
+    return std::nullopt;
+  }
+
+  // Whether `parent` may hold `id`: it exists, is not `id` nor under it, and
+  // the chain above stays within the depth limit.
+  Check parent_problem(const std::string& id, const std::string& parent) const {
+    if (parent.empty()) return std::nullopt;
+    const Instance* above = nullptr;
+    if (auto wrong = existing("parent", parent, above)) return wrong;
+    std::size_t depth = 1;
+    for (std::string at = parent; !at.empty(); at = scene_.instances_.at(at).parent, ++depth) {
+      if (at == id)
+        return Wrong{"parent", "'" + parent + "' is '" + id + "' or under it: an instance cannot hold itself"};
+      if (depth > scene_.limits_.max_depth) {
+        return Wrong{"parent", "would put '" + id + "' more than " + std::to_string(scene_.limits_.max_depth) +
+                                   " instances deep"};
+      }
+    }
+    return std::nullopt;
+  }
+
+  Check create(const session::CreateInstance& c) {
+    if (auto wrong = id_problem("instance", c.instance())) return wrong;
+    if (scene_.instances_.count(c.instance()) != 0) {
+      return Wrong{"instance", "'" + c.instance() + "' exists already"};
+    }
+    if (scene_.instances_.size() >= scene_.limits_.max_instances) {
+      return Wrong{"instance",
+                   "the scene holds " + std::to_string(scene_.limits_.max_instances) + " instances, the most it may"};
+    }
+    if (auto wrong = id_problem("asset", c.asset())) return wrong;
+    if (!scene_.has_asset(c.asset())) return Wrong{"asset", "no asset '" + c.asset() + "' is loaded"};
+    if (auto wrong = parent_problem(c.instance(), c.parent())) return wrong;
+    Instance instance;
+    instance.asset = c.asset();
+    instance.parent = c.parent();
+    instance.visible = !c.hidden();
+    if (auto wrong = read_transform(c.transform(), instance.pose)) return wrong;
+    put(c.instance(), std::move(instance));
+    return std::nullopt;
+  }
+
+  Check transform(const session::SetTransform& t) {
+    const Instance* instance = nullptr;
+    if (auto wrong = existing("instance", t.instance(), instance)) return wrong;
+    Instance changed = *instance;
+    if (auto wrong = read_transform(t.transform(), changed.pose)) return wrong;
+    put(t.instance(), std::move(changed));
+    return std::nullopt;
+  }
+
+  Check parent(const session::SetParent& p) {
+    const Instance* instance = nullptr;
+    if (auto wrong = existing("instance", p.instance(), instance)) return wrong;
+    if (auto wrong = parent_problem(p.instance(), p.parent())) return wrong;
+    // The instances under it go along: each must stay within the depth limit.
+    if (auto wrong = subtree_depth_problem(p.instance(), p.parent())) return wrong;
+    Instance changed = *instance;
+    changed.parent = p.parent();
+    put(p.instance(), std::move(changed));
+    return std::nullopt;
+  }
+
+  Check visible(const session::SetVisible& v) {
+    const Instance* instance = nullptr;
+    if (auto wrong = existing("instance", v.instance(), instance)) return wrong;
+    Instance changed = *instance;
+    changed.visible = v.visible();
+    put(v.instance(), std::move(changed));
+    return std::nullopt;
+  }
+
+  Check remove(const session::RemoveInstance& r) {
+    const Instance* instance = nullptr;
+    if (auto wrong = existing("instance", r.instance(), instance)) return wrong;
+    // The instances under it first, deepest first, then itself.
+    std::vector<std::string> order{r.instance()};
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      for (const std::string& child : scene_.children(order[i])) order.push_back(child);
+    }
+    for (auto it = order.rbegin(); it != order.rend(); ++it) put(*it, std::nullopt);
+    return std::nullopt;
+  }
+
+  Check factors(const session::SetFactors& f) {
+    const Instance* instance = nullptr;
+    if (auto wrong = existing("instance", f.instance(), instance)) return wrong;
+    Instance changed = *instance;
+    if (!f.base_color().empty()) {
+      if (auto wrong = count_problem("base_color", f.base_color_size(), {4}, "[r, g, b, a]")) return wrong;
+      if (auto wrong = numbers_problem("base_color", f.base_color(), 0.0, 1.0)) return wrong;
+      changed.base_color = {f.base_color(0), f.base_color(1), f.base_color(2), f.base_color(3)};
+    }
+    if (!f.emissive().empty()) {
+      if (auto wrong = count_problem("emissive", f.emissive_size(), {3}, "[r, g, b]")) return wrong;
+      if (auto wrong = numbers_problem("emissive", f.emissive(), 0.0, kMaxEmissive)) return wrong;
+      changed.emissive = {f.emissive(0), f.emissive(1), f.emissive(2)};
+    }
+    put(f.instance(), std::move(changed));
+    return std::nullopt;
+  }
+
+  // The depth of `id`'s deepest descendant, below `parent`.
+  Check subtree_depth_problem(const std::string& id, const std::string& parent) const {
+    std::size_t above = 1;  // `id` itself
+    for (std::string at = parent; !at.empty(); at = scene_.instances_.at(at).parent) ++above;
+    std::vector<std::pair<std::string, std::size_t>> stack{{id, above}};
+    while (!stack.empty()) {
+      auto [at, depth] = stack.back();
+      stack.pop_back();
+      if (depth > scene_.limits_.max_depth + 1) {
+        return Wrong{"parent", "would put '" + at + "' more than " + std::to_string(scene_.limits_.max_depth) +
+                                   " instances deep"};
+      }
+      for (const std::string& child : scene_.children(at)) stack.emplace_back(child, depth + 1);
+    }
+    return std::nullopt;
+  }
+
+  LiveScene& scene_;
+  std::set<std::string> touched_;
+  std::vector<std::pair<std::string, std::optional<Instance>>> before_;
+};
+
+const std::set<std::string>& LiveScene::children(const std::string& parent) const {
+  static const std::set<std::string> kNone;
+  const auto found = children_.find(parent);
+  return found == children_.end() ? kNone : found->second;
+}
+
+void LiveScene::put(const std::string& id, std::optional<Instance> instance) {
+  if (const auto old = instances_.find(id); old != instances_.end()) {
+    auto& siblings = children_[old->second.parent];
+    siblings.erase(id);
+    if (siblings.empty()) children_.erase(old->second.parent);
+    instances_.erase(old);
+  }
+  if (instance) {
+    children_[instance->parent].insert(id);
+    instances_.emplace(id, std::move(*instance));
+  }
+}
+
+std::optional<Refusal> LiveScene::apply(const session::Transaction& transaction) {
+  const auto count = static_cast<std::size_t>(transaction.edits_size());
+  if (count > limits_.max_edits_per_frame - edits_this_frame_) {
+    return Refusal{0, "edits",
+                   std::to_string(count) + " edits, but " +
+                       std::to_string(limits_.max_edits_per_frame - edits_this_frame_) + " of this frame's " +
+                       std::to_string(limits_.max_edits_per_frame) + " are left: send the rest in a later frame"};
+  }
+  Edits edits(*this);
+  for (std::size_t i = 0; i < count; ++i) {
+    if (auto wrong = edits.apply(transaction.edits(static_cast<int>(i)))) {
+      edits.undo();
+      const std::string at = "edits[" + std::to_string(i) + "]";
+      return Refusal{i, wrong->field.empty() ? at : at + "." + wrong->field, std::move(wrong->reason)};
+    }
+  }
+  edits_this_frame_ += count;
+  return std::nullopt;
+}
+
+}  // namespace optique::master

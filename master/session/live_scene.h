@@ -1,0 +1,80 @@
+#pragma once
+// The live scene applications edit (proto/optique/session.proto): the assets
+// loaded, and the instances of them, each with its parent, placement,
+// visibility and material factors. A transaction is checked edit by edit
+// against the scene as the edits before it left it, and lands whole or not at
+// all: the first edit that cannot be applied is named with its field and
+// why, and the scene is as it was. No IO: the master's session shell decodes
+// the bytes, hands the transaction here, and reads the instances at each
+// frame's beginning, so that a transaction received before frame k begins is
+// in frame k.
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "optique/session.pb.h"
+#include "scene/state.h"
+
+namespace optique::master {
+
+struct Instance {
+  std::string asset;
+  std::string parent;  // empty: the world
+  scene::Pose pose;    // relative to the parent
+  bool visible = true;
+  glm::dvec4 base_color{1.0};  // multiplies the asset's base colour
+  glm::dvec3 emissive{1.0};    // multiplies the asset's emissive colour
+  friend bool operator==(const Instance&, const Instance&) = default;
+};
+
+struct LiveSceneLimits {
+  std::size_t max_instances = 100000;
+  std::size_t max_edits_per_frame = 100000;  // over every transaction of a frame
+  std::size_t max_depth = 64;                // instances above an instance, the world not counted
+};
+
+// Why a transaction was refused: its first edit that could not be applied.
+struct Refusal {
+  std::size_t edit = 0;
+  std::string field;   // "edits[3].transform.scale[1]"
+  std::string reason;  // "must be in [1e-4, 1e4] (got 0)"
+};
+
+class LiveScene {
+ public:
+  explicit LiveScene(LiveSceneLimits limits = {}) : limits_(limits) {}
+
+  // An asset the nodes can draw (loaded and shipped by the scene transfer).
+  void add_asset(const std::string& id) { assets_.insert(id); }
+  [[nodiscard]] bool has_asset(const std::string& id) const { return assets_.count(id) != 0; }
+
+  // Applies every edit, or none and says which and why.
+  [[nodiscard]] std::optional<Refusal> apply(const session::Transaction& transaction);
+  // A new frame: the budget of edits starts again.
+  void begin_frame() { edits_this_frame_ = 0; }
+
+  [[nodiscard]] const std::map<std::string, Instance>& instances() const { return instances_; }
+  [[nodiscard]] const std::set<std::string>& children(const std::string& parent) const;
+
+ private:
+  class Edits;  // one transaction's edits with their undo (live_scene.cpp)
+
+  // Sets or (nullopt) removes an instance, keeping the children index true.
+  void put(const std::string& id, std::optional<Instance> instance);
+
+  LiveSceneLimits limits_;
+  std::set<std::string> assets_;
+  std::map<std::string, Instance> instances_;
+  std::map<std::string, std::set<std::string>> children_;  // parent → its children; "" → the world's
+  std::size_t edits_this_frame_ = 0;
+};
+
+}  // namespace optique::master

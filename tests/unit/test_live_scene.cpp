@@ -1,0 +1,192 @@
+// The live scene applications edit: master/session/live_scene.h.
+#include <google/protobuf/text_format.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "master/session/live_scene.h"
+
+namespace optique::master {
+namespace {
+
+session::Transaction transaction(const std::string& text) {
+  session::Transaction t;
+  EXPECT_TRUE(google::protobuf::TextFormat::ParseFromString(text, &t)) << text;
+  return t;
+}
+
+LiveScene with_torus(LiveSceneLimits limits = {}) {
+  LiveScene scene(limits);
+  scene.add_asset("torus");
+  scene.add_asset("duck");
+  return scene;
+}
+
+LiveSceneLimits limits_with(std::size_t LiveSceneLimits::*limit, std::size_t value) {
+  LiveSceneLimits limits;
+  limits.*limit = value;
+  return limits;
+}
+
+// The refusal of `text`, which must be refused.
+Refusal refused(LiveScene& scene, const std::string& text) {
+  const auto refusal = scene.apply(transaction(text));
+  EXPECT_TRUE(refusal.has_value()) << "accepted: " << text;
+  return refusal.value_or(Refusal{});
+}
+
+void accept(LiveScene& scene, const std::string& text) {
+  const auto refusal = scene.apply(transaction(text));
+  ASSERT_FALSE(refusal) << refusal->field << ": " << refusal->reason;
+}
+
+TEST(LiveScene, AnInstanceIsPlacedShownAndTinted) {
+  LiveScene scene = with_torus();
+  accept(scene, R"(edits { create { instance: "t1" asset: "torus"
+                                     transform { position: [1, 2, 3] rotation: [0, 0, 2, 0] scale: [2] } } })");
+  const Instance& t1 = scene.instances().at("t1");
+  EXPECT_EQ(t1.asset, "torus");
+  EXPECT_EQ(t1.pose.position, glm::dvec3(1, 2, 3));
+  EXPECT_DOUBLE_EQ(t1.pose.rotation.y, 1.0) << "the quaternion is normalized";
+  EXPECT_EQ(t1.pose.scale, glm::dvec3(2.0));
+  EXPECT_TRUE(t1.visible);
+
+  accept(scene, R"(edits { transform { instance: "t1" transform { scale: [1, 2, 3] } } }
+                   edits { visible { instance: "t1" visible: false } }
+                   edits { factors { instance: "t1" base_color: [1, 0, 0, 0.5] } })");
+  const Instance& changed = scene.instances().at("t1");
+  EXPECT_EQ(changed.pose.position, glm::dvec3(1, 2, 3)) << "what a transform leaves out keeps its value";
+  EXPECT_EQ(changed.pose.scale, glm::dvec3(1, 2, 3));
+  EXPECT_FALSE(changed.visible);
+  EXPECT_EQ(changed.base_color, glm::dvec4(1, 0, 0, 0.5));
+  EXPECT_EQ(changed.emissive, glm::dvec3(1.0));
+}
+
+TEST(LiveScene, ATransactionLandsWholeOrNotAtAll) {
+  LiveScene scene = with_torus();
+  accept(scene, R"(edits { create { instance: "t1" asset: "torus" transform { position: [1, 0, 0] } } })");
+  const LiveScene before = scene;
+  const Refusal refusal = refused(scene, R"(
+      edits { transform { instance: "t1" transform { position: [5, 5, 5] } } }
+      edits { remove { instance: "t1" } }
+      edits { create { instance: "t1" asset: "duck" } }
+      edits { create { instance: "t2" asset: "torus" parent: "t1" } }
+      edits { create { instance: "t3" asset: "teapot" } })");
+  EXPECT_EQ(refusal.edit, 4u);
+  EXPECT_EQ(refusal.field, "edits[4].create.asset");
+  EXPECT_EQ(refusal.reason, "no asset 'teapot' is loaded");
+  EXPECT_EQ(scene.instances(), before.instances());
+  EXPECT_EQ(scene.children(""), before.children(""));
+  EXPECT_TRUE(scene.children("t1").empty());
+}
+
+TEST(LiveScene, NumbersThatPlaceNothingAreRefusedWithTheirField) {
+  LiveScene scene = with_torus();
+  accept(scene, R"(edits { create { instance: "t1" asset: "torus" } })");
+  const auto field_of = [&](const std::string& transform) {
+    return refused(scene, R"(edits { transform { instance: "t1" transform { )" + transform + " } } }");
+  };
+  EXPECT_EQ(field_of("position: [0, nan, 0]").field, "edits[0].transform.transform.position[1]");
+  EXPECT_EQ(field_of("position: [0, 1e7, 0]").field, "edits[0].transform.transform.position[1]");
+  EXPECT_EQ(field_of("position: [0, 1]").reason, "must be [x, y, z] (got 2 numbers)");
+  EXPECT_EQ(field_of("rotation: [0, 0, 0, 0]").reason, "has length 0: it is no rotation");
+  EXPECT_EQ(field_of("rotation: [1, 0, inf, 0]").field, "edits[0].transform.transform.rotation[2]");
+  EXPECT_EQ(field_of("scale: [0]").reason, "must be in [0.0001, 10000] (got 0)");
+  EXPECT_EQ(field_of("scale: [1, -1, 1]").field, "edits[0].transform.transform.scale[1]");
+  EXPECT_EQ(field_of("scale: [1e5]").field, "edits[0].transform.transform.scale[0]");
+  EXPECT_EQ(refused(scene, R"(edits { factors { instance: "t1" base_color: [1, 1, 2, 1] } })").field,
+            "edits[0].factors.base_color[2]");
+  EXPECT_EQ(refused(scene, R"(edits { factors { instance: "t1" emissive: [1, 1] } })").field,
+            "edits[0].factors.emissive");
+  Instance untouched;
+  untouched.asset = "torus";
+  EXPECT_EQ(scene.instances().at("t1"), untouched);
+}
+
+TEST(LiveScene, IdsAreCheckedAndMustExist) {
+  LiveScene scene = with_torus();
+  EXPECT_EQ(refused(scene, R"(edits { create { asset: "torus" } })").reason, "is needed");
+  EXPECT_EQ(refused(scene, R"(edits { create { instance: "a b" asset: "torus" } })").reason,
+            "may only use letters, digits, '-', '_' and '.'");
+  EXPECT_EQ(refused(scene, "edits { create { instance: \"" + std::string(65, 'x') + "\" asset: \"torus\" } }").field,
+            "edits[0].create.instance");
+  EXPECT_EQ(refused(scene, R"(edits { visible { instance: "ghost" visible: true } })").reason, "no instance 'ghost'");
+  EXPECT_EQ(refused(scene, R"(edits { create { instance: "a" asset: "torus" parent: "ghost" } })").field,
+            "edits[0].create.parent");
+  accept(scene, R"(edits { create { instance: "a" asset: "torus" } })");
+  EXPECT_EQ(refused(scene, R"(edits { create { instance: "a" asset: "duck" } })").reason, "'a' exists already");
+  const Refusal empty = refused(scene, "edits { }");
+  EXPECT_EQ(empty.field, "edits[0]");
+  EXPECT_EQ(empty.reason, "is empty or of a kind this master does not know");
+}
+
+TEST(LiveScene, AnInstanceCannotHoldItself) {
+  LiveScene scene = with_torus();
+  accept(scene, R"(edits { create { instance: "a" asset: "torus" } }
+                   edits { create { instance: "b" asset: "torus" parent: "a" } }
+                   edits { create { instance: "c" asset: "torus" parent: "b" } })");
+  EXPECT_EQ(refused(scene, R"(edits { parent { instance: "a" parent: "c" } })").reason,
+            "'c' is 'a' or under it: an instance cannot hold itself");
+  EXPECT_EQ(refused(scene, R"(edits { parent { instance: "b" parent: "b" } })").field, "edits[0].parent.parent");
+  accept(scene, R"(edits { parent { instance: "c" parent: "" } })");
+  EXPECT_EQ(scene.instances().at("c").parent, "");
+  EXPECT_EQ(scene.children("b").size(), 0u);
+  EXPECT_EQ(scene.children("").size(), 2u);
+}
+
+TEST(LiveScene, RemovingAnInstanceRemovesWhatItHolds) {
+  LiveScene scene = with_torus();
+  accept(scene, R"(edits { create { instance: "a" asset: "torus" } }
+                   edits { create { instance: "b" asset: "torus" parent: "a" } }
+                   edits { create { instance: "c" asset: "torus" parent: "b" } }
+                   edits { create { instance: "d" asset: "duck" } })");
+  accept(scene, R"(edits { remove { instance: "a" } })");
+  ASSERT_EQ(scene.instances().size(), 1u);
+  EXPECT_EQ(scene.instances().count("d"), 1u);
+  EXPECT_TRUE(scene.children("a").empty());
+  EXPECT_TRUE(scene.children("b").empty());
+  // The ids are free again.
+  accept(scene, R"(edits { create { instance: "b" asset: "torus" parent: "d" } })");
+}
+
+TEST(LiveScene, TheChainOfParentsIsBounded) {
+  LiveScene scene = with_torus(limits_with(&LiveSceneLimits::max_depth, 2));
+  accept(scene, R"(edits { create { instance: "a" asset: "torus" } }
+                   edits { create { instance: "b" asset: "torus" parent: "a" } }
+                   edits { create { instance: "c" asset: "torus" parent: "b" } })");
+  EXPECT_EQ(refused(scene, R"(edits { create { instance: "d" asset: "torus" parent: "c" } })").reason,
+            "would put 'd' more than 2 instances deep");
+  // Moving a holder moves what it holds: b (with c) under a new x under a.
+  accept(scene, R"(edits { create { instance: "x" asset: "torus" } })");
+  EXPECT_EQ(refused(scene, R"(edits { parent { instance: "b" parent: "c" } })").field, "edits[0].parent.parent");
+  EXPECT_EQ(refused(scene, R"(edits { parent { instance: "a" parent: "x" } })").reason,
+            "would put 'c' more than 2 instances deep");
+  accept(scene, R"(edits { parent { instance: "c" parent: "x" } })");
+}
+
+TEST(LiveScene, EachFrameHasABudgetOfEdits) {
+  LiveScene scene = with_torus(limits_with(&LiveSceneLimits::max_edits_per_frame, 3));
+  accept(scene, R"(edits { create { instance: "a" asset: "torus" } }
+                   edits { create { instance: "b" asset: "torus" } })");
+  const Refusal over = refused(scene, R"(edits { visible { instance: "a" visible: false } }
+                                         edits { visible { instance: "b" visible: false } })");
+  EXPECT_EQ(over.field, "edits");
+  EXPECT_EQ(over.reason, "2 edits, but 1 of this frame's 3 are left: send the rest in a later frame");
+  EXPECT_TRUE(scene.instances().at("a").visible);
+  scene.begin_frame();
+  accept(scene, R"(edits { visible { instance: "a" visible: false } }
+                   edits { visible { instance: "b" visible: false } })");
+}
+
+TEST(LiveScene, TheNumberOfInstancesIsBounded) {
+  LiveScene scene = with_torus(limits_with(&LiveSceneLimits::max_instances, 2));
+  accept(scene, R"(edits { create { instance: "a" asset: "torus" } }
+                   edits { create { instance: "b" asset: "torus" } })");
+  EXPECT_EQ(refused(scene, R"(edits { create { instance: "c" asset: "torus" } })").reason,
+            "the scene holds 2 instances, the most it may");
+  accept(scene, R"(edits { remove { instance: "a" } } edits { create { instance: "c" asset: "torus" } })");
+}
+
+}  // namespace
+}  // namespace optique::master
