@@ -1,5 +1,6 @@
 #include "scene/state.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <glm/common.hpp>
@@ -33,6 +34,26 @@ class Fnv1a {
     add(p.rotation);
     add(p.scale);
   }
+  void add(const glm::dvec4& v) {
+    add(glm::dvec3(v));
+    add(v.w);
+  }
+  void add(std::string_view text) {
+    add(static_cast<std::uint64_t>(text.size()));
+    for (char c : text) {
+      hash_ ^= static_cast<unsigned char>(c);
+      hash_ *= 0x100000001b3ull;
+    }
+  }
+  void add(const InstanceState& i) {
+    add(i.asset);
+    add(i.parent);
+    add(i.pose.now);
+    add(i.pose.next);
+    add(static_cast<std::uint64_t>(i.visible ? 1 : 0));
+    add(i.base_color);
+    add(i.emissive);
+  }
   [[nodiscard]] std::uint64_t value() const { return hash_; }
 
  private:
@@ -59,6 +80,12 @@ bool identical(const ObjectState& a, const ObjectState& b) {
   return identical(a.now, b.now) && identical(a.next, b.next);
 }
 
+bool identical(const InstanceState& a, const InstanceState& b) {
+  return a.asset == b.asset && a.parent == b.parent && identical(a.pose, b.pose) && a.visible == b.visible &&
+         identical(glm::dvec3(a.base_color), glm::dvec3(b.base_color)) && same_bits(a.base_color.w, b.base_color.w) &&
+         identical(a.emissive, b.emissive);
+}
+
 void to_wire(const glm::dvec3& v, wire::Vec3& out) {
   out.set_x(v.x);
   out.set_y(v.y);
@@ -82,6 +109,22 @@ void to_wire(std::uint32_t id, const ObjectState& o, wire::ObjectState& out) {
   out.set_id(id);
   to_wire(o.now, *out.mutable_now());
   to_wire(o.next, *out.mutable_next());
+}
+
+void to_wire(const std::string& id, const InstanceState& i, wire::InstanceState& out) {
+  out.set_id(id);
+  out.set_asset(i.asset);
+  out.set_parent(i.parent);
+  to_wire(i.pose.now, *out.mutable_now());
+  to_wire(i.pose.next, *out.mutable_next());
+  out.set_hidden(!i.visible);
+  // The factors that change nothing are left out.
+  if (i.base_color != glm::dvec4(1.0)) {
+    for (int k = 0; k < 4; ++k) out.add_base_color(i.base_color[k]);
+  }
+  if (i.emissive != glm::dvec3(1.0)) {
+    for (int k = 0; k < 3; ++k) out.add_emissive(i.emissive[k]);
+  }
 }
 
 const glm::dquat kNoTurn{1.0, 0.0, 0.0, 0.0};
@@ -142,6 +185,63 @@ Result<ObjectState> from_wire(const wire::ObjectState& o) {
   return ObjectState{now.value(), next.value()};
 }
 
+// Numbers in [low, high], `count` of them or none.
+Result<void> factors_from_wire(const google::protobuf::RepeatedField<double>& v, int count, double high,
+                               const std::string& what) {
+  if (!v.empty() && v.size() != count) {
+    return Error{what + " has " + std::to_string(v.size()) + " numbers, not " + std::to_string(count)};
+  }
+  for (double x : v) {
+    if (!std::isfinite(x) || x < 0.0 || x > high) return Error{what + " is outside [0, " + std::to_string(high) + "]"};
+  }
+  return {};
+}
+
+Result<std::pair<std::string, InstanceState>> from_wire(const wire::InstanceState& i) {
+  if (!is_instance_id(i.id())) return Error{"an instance's id is not one (1 to 64 of a-z A-Z 0-9 - _ .)"};
+  const std::string what = "instance " + i.id();
+  if (!is_instance_id(i.asset())) return Error{what + ": its asset's id is not one"};
+  if (!i.parent().empty() && !is_instance_id(i.parent())) return Error{what + ": its parent's id is not one"};
+  if (i.parent() == i.id()) return Error{what + " is its own parent"};
+  InstanceState out;
+  out.asset = i.asset();
+  out.parent = i.parent();
+  out.visible = !i.hidden();
+  auto now = from_wire(i.now(), what + " (now)");
+  if (!now) return Error{now.error()};
+  auto next = from_wire(i.next(), what + " (next)");
+  if (!next) return Error{next.error()};
+  out.pose = {now.value(), next.value()};
+  if (auto ok = factors_from_wire(i.base_color(), 4, 1.0, what + " base colour"); !ok) return Error{ok.error()};
+  if (auto ok = factors_from_wire(i.emissive(), 3, kMaxEmissiveFactor, what + " emissive"); !ok) {
+    return Error{ok.error()};
+  }
+  if (!i.base_color().empty()) out.base_color = {i.base_color(0), i.base_color(1), i.base_color(2), i.base_color(3)};
+  if (!i.emissive().empty()) out.emissive = {i.emissive(0), i.emissive(1), i.emissive(2)};
+  return std::pair{i.id(), std::move(out)};
+}
+
+// Every instance a change names, and every one left without its parent by a
+// removal: its parent is there, and the chain above it ends at the world
+// within kMaxInstanceDepth (so without a cycle). `lookup` gives an instance as
+// the delta would leave the state.
+template <class Lookup>
+Result<void> check_parents(const std::vector<std::string>& ids, const Lookup& lookup) {
+  for (const std::string& id : ids) {
+    std::size_t depth = 0;
+    for (const InstanceState* at = lookup(id); !at->parent.empty(); ++depth) {
+      if (depth == kMaxInstanceDepth) {
+        return Error{"instance " + id + " is more than " + std::to_string(kMaxInstanceDepth) +
+                     " instances deep, or under itself"};
+      }
+      const InstanceState* parent = lookup(at->parent);
+      if (parent == nullptr) return Error{"instance " + id + " is under " + at->parent + ", which does not exist"};
+      at = parent;
+    }
+  }
+  return {};
+}
+
 struct ViewerPair {
   glm::dvec3 eye_now;
   glm::dvec3 eye_next;
@@ -178,6 +278,14 @@ void set_viewer(SceneState& state, const ViewerPair& viewer) {
 
 }  // namespace
 
+bool is_instance_id(std::string_view id) {
+  if (id.empty() || id.size() > kMaxInstanceIdLength) return false;
+  return std::all_of(id.begin(), id.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' ||
+           c == '.';
+  });
+}
+
 // A viewer that does not move is where it is, to the bit.
 glm::dvec3 eyes_at(const SceneState& state, double fraction) {
   return identical(state.eye_now, state.eye_next) ? state.eye_now : glm::mix(state.eye_now, state.eye_next, fraction);
@@ -202,6 +310,11 @@ std::uint64_t state_hash(const SceneState& state) {
   h.add(state.head_next);
   h.add(static_cast<std::uint64_t>(state.lights_off.size()));
   for (std::uint32_t light : state.lights_off) h.add(static_cast<std::uint64_t>(light));
+  h.add(static_cast<std::uint64_t>(state.instances.size()));
+  for (const auto& [id, instance] : state.instances) {
+    h.add(std::string_view(id));
+    h.add(instance);
+  }
   return h.value();
 }
 
@@ -210,6 +323,7 @@ wire::Snapshot to_snapshot(const SceneState& state) {
   for (const auto& [id, object] : state.objects) to_wire(id, object, *snapshot.add_objects());
   to_wire(state, *snapshot.mutable_viewer());
   snapshot.mutable_lights_off()->Add(state.lights_off.begin(), state.lights_off.end());
+  for (const auto& [id, instance] : state.instances) to_wire(id, instance, *snapshot.add_instances());
   return snapshot;
 }
 
@@ -230,6 +344,20 @@ Result<SceneState> from_snapshot(const wire::Snapshot& snapshot) {
       return Error{"snapshot lists light " + std::to_string(light) + " as off twice"};
     }
   }
+  std::vector<std::string> ids;
+  for (const auto& i : snapshot.instances()) {
+    auto instance = from_wire(i);
+    if (!instance) return Error{"snapshot: " + instance.error()};
+    if (!state.instances.emplace(std::move(instance).value()).second) {
+      return Error{"snapshot lists instance " + i.id() + " twice"};
+    }
+    ids.push_back(i.id());
+  }
+  const auto lookup = [&](const std::string& id) -> const InstanceState* {
+    const auto found = state.instances.find(id);
+    return found == state.instances.end() ? nullptr : &found->second;
+  };
+  if (auto ok = check_parents(ids, lookup); !ok) return Error{"snapshot: " + ok.error()};
   return state;
 }
 
@@ -251,6 +379,15 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
   }
   for (std::uint32_t light : before.lights_off) {
     if (!after.lights_off.contains(light)) delta.add_lights_on(light);
+  }
+  for (const auto& [id, instance] : after.instances) {
+    const auto old = before.instances.find(id);
+    if (old == before.instances.end() || !identical(old->second, instance)) {
+      to_wire(id, instance, *delta.add_instances_changed());
+    }
+  }
+  for (const auto& [id, instance] : before.instances) {
+    if (!after.instances.contains(id)) delta.add_instances_removed(id);
   }
   return delta;
 }
@@ -287,7 +424,43 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
     }
   }
 
+  std::map<std::string, InstanceState> instances_changed;
+  for (const auto& i : delta.instances_changed()) {
+    auto instance = from_wire(i);
+    if (!instance) return Error{"delta: " + instance.error()};
+    if (!instances_changed.insert(std::move(instance).value()).second) {
+      return Error{"delta changes instance " + i.id() + " twice"};
+    }
+  }
+  std::set<std::string> instances_removed;
+  for (const std::string& id : delta.instances_removed()) {
+    if (!is_instance_id(id)) return Error{"delta removes an instance whose id is not one"};
+    if (!state.instances.contains(id) || instances_changed.contains(id) || !instances_removed.insert(id).second) {
+      return Error{"delta removes instance " + id +
+                   ", which it cannot: it is not there, changed too, or removed twice"};
+    }
+  }
+  if (!instances_changed.empty() || !instances_removed.empty()) {
+    const auto lookup = [&](const std::string& id) -> const InstanceState* {
+      if (const auto changed_here = instances_changed.find(id); changed_here != instances_changed.end()) {
+        return &changed_here->second;
+      }
+      const auto found = state.instances.find(id);
+      return found == state.instances.end() || instances_removed.contains(id) ? nullptr : &found->second;
+    };
+    std::vector<std::string> ids;
+    for (const auto& [id, instance] : instances_changed) ids.push_back(id);
+    if (!instances_removed.empty()) {  // what a removal leaves behind
+      for (const auto& [id, instance] : state.instances) {
+        if (instances_removed.contains(instance.parent) && lookup(id) != nullptr) ids.push_back(id);
+      }
+    }
+    if (auto ok = check_parents(ids, lookup); !ok) return Error{"delta: " + ok.error()};
+  }
+
   for (auto& [id, object] : changed) state.objects.insert_or_assign(id, object);
+  for (auto& [id, instance] : instances_changed) state.instances.insert_or_assign(id, std::move(instance));
+  for (const std::string& id : instances_removed) state.instances.erase(id);
   for (std::uint32_t id : delta.removed()) state.objects.erase(id);
   set_viewer(state, viewer);
   state.lights_off = std::move(lights_off);

@@ -7,9 +7,12 @@
 #include <cstdint>
 #include <map>
 #include <set>
+#include <string>
+#include <string_view>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include "optique/wire.pb.h"
 #include "util/result.h"
@@ -31,6 +34,28 @@ struct ObjectState {
   bool operator==(const ObjectState&) const = default;
 };
 
+// An instance of an asset an application placed (master/session/live_scene.h).
+struct InstanceState {
+  std::string asset;
+  std::string parent;  // empty: the world; its pose is relative to the parent's
+  ObjectState pose;
+  bool visible = true;
+  glm::dvec4 base_color{1.0};  // multiplies the asset's base colour
+  glm::dvec3 emissive{1.0};    // multiplies the asset's emissive colour
+
+  bool operator==(const InstanceState&) const = default;
+};
+
+// The most instances a chain of parents holds (the world not counted): what a
+// node accepts from the wire, and what the master's live scene allows.
+inline constexpr std::size_t kMaxInstanceDepth = 64;
+inline constexpr std::size_t kMaxInstanceIdLength = 64;
+inline constexpr double kMaxEmissiveFactor = 1e3;
+
+// 1 to kMaxInstanceIdLength letters, digits, '-', '_' or '.': an id safe in a
+// log, a file name and JSON as it is.
+[[nodiscard]] bool is_instance_id(std::string_view id);
+
 struct SceneState {
   std::map<std::uint32_t, ObjectState> objects;
   glm::dvec3 eye_now{0.0};  // the centre of the eyes
@@ -42,6 +67,8 @@ struct SceneState {
   // Indices into the scene's lights. A light that goes dark costs nothing: no node
   // draws it, and the automatic light split shares out only the others.
   std::set<std::uint32_t> lights_off;
+  // By id: the live scene's instances, as the frame shows them.
+  std::map<std::string, InstanceState> instances;
 
   bool operator==(const SceneState&) const = default;
 };
@@ -63,7 +90,8 @@ struct SceneState {
 
 // Applies `delta` to `state`, or leaves it untouched and says what is wrong
 // (non-finite numbers, removing an object that does not exist, switching off a
-// light that is off or on one that is on).
+// light that is off or on one that is on, an instance whose parent is missing,
+// is itself or under it, or deeper than kMaxInstanceDepth).
 [[nodiscard]] Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta);
 
 }  // namespace optique::scene

@@ -11,11 +11,9 @@ namespace {
 
 using util::number_text;
 
-constexpr std::size_t kMaxIdLength = 64;
 constexpr double kMaxPosition = 1e6;  // metres from the origin: a world larger than any room, short of float trouble
 constexpr double kMinScale = 1e-4;
 constexpr double kMaxScale = 1e4;
-constexpr double kMaxEmissive = 1e3;
 
 // What is wrong, at a field relative to the edit ("transform.scale[1]").
 struct Wrong {
@@ -26,15 +24,11 @@ using Check = std::optional<Wrong>;
 
 Check id_problem(const std::string& field, const std::string& id) {
   if (id.empty()) return Wrong{field, "is needed"};
-  if (id.size() > kMaxIdLength) {
-    return Wrong{field,
-                 "is " + std::to_string(id.size()) + " characters long; at most " + std::to_string(kMaxIdLength)};
+  if (id.size() > scene::kMaxInstanceIdLength) {
+    return Wrong{field, "is " + std::to_string(id.size()) + " characters long; at most " +
+                            std::to_string(scene::kMaxInstanceIdLength)};
   }
-  for (char c : id) {
-    const bool ok =
-        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
-    if (!ok) return Wrong{field, "may only use letters, digits, '-', '_' and '.'"};
-  }
+  if (!scene::is_instance_id(id)) return Wrong{field, "may only use letters, digits, '-', '_' and '.'"};
   return std::nullopt;
 }
 
@@ -230,7 +224,7 @@ class LiveScene::Edits {
     }
     if (!f.emissive().empty()) {
       if (auto wrong = count_problem("emissive", f.emissive_size(), {3}, "[r, g, b]")) return wrong;
-      if (auto wrong = numbers_problem("emissive", f.emissive(), 0.0, kMaxEmissive)) return wrong;
+      if (auto wrong = numbers_problem("emissive", f.emissive(), 0.0, scene::kMaxEmissiveFactor)) return wrong;
       changed.emissive = {f.emissive(0), f.emissive(1), f.emissive(2)};
     }
     put(f.instance(), std::move(changed));

@@ -37,8 +37,8 @@ struct Instance {
 
 struct LiveSceneLimits {
   std::size_t max_instances = 100000;
-  std::size_t max_edits_per_frame = 100000;  // over every transaction of a frame
-  std::size_t max_depth = 64;                // instances above an instance, the world not counted
+  std::size_t max_edits_per_frame = 100000;          // over every transaction of a frame
+  std::size_t max_depth = scene::kMaxInstanceDepth;  // instances above an instance, the world not counted
 };
 
 // Why a transaction was refused: its first edit that could not be applied.

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -417,6 +418,128 @@ bool finite(const Pose& p) {
          std::isfinite(p.rotation.w) && std::isfinite(p.rotation.x) && std::isfinite(p.rotation.y) &&
          std::isfinite(p.rotation.z) && std::isfinite(p.scale.x) && std::isfinite(p.scale.y) &&
          std::isfinite(p.scale.z);
+}
+
+InstanceState instance(const std::string& asset, const std::string& parent, double x) {
+  InstanceState i;
+  i.asset = asset;
+  i.parent = parent;
+  i.pose = {pose(x, 1.0, 0.0, 0.1), pose(x + 0.1, 1.0, 0.0, 0.2)};
+  return i;
+}
+
+SceneState with_instances() {
+  SceneState s = before_state();
+  s.instances["table"] = instance("table", "", 0.0);
+  s.instances["cup"] = instance("cup", "table", 0.5);
+  s.instances["lamp"] = instance("lamp", "", 2.0);
+  s.instances["lamp"].visible = false;
+  s.instances["lamp"].emissive = {4.0, 3.0, 2.0};
+  return s;
+}
+
+// The instances an application placed travel as the objects do: in the
+// snapshot, in the delta only what changed, and in the hash.
+TEST(SceneInstances, TravelInSnapshotsDeltasAndTheHash) {
+  const SceneState before = with_instances();
+  auto snapshot = from_snapshot(to_snapshot(before));
+  ASSERT_TRUE(snapshot) << snapshot.error();
+  EXPECT_EQ(snapshot.value(), before);
+  EXPECT_EQ(state_hash(snapshot.value()), state_hash(before));
+
+  SceneState after = before;
+  after.instances["cup"].base_color = {1.0, 0.0, 0.0, 0.5};
+  after.instances["cup"].parent = "lamp";
+  after.instances.erase("table");
+  after.instances["chair"] = instance("chair", "", -1.0);
+  EXPECT_NE(state_hash(after), state_hash(before));
+  const wire::StateDelta delta = make_delta(before, after);
+  EXPECT_EQ(delta.instances_changed_size(), 2);  // the cup and the chair; not the lamp
+  ASSERT_EQ(delta.instances_removed_size(), 1);
+  EXPECT_EQ(delta.instances_removed(0), "table");
+  SceneState applied = before;
+  ASSERT_TRUE(apply_delta(applied, delta)) << apply_delta(applied, delta).error();
+  EXPECT_EQ(applied, after);
+  EXPECT_EQ(state_hash(applied), state_hash(after));
+  EXPECT_EQ(make_delta(after, after).instances_changed_size(), 0);
+}
+
+TEST(SceneInstances, EachFieldChangesTheHash) {
+  const SceneState base = with_instances();
+  const std::vector<void (*)(InstanceState&)> changes{
+      [](InstanceState& i) { i.asset = "teapot"; },       [](InstanceState& i) { i.parent = "lamp"; },
+      [](InstanceState& i) { i.pose.next.scale.y *= 2; }, [](InstanceState& i) { i.visible = false; },
+      [](InstanceState& i) { i.base_color.a = 0.5; },     [](InstanceState& i) { i.emissive.b = 0.0; }};
+  for (std::size_t k = 0; k < changes.size(); ++k) {
+    SceneState changed = base;
+    changes[k](changed.instances["cup"]);
+    EXPECT_NE(state_hash(changed), state_hash(base)) << "change " << k;
+    EXPECT_EQ(make_delta(base, changed).instances_changed_size(), 1) << "change " << k;
+  }
+}
+
+// What the parents make of the instances is checked as the delta would leave
+// them, and a refused delta leaves the state as it was.
+TEST(SceneInstances, ADeltaThatBreaksTheParentsIsRefused) {
+  const SceneState base = with_instances();
+  const auto refusal = [&](const std::function<void(wire::StateDelta&)>& edit) {
+    wire::StateDelta delta;
+    edit(delta);
+    SceneState state = base;
+    auto applied = apply_delta(state, delta);
+    if (applied) return std::string("accepted");
+    EXPECT_EQ(state, base) << "refused, but changed: " << applied.error();
+    return applied.error();
+  };
+  const auto changed = [](wire::StateDelta& d, const std::string& id, const InstanceState& i) {
+    SceneState one;
+    one.instances[id] = i;
+    d.add_instances_changed()->CopyFrom(to_snapshot(one).instances(0));
+  };
+  EXPECT_EQ(refusal([&](auto& d) { d.add_instances_removed("table"); }),
+            "delta: instance cup is under table, which does not exist");
+  EXPECT_EQ(refusal([&](auto& d) { changed(d, "saucer", instance("saucer", "plate", 0.0)); }),
+            "delta: instance saucer is under plate, which does not exist");
+  EXPECT_NE(refusal([&](auto& d) {
+              changed(d, "table", instance("table", "cup", 0.0));  // the cup is on the table
+            }).find("more than 64 instances deep, or under itself"),
+            std::string::npos);
+  EXPECT_EQ(refusal([&](auto& d) { changed(d, "cup", instance("cup", "cup", 0.0)); }),
+            "delta: instance cup is its own parent");
+  EXPECT_EQ(refusal([&](auto& d) { changed(d, "a b", instance("x", "", 0.0)); }),
+            "delta: an instance's id is not one (1 to 64 of a-z A-Z 0-9 - _ .)");
+  EXPECT_EQ(refusal([&](auto& d) { d.add_instances_removed("ghost"); }),
+            "delta removes instance ghost, which it cannot: it is not there, changed too, or removed twice");
+  EXPECT_EQ(refusal([&](auto& d) {
+              InstanceState red = instance("cup", "table", 0.0);
+              red.base_color = {2.0, 0.0, 0.0, 1.0};
+              changed(d, "cup", red);
+            }),
+            "delta: instance cup base colour is outside [0, 1.000000]");
+  EXPECT_EQ(refusal([&](auto& d) {
+              InstanceState lost = instance("cup", "table", 0.0);
+              lost.pose.now.position.x = std::nan("");
+              changed(d, "cup", lost);
+            }),
+            "delta: instance cup (now) position has a non-finite coordinate");
+  // Moving the cup off the table, then removing the table, is fine in one delta.
+  EXPECT_EQ(refusal([&](auto& d) {
+              changed(d, "cup", instance("cup", "lamp", 0.0));
+              d.add_instances_removed("table");
+            }),
+            "accepted");
+}
+
+TEST(SceneInstances, AChainOfParentsDeeperThanTheLimitIsRefused) {
+  SceneState deep;
+  for (std::size_t k = 0; k <= kMaxInstanceDepth; ++k) {
+    deep.instances["i" + std::to_string(k)] = instance("box", k == 0 ? "" : "i" + std::to_string(k - 1), 0.0);
+  }
+  EXPECT_TRUE(from_snapshot(to_snapshot(deep))) << "64 above the deepest: the limit";
+  deep.instances["i65"] = instance("box", "i64", 0.0);
+  auto refused = from_snapshot(to_snapshot(deep));
+  ASSERT_FALSE(refused);
+  EXPECT_EQ(refused.error(), "snapshot: instance i65 is more than 64 instances deep, or under itself");
 }
 
 TEST(BuiltinScene, CubesPosesAreFiniteUnitAndDeterministic) {
