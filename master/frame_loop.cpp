@@ -85,6 +85,11 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
 wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nanos display, bool captured,
                                                 clock::Nanos now, Actions& out) {
   scene::SceneState state = authority_.state_at_frame(frame);
+  if (settings_.live != nullptr) {
+    // Every edit made until now is in this frame; the next frame's budget of edits starts.
+    state.instances = frame_instances(*settings_.live);
+    settings_.live->begin_frame();
+  }
   if (head_) {
     std::vector<std::string> said;
     const HeadShown shown = head_->track(state, frame, display, now, said);
@@ -162,6 +167,9 @@ bool MasterProtocol::send_frame_begin(std::size_t slot, const wire::Envelope& en
     const std::uint64_t ahead = frame + static_cast<std::uint64_t>(up_conversion.frames_ahead());
     auto& begin_ahead = *to_node.mutable_frame_begin();
     scene::SceneState ahead_state = authority_.state_at_frame(ahead);
+    // Live edits cannot be known ahead: the key frame has the instances as
+    // they are now, and an edit reaches it `ahead - frame` frames late.
+    ahead_state.instances = current_state_.instances;
     // A tracked head that far ahead is a prediction that far ahead.
     if (head_) (void)head_->into(ahead_state, display + static_cast<clock::Nanos>(ahead - frame) * frame_period_);
     *begin_ahead.mutable_ahead() = scene::to_snapshot(ahead_state);

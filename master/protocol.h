@@ -38,6 +38,7 @@
 #include "master/run/stacked_groups.h"
 #include "master/run_recorder.h"
 #include "master/scene_server.h"
+#include "master/session/live_scene.h"
 #include "master/viewer_head.h"
 #include "net/auth.h"
 #include "net/session_seal.h"
@@ -62,6 +63,10 @@ struct RunSettings {
   // is computed: a barrier round is from then to the Swap, not the master's own
   // work on the frame. Unset (tests): the time of the event that began the frame.
   std::function<clock::Nanos()> send_clock;
+  // The live scene applications edit (master/session/live_scene.h), which must
+  // outlive the protocol: an edit made before frame k begins is in frame k.
+  // None: the scene is a function of time alone.
+  LiveScene* live = nullptr;
 };
 
 class MasterProtocol {

@@ -292,4 +292,18 @@ std::optional<Refusal> LiveScene::apply(const session::Transaction& transaction)
   return std::nullopt;
 }
 
+std::map<std::string, scene::InstanceState> frame_instances(const LiveScene& live) {
+  std::map<std::string, scene::InstanceState> states;
+  for (const auto& [id, instance] : live.instances()) {
+    scene::InstanceState& state = states[id];
+    state.asset = instance.asset;
+    state.parent = instance.parent;
+    state.pose = {instance.pose, instance.pose};
+    state.visible = instance.visible;
+    state.base_color = instance.base_color;
+    state.emissive = instance.emissive;
+  }
+  return states;
+}
+
 }  // namespace optique::master

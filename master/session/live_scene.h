@@ -77,4 +77,9 @@ class LiveScene {
   std::size_t edits_this_frame_ = 0;
 };
 
+// The instances as a frame shows them (scene/state.h): each at its pose, the
+// same now and at the next frame time, as an edit between them is not known
+// yet.
+[[nodiscard]] std::map<std::string, scene::InstanceState> frame_instances(const LiveScene& live);
+
 }  // namespace optique::master

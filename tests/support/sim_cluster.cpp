@@ -42,6 +42,8 @@ struct SimCluster::SimNode {
   std::vector<std::uint64_t> presented;
   std::uint64_t last_rendered = 0;
   std::optional<std::uint64_t> repaired_frame;  // the frame a repair snapshot precedes: its ready must match
+  std::map<std::uint64_t, std::set<std::string>> instances_drawn;
+  std::map<std::uint64_t, std::set<std::string>> instances_ahead;
 };
 
 SimCluster::SimCluster(const master::RunConfig& run, master::RunSettings settings, std::uint64_t corrupt_frame) {
@@ -63,6 +65,14 @@ SimCluster::~SimCluster() = default;
 
 void SimCluster::violation(const std::string& what) {
   if (violations_.size() < 20) violations_.push_back(what);
+}
+
+const std::map<std::uint64_t, std::set<std::string>>& SimCluster::instances_drawn(std::size_t node) const {
+  return nodes_.at(node)->instances_drawn;
+}
+
+const std::map<std::uint64_t, std::set<std::string>>& SimCluster::instances_ahead(std::size_t node) const {
+  return nodes_.at(node)->instances_ahead;
 }
 
 const std::vector<std::uint64_t>& SimCluster::presented(std::size_t node) const { return nodes_[node]->presented; }
@@ -284,6 +294,13 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
             },
             [&](node::Render& a) {
               n.last_rendered = a.frame.frame_id;
+              for (const auto& instance : n.protocol.state().instances) {
+                n.instances_drawn[a.frame.frame_id].insert(instance.first);
+              }
+              if (a.frame.ahead != nullptr) {
+                auto& ahead = n.instances_ahead[a.frame.frame_id];
+                for (const auto& instance : a.frame.ahead->instances) ahead.insert(instance.first);
+              }
               node_actions(i,
                            n.protocol.answer(node::FrameRendered{a.frame.frame_id, clock::kNanosPerMilli, {}}, now_));
             },

@@ -57,6 +57,10 @@ class SimCluster {
   [[nodiscard]] std::size_t nodes() const { return nodes_.size(); }
   // Frames node i showed, in order.
   [[nodiscard]] const std::vector<std::uint64_t>& presented(std::size_t node) const;
+  // The live scene's instances in the state node i drew each frame with (none: not listed).
+  [[nodiscard]] const std::map<std::uint64_t, std::set<std::string>>& instances_drawn(std::size_t node) const;
+  // The same in the state sent ahead with each frame (a node that interpolates).
+  [[nodiscard]] const std::map<std::uint64_t, std::set<std::string>>& instances_ahead(std::size_t node) const;
   [[nodiscard]] const master::MasterProtocol& master() const { return *master_; }
   [[nodiscard]] const master::RunRecorder& recorder() const { return *recorder_; }
 

@@ -45,6 +45,48 @@ TEST(SimCluster, EveryNodeShowsEveryFrameAndTheRunEndsCleanly) {
   EXPECT_EQ(report.sync().present_skew_us().max(), 0.0) << "one clock: every node presents at the deadline";
 }
 
+// An application's edit made before frame k begins is drawn in frame k by
+// every node, and not before; the nodes' states keep the master's hash.
+// Also where a projector interpolates between key frames drawn ahead (the
+// state sent ahead carries the instances as they are when it is sent).
+class LiveEdits : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(LiveEdits, AnEditBeforeAFrameBeginsIsInThatFrameOnEveryNode) {
+  const master::RunConfig run = load(GetParam());
+  master::LiveScene live;
+  live.add_asset("torus");
+  master::RunSettings settings = for_frames(30);
+  settings.live = &live;
+  SimCluster cluster(run, settings);
+  cluster.start();
+  cluster.run_promptly(cluster.now() + kSecond / 6);  // about ten frames in
+  const std::uint64_t k = cluster.master().progress().next_frame;
+  ASSERT_GT(k, 2u);
+  ASSERT_LT(k, 25u);
+  session::Transaction create;
+  create.add_edits()->mutable_create()->set_instance("t1");
+  create.mutable_edits(0)->mutable_create()->set_asset("torus");
+  ASSERT_FALSE(live.apply(create));
+  cluster.run_promptly(cluster.now() + 10 * kSecond);
+  EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
+  const report::RunReport report = cluster.master().report();
+  for (std::size_t i = 0; i < cluster.nodes(); ++i) {
+    EXPECT_EQ(cluster.presented(i), frames(0, 30)) << i;
+    EXPECT_EQ(report.nodes(static_cast<int>(i)).hash_mismatches(), 0u) << i;
+    for (std::uint64_t frame = 0; frame < 30; ++frame) {
+      const auto& drawn = cluster.instances_drawn(i);
+      const bool has = drawn.contains(frame) && drawn.at(frame).contains("t1");
+      EXPECT_EQ(has, frame >= k) << "node " << i << ", frame " << frame << ", edit before frame " << k;
+    }
+    // Sent ahead: the instances as they are when the frame that carries them begins.
+    for (const auto& [frame, ahead] : cluster.instances_ahead(i)) {
+      EXPECT_EQ(ahead.contains("t1"), frame >= k) << "node " << i << ", ahead with frame " << frame;
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Configs, LiveEdits, ::testing::Values("powerwall-2x2.json", "stacked-upconversion.json"));
+
 TEST(SimCluster, AWrongStateIsRepairedTheNextFrame) {
   const master::RunConfig run = load("powerwall-2x2.json");
   SimCluster cluster(run, for_frames(20), 5);
