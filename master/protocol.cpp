@@ -6,6 +6,7 @@
 #include <csignal>
 
 #include "net/envelope.h"
+#include "net/hello_proof.h"
 #include "protocol/scene_fetch.h"
 #include "protocol/welcome.h"
 #include "util/join.h"
@@ -13,19 +14,6 @@
 namespace optique::master {
 
 using clock::nanos;
-
-namespace {
-
-// A Refuse: its reason, and whether trying again later may get in.
-wire::Envelope refusal(const std::string& reason, bool retriable) {
-  wire::Envelope envelope;
-  envelope.set_protocol_version(net::kProtocolVersion);
-  envelope.mutable_refuse()->set_reason(reason);
-  envelope.mutable_refuse()->set_retriable(retriable);
-  return envelope;
-}
-
-}  // namespace
 
 MasterProtocol::MasterProtocol(const config::Installation& installation, const scene::LoadedScene& scene,
                                RunSettings settings, RunRecorder& recorder)
@@ -99,11 +87,11 @@ Actions MasterProtocol::accepted(PeerId peer, const std::string& peer_text, bool
   const auto refuse_at_door = [&](const std::string& reason, bool retriable) {
     out.push_back(Log{spdlog::level::warn, "refused connection from " + peer_text + ": " + reason});
     ++refused_connections_;
-    out.push_back(Send{peer, refusal(reason, retriable)});
+    out.push_back(Send{peer, net::refusal(reason, retriable)});
     out.push_back(Close{peer, "refused: " + reason, true});
   };
   if (state_ != RunState::starting && state_ != RunState::running) {
-    out.push_back(Send{peer, refusal("the master is shutting down", true)});
+    out.push_back(Send{peer, net::refusal("the master is shutting down", true)});
     out.push_back(Close{peer, "the master is shutting down", true});
     return out;
   }
@@ -207,7 +195,7 @@ void MasterProtocol::refuse(PeerId peer, Session& session, const std::string& no
   out.push_back(Log{spdlog::level::warn, "refused node '" + node_id + "' from " + session.peer_text + ": " + reason});
   session.refused = true;
   ++refused_connections_;
-  out.push_back(Send{peer, refusal(reason, retriable)});
+  out.push_back(Send{peer, net::refusal(reason, retriable)});
   out.push_back(Close{peer, "refused: " + reason, true});
 }
 
@@ -236,34 +224,15 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
     return;
   }
   if (settings_.secret) {
-    const std::string& mac = hello.nonce_mac();
-    if (mac.empty()) {
-      refuse(peer, session, hello.node_id(),
-             "this master requires the installation's shared secret: start the node with --secret-file", false, out);
-      return;
-    }
-    const std::string& node_nonce = hello.node_nonce();
-    if (node_nonce.size() != net::kNonceBytes) {
-      refuse(peer, session, hello.node_id(),
-             fmt::format("the hello's node nonce has {} bytes, not {}", node_nonce.size(), net::kNonceBytes), false,
-             out);
-      return;
-    }
-    std::vector<std::uint8_t> both = session.nonce;
-    both.insert(both.end(), node_nonce.begin(), node_nonce.end());
-    if (!net::verify_hello_mac(*settings_.secret, both, hello.node_id(), message.protocol_version(),
-                               std::span(reinterpret_cast<const std::uint8_t*>(mac.data()), mac.size()))) {
-      refuse(peer, session, hello.node_id(), "authentication failed: the node's secret does not match the master's",
-             false, out);
+    auto keys = net::check_hello(*settings_.secret, session.nonce, hello, message.protocol_version(), "node",
+                                 "start the node with --secret-file");
+    if (!keys) {
+      refuse(peer, session, hello.node_id(), keys.error(), false, out);
       return;
     }
     // Everything from here on is sealed, refusals included: the node knows its
     // master by the first message that opens.
-    out.push_back(Protect{
-        peer,
-        net::derive_session_keys(*settings_.secret, session.nonce,
-                                 std::span(reinterpret_cast<const std::uint8_t*>(node_nonce.data()), node_nonce.size()),
-                                 hello.node_id(), message.protocol_version())});
+    out.push_back(Protect{peer, keys.value()});
   }
   const std::optional<std::size_t> slot = installation_.find_projector(hello.node_id());
   if (!slot) {

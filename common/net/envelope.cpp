@@ -30,4 +30,12 @@ const char* body_name(const wire::Envelope& envelope) {
   return field != nullptr ? field->name().c_str() : "none";
 }
 
+wire::Envelope refusal(const std::string& reason, bool retriable) {
+  wire::Envelope envelope;
+  envelope.set_protocol_version(kProtocolVersion);
+  envelope.mutable_refuse()->set_reason(reason);
+  envelope.mutable_refuse()->set_retriable(retriable);
+  return envelope;
+}
+
 }  // namespace optique::net

@@ -5,6 +5,8 @@
 #include <span>
 #include <vector>
 
+#include <string>
+
 #include "optique/wire.pb.h"
 #include "util/result.h"
 
@@ -13,8 +15,10 @@ namespace optique::net {
 // Bumped whenever a message changes meaning; master and node must agree exactly.
 // 5: the welcome says how many lights the scene has; 6: the scene's files travel
 // from the master to nodes that lack them; 7: a node that is behind is told to
-// skip frames, and says how long its warm-up frame took.
-inline constexpr std::uint32_t kProtocolVersion = 7;
+// skip frames, and says how long its warm-up frame took; 8: the state carries
+// the live scene's instances (and the hash covers them), and applications speak
+// the scene session on master.api.
+inline constexpr std::uint32_t kProtocolVersion = 8;
 
 // Serializes `envelope` and appends it as one frame to `out`.
 void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envelope);
@@ -25,5 +29,9 @@ void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envel
 
 // "frame_begin", "hello", ...: for log lines.
 [[nodiscard]] const char* body_name(const wire::Envelope& envelope);
+
+// A Refuse: its reason, and whether trying again later may get in (sent plain,
+// with the protocol version, as a peer that is refused may not share keys).
+[[nodiscard]] wire::Envelope refusal(const std::string& reason, bool retriable);
 
 }  // namespace optique::net

@@ -1,0 +1,159 @@
+#include "master/session/scene_sessions.h"
+
+#include <algorithm>
+
+#include "net/envelope.h"
+#include "net/hello_proof.h"
+
+namespace optique::master {
+namespace {
+
+using session_action::Close;
+using session_action::Log;
+using session_action::Protect;
+using session_action::Send;
+
+wire::Envelope reply(std::uint64_t id) {
+  wire::Envelope envelope;
+  envelope.mutable_session_reply()->set_id(id);
+  return envelope;
+}
+
+}  // namespace
+
+SessionActions SceneSessions::accepted(SessionId id, const std::string& peer_text, bool loopback,
+                                       const std::vector<std::uint8_t>& nonce) {
+  SessionActions out;
+  Session& session = sessions_[id];
+  session.peer_text = peer_text;
+  session.nonce = nonce;
+  if (!loopback && !settings_.secret) {
+    refuse(id, session, "this master takes applications from other machines only with the shared secret", false, out);
+    return out;
+  }
+  if (sessions_.size() > settings_.max_sessions) {
+    refuse(id, session,
+           "the master holds " + std::to_string(settings_.max_sessions) + " scene sessions, the most it may", true,
+           out);
+    return out;
+  }
+  wire::Envelope challenge;
+  challenge.set_protocol_version(net::kProtocolVersion);
+  challenge.mutable_challenge()->set_nonce(std::string(nonce.begin(), nonce.end()));
+  challenge.mutable_challenge()->set_secret_required(settings_.secret.has_value());
+  out.push_back(Send{id, std::move(challenge)});
+  return out;
+}
+
+SessionActions SceneSessions::message(SessionId id, const wire::Envelope& message, std::uint64_t next_frame) {
+  SessionActions out;
+  const auto found = sessions_.find(id);
+  if (found == sessions_.end() || found->second.refused) return out;
+  Session& session = found->second;
+  if (session.application.empty()) {
+    on_hello(id, session, message, out);
+    return out;
+  }
+  if (message.protocol_version() != net::kProtocolVersion) {
+    out.push_back(Close{id, "protocol version changed mid-connection"});
+    return out;
+  }
+  switch (message.body_case()) {
+    case wire::Envelope::kSessionRequest:
+      on_request(id, message.session_request(), next_frame, out);
+      break;
+    case wire::Envelope::kHeartbeat:
+      break;
+    case wire::Envelope::kGoodbye:
+      out.push_back(Close{id, "the application said goodbye"});
+      break;
+    default:
+      out.push_back(Close{id, std::string("unexpected ") + net::body_name(message) + " from an application"});
+      break;
+  }
+  return out;
+}
+
+SessionActions SceneSessions::closed(SessionId id, const std::string& reason) {
+  SessionActions out;
+  const auto found = sessions_.find(id);
+  if (found == sessions_.end()) return out;
+  if (!found->second.application.empty()) {
+    out.push_back(Log{spdlog::level::info, "application '" + found->second.application + "' at " +
+                                               found->second.peer_text + " left: " + reason});
+  }
+  sessions_.erase(found);
+  return out;
+}
+
+void SceneSessions::refuse(SessionId id, Session& session, const std::string& reason, bool retriable,
+                           SessionActions& out) {
+  out.push_back(Log{spdlog::level::warn, "refused an application at " + session.peer_text + ": " + reason});
+  session.refused = true;
+  out.push_back(Send{id, net::refusal(reason, retriable)});
+  out.push_back(Close{id, "refused: " + reason, true});
+}
+
+void SceneSessions::on_hello(SessionId id, Session& session, const wire::Envelope& message, SessionActions& out) {
+  if (message.body_case() != wire::Envelope::kHello) {
+    refuse(id, session, std::string("expected hello, got ") + net::body_name(message), false, out);
+    return;
+  }
+  const wire::Hello& hello = message.hello();
+  if (message.protocol_version() != net::kProtocolVersion) {
+    refuse(id, session,
+           "protocol version mismatch: the application speaks v" + std::to_string(message.protocol_version()) +
+               ", the master v" + std::to_string(net::kProtocolVersion),
+           false, out);
+    return;
+  }
+  const auto& capabilities = hello.capabilities();
+  if (std::find(capabilities.begin(), capabilities.end(), kSceneSessionCapability) == capabilities.end()) {
+    refuse(id, session,
+           std::string("this port is the scene session: say \"") + kSceneSessionCapability +
+               "\" among the hello's capabilities",
+           false, out);
+    return;
+  }
+  // Its name goes into logs and the operator's page as it is.
+  if (!scene::is_instance_id(hello.node_id())) {
+    refuse(id, session, "name the application in the hello: 1 to 64 letters, digits, '-', '_' or '.'", false, out);
+    return;
+  }
+  if (settings_.secret) {
+    auto keys = net::check_hello(*settings_.secret, session.nonce, hello, message.protocol_version(), "application",
+                                 "give the application the installation's secret file");
+    if (!keys) {
+      refuse(id, session, keys.error(), false, out);
+      return;
+    }
+    out.push_back(Protect{id, keys.value()});
+  }
+  session.application = hello.node_id();
+  out.push_back(
+      Log{spdlog::level::info, "application '" + session.application + "' connected from " + session.peer_text});
+}
+
+void SceneSessions::on_request(SessionId id, const session::Request& request, std::uint64_t next_frame,
+                               SessionActions& out) {
+  wire::Envelope answer = reply(request.id());
+  switch (request.request_case()) {
+    case session::Request::kTransaction:
+      if (auto refusal = live_.apply(request.transaction())) {
+        auto& refused = *answer.mutable_session_reply()->mutable_refused();
+        refused.set_edit(static_cast<std::uint32_t>(refusal->edit));
+        refused.set_field(refusal->field);
+        refused.set_reason(refusal->reason);
+      } else {
+        answer.mutable_session_reply()->mutable_applied()->set_frame(next_frame);
+      }
+      break;
+    case session::Request::REQUEST_NOT_SET:
+      answer.mutable_session_reply()->mutable_refused()->set_field("request");
+      answer.mutable_session_reply()->mutable_refused()->set_reason("is empty or of a kind this master does not know");
+      break;
+  }
+  out.push_back(Send{id, std::move(answer)});
+}
+
+}  // namespace optique::master

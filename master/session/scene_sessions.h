@@ -1,0 +1,95 @@
+#pragma once
+// The scene session's rules (master.api), with no socket: an application's
+// connection is greeted with a Challenge as a node's is, answers with a Hello
+// naming itself (capability "scene-session"; with the installation's shared
+// secret, its MAC, and every message after it sealed), then sends requests;
+// each transaction is applied to the live scene (live_scene.h) and answered
+// with the frame from which every node shows it, or why it was refused. The
+// master's shell carries out the actions on its connections.
+
+#include <spdlog/common.h>
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "master/session/live_scene.h"
+#include "net/auth.h"
+#include "net/session_seal.h"
+#include "optique/wire.pb.h"
+
+namespace optique::master {
+
+using SessionId = std::uint64_t;
+
+namespace session_action {
+struct Send {
+  SessionId session = 0;
+  wire::Envelope message;
+};
+// Close the connection; `after_sending`: once what is queued has gone (a refusal).
+struct Close {
+  SessionId session = 0;
+  std::string reason;
+  bool after_sending = false;
+};
+// Seal everything from now on (net/session_seal.h).
+struct Protect {
+  SessionId session = 0;
+  net::SessionKeys keys;
+};
+struct Log {
+  spdlog::level::level_enum level = spdlog::level::info;
+  std::string text;
+};
+}  // namespace session_action
+
+using SessionAction =
+    std::variant<session_action::Send, session_action::Close, session_action::Protect, session_action::Log>;
+using SessionActions = std::vector<SessionAction>;
+
+// The capability an application's Hello names.
+inline constexpr const char* kSceneSessionCapability = "scene-session";
+
+struct SceneSessionSettings {
+  std::size_t max_sessions = 16;
+  // Applications must prove they hold it; without one only loopback peers are accepted.
+  std::optional<net::Secret> secret;
+};
+
+class SceneSessions {
+ public:
+  // `live` must outlive it.
+  SceneSessions(LiveScene& live, SceneSessionSettings settings) : live_(live), settings_(std::move(settings)) {}
+
+  // A connection from `peer_text` (loopback: from this machine); `nonce`: fresh
+  // randomness for its challenge (net::random_nonce()).
+  [[nodiscard]] SessionActions accepted(SessionId session, const std::string& peer_text, bool loopback,
+                                        const std::vector<std::uint8_t>& nonce);
+  // `next_frame`: the frame the master begins next, which shows what is applied now.
+  [[nodiscard]] SessionActions message(SessionId session, const wire::Envelope& message, std::uint64_t next_frame);
+  [[nodiscard]] SessionActions closed(SessionId session, const std::string& reason);
+
+  [[nodiscard]] std::size_t open() const { return sessions_.size(); }
+
+ private:
+  struct Session {
+    std::string peer_text;
+    std::vector<std::uint8_t> nonce;
+    std::string application;  // from its hello; empty before
+    bool refused = false;
+  };
+
+  void on_hello(SessionId id, Session& session, const wire::Envelope& message, SessionActions& out);
+  void refuse(SessionId id, Session& session, const std::string& reason, bool retriable, SessionActions& out);
+  void on_request(SessionId id, const session::Request& request, std::uint64_t next_frame, SessionActions& out);
+
+  LiveScene& live_;
+  SceneSessionSettings settings_;
+  std::map<SessionId, Session> sessions_;
+};
+
+}  // namespace optique::master

@@ -1,0 +1,170 @@
+// The scene session's rules: master/session/scene_sessions.h.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "master/session/scene_sessions.h"
+#include "net/envelope.h"
+
+namespace optique::master {
+namespace {
+
+const std::vector<std::uint8_t> kNonce(net::kNonceBytes, 7);
+
+wire::Envelope hello(const std::string& name, bool capable = true) {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  e.mutable_hello()->set_node_id(name);
+  if (capable) e.mutable_hello()->add_capabilities(kSceneSessionCapability);
+  return e;
+}
+
+wire::Envelope create(std::uint64_t id, const std::string& instance, const std::string& asset) {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  e.mutable_session_request()->set_id(id);
+  auto& c = *e.mutable_session_request()->mutable_transaction()->add_edits()->mutable_create();
+  c.set_instance(instance);
+  c.set_asset(asset);
+  return e;
+}
+
+template <class T>
+std::vector<T> of(const SessionActions& actions) {
+  std::vector<T> found;
+  for (const SessionAction& a : actions) {
+    if (const T* t = std::get_if<T>(&a)) found.push_back(*t);
+  }
+  return found;
+}
+
+std::string refusal_of(const SessionActions& actions) {
+  const auto sends = of<session_action::Send>(actions);
+  const auto closes = of<session_action::Close>(actions);
+  if (sends.size() != 1 || !sends[0].message.has_refuse() || closes.size() != 1 || !closes[0].after_sending) {
+    return "not refused";
+  }
+  return sends[0].message.refuse().reason();
+}
+
+class SceneSessionsTest : public ::testing::Test {
+ protected:
+  SceneSessionsTest() { live_.add_asset("torus"); }
+  LiveScene live_;
+};
+
+TEST_F(SceneSessionsTest, AnApplicationIsChallengedSaysHelloAndItsEditsNameTheirFrame) {
+  SceneSessions sessions(live_, {});
+  const auto greeted = sessions.accepted(1, "127.0.0.1:5000", true, kNonce);
+  ASSERT_EQ(of<session_action::Send>(greeted).size(), 1u);
+  const wire::Envelope challenge = of<session_action::Send>(greeted)[0].message;
+  ASSERT_TRUE(challenge.has_challenge());
+  EXPECT_FALSE(challenge.challenge().secret_required());
+  EXPECT_EQ(challenge.challenge().nonce(), std::string(kNonce.begin(), kNonce.end()));
+
+  const auto admitted = sessions.message(1, hello("design-review"), 40);
+  ASSERT_EQ(of<session_action::Log>(admitted).size(), 1u);
+  EXPECT_EQ(of<session_action::Log>(admitted)[0].text, "application 'design-review' connected from 127.0.0.1:5000");
+  EXPECT_TRUE(of<session_action::Send>(admitted).empty());
+
+  const auto applied = sessions.message(1, create(9, "t1", "torus"), 41);
+  ASSERT_EQ(of<session_action::Send>(applied).size(), 1u);
+  const session::Reply ok = of<session_action::Send>(applied)[0].message.session_reply();
+  EXPECT_EQ(ok.id(), 9u);
+  ASSERT_TRUE(ok.has_applied());
+  EXPECT_EQ(ok.applied().frame(), 41u);
+  EXPECT_EQ(live_.instances().count("t1"), 1u);
+
+  const auto refused = sessions.message(1, create(10, "t2", "teapot"), 42);
+  const session::Reply no = of<session_action::Send>(refused)[0].message.session_reply();
+  EXPECT_EQ(no.id(), 10u);
+  ASSERT_TRUE(no.has_refused());
+  EXPECT_EQ(no.refused().field(), "edits[0].create.asset");
+  EXPECT_EQ(no.refused().reason(), "no asset 'teapot' is loaded");
+  EXPECT_TRUE(of<session_action::Close>(refused).empty()) << "a refused edit keeps the session";
+
+  wire::Envelope empty;
+  empty.set_protocol_version(net::kProtocolVersion);
+  empty.mutable_session_request()->set_id(11);
+  const auto unknown = sessions.message(1, empty, 42);
+  EXPECT_EQ(of<session_action::Send>(unknown)[0].message.session_reply().refused().field(), "request");
+
+  const auto left = sessions.closed(1, "connection reset");
+  EXPECT_EQ(of<session_action::Log>(left)[0].text,
+            "application 'design-review' at 127.0.0.1:5000 left: connection reset");
+  EXPECT_EQ(sessions.open(), 0u);
+}
+
+TEST_F(SceneSessionsTest, WhatIsNotAnApplicationIsRefused) {
+  SceneSessions sessions(live_, {});
+  (void)sessions.accepted(1, "a", true, kNonce);
+  EXPECT_NE(refusal_of(sessions.message(1, hello("node-1", false), 0)).find("say \"scene-session\""),
+            std::string::npos);
+  (void)sessions.accepted(2, "b", true, kNonce);
+  EXPECT_NE(refusal_of(sessions.message(2, hello("a b"), 0)).find("name the application"), std::string::npos);
+  (void)sessions.accepted(3, "c", true, kNonce);
+  EXPECT_EQ(refusal_of(sessions.message(3, create(1, "t", "torus"), 0)), "expected hello, got session_request");
+  EXPECT_TRUE(live_.instances().empty());
+  (void)sessions.accepted(4, "d", true, kNonce);
+  wire::Envelope old = hello("app");
+  old.set_protocol_version(net::kProtocolVersion - 1);
+  EXPECT_NE(refusal_of(sessions.message(4, old, 0)).find("protocol version mismatch"), std::string::npos);
+  // After its hello, a node's message closes the session.
+  (void)sessions.accepted(5, "e", true, kNonce);
+  (void)sessions.message(5, hello("app"), 0);
+  wire::Envelope ready;
+  ready.set_protocol_version(net::kProtocolVersion);
+  ready.mutable_frame_ready()->set_frame_id(3);
+  const auto closed = of<session_action::Close>(sessions.message(5, ready, 0));
+  ASSERT_EQ(closed.size(), 1u);
+  EXPECT_EQ(closed[0].reason, "unexpected frame_ready from an application");
+}
+
+TEST_F(SceneSessionsTest, FromAnotherMachineOnlyWithTheSecret) {
+  SceneSessions open(live_, {});
+  EXPECT_NE(refusal_of(open.accepted(1, "10.0.0.5:4000", false, kNonce)).find("only with the shared secret"),
+            std::string::npos);
+
+  SceneSessionSettings settings;
+  settings.secret = net::Secret{std::vector<std::uint8_t>(32, 9)};
+  SceneSessions guarded(live_, settings);
+  const auto greeted = guarded.accepted(2, "10.0.0.5:4001", false, kNonce);
+  EXPECT_TRUE(of<session_action::Send>(greeted)[0].message.challenge().secret_required());
+  EXPECT_NE(refusal_of(guarded.message(2, hello("app"), 0)).find("requires the installation's shared secret"),
+            std::string::npos);
+
+  const std::vector<std::uint8_t> app_nonce(net::kNonceBytes, 3);
+  std::vector<std::uint8_t> both = kNonce;
+  both.insert(both.end(), app_nonce.begin(), app_nonce.end());
+  const auto with_mac = [&](const net::Secret& secret) {
+    wire::Envelope e = hello("app");
+    const auto mac = net::hello_mac(secret, both, "app", net::kProtocolVersion);
+    e.mutable_hello()->set_nonce_mac(std::string(mac.begin(), mac.end()));
+    e.mutable_hello()->set_node_nonce(std::string(app_nonce.begin(), app_nonce.end()));
+    return e;
+  };
+  (void)guarded.accepted(3, "10.0.0.5:4002", false, kNonce);
+  EXPECT_NE(refusal_of(guarded.message(3, with_mac(net::Secret{std::vector<std::uint8_t>(32, 8)}), 0))
+                .find("the application's secret does not match"),
+            std::string::npos);
+  (void)guarded.accepted(4, "10.0.0.5:4003", false, kNonce);
+  const auto admitted = guarded.message(4, with_mac(*settings.secret), 0);
+  EXPECT_EQ(of<session_action::Protect>(admitted).size(), 1u) << "everything after the hello is sealed";
+  EXPECT_EQ(of<session_action::Send>(guarded.message(4, create(1, "t", "torus"), 5)).size(), 1u);
+}
+
+TEST_F(SceneSessionsTest, TheNumberOfSessionsIsBounded) {
+  SceneSessionSettings settings;
+  settings.max_sessions = 2;
+  SceneSessions sessions(live_, settings);
+  EXPECT_EQ(refusal_of(sessions.accepted(1, "a", true, kNonce)), "not refused");
+  EXPECT_EQ(refusal_of(sessions.accepted(2, "b", true, kNonce)), "not refused");
+  EXPECT_EQ(refusal_of(sessions.accepted(3, "c", true, kNonce)), "the master holds 2 scene sessions, the most it may");
+  (void)sessions.closed(3, "refused");
+  (void)sessions.closed(1, "gone");
+  EXPECT_EQ(refusal_of(sessions.accepted(4, "d", true, kNonce)), "not refused");
+}
+
+}  // namespace
+}  // namespace optique::master
