@@ -84,6 +84,7 @@ report::RunReport MasterProtocol::report() const {
   report.set_stopped_because(stopped_because_);
   report.set_connections_refused(refused_connections_);
   if (head_) *report.mutable_tracking() = head_->report();
+  report.set_instances(current_state_.instances.size());
   return report;
 }
 

@@ -145,6 +145,21 @@ std::string summarize(const config::LoadedConfig& config) {
                                   : "controls need the token")
         << "; at most " << m.status->max_connections << " connections\n";
   }
+  if (m.api) {
+    const std::string host = m.api->listen.find(':') != std::string::npos ? "[" + m.api->listen + "]" : m.api->listen;
+    out << "  api: scene sessions on " << host << ":"
+        << (m.api->port == 0 ? "an ephemeral port the master logs when it starts" : std::to_string(m.api->port))
+        << (config::is_loopback_address(m.api->listen) ? "" : ", applications prove the shared secret") << "; at most "
+        << m.api->max_sessions << " sessions, " << m.api->max_instances << " instances, " << m.api->max_edits_per_frame
+        << " edits a frame; an edit made before frame k begins is in frame k";
+    // Key frames drawn ahead cannot know a later edit.
+    for (const config::Projector& p : inst.projectors) {
+      if (p.up_conversion.frames_ahead() > 0) {
+        out << "; on " << p.id << " (interpolating) " << p.up_conversion.frames_ahead() << " frames later";
+      }
+    }
+    out << "\n";
+  }
   out << "  scene: " << (inst.scene.builtin.empty() ? "glTF " + inst.scene.gltf : "builtin " + inst.scene.builtin);
   if (!inst.scene.light_switches.empty()) {
     out << ", " << inst.scene.light_switches.size() << " light switch(es) from "

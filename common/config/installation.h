@@ -154,6 +154,15 @@ struct StatusServer {
   std::uint32_t max_connections = defaults::kStatusMaxConnections;
 };
 
+// master.api: the scene session, where applications edit the live scene.
+struct ApiServer {
+  std::string listen = "127.0.0.1";
+  std::uint16_t port = defaults::kApiPort;  // 0: ephemeral
+  std::uint32_t max_sessions = defaults::kApiMaxSessions;
+  std::uint32_t max_edits_per_frame = defaults::kApiMaxEditsPerFrame;
+  std::uint32_t max_instances = defaults::kApiMaxInstances;
+};
+
 struct MasterSettings {
   std::string listen = "0.0.0.0";
   std::uint16_t port = 0;  // 0: ephemeral
@@ -169,6 +178,7 @@ struct MasterSettings {
   std::uint32_t max_pending_connections = defaults::kMaxPendingConnections;
   StragglerPolicy straggler_policy = StragglerPolicy::present;
   std::optional<StatusServer> status;
+  std::optional<ApiServer> api;  // none: no application can connect
   // The share of frames every projector must show for the run to succeed;
   // none: at least one frame shown by any projector.
   std::optional<double> min_presented;

@@ -14,17 +14,24 @@ T or_default(T value, T fallback) {
   return value == T{} ? fallback : value;
 }
 
+// An address to listen on (empty: loopback); beyond loopback only with the
+// shared secret, for `why`.
+void check_listen(Checker& check, const std::string& path, const std::string& listen, const schema::MasterSettings& m,
+                  const std::string& why) {
+  if (listen.empty()) return;
+  if (!is_ip_address(listen)) {
+    check.fail(path, "'" + listen + "' is not an IPv4 or IPv6 address");
+  } else if (!is_loopback_address(listen) && m.secret_file().empty()) {
+    check.fail(path, "'" + listen + "' is reached from other machines, so " + why +
+                         ": set master.secret_file (or listen on 127.0.0.1)");
+  }
+}
+
 std::optional<StatusServer> parse_status(const schema::MasterSettings& m, Checker& check) {
   if (!m.has_status()) return std::nullopt;
   const schema::StatusServer& st = m.status();
-  if (!st.listen().empty() && !is_ip_address(st.listen())) {
-    check.fail("master.status.listen", "'" + st.listen() + "' is not an IPv4 or IPv6 address");
-  } else if (!st.listen().empty() && !is_loopback_address(st.listen()) && m.secret_file().empty()) {
-    check.fail("master.status.listen",
-               "'" + st.listen() +
-                   "' is reached from other machines, so the status needs a bearer token, derived from the "
-                   "shared secret: set master.secret_file (or listen on 127.0.0.1)");
-  }
+  check_listen(check, "master.status.listen", st.listen(), m,
+               "the status needs a bearer token, derived from the shared secret");
   if (st.port() > 65535) check.fail("master.status.port", "must be 0..65535 (got " + std::to_string(st.port()) + ")");
   if (st.max_connections() > 100000) {
     check.fail("master.status.max_connections",
@@ -35,6 +42,31 @@ std::optional<StatusServer> parse_status(const schema::MasterSettings& m, Checke
   if (st.has_port()) status.port = static_cast<std::uint16_t>(st.port());
   status.max_connections = or_default(st.max_connections(), defaults::kStatusMaxConnections);
   return status;
+}
+
+// Beyond loopback only with the secret, as the status server.
+std::optional<ApiServer> parse_api(const schema::MasterSettings& m, Checker& check) {
+  if (!m.has_api()) return std::nullopt;
+  const schema::ApiServer& a = m.api();
+  check_listen(check, "master.api.listen", a.listen(), m, "applications must prove they hold the shared secret");
+  if (a.port() > 65535) check.fail("master.api.port", "must be 0..65535 (got " + std::to_string(a.port()) + ")");
+  if (a.max_sessions() > 1000) {
+    check.fail("master.api.max_sessions", "must be at most 1000 (got " + std::to_string(a.max_sessions()) + ")");
+  }
+  if (a.max_edits_per_frame() > 10000000) {
+    check.fail("master.api.max_edits_per_frame",
+               "must be at most 10000000 (got " + std::to_string(a.max_edits_per_frame()) + ")");
+  }
+  if (a.max_instances() > 10000000) {
+    check.fail("master.api.max_instances", "must be at most 10000000 (got " + std::to_string(a.max_instances()) + ")");
+  }
+  ApiServer api;
+  if (!a.listen().empty()) api.listen = a.listen();
+  if (a.has_port()) api.port = static_cast<std::uint16_t>(a.port());
+  api.max_sessions = or_default(a.max_sessions(), defaults::kApiMaxSessions);
+  api.max_edits_per_frame = or_default(a.max_edits_per_frame(), defaults::kApiMaxEditsPerFrame);
+  api.max_instances = or_default(a.max_instances(), defaults::kApiMaxInstances);
+  return api;
 }
 
 }  // namespace
@@ -72,6 +104,7 @@ MasterSettings parse_master(const schema::MasterSettings& m, Checker& check) {
   }
   master.max_message_bytes = or_default(m.max_message_bytes(), defaults::kMaxMessageBytes);
   master.status = parse_status(m, check);
+  master.api = parse_api(m, check);
   master.frame_timeout = milliseconds(or_default(m.frame_timeout_ms(), defaults::kFrameTimeoutMs));
   master.startup_timeout = milliseconds(or_default(m.startup_timeout_ms(), defaults::kStartupTimeoutMs));
   master.handshake_timeout = milliseconds(or_default(m.handshake_timeout_ms(), defaults::kHandshakeTimeoutMs));

@@ -176,6 +176,14 @@ schema::MasterSettings to_schema(const MasterSettings& m) {
     status.set_port(m.status->port);
     status.set_max_connections(m.status->max_connections);
   }
+  if (m.api) {
+    schema::ApiServer& api = *out.mutable_api();
+    api.set_listen(m.api->listen);
+    api.set_port(m.api->port);
+    api.set_max_sessions(m.api->max_sessions);
+    api.set_max_edits_per_frame(m.api->max_edits_per_frame);
+    api.set_max_instances(m.api->max_instances);
+  }
   return out;
 }
 

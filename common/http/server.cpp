@@ -11,6 +11,8 @@
 #include <deque>
 #include <optional>
 
+#include "http/listen.h"
+
 namespace optique::http {
 namespace {
 
@@ -315,17 +317,8 @@ Server::Server(asio::io_context& io, ServerLimits limits, Handler handler, spdlo
 Server::~Server() = default;
 
 Result<std::uint16_t> Server::listen(const std::string& address, std::uint16_t port) {
-  boost::system::error_code ec;
-  const auto ip = asio::ip::make_address(address, ec);
-  if (ec) return Error{"'" + address + "' is not an address"};
-  const asio::ip::tcp::endpoint endpoint(ip, port);
-  acceptor_.open(endpoint.protocol(), ec);
-  if (!ec) acceptor_.set_option(asio::ip::tcp::acceptor::reuse_address(true), ec);
-  if (!ec) acceptor_.bind(endpoint, ec);
-  if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) return Error{"cannot listen on " + address + ":" + std::to_string(port) + ": " + ec.message()};
-  const std::uint16_t bound = acceptor_.local_endpoint().port();
-  accept_next();
+  auto bound = listen_on(acceptor_, address, port);
+  if (bound) accept_next();
   return bound;
 }
 

@@ -72,6 +72,8 @@ int run_cli(int argc, char** argv) {
       ->check(CLI::Range(0, 65535));
   app.add_option("--status-port-file", options.status_port_file,
                  "write the status server's port once listening (for scripts)");
+  app.add_option("--api-port-file", options.api_port_file,
+                 "write the scene session's port (master.api) once listening (for scripts)");
   app.add_flag("--print-status-token", print_status_token,
                "print the status server's bearer token (derived from master.secret_file) and exit");
   app.add_option("--capture-every", options.run.capture_every,

@@ -34,22 +34,14 @@ Result<void> write_port_file(const std::string& path, unsigned port, const std::
 
 using std::chrono::milliseconds;
 
-bool is_loopback(const asio::ip::address& address) {
-  if (address.is_v6() && address.to_v6().is_v4_mapped()) {
-    return asio::ip::make_address_v4(asio::ip::v4_mapped, address.to_v6()).is_loopback();
-  }
-  return address.is_loopback();
-}
-
 }  // namespace
 
 Master::Master(asio::io_context& io, MasterOptions options, spdlog::logger& log)
     : io_(io),
       options_(std::move(options)),
       log_(log),
-      acceptor_(io),
+      listener_(io, log),
       tracker_socket_(io),
-      accept_retry_timer_(io),
       signals_(io, SIGINT, SIGTERM),
       housekeeping_timer_(io),
       status_(options_.status_line) {
@@ -117,21 +109,18 @@ Result<void> Master::start() {
     if (!head_csv_) return Error{"cannot write " + head_path.string()};
     head_csv_ << head_csv_header();
   }
+  if (settings.api) {
+    session_port_.emplace(io_, *settings.api, options_.run.secret, settings.max_message_bytes, log_);
+    // For now the one asset is the installation's own scene, by name.
+    session_port_->live().add_asset(scene_asset_id(installation.scene.builtin, installation.scene.gltf));
+    run.live = &session_port_->live();
+  }
   protocol_.emplace(installation, options_.scene, std::move(run), *recorder_);
 
   // Listen.
-  boost::system::error_code ec;
-  const auto address = asio::ip::make_address(settings.listen, ec);
-  if (ec) return Error{"master.listen: '" + settings.listen + "' is not an address"};
-  const asio::ip::tcp::endpoint endpoint(address, settings.port);
-  acceptor_.open(endpoint.protocol(), ec);
-  if (!ec) acceptor_.set_option(asio::ip::tcp::acceptor::reuse_address(true), ec);
-  if (!ec) acceptor_.bind(endpoint, ec);
-  if (!ec) acceptor_.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) {
-    return Error{"cannot listen on " + settings.listen + ":" + std::to_string(settings.port) + ": " + ec.message()};
-  }
-  port_ = acceptor_.local_endpoint().port();
+  auto bound = listener_.listen(settings.listen, settings.port);
+  if (!bound) return Error{"master.listen: " + bound.error()};
+  port_ = bound.value();
   if (auto written = write_port_file(options_.port_file, port_, "port file"); !written) return written;
   log_.info("listening on {}:{}; waiting for {} node(s): {}", settings.listen, port_, ids.size(), util::joined(ids));
   if (tracking && tracking->source == config::TrackingSource::dtrack) {
@@ -142,6 +131,15 @@ Result<void> Master::start() {
   }
   if (settings.status) {
     if (auto serving = start_status_service(*settings.status); !serving) return serving;
+  }
+  if (session_port_) {
+    auto port = session_port_->start([this] { return protocol_->progress().next_frame; });
+    if (!port) return Error{port.error()};
+    log_.info("scene sessions on {}:{}: applications may place instances of '{}'", settings.api->listen, port.value(),
+              scene_asset_id(installation.scene.builtin, installation.scene.gltf));
+    if (auto written = write_port_file(options_.api_port_file, port.value(), "api port file"); !written) {
+      return written;
+    }
   }
   if (options_.run.secret) {
     log_.info("nodes must prove they hold the shared secret in {}", options_.secret_path);
@@ -172,7 +170,9 @@ Result<void> Master::start() {
   signals_.async_wait([this](const boost::system::error_code& error, int signal) {
     if (!error) on_signal(signal);
   });
-  accept_next();
+  listener_.start([this](asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback) {
+    if (!finished_) on_accepted(std::move(socket), peer_text, loopback);
+  });
   const clock::Nanos now = clock::monotonic_now();
   if (launcher_) carry_out(protocol_->local_nodes_running(launcher_->running(), now));
   carry_out(protocol_->start(now));
@@ -216,32 +216,7 @@ void Master::publish_status() {
 
 // ---------------------------------------------------------------- connections
 
-void Master::accept_next() {
-  acceptor_.async_accept([this](const boost::system::error_code& error, asio::ip::tcp::socket socket) {
-    if (error) {
-      if (error == asio::error::operation_aborted || !acceptor_.is_open() || finished_) return;
-      // Out of file descriptors and the like: try again shortly, and say so once
-      // per failure streak rather than thousands of times a second.
-      if (!accept_failing_) log_.warn("accept failed: {}; retrying every 100 ms", error.message());
-      accept_failing_ = true;
-      accept_retry_timer_.expires_after(milliseconds(100));
-      accept_retry_timer_.async_wait([this](const boost::system::error_code& e) {
-        if (!e) accept_next();
-      });
-      return;
-    }
-    if (accept_failing_) log_.info("accepting connections again");
-    accept_failing_ = false;
-    on_accepted(std::move(socket));
-    accept_next();
-  });
-}
-
-void Master::on_accepted(asio::ip::tcp::socket socket) {
-  boost::system::error_code error;
-  const asio::ip::tcp::endpoint peer = socket.remote_endpoint(error);
-  if (error) return;  // gone already
-  const std::string peer_text = peer.address().to_string() + ":" + std::to_string(peer.port());
+void Master::on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback) {
   const PeerId id = next_peer_++;
   auto connection = net::Connection::create(std::move(socket), kMaxHelloBytes);
   connections_[id] = connection;
@@ -254,8 +229,7 @@ void Master::on_accepted(asio::ip::tcp::socket socket) {
         carry_out(protocol_->closed(id, reason, clock::monotonic_now()));
       },
   });
-  carry_out(
-      protocol_->accepted(id, peer_text, is_loopback(peer.address()), net::random_nonce(), clock::monotonic_now()));
+  carry_out(protocol_->accepted(id, peer_text, loopback, net::random_nonce(), clock::monotonic_now()));
 }
 
 net::Connection* Master::connection(PeerId peer) {
@@ -307,10 +281,7 @@ void Master::carry_out(Action& action) {
                    ++timer_generations_[timer_slot(a.timer)];
                    timers_[timer_slot(a.timer)]->cancel();
                  },
-                 [&](StopAccepting&) {
-                   boost::system::error_code ignored;
-                   acceptor_.close(ignored);
-                 },
+                 [&](StopAccepting&) { listener_.close(); },
                  [&](SignalLocalNodes& a) {
                    if (launcher_) launcher_->signal_all(a.signal);
                  },
@@ -407,10 +378,10 @@ void Master::finish(int exit_code) {
   status_.clear();
   for (auto& timer : timers_) timer->cancel();
   housekeeping_timer_.cancel();
-  accept_retry_timer_.cancel();
   signals_.cancel();
+  listener_.close();
+  if (session_port_) session_port_->close("the master is shutting down");
   boost::system::error_code ignored;
-  acceptor_.close(ignored);
   if (tracker_receiver_) {
     tracker_receiver_->stop();
     carry_out(protocol_->tracker_input(tracker_receiver_->take()));  // the last counts, for run.json

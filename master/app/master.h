@@ -22,10 +22,12 @@
 
 #include "config/load.h"
 #include "master/app/local_launcher.h"
+#include "master/app/session_port.h"
 #include "master/app/status_line.h"
+#include "master/app/tcp_listener.h"
 #include "master/app/tracker_receiver.h"
-#include "master/run/exit_codes.h"
 #include "master/protocol.h"
+#include "master/run/exit_codes.h"
 #include "master/run_recorder.h"
 #include "master/status/status_service.h"
 #include "net/auth.h"
@@ -53,6 +55,7 @@ struct MasterOptions {
   // the logger by whoever made it); none: the page lists none.
   std::shared_ptr<WarningSink> warnings;
   std::string status_port_file;  // write the status server's port once listening
+  std::string api_port_file;     // write the scene session's port (master.api) once listening
 };
 
 class Master {
@@ -67,12 +70,11 @@ class Master {
   [[nodiscard]] int exit_code() const { return exit_code_; }
 
  private:
-  void accept_next();
   // The head tracker's datagrams (viewer.tracking, source dtrack), read on
   // their own thread; what they brought taken on this one.
   [[nodiscard]] Result<void> listen_to_tracker(const config::Tracking& tracking, double frame_rate);
   void take_tracker_input();
-  void on_accepted(asio::ip::tcp::socket socket);
+  void on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback);
   void carry_out(Actions actions);
   void carry_out(Action& action);
   void arm(Timer timer, clock::Nanos at);
@@ -95,13 +97,12 @@ class Master {
   std::ofstream csv_;
   std::ofstream head_csv_;  // the head shown each frame, with tracking
   std::optional<RunRecorder> recorder_;
+  std::optional<SessionPort> session_port_;  // master.api; its live scene outlives the protocol
   std::optional<MasterProtocol> protocol_;
 
-  asio::ip::tcp::acceptor acceptor_;
+  TcpListener listener_;  // the nodes'
   asio::ip::udp::socket tracker_socket_;
   std::unique_ptr<TrackerReceiver> tracker_receiver_;  // reads tracker_socket_: stopped before it closes
-  asio::steady_timer accept_retry_timer_;
-  bool accept_failing_ = false;
   asio::signal_set signals_;
   std::array<std::unique_ptr<asio::steady_timer>, kTimers.size()> timers_;  // one per Timer
   std::array<std::uint64_t, kTimers.size()> timer_generations_{};           // each arm or disarm: the one pending

@@ -471,6 +471,33 @@ TEST(ParseInstallation, StatusBeyondLoopbackNeedsTheSecret) {
   }
 }
 
+// master.api: off unless given; loopback, port 7490 and the limits by default;
+// beyond loopback only with the shared secret.
+TEST(ParseInstallation, TheSceneSessionPort) {
+  EXPECT_FALSE(parse(kValid).value().master.api) << "off unless asked for";
+  auto parsed = parse(with(R"("port": 7400)", R"("port": 7400, "api": {})"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  ASSERT_TRUE(parsed.value().master.api);
+  const ApiServer& api = *parsed.value().master.api;
+  EXPECT_EQ(api.listen, "127.0.0.1");
+  EXPECT_EQ(api.port, 7490u);
+  EXPECT_EQ(api.max_sessions, 16u);
+  EXPECT_EQ(api.max_edits_per_frame, 100000u);
+  EXPECT_EQ(api.max_instances, 100000u);
+  parsed = parse(with(R"("port": 7400)", R"("port": 7400, "api": {"port": 0, "max_sessions": 2})"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().master.api->port, 0u);
+  EXPECT_EQ(parsed.value().master.api->max_sessions, 2u);
+  // Written back as it was read (a job, check-config).
+  EXPECT_TRUE(validate(to_schema(parsed.value()), test_dir()).empty());
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "api": {"listen": "0.0.0.0"})")), "master.api.listen",
+                 {"'0.0.0.0' is reached from other machines", "applications must prove", "master.secret_file"});
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "api": {"port": 70000})")), "master.api.port",
+                 {"got 70000"});
+  expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "api": {"max_instances": 20000000})")),
+                 "master.api.max_instances", {"at most 10000000"});
+}
+
 TEST(ParseInstallation, SeveralProblemsReportedAtOnce) {
   std::string json = with(R"("width": 640)", R"("width": 0)");
   json = replaced(json, R"("builtin": "cubes")", R"("builtin": "nope")");

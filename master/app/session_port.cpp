@@ -1,0 +1,104 @@
+#include "master/app/session_port.h"
+
+#include "net/auth.h"
+#include "util/overloaded.h"
+
+namespace optique::master {
+namespace {
+
+// Before its hello an application has said nothing worth more.
+constexpr std::uint32_t kMaxHelloBytes = 4096;
+
+LiveSceneLimits limits_of(const config::ApiServer& settings) {
+  LiveSceneLimits limits;
+  limits.max_instances = settings.max_instances;
+  limits.max_edits_per_frame = settings.max_edits_per_frame;
+  return limits;
+}
+
+}  // namespace
+
+SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings, std::optional<net::Secret> secret,
+                         std::uint32_t max_message_bytes, spdlog::logger& log)
+    : settings_(settings),
+      max_message_bytes_(max_message_bytes),
+      log_(log),
+      live_(limits_of(settings)),
+      sessions_(live_, SceneSessionSettings{settings.max_sessions, std::move(secret)}),
+      listener_(io, log) {}
+
+Result<std::uint16_t> SessionPort::start(std::function<std::uint64_t()> next_frame) {
+  next_frame_ = std::move(next_frame);
+  auto bound = listener_.listen(settings_.listen, settings_.port);
+  if (!bound) return Error{"master.api: " + bound.error()};
+  listener_.start([this](asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback) {
+    on_accepted(std::move(socket), peer_text, loopback);
+  });
+  return bound;
+}
+
+void SessionPort::close(const std::string& reason) {
+  listener_.close();
+  wire::Envelope goodbye;
+  goodbye.mutable_goodbye()->set_reason(reason);
+  // Closing may call back into connections_: walk a copy.
+  const auto open = connections_;
+  for (const auto& [id, connection] : open) {
+    if (!connection->is_open()) continue;
+    connection->send(goodbye);
+    connection->close_after_sending(reason);
+  }
+}
+
+void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback) {
+  const SessionId id = next_id_++;
+  auto connection = net::Connection::create(std::move(socket), kMaxHelloBytes);
+  connections_[id] = connection;
+  connection->start({
+      [this, id](wire::Envelope& message, clock::Nanos) {
+        // Once it has said hello, an application may send transactions up to
+        // the master's message size.
+        if (message.has_hello()) {
+          if (auto found = connections_.find(id); found != connections_.end()) {
+            found->second->set_max_payload_bytes(max_message_bytes_);
+          }
+        }
+        carry_out(sessions_.message(id, message, next_frame_()));
+      },
+      [this, id](const std::string& reason) {
+        connections_.erase(id);
+        carry_out(sessions_.closed(id, reason));
+      },
+  });
+  carry_out(sessions_.accepted(id, peer_text, loopback, net::random_nonce()));
+}
+
+void SessionPort::carry_out(SessionActions actions) {
+  for (SessionAction& action : actions) {
+    std::visit(util::Overloaded{
+                   [&](session_action::Send& a) {
+                     if (auto found = connections_.find(a.session); found != connections_.end()) {
+                       found->second->send(a.message);
+                     }
+                   },
+                   [&](session_action::Close& a) {
+                     const auto found = connections_.find(a.session);
+                     if (found == connections_.end()) return;
+                     if (a.after_sending) {
+                       found->second->close_after_sending(a.reason);
+                     } else {
+                       found->second->close(a.reason);
+                     }
+                   },
+                   [&](session_action::Protect& a) {
+                     if (auto found = connections_.find(a.session); found != connections_.end()) {
+                       found->second->protect(a.keys.to_node, a.keys.to_master, false);
+                     }
+                   },
+                   [&](session_action::Log& a) { log_.log(a.level, "{}", a.text); },
+               },
+               action);
+  }
+}
+
+}  // namespace optique::master

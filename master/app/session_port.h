@@ -1,0 +1,53 @@
+#pragma once
+// The scene session's Asio shell (master.api): the port applications connect
+// to, their connections, and what SceneSessions (master/session) decides
+// carried out on them. It holds the live scene the frame loop reads.
+
+#include <spdlog/logger.h>
+#include <boost/asio.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "config/installation.h"
+#include "master/app/tcp_listener.h"
+#include "master/session/live_scene.h"
+#include "master/session/scene_sessions.h"
+#include "net/connection.h"
+#include "util/result.h"
+
+namespace optique::master {
+
+class SessionPort {
+ public:
+  SessionPort(asio::io_context& io, const config::ApiServer& settings, std::optional<net::Secret> secret,
+              std::uint32_t max_message_bytes, spdlog::logger& log);
+
+  // What the frame loop reads (RunSettings::live).
+  [[nodiscard]] LiveScene& live() { return live_; }
+  // Listens and accepts; `next_frame` says which frame the master begins next.
+  // The port bound.
+  [[nodiscard]] Result<std::uint16_t> start(std::function<std::uint64_t()> next_frame);
+  // No more sessions; the open ones are told goodbye.
+  void close(const std::string& reason);
+
+ private:
+  void on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback);
+  void carry_out(SessionActions actions);
+
+  const config::ApiServer settings_;
+  const std::uint32_t max_message_bytes_;
+  spdlog::logger& log_;
+  LiveScene live_;
+  SceneSessions sessions_;
+  TcpListener listener_;
+  std::function<std::uint64_t()> next_frame_;
+  std::map<SessionId, std::shared_ptr<net::Connection>> connections_;
+  SessionId next_id_ = 1;
+};
+
+}  // namespace optique::master
