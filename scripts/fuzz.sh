@@ -7,7 +7,7 @@
 #   scripts/fuzz.sh [SECONDS]      seconds per target (or FUZZ_SECONDS; default 30)
 #
 # Environment:
-#   FUZZ_TARGETS   which targets (default "frames deltas protocol node tracker")
+#   FUZZ_TARGETS   which targets (default "frames deltas protocol node tracker session")
 #   FUZZ_JOBS      build parallelism (default: nproc)
 #   FUZZ_PARALLEL  targets run at a time, one core each (default: nproc)
 #   FUZZ_KEEP=1    keep the work folder (new corpus entries) even when nothing crashed
@@ -29,7 +29,7 @@ if ! [[ "$seconds" =~ ^[0-9]+$ ]] || [ "$seconds" -eq 0 ]; then
   echo "fuzz: seconds per target must be a positive whole number, not '$seconds'" >&2
   exit 2
 fi
-read -ra targets <<<"${FUZZ_TARGETS:-frames deltas protocol node tracker}"
+read -ra targets <<<"${FUZZ_TARGETS:-frames deltas protocol node tracker session}"
 jobs="${FUZZ_JOBS:-$(nproc)}"
 build_dir="$root/$asan_build_dir"
 

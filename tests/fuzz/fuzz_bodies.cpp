@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <map>
 #include <vector>
 
+#include "master/session/scene_sessions.h"
 #include "net/envelope.h"
 #include "net/framing.h"
 #include "scene/state.h"
@@ -296,7 +298,96 @@ std::string tracker(std::span<const std::uint8_t> input, Outcome& out) {
   return {};
 }
 
+// The live scene after any transactions: whole, and what the nodes accept.
+std::string check_live(const master::LiveScene& live, const master::LiveSceneLimits& limits,
+                       scene::SceneState& previous) {
+  OPTIQUE_FUZZ_REQUIRE(live.instances().size() <= limits.max_instances);
+  std::size_t listed = 0;
+  for (const auto& [id, instance] : live.instances()) {
+    OPTIQUE_FUZZ_REQUIRE(scene::is_instance_id(id));
+    OPTIQUE_FUZZ_REQUIRE(live.children(instance.parent).contains(id));
+    std::size_t depth = 0;
+    for (std::string at = instance.parent; !at.empty();) {
+      OPTIQUE_FUZZ_REQUIRE(live.instances().contains(at));
+      OPTIQUE_FUZZ_REQUIRE(++depth <= limits.max_depth);
+      at = live.instances().at(at).parent;
+    }
+    listed += live.children(id).size();
+  }
+  listed += live.children("").size();
+  OPTIQUE_FUZZ_REQUIRE(listed == live.instances().size());
+  scene::SceneState state;
+  state.instances = master::frame_instances(live);
+  if (auto broken = check_state(state); !broken.empty()) return broken;
+  scene::SceneState node = previous;
+  OPTIQUE_FUZZ_REQUIRE(scene::apply_delta(node, scene::make_delta(previous, state)).ok());
+  OPTIQUE_FUZZ_REQUIRE(node == state);
+  previous = std::move(state);
+  return {};
+}
+
+std::string session(std::span<const std::uint8_t> input, Outcome& out) {
+  master::LiveSceneLimits limits;
+  limits.max_instances = 64;
+  limits.max_edits_per_frame = 256;
+  limits.max_depth = 8;
+  master::LiveScene live(limits);
+  live.add_asset("torus");
+  live.add_asset("duck");
+  master::SceneSessions sessions(live, {});
+  (void)sessions.accepted(1, "127.0.0.1:1", true, std::vector<std::uint8_t>(net::kNonceBytes, 1));
+  wire::Envelope hello;
+  hello.set_protocol_version(net::kProtocolVersion);
+  hello.mutable_hello()->set_node_id("fuzz");
+  hello.mutable_hello()->add_capabilities(master::kSceneSessionCapability);
+  (void)sessions.message(1, hello, 0);
+  scene::SceneState previous;
+  std::uint64_t frame = 0;
+  for (std::span<const std::uint8_t> chunk : split_chunks(input)) {
+    if (chunk.size() == 1) {
+      live.begin_frame();
+      ++frame;
+      continue;
+    }
+    wire::Envelope message;
+    if (!message.ParseFromArray(chunk.data(), static_cast<int>(chunk.size()))) continue;
+    ++out.envelopes;
+    const std::map<std::string, master::Instance> before = live.instances();
+    const master::SessionActions actions = sessions.message(1, message, frame);
+    bool closed = false;
+    int replies = 0;
+    for (const master::SessionAction& action : actions) {
+      closed = closed || std::holds_alternative<master::session_action::Close>(action);
+      const auto* sent = std::get_if<master::session_action::Send>(&action);
+      if (sent == nullptr || !sent->message.has_session_reply()) continue;
+      ++replies;
+      OPTIQUE_FUZZ_REQUIRE(sent->message.session_reply().id() == message.session_request().id());
+      if (sent->message.session_reply().has_applied()) {
+        OPTIQUE_FUZZ_REQUIRE(sent->message.session_reply().applied().frame() == frame);
+        ++out.applied;
+      } else {
+        OPTIQUE_FUZZ_REQUIRE(sent->message.session_reply().has_refused());
+        OPTIQUE_FUZZ_REQUIRE(live.instances() == before);  // nothing of a refused transaction stays
+        ++out.refused;
+      }
+    }
+    const bool request = message.has_session_request() && message.protocol_version() == net::kProtocolVersion;
+    OPTIQUE_FUZZ_REQUIRE(replies == (request ? 1 : 0));
+    OPTIQUE_FUZZ_REQUIRE(request || closed || message.has_heartbeat());
+    if (auto broken = check_live(live, limits, previous); !broken.empty()) return broken;
+    if (closed) break;
+  }
+  return {};
+}
+
 }  // namespace
+
+Outcome run_session(std::span<const std::uint8_t> input) {
+  const QuietProtobuf quiet;
+  Outcome out;
+  out.broken = session(input, out);
+  return out;
+}
 
 Outcome run_tracker(std::span<const std::uint8_t> input) {
   Outcome out;

@@ -57,15 +57,17 @@ struct Outcome {
   int deltas_applied = 0;  // deltas that apply_delta accepted
   int deltas_refused = 0;  // parsed deltas that apply_delta refused
   bool snapshot_accepted = false;
-  int frames_presented = 0;  // run_protocol: by all nodes; run_node: by the node
-  int renders = 0;           // run_node: frames the node drew
-  int closes = 0;            // run_node: messages that made it close or stop
-  int configured = 0;        // run_node: times the node set its renderer up
-  int scene_chunks = 0;      // run_node: chunks of a scene's files it stored
+  int frames_presented = 0;            // run_protocol: by all nodes; run_node: by the node
+  int renders = 0;                     // run_node: frames the node drew
+  int closes = 0;                      // run_node: messages that made it close or stop
+  int configured = 0;                  // run_node: times the node set its renderer up
+  int scene_chunks = 0;                // run_node: chunks of a scene's files it stored
   scene::SceneManifest scene_files{};  // run_node: the scene being fetched
-  bool finished = false;     // run_protocol: the master's run ended
-  int datagrams_parsed = 0;  // run_tracker: datagrams parse_dtrack took
-  int samples = 0;           // run_tracker: samples the head tracker took
+  bool finished = false;               // run_protocol: the master's run ended
+  int datagrams_parsed = 0;            // run_tracker: datagrams parse_dtrack took
+  int samples = 0;                     // run_tracker: samples the head tracker took
+  int applied = 0;                     // run_session: transactions the live scene took
+  int refused = 0;                     // run_session: transactions it refused
 };
 
 // Input: byte 0 picks how the rest is cut into fragments (0: all at once, 1: byte
@@ -107,5 +109,14 @@ struct Outcome {
 // its turn a unit quaternion; every datagram is counted once (taken, malformed,
 // without the body, backwards or flood).
 [[nodiscard]] Outcome run_tracker(std::span<const std::uint8_t> input);
+
+// Input: serialized wire::Envelopes from an application, separated by
+// kChunkSeparator, to a scene session past its hello (a chunk that does not parse
+// is skipped, as a connection would close on it; a chunk of one byte begins a
+// frame). Invariants: every request is answered once, with its id, or the session
+// is closed; the live scene stays whole (every parent there, the children index
+// its parents', the chains and the count within their limits); and the state a
+// frame makes of it is one a node accepts, through a snapshot and a delta.
+[[nodiscard]] Outcome run_session(std::span<const std::uint8_t> input);
 
 }  // namespace optique::fuzz

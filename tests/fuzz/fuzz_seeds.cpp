@@ -10,6 +10,7 @@
 #include "master/run/run_config.h"
 #include "net/envelope.h"
 #include "net/framing.h"
+#include "optique/session.pb.h"
 #include "protocol/welcome.h"
 #include "scene/manifest.h"
 #include "scene/state.h"
@@ -549,13 +550,15 @@ std::vector<Seed> node_seeds() {
     seeds.push_back({"welcome_no_frame_period", node_seed(bad, {})});
   }
   // Behind: frames to skip (a share of the lights with one of them), then one to draw.
-  seeds.push_back({"frames_skipped_while_behind",
-                   node_seed(welcome, {frame_and_swap(0), frame_and_swap(1, [](wire::FrameBegin& b) {
-                                         b.set_skip(true);
-                                         b.mutable_lights()->add_lights(1);
-                                       }),
-                                       frame_and_swap(2, [](wire::FrameBegin& b) { b.set_skip(true); }),
-                                       frame_and_swap(3)})});
+  seeds.push_back(
+      {"frames_skipped_while_behind",
+       node_seed(welcome, {frame_and_swap(0),
+                           frame_and_swap(1,
+                                          [](wire::FrameBegin& b) {
+                                            b.set_skip(true);
+                                            b.mutable_lights()->add_lights(1);
+                                          }),
+                           frame_and_swap(2, [](wire::FrameBegin& b) { b.set_skip(true); }), frame_and_swap(3)})});
   seeds.push_back(
       {"frame_light_out_of_range",
        node_seed(welcome, {frame_and_swap(0, [](wire::FrameBegin& b) { b.mutable_lights()->add_lights(9); })})});
@@ -574,8 +577,8 @@ std::vector<Seed> node_seeds() {
     const std::string gltf = R"({"asset":{"version":"2.0"}})";
     std::string bin(5000, '\0');
     for (std::size_t i = 0; i < bin.size(); ++i) bin[i] = static_cast<char>(i * 13);
-    const scene::SceneManifest files{4096, {scene::describe_file("s.gltf", gltf, 4096),
-                                            scene::describe_file("s.bin", bin, 4096)}};
+    const scene::SceneManifest files{
+        4096, {scene::describe_file("s.gltf", gltf, 4096), scene::describe_file("s.bin", bin, 4096)}};
     wire::Welcome with_files = welcome;
     with_files.set_scene_sha256(scene::manifest_sha256(files));
     *with_files.mutable_scene_files() = protocol::to_wire(files);
@@ -652,6 +655,116 @@ std::vector<Seed> tracker_seeds() {
                          datagram(5, "fr 2\nts2 0 0 499\n6d 1 [0 1][99000 0 0][1 0 0 0 1 0 0 0 1]"),
                          datagram(200, "fr 3\nts2 0 0 0\n6d 1 [0 1][99000 0 0][0 1 0 -1 0 0 0 0 1]")})});
   seeds.push_back({"empty", {}});
+  return seeds;
+}
+
+namespace {
+
+// A scene session's request: one transaction of `edits` (text format of
+// session.Edit, one per entry).
+Bytes request(std::uint64_t id, const std::vector<std::function<void(session::Edit&)>>& edits) {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  e.mutable_session_request()->set_id(id);
+  auto& transaction = *e.mutable_session_request()->mutable_transaction();
+  for (const auto& edit : edits) edit(*transaction.add_edits());
+  return serialize(e);
+}
+
+std::function<void(session::Edit&)> create(const std::string& id, const std::string& asset,
+                                           const std::string& parent = "", double x = 0.0) {
+  return [=](session::Edit& e) {
+    auto& c = *e.mutable_create();
+    c.set_instance(id);
+    c.set_asset(asset);
+    c.set_parent(parent);
+    c.mutable_transform()->add_position(x);
+    c.mutable_transform()->add_position(1.0);
+    c.mutable_transform()->add_position(-x);
+  };
+}
+
+std::function<void(session::Edit&)> move(const std::string& id, std::vector<double> position,
+                                         std::vector<double> rotation = {}, std::vector<double> scale = {}) {
+  return [=](session::Edit& e) {
+    auto& t = *e.mutable_transform();
+    t.set_instance(id);
+    for (double v : position) t.mutable_transform()->add_position(v);
+    for (double v : rotation) t.mutable_transform()->add_rotation(v);
+    for (double v : scale) t.mutable_transform()->add_scale(v);
+  };
+}
+
+std::function<void(session::Edit&)> reparent(const std::string& id, const std::string& parent) {
+  return [=](session::Edit& e) {
+    e.mutable_parent()->set_instance(id);
+    e.mutable_parent()->set_parent(parent);
+  };
+}
+
+std::function<void(session::Edit&)> remove(const std::string& id) {
+  return [=](session::Edit& e) { e.mutable_remove()->set_instance(id); };
+}
+
+const Bytes kNextFrame{0};
+
+}  // namespace
+
+std::vector<Seed> session_seeds() {
+  std::vector<Seed> seeds;
+  seeds.push_back({"place_move_remove",
+                   join({request(1, {create("table", "torus"), create("cup", "duck", "table", 0.5)}), kNextFrame,
+                         request(2, {move("table", {1, 0, 0}, {0, 0, 1, 0}, {2}),
+                                     [](session::Edit& e) {
+                                       e.mutable_visible()->set_instance("cup");
+                                       e.mutable_visible()->set_visible(false);
+                                     },
+                                     [](session::Edit& e) {
+                                       e.mutable_factors()->set_instance("table");
+                                       for (double v : {1.0, 0.5, 0.25, 1.0}) e.mutable_factors()->add_base_color(v);
+                                       for (double v : {2.0, 0.0, 0.0}) e.mutable_factors()->add_emissive(v);
+                                     }}),
+                         kNextFrame, request(3, {remove("table")}), request(4, {create("table", "duck")})})});
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  seeds.push_back({"refusals", join({request(1, {create("a", "torus"), create("b", "teapot")}),
+                                     request(2, {create("a", "torus"), move("a", {0, nan, 0})}),
+                                     request(3, {create("a", "torus"), move("a", {0, 0, 0}, {0, 0, 0, 0})}),
+                                     request(4, {create("a", "torus"), move("a", {0, 0, 0}, {}, {0})}),
+                                     request(5, {create("a", "torus"), create("b", "torus", "a"), reparent("a", "b")}),
+                                     request(6, {remove("ghost")}), request(7, {[](session::Edit&) {}}),
+                                     request(8, {create("a b", "torus")}), request(9, {})})});
+  {
+    std::vector<std::function<void(session::Edit&)>> chain;
+    for (int i = 0; i < 10; ++i)
+      chain.push_back(create("c" + std::to_string(i), "torus", i ? "c" + std::to_string(i - 1) : ""));
+    std::vector<std::function<void(session::Edit&)>> shallow(chain.begin(), chain.begin() + 5);
+    seeds.push_back(
+        {"deep_chain",
+         join({request(1, chain), request(2, shallow), kNextFrame,
+               request(3, {create("x", "torus", "c4"), reparent("c1", "c4")}), request(4, {reparent("c3", "")}),
+               // d0 … d4 moved under c4: d4 would be 9 deep.
+               request(5, {create("d0", "duck"), create("d1", "duck", "d0"), create("d2", "duck", "d1"),
+                           create("d3", "duck", "d2"), create("d4", "duck", "d3")}),
+               request(6, {reparent("c3", "c2"), reparent("d0", "c4")})})});
+  }
+  {
+    std::vector<Bytes> chunks;
+    for (int i = 0; i < 70; ++i) {
+      chunks.push_back(request(static_cast<std::uint64_t>(i), {create("i" + std::to_string(i), "torus")}));
+      if (i % 20 == 19) chunks.push_back(kNextFrame);
+    }
+    std::vector<std::function<void(session::Edit&)>> many;
+    for (int i = 0; i < 300; ++i) many.push_back(move("i0", {static_cast<double>(i), 0, 0}));
+    chunks.push_back(request(100, many));
+    seeds.push_back({"limits", join(chunks)});
+  }
+  {
+    wire::Envelope ready;
+    ready.set_protocol_version(net::kProtocolVersion);
+    ready.mutable_frame_ready()->set_frame_id(3);
+    seeds.push_back({"noise_then_a_node_message", join({noise(40, 7), request(1, {create("a", "torus")}),
+                                                        serialize(ready), request(2, {create("b", "torus")})})});
+  }
   return seeds;
 }
 

@@ -29,4 +29,8 @@ struct Seed {
 // Inputs for run_tracker: a gap byte and a datagram each, joined by kChunkSeparator.
 [[nodiscard]] std::vector<Seed> tracker_seeds();
 
+// Inputs for run_session: an application's Envelopes (a one-byte chunk: the next
+// frame), joined by kChunkSeparator.
+[[nodiscard]] std::vector<Seed> session_seeds();
+
 }  // namespace optique::fuzz

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
                   write_all(dir / "deltas", optique::fuzz::delta_seeds()) &&
                   write_all(dir / "protocol", optique::fuzz::protocol_seeds()) &&
                   write_all(dir / "node", optique::fuzz::node_seeds()) &&
-                  write_all(dir / "tracker", optique::fuzz::tracker_seeds());
+                  write_all(dir / "tracker", optique::fuzz::tracker_seeds()) &&
+                  write_all(dir / "session", optique::fuzz::session_seeds());
   return ok ? 0 : 1;
 }
