@@ -1,9 +1,11 @@
 #include "config/checker.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/geometric.hpp>
 
+#include "util/id_text.h"
 #include "util/number_text.h"
 
 namespace optique::config {
@@ -13,12 +15,7 @@ using util::number_text;
 
 bool usable_as_file_name(const std::string& id) {
   if (id.empty() || id == "." || id == "..") return false;
-  for (char c : id) {
-    const bool ok =
-        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
-    if (!ok) return false;
-  }
-  return true;
+  return std::all_of(id.begin(), id.end(), util::is_id_char);
 }
 
 }  // namespace

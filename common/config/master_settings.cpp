@@ -14,6 +14,10 @@ T or_default(T value, T fallback) {
   return value == T{} ? fallback : value;
 }
 
+void check_port(Checker& check, const std::string& path, std::uint32_t port) {
+  if (port > 65535) check.fail(path, "must be 0..65535 (got " + std::to_string(port) + ")");
+}
+
 // An address to listen on (empty: loopback); beyond loopback only with the
 // shared secret, for `why`.
 void check_listen(Checker& check, const std::string& path, const std::string& listen, const schema::MasterSettings& m,
@@ -32,7 +36,7 @@ std::optional<StatusServer> parse_status(const schema::MasterSettings& m, Checke
   const schema::StatusServer& st = m.status();
   check_listen(check, "master.status.listen", st.listen(), m,
                "the status needs a bearer token, derived from the shared secret");
-  if (st.port() > 65535) check.fail("master.status.port", "must be 0..65535 (got " + std::to_string(st.port()) + ")");
+  check_port(check, "master.status.port", st.port());
   if (st.max_connections() > 100000) {
     check.fail("master.status.max_connections",
                "must be at most 100000 (got " + std::to_string(st.max_connections()) + ")");
@@ -49,7 +53,7 @@ std::optional<ApiServer> parse_api(const schema::MasterSettings& m, Checker& che
   if (!m.has_api()) return std::nullopt;
   const schema::ApiServer& a = m.api();
   check_listen(check, "master.api.listen", a.listen(), m, "applications must prove they hold the shared secret");
-  if (a.port() > 65535) check.fail("master.api.port", "must be 0..65535 (got " + std::to_string(a.port()) + ")");
+  check_port(check, "master.api.port", a.port());
   if (a.max_sessions() > 1000) {
     check.fail("master.api.max_sessions", "must be at most 1000 (got " + std::to_string(a.max_sessions()) + ")");
   }
@@ -79,7 +83,7 @@ MasterSettings parse_master(const schema::MasterSettings& m, Checker& check) {
     if (!is_ip_address(m.listen())) check.fail("master.listen", "'" + m.listen() + "' is not an IPv4 or IPv6 address");
     master.listen = m.listen();
   }
-  if (m.port() > 65535) check.fail("master.port", "must be 0..65535 (got " + std::to_string(m.port()) + ")");
+  check_port(check, "master.port", m.port());
   master.port = static_cast<std::uint16_t>(m.port());
   if (check.finite("master.frame_rate", m.frame_rate()) && (m.frame_rate() < 0.0 || m.frame_rate() > 1000.0)) {
     check.fail("master.frame_rate",

@@ -6,6 +6,8 @@
 #include <glm/common.hpp>
 #include <string>
 
+#include "util/id_text.h"
+
 namespace optique::scene {
 namespace {
 
@@ -280,10 +282,7 @@ void set_viewer(SceneState& state, const ViewerPair& viewer) {
 
 bool is_instance_id(std::string_view id) {
   if (id.empty() || id.size() > kMaxInstanceIdLength) return false;
-  return std::all_of(id.begin(), id.end(), [](char c) {
-    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' ||
-           c == '.';
-  });
+  return std::all_of(id.begin(), id.end(), util::is_id_char);
 }
 
 // A viewer that does not move is where it is, to the bit.

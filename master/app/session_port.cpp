@@ -21,10 +21,9 @@ LiveSceneLimits limits_of(const config::ApiServer& settings) {
 SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings, std::optional<net::Secret> secret,
                          std::uint32_t max_message_bytes, spdlog::logger& log)
     : settings_(settings),
-      max_message_bytes_(max_message_bytes),
       log_(log),
       live_(limits_of(settings)),
-      sessions_(live_, SceneSessionSettings{settings.max_sessions, std::move(secret)}),
+      sessions_(live_, SceneSessionSettings{settings.max_sessions, max_message_bytes, std::move(secret)}),
       listener_(io, log) {}
 
 Result<std::uint16_t> SessionPort::start(std::function<std::uint64_t()> next_frame) {
@@ -55,16 +54,7 @@ void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& p
   auto connection = net::Connection::create(std::move(socket), kMaxHelloBytes);
   connections_[id] = connection;
   connection->start({
-      [this, id](wire::Envelope& message, clock::Nanos) {
-        // Once it has said hello, an application may send transactions up to
-        // the master's message size.
-        if (message.has_hello()) {
-          if (auto found = connections_.find(id); found != connections_.end()) {
-            found->second->set_max_payload_bytes(max_message_bytes_);
-          }
-        }
-        carry_out(sessions_.message(id, message, next_frame_()));
-      },
+      [this, id](wire::Envelope& message, clock::Nanos) { carry_out(sessions_.message(id, message, next_frame_())); },
       [this, id](const std::string& reason) {
         connections_.erase(id);
         carry_out(sessions_.closed(id, reason));
@@ -88,6 +78,11 @@ void SessionPort::carry_out(SessionActions actions) {
                        found->second->close_after_sending(a.reason);
                      } else {
                        found->second->close(a.reason);
+                     }
+                   },
+                   [&](session_action::SetMaxPayload& a) {
+                     if (auto found = connections_.find(a.session); found != connections_.end()) {
+                       found->second->set_max_payload_bytes(a.bytes);
                      }
                    },
                    [&](session_action::Protect& a) {

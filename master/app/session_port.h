@@ -40,7 +40,6 @@ class SessionPort {
   void carry_out(SessionActions actions);
 
   const config::ApiServer settings_;
-  const std::uint32_t max_message_bytes_;
   spdlog::logger& log_;
   LiveScene live_;
   SceneSessions sessions_;

@@ -1,9 +1,11 @@
 #include "master/session/live_scene.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "util/id_text.h"
 #include "util/number_text.h"
 
 namespace optique::master {
@@ -132,6 +134,18 @@ class LiveScene::Edits {
     return std::nullopt;
   }
 
+  // The instance `id` names, changed by `change` (which says what is wrong
+  // instead, leaving it as it was).
+  template <class Change>
+  Check modify(const std::string& id, const Change& change) {
+    const Instance* instance = nullptr;
+    if (auto wrong = existing("instance", id, instance)) return wrong;
+    Instance changed = *instance;
+    if (auto wrong = change(changed)) return wrong;
+    put(id, std::move(changed));
+    return std::nullopt;
+  }
+
   // Whether `parent` may hold `id`: it exists, is not `id` nor under it, and
   // the chain above stays within the depth limit.
   Check parent_problem(const std::string& id, const std::string& parent) const {
@@ -172,33 +186,24 @@ class LiveScene::Edits {
   }
 
   Check transform(const session::SetTransform& t) {
-    const Instance* instance = nullptr;
-    if (auto wrong = existing("instance", t.instance(), instance)) return wrong;
-    Instance changed = *instance;
-    if (auto wrong = read_transform(t.transform(), changed.pose)) return wrong;
-    put(t.instance(), std::move(changed));
-    return std::nullopt;
+    return modify(t.instance(), [&](Instance& changed) { return read_transform(t.transform(), changed.pose); });
   }
 
   Check parent(const session::SetParent& p) {
-    const Instance* instance = nullptr;
-    if (auto wrong = existing("instance", p.instance(), instance)) return wrong;
-    if (auto wrong = parent_problem(p.instance(), p.parent())) return wrong;
-    // The instances under it go along: each must stay within the depth limit.
-    if (auto wrong = subtree_depth_problem(p.instance(), p.parent())) return wrong;
-    Instance changed = *instance;
-    changed.parent = p.parent();
-    put(p.instance(), std::move(changed));
-    return std::nullopt;
+    return modify(p.instance(), [&](Instance& changed) -> Check {
+      if (auto wrong = parent_problem(p.instance(), p.parent())) return wrong;
+      // The instances under it go along: each must stay within the depth limit.
+      if (auto wrong = subtree_depth_problem(p.instance(), p.parent())) return wrong;
+      changed.parent = p.parent();
+      return std::nullopt;
+    });
   }
 
   Check visible(const session::SetVisible& v) {
-    const Instance* instance = nullptr;
-    if (auto wrong = existing("instance", v.instance(), instance)) return wrong;
-    Instance changed = *instance;
-    changed.visible = v.visible();
-    put(v.instance(), std::move(changed));
-    return std::nullopt;
+    return modify(v.instance(), [&](Instance& changed) -> Check {
+      changed.visible = v.visible();
+      return std::nullopt;
+    });
   }
 
   Check remove(const session::RemoveInstance& r) {
@@ -214,21 +219,19 @@ class LiveScene::Edits {
   }
 
   Check factors(const session::SetFactors& f) {
-    const Instance* instance = nullptr;
-    if (auto wrong = existing("instance", f.instance(), instance)) return wrong;
-    Instance changed = *instance;
-    if (!f.base_color().empty()) {
-      if (auto wrong = count_problem("base_color", f.base_color_size(), {4}, "[r, g, b, a]")) return wrong;
-      if (auto wrong = numbers_problem("base_color", f.base_color(), 0.0, 1.0)) return wrong;
-      changed.base_color = {f.base_color(0), f.base_color(1), f.base_color(2), f.base_color(3)};
-    }
-    if (!f.emissive().empty()) {
-      if (auto wrong = count_problem("emissive", f.emissive_size(), {3}, "[r, g, b]")) return wrong;
-      if (auto wrong = numbers_problem("emissive", f.emissive(), 0.0, scene::kMaxEmissiveFactor)) return wrong;
-      changed.emissive = {f.emissive(0), f.emissive(1), f.emissive(2)};
-    }
-    put(f.instance(), std::move(changed));
-    return std::nullopt;
+    return modify(f.instance(), [&](Instance& changed) -> Check {
+      if (!f.base_color().empty()) {
+        if (auto wrong = count_problem("base_color", f.base_color_size(), {4}, "[r, g, b, a]")) return wrong;
+        if (auto wrong = numbers_problem("base_color", f.base_color(), 0.0, 1.0)) return wrong;
+        changed.base_color = {f.base_color(0), f.base_color(1), f.base_color(2), f.base_color(3)};
+      }
+      if (!f.emissive().empty()) {
+        if (auto wrong = count_problem("emissive", f.emissive_size(), {3}, "[r, g, b]")) return wrong;
+        if (auto wrong = numbers_problem("emissive", f.emissive(), 0.0, scene::kMaxEmissiveFactor)) return wrong;
+        changed.emissive = {f.emissive(0), f.emissive(1), f.emissive(2)};
+      }
+      return std::nullopt;
+    });
   }
 
   // The depth of `id`'s deepest descendant, below `parent`.
@@ -300,9 +303,8 @@ std::string scene_asset_id(const std::string& builtin, const std::string& gltf_p
     if (const std::size_t dot = id.rfind('.'); dot != std::string::npos && dot > 0) id.resize(dot);
   }
   if (id.size() > scene::kMaxInstanceIdLength) id.resize(scene::kMaxInstanceIdLength);
-  for (char& c : id) {
-    if (!scene::is_instance_id(std::string(1, c))) c = '-';
-  }
+  std::replace_if(
+      id.begin(), id.end(), [](char c) { return !util::is_id_char(c); }, '-');
   return id.empty() ? "scene" : id;
 }
 

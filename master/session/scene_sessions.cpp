@@ -130,6 +130,7 @@ void SceneSessions::on_hello(SessionId id, Session& session, const wire::Envelop
     out.push_back(Protect{id, keys.value()});
   }
   session.application = hello.node_id();
+  out.push_back(session_action::SetMaxPayload{id, settings_.max_message_bytes});
   out.push_back(
       Log{spdlog::level::info, "application '" + session.application + "' connected from " + session.peer_text});
 }

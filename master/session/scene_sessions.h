@@ -36,6 +36,11 @@ struct Close {
   std::string reason;
   bool after_sending = false;
 };
+// The largest message the application may send from now on.
+struct SetMaxPayload {
+  SessionId session = 0;
+  std::uint32_t bytes = 0;
+};
 // Seal everything from now on (net/session_seal.h).
 struct Protect {
   SessionId session = 0;
@@ -47,8 +52,8 @@ struct Log {
 };
 }  // namespace session_action
 
-using SessionAction =
-    std::variant<session_action::Send, session_action::Close, session_action::Protect, session_action::Log>;
+using SessionAction = std::variant<session_action::Send, session_action::Close, session_action::SetMaxPayload,
+                                   session_action::Protect, session_action::Log>;
 using SessionActions = std::vector<SessionAction>;
 
 // The capability an application's Hello names.
@@ -56,6 +61,9 @@ inline constexpr const char* kSceneSessionCapability = "scene-session";
 
 struct SceneSessionSettings {
   std::size_t max_sessions = 16;
+  // What an application may send once it has said hello (a transaction's
+  // size); before, only what a hello needs.
+  std::uint32_t max_message_bytes = 16u << 20;
   // Applications must prove they hold it; without one only loopback peers are accepted.
   std::optional<net::Secret> secret;
 };

@@ -116,6 +116,7 @@ TEST(LiveScene, IdsAreCheckedAndMustExist) {
             "edits[0].create.parent");
   accept(scene, R"(edits { create { instance: "a" asset: "torus" } })");
   EXPECT_EQ(refused(scene, R"(edits { create { instance: "a" asset: "duck" } })").reason, "'a' exists already");
+  accept(scene, R"(edits { create { instance: "Lamp-2_b.v1" asset: "duck" } })");  // every kind of character
   const Refusal empty = refused(scene, "edits { }");
   EXPECT_EQ(empty.field, "edits[0]");
   EXPECT_EQ(empty.reason, "is empty or of a kind this master does not know");

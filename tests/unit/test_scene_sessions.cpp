@@ -67,6 +67,9 @@ TEST_F(SceneSessionsTest, AnApplicationIsChallengedSaysHelloAndItsEditsNameTheir
   ASSERT_EQ(of<session_action::Log>(admitted).size(), 1u);
   EXPECT_EQ(of<session_action::Log>(admitted)[0].text, "application 'design-review' connected from 127.0.0.1:5000");
   EXPECT_TRUE(of<session_action::Send>(admitted).empty());
+  ASSERT_EQ(of<session_action::SetMaxPayload>(admitted).size(), 1u)
+      << "transactions may be as large as the master's messages";
+  EXPECT_EQ(of<session_action::SetMaxPayload>(admitted)[0].bytes, SceneSessionSettings{}.max_message_bytes);
 
   const auto applied = sessions.message(1, create(9, "t1", "torus"), 41);
   ASSERT_EQ(of<session_action::Send>(applied).size(), 1u);
