@@ -4,12 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <nlohmann/json.hpp>
-#include <sstream>
 
 #include "calib/screen_frame.h"
 #include "util/join.h"
+#include "util/read_file.h"
 
 namespace optique::calib {
 namespace {
@@ -189,11 +188,9 @@ Result<PointsFile> parse_points_file(std::string_view text, const std::string& n
 }
 
 Result<PointsFile> read_points_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path + ": cannot open the points file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_points_file(text.str(), path);
+  auto text = util::read_file(path, "points file");
+  if (!text) return Error{text.error()};
+  return parse_points_file(text.value(), path);
 }
 
 }  // namespace optique::calib

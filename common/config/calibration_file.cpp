@@ -1,19 +1,17 @@
 #include "config/calibration_file.h"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
+
+#include "util/read_file.h"
 
 namespace optique::config {
 
 Result<glm::dmat3> read_calibration_homography(const std::string& path, std::uint32_t width, std::uint32_t height) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{path + ": cannot open the calibration file"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  const auto document = nlohmann::json::parse(text.str(), nullptr, /*allow_exceptions=*/false);
+  auto text = util::read_file(path, "calibration file");
+  if (!text) return Error{text.error()};
+  const auto document = nlohmann::json::parse(text.value(), nullptr, /*allow_exceptions=*/false);
   if (document.is_discarded()) return Error{path + ": not valid JSON"};
   // Files from before calibrate wrote the image size say nothing: taken as they are.
   if (const auto image = document.find("projector"); image != document.end() && image->is_object()) {

@@ -4,14 +4,11 @@
 
 #include <nlohmann/json.hpp>
 
-#include <cerrno>
-#include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include "config/parse.h"
 #include "config/schema_check.h"
+#include "util/read_file.h"
 #include "util/sha256.h"
 
 namespace optique::config {
@@ -61,23 +58,17 @@ Result<Installation> parse_installation(const std::string& json, const std::stri
 }
 
 Result<LoadedConfig> load_installation(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    const int error = errno;
-    return Error{path + ": cannot open the config file: " + std::strerror(error)};
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) return Error{path + ": cannot read the config file"};
+  auto text = util::read_file(path, "config file");
+  if (!text) return Error{text.error()};
 
   LoadedConfig loaded;
   loaded.path = path;
   loaded.directory = std::filesystem::path(path).parent_path().string();
   if (loaded.directory.empty()) loaded.directory = ".";
-  auto installation = parse_installation(text.str(), path, loaded.directory);
+  auto installation = parse_installation(text.value(), path, loaded.directory);
   if (!installation) return Error{installation.error()};
   loaded.installation = std::move(installation).value();
-  loaded.sha256 = util::sha256_hex(text.str());
+  loaded.sha256 = util::sha256_hex(text.value());
   return loaded;
 }
 

@@ -2,8 +2,8 @@
 
 #include <charconv>
 #include <cmath>
-#include <fstream>
-#include <sstream>
+
+#include "util/read_file.h"
 
 namespace optique::tracking {
 namespace {
@@ -86,11 +86,9 @@ Result<std::vector<ReplaySample>> parse_replay(std::string_view text, const std:
 }
 
 Result<std::vector<ReplaySample>> load_replay(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Error{"cannot read the tracking replay '" + path + "'"};
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_replay(text.str(), path);
+  auto text = util::read_file(path, "tracking replay");
+  if (!text) return Error{text.error()};
+  return parse_replay(text.value(), path);
 }
 
 }  // namespace optique::tracking

@@ -123,7 +123,7 @@ TEST(PointsFile, TrackerToScreenMustBeRigidAndGoWithTrackerPoints) {
 TEST(PointsFile, MissingFileIsNamed) {
   auto parsed = read_points_file("/nonexistent/pts.json");
   ASSERT_FALSE(parsed.ok());
-  EXPECT_EQ(parsed.error(), "/nonexistent/pts.json: cannot open the points file");
+  EXPECT_EQ(parsed.error(), "/nonexistent/pts.json: cannot open the points file: No such file or directory");
 }
 
 }  // namespace
