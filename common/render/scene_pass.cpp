@@ -9,6 +9,7 @@
 #include <glm/mat3x3.hpp>
 
 #include "render/shaders.h"
+#include "scene/instance_tree.h"
 #include "up/between.h"
 
 namespace optique::render {
@@ -136,6 +137,7 @@ Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
 
   pass.materials_ = scene.materials;
   pass.instances_ = scene.instances;
+  pass.asset_id_ = scene.asset_id;
   pass.ambient_ = scene.ambient;
   pass.background_ = scene.background;
   pass.set_all_lights();
@@ -225,36 +227,65 @@ void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, cons
   glUniform1i(u.light_count, light_count_);
   const glm::dmat4 view_projection = view.view_projection();
 
+  // The installation's scene where it is, then every visible instance of it
+  // an application placed (which moves between frames: never drawn as still).
+  Placement placement;
+  placement.view_projection = view_projection;
+  placement.moving_only = which == Objects::moving;
+  placement.still_only = which == Objects::still;
+  draw_placed(placement, state, view, terms, u, motion);
+  if (which == Objects::still || asset_id_.empty()) return;
+  placement.moving_only = false;
+  for (const auto& [id, instance] : state.instances) {
+    if (instance.asset != asset_id_) continue;
+    const auto now = scene::instance_world(state, id, view.fraction);
+    if (!now) continue;
+    placement.world = *now;
+    for (int e = 0; e < (motion ? 2 : 0); ++e) {
+      const MotionEnd& end = motion->ends[e];
+      placement.world_at_end[e] = end.state ? scene::instance_world(*end.state, id, end.fraction) : std::nullopt;
+    }
+    placement.base_colour = glm::vec3(instance.base_color);
+    placement.emissive = glm::vec3(instance.emissive);
+    draw_placed(placement, state, view, terms, u, motion);
+  }
+}
+
+void ScenePass::draw_placed(const Placement& placement, const scene::SceneState& state, const Viewpoint& view,
+                            const LightTerms& terms, const Uniforms& u, const Motion* motion) {
+  const int keys = motion ? motion->key_frames : 0;
   for (const auto& instance : instances_) {
-    if ((which == Objects::still && instance.object) || (which == Objects::moving && !instance.object)) continue;
+    if ((placement.still_only && instance.object) || (placement.moving_only && !instance.object)) continue;
     glm::dmat4 model = instance.transform;
     if (instance.object) {
       const auto found = state.objects.find(*instance.object);
       if (found == state.objects.end()) continue;  // not in the state (yet): nothing to place
       model = scene::model_matrix(scene::interpolate(found->second, view.fraction)) * instance.transform;
     }
+    model = placement.world * model;
     // Products in double, then to float: keeps precision for large worlds.
-    const glm::mat4 mvp(view_projection * model);
+    const glm::mat4 mvp(placement.view_projection * model);
     const glm::mat4 model_f(model);
     const glm::mat3 normal_matrix(glm::transpose(glm::inverse(glm::dmat3(model))));
     glUniformMatrix4fv(u.model_view_projection, 1, GL_FALSE, glm::value_ptr(mvp));
     if (motion) {
-      // Where this instance is at the motion's two ends; an object not in the
-      // scene then projects to w = 0: no place.
+      // Where this instance is at the motion's two ends; an object (or a
+      // placed instance) not in the scene then projects to w = 0: no place.
       const GLint locations[2] = {u.model_view_projection_now, u.model_view_projection_next};
       const GLint normal_locations[2] = {u.normal_matrix_now, u.normal_matrix_next};
       for (int e = 0; e < (keys == 1 ? 1 : 2); ++e) {
         const MotionEnd& end = motion->ends[e];
         glm::dmat4 then = instance.transform;
-        bool there = true;
-        if (instance.object) {
+        bool there = placement.world_at_end[e].has_value();
+        if (instance.object && there) {
           const auto found = end.state->objects.find(*instance.object);
           there = found != end.state->objects.end();
           if (there) then = scene::model_matrix(scene::interpolate(found->second, end.fraction)) * instance.transform;
         }
+        if (there) then = *placement.world_at_end[e] * then;
         const glm::mat4 clip(there ? end.view_projection * then : glm::dmat4(0.0));
         glUniformMatrix4fv(locations[e], 1, GL_FALSE, glm::value_ptr(clip));
-        if (key_frames) {
+        if (keys > 0) {
           const glm::mat3 normals(glm::transpose(glm::inverse(glm::dmat3(then))));
           glUniformMatrix3fv(normal_locations[e], 1, GL_FALSE, glm::value_ptr(normals));
         }
@@ -263,12 +294,13 @@ void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, cons
     glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(model_f));
     glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
     const scene::Material& m = materials_[instance.material];
-    glUniform3fv(u.base_colour, 1, glm::value_ptr(m.base_colour));
+    const glm::vec3 base_colour = m.base_colour * placement.base_colour;
+    glUniform3fv(u.base_colour, 1, glm::value_ptr(base_colour));
     glUniform1i(u.has_base_colour_texture, m.base_colour_texture ? 1 : 0);
     if (m.base_colour_texture) glBindTextureUnit(1, textures_[*m.base_colour_texture].get());  // unit 0: encode
     glUniform1f(u.metallic, m.metallic);
     glUniform1f(u.roughness, m.roughness);
-    const glm::vec3 emissive = terms.emissive ? m.emissive : glm::vec3(0.0f);
+    const glm::vec3 emissive = terms.emissive ? m.emissive * placement.emissive : glm::vec3(0.0f);
     glUniform3fv(u.emissive, 1, glm::value_ptr(emissive));
     const MeshRange& mesh = meshes_[instance.mesh];
     glDrawElementsBaseVertex(GL_TRIANGLES, mesh.count, GL_UNSIGNED_INT,

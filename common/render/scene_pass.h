@@ -8,8 +8,10 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <set>
 #include <span>
+#include <string>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -78,8 +80,22 @@ class ScenePass {
   };
 
  private:
+  // One placement of the scene's instances: the installation's (the world
+  // unmoved), or an instance of the whole scene an application placed.
+  struct Placement {
+    glm::dmat4 view_projection{1.0};
+    glm::dmat4 world{1.0};                                                           // at the view's moment
+    std::optional<glm::dmat4> world_at_end[2] = {glm::dmat4(1.0), glm::dmat4(1.0)};  // at the motion's ends
+    glm::vec3 base_colour{1.0f};                                                     // factors on every material
+    glm::vec3 emissive{1.0f};
+    bool still_only = false;   // only the instances on no animated object
+    bool moving_only = false;  // only those on one
+  };
+
   ScenePass() = default;
   void upload_shining_lights(const std::set<std::uint32_t>& off);
+  void draw_placed(const Placement& placement, const scene::SceneState& state, const Viewpoint& view,
+                   const LightTerms& terms, const Uniforms& u, const Motion* motion);
 
   struct MeshRange {
     GLsizei count = 0;
@@ -102,6 +118,7 @@ class ScenePass {
   std::vector<MeshRange> meshes_;
   std::vector<scene::Material> materials_;
   std::vector<scene::Instance> instances_;
+  std::string asset_id_;  // the scene's: the live instances of it are drawn too
   glm::vec3 ambient_{0.0f};
   glm::vec3 background_{0.0f};
   std::vector<glm::vec4> all_lights_;           // position, radiance: two per light

@@ -81,6 +81,9 @@ struct AnimatedObject {
 
 struct SceneDefinition {
   std::string name;
+  // What applications call it when they place it again (scene/asset_id.h):
+  // set where an installation's scene is loaded; empty for a scene made in code.
+  std::string asset_id;
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
   std::vector<Texture> textures;

@@ -1,12 +1,17 @@
 #include "scene_load/installation_scene.h"
 
+#include "scene/asset_id.h"
+
 namespace optique::config {
 
 Result<scene::LoadedScene> load_scene(const Installation& installation, const scene::ImageDecoder& decode,
                                       const std::string& gltf_path) {
   const SceneSource& source = installation.scene;
-  return scene::load_scene(source.builtin, gltf_path.empty() ? source.gltf : gltf_path, decode,
-                           installation.viewer.eye_at(0.0));
+  auto loaded = scene::load_scene(source.builtin, gltf_path.empty() ? source.gltf : gltf_path, decode,
+                                  installation.viewer.eye_at(0.0));
+  // Named by the master's file, wherever this copy of it is.
+  if (loaded) loaded.value().definition.asset_id = scene::scene_asset_id(source.builtin, source.gltf);
+  return loaded;
 }
 
 }  // namespace optique::config

@@ -112,7 +112,7 @@ Result<void> Master::start() {
   if (settings.api) {
     session_port_.emplace(io_, *settings.api, options_.run.secret, settings.max_message_bytes, log_);
     // For now the one asset is the installation's own scene, by name.
-    session_port_->live().add_asset(scene_asset_id(installation.scene.builtin, installation.scene.gltf));
+    session_port_->live().add_asset(options_.scene.definition.asset_id);
     run.live = &session_port_->live();
   }
   protocol_.emplace(installation, options_.scene, std::move(run), *recorder_);
@@ -136,7 +136,7 @@ Result<void> Master::start() {
     auto port = session_port_->start([this] { return protocol_->progress().next_frame; });
     if (!port) return Error{port.error()};
     log_.info("scene sessions on {}:{}: applications may place instances of '{}'", settings.api->listen, port.value(),
-              scene_asset_id(installation.scene.builtin, installation.scene.gltf));
+              options_.scene.definition.asset_id);
     if (auto written = write_port_file(options_.api_port_file, port.value(), "api port file"); !written) {
       return written;
     }

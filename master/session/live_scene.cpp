@@ -295,19 +295,6 @@ std::optional<Refusal> LiveScene::apply(const session::Transaction& transaction)
   return std::nullopt;
 }
 
-std::string scene_asset_id(const std::string& builtin, const std::string& gltf_path) {
-  std::string id = builtin;
-  if (id.empty()) {
-    const std::size_t slash = gltf_path.find_last_of('/');
-    id = gltf_path.substr(slash == std::string::npos ? 0 : slash + 1);
-    if (const std::size_t dot = id.rfind('.'); dot != std::string::npos && dot > 0) id.resize(dot);
-  }
-  if (id.size() > scene::kMaxInstanceIdLength) id.resize(scene::kMaxInstanceIdLength);
-  std::replace_if(
-      id.begin(), id.end(), [](char c) { return !util::is_id_char(c); }, '-');
-  return id.empty() ? "scene" : id;
-}
-
 std::map<std::string, scene::InstanceState> frame_instances(const LiveScene& live) {
   std::map<std::string, scene::InstanceState> states;
   for (const auto& [id, instance] : live.instances()) {

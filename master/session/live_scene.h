@@ -77,11 +77,6 @@ class LiveScene {
   std::size_t edits_this_frame_ = 0;
 };
 
-// The asset an application instantiates to place the installation's own scene
-// again: the built-in scene's name, or the glTF file's name without its folder
-// and extension (characters an id may not hold made '-', at most 64).
-[[nodiscard]] std::string scene_asset_id(const std::string& builtin, const std::string& gltf_path);
-
 // The instances as a frame shows them (scene/state.h): each at its pose, the
 // same now and at the next frame time, as an edit between them is not known
 // yet.

@@ -172,6 +172,27 @@ TEST_F(FieldGather, ASpeedAtTheThresholdDoesNotPop) {
   }
 }
 
+// A live instance that moves within the frame (its pose now and next apart:
+// as a node may be sent) has that motion in the gather's velocity: the copy of
+// the moving square carried 0.1 m a frame (16 px at 160 px/m) is the fastest
+// surface, not the square's own 3.6 px.
+TEST_F(FieldGather, ALiveInstanceMovingWithinTheFrameHasItsVelocity) {
+  open("dlp-120hz.json");
+  fields().method = config::FieldMethod::gather;
+  auto pipeline = render::ProjectorPipeline::make(config::job_for(installation(), 0), gl_.scene, {});
+  ASSERT_TRUE(pipeline) << pipeline.error();
+  scene::SceneState state = state_at(60);
+  scene::InstanceState copy;
+  copy.asset = gl_.scene.asset_id;
+  copy.pose.now.position = {0.0, 0.2, 0.0};
+  copy.pose.next.position = {0.1, 0.2, 0.0};
+  state.instances["copy"] = copy;
+  ASSERT_TRUE(pipeline.value()->draw_frame(state));
+  const double fastest = pipeline.value()->gather_report().fastest;
+  EXPECT_GT(fastest, 15.0);
+  EXPECT_LT(fastest, 22.0);
+}
+
 // A white wheel turning: with a threshold below its rim's speed, the rim gets
 // motion blur, the same in every channel — no colour fringes added.
 TEST_F(FieldGather, AWheelFasterThanTheThresholdIsBlurredWithoutFringes) {

@@ -20,8 +20,8 @@
 #include "render/gl_context.h"
 #include "render/scene_renderer.h"
 #include "scene/definition.h"
-#include "scene_load/gltf.h"
 #include "scene/state.h"
+#include "scene_load/gltf.h"
 
 namespace optique::render {
 namespace {
@@ -273,6 +273,88 @@ TEST_F(SceneRendererTest, MaterialTextureOutOfRangeFailsCreate) {
   scene.materials.emplace_back(glm::vec3(1.0f), 0.0f, 1.0f, glm::vec3(0.0f), 3u);
   scene.instances.push_back({0, 0, std::nullopt, glm::dmat4(1.0)});
   EXPECT_FALSE(SceneRenderer::create(scene, kSize, kSize).ok());
+}
+
+// A small emissive square at the world's origin, lit by nothing else: the
+// scene an application places again (its asset id "square").
+scene::SceneDefinition emissive_square() {
+  scene::SceneDefinition scene;
+  scene.name = "square";
+  scene.asset_id = "square";
+  scene::Mesh mesh = textured_quad();
+  for (auto& vertex : mesh.vertices) vertex.position *= 0.1f;  // 0.2 m wide: ±3.3 pixels
+  scene.meshes.push_back(std::move(mesh));
+  scene.materials.emplace_back(glm::vec3(0.0f), 0.0f, 1.0f, glm::vec3(0.25f, 0.5f, 0.125f));
+  scene.instances.push_back({0, 0, std::nullopt, glm::dmat4(1.0)});
+  scene.lights.clear();
+  scene.ambient = glm::vec3(0.0f);
+  return scene;
+}
+
+scene::InstanceState square_at(double x, double y, const std::string& parent = {}) {
+  scene::InstanceState instance;
+  instance.asset = "square";
+  instance.parent = parent;
+  scene::Pose pose;
+  pose.position = {x, y, 0.0};
+  instance.pose = {pose, pose};
+  return instance;
+}
+
+// Each visible instance of the installation's scene is drawn where its chain
+// of parents puts it, with its factors on every material; a hidden one, one
+// under a hidden group, or one of another asset, is not. The world point
+// (0.5, 0.5) is pixel (49, 16) (top row first), the origin pixel (33, 33).
+TEST_F(SceneRendererTest, LiveInstancesOfTheSceneAreDrawnWhereTheirParentsPutThem) {
+  auto renderer = SceneRenderer::create(emissive_square(), kSize, kSize);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  const auto channel = [&](const scene::SceneState& state, int x, int y, int c) {
+    renderer.value()->draw(state, {0.0, kEye, view_of_unit_square()});
+    return renderer.value()->read_rendered().at(x, y, c);
+  };
+  scene::SceneState state;
+  EXPECT_NEAR(channel(state, kSize / 2, kSize / 2, 1), 0.5f, kTolerance);  // the scene where it is
+  EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.0f, kTolerance);
+  state.instances["copy"] = square_at(0.5, 0.5);
+  EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.5f, kTolerance);
+  EXPECT_NEAR(channel(state, kSize / 2, kSize / 2, 1), 0.5f, kTolerance);  // still there too
+  state.instances["copy"].emissive = {2.0, 0.5, 0.0};
+  EXPECT_NEAR(channel(state, kFar, kNear, 0), 0.5f, kTolerance);
+  EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.25f, kTolerance);
+  EXPECT_NEAR(channel(state, kFar, kNear, 2), 0.0f, kTolerance);
+  state.instances["copy"].visible = false;
+  EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.0f, kTolerance);
+
+  // Under a group moved to (0.5, 0): the child's (0, 0.5) lands at (0.5, 0.5).
+  state.instances.erase("copy");
+  state.instances["group"] = square_at(0.5, 0.0);
+  state.instances["child"] = square_at(0.0, 0.5, "group");
+  EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.5f, kTolerance);
+  state.instances["group"].visible = false;
+  EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.0f, kTolerance);
+
+  state.instances.clear();
+  state.instances["other"] = square_at(0.5, 0.5);
+  state.instances["other"].asset = "teapot";
+  EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.0f, kTolerance);
+}
+
+// A DLP projector's fields draw what does not move once for every field: a
+// live instance is drawn in each field all the same.
+TEST_F(SceneRendererTest, LiveInstancesAreDrawnInEveryColourField) {
+  auto renderer = SceneRenderer::create(emissive_square(), kSize, kSize);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  scene::SceneState state;
+  state.instances["copy"] = square_at(0.5, 0.5);
+  const Viewpoint view{0.0, kEye, view_of_unit_square()};
+  const FieldPass passes[] = {{view, true, false, false}, {view, false, true, false}, {view, false, false, true}};
+  renderer.value()->draw_fields(state, passes);
+  const auto image = renderer.value()->read_rendered();
+  const float expected[] = {0.25f, 0.5f, 0.125f};
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(image.at(kFar, kNear, c), expected[c], kTolerance) << "channel " << c;
+    EXPECT_NEAR(image.at(kSize / 2, kSize / 2, c), expected[c], kTolerance) << "channel " << c;
+  }
 }
 
 }  // namespace
