@@ -86,6 +86,11 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
                                                 clock::Nanos now, Actions& out) {
   scene::SceneState state = authority_.state_at_frame(frame);
   if (settings_.live != nullptr) {
+    if (settings_.journal_replay != nullptr) {
+      for (std::string& problem : settings_.journal_replay->apply_due(*settings_.live, frame)) {
+        out.push_back(Log{spdlog::level::warn, std::move(problem)});
+      }
+    }
     // Every edit made until now is in this frame; the next frame's budget of edits starts.
     state.instances = frame_instances(*settings_.live);
     settings_.live->begin_frame();

@@ -38,6 +38,7 @@
 #include "master/run/stacked_groups.h"
 #include "master/run_recorder.h"
 #include "master/scene_server.h"
+#include "master/session/journal.h"
 #include "master/session/live_scene.h"
 #include "master/viewer_head.h"
 #include "net/auth.h"
@@ -67,6 +68,9 @@ struct RunSettings {
   // outlive the protocol: an edit made before frame k begins is in frame k.
   // None: the scene is a function of time alone.
   LiveScene* live = nullptr;
+  // A recorded session played again into `live` (--replay): its transactions
+  // of frame k applied as frame k begins. Must outlive the protocol.
+  JournalReplay* journal_replay = nullptr;
 };
 
 class MasterProtocol {

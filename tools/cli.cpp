@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 
 #include "image/texture_decode.h"
 #include "log/logger.h"
@@ -104,6 +105,9 @@ int run_cli(int argc, char** argv) {
       ->add_option("--supersample", reference_options.supersample,
                    "S×S samples per pixel, box-filtered (compare with composites, which integrate each pixel)")
       ->check(CLI::Range(1, 8));
+  std::string reference_replay;
+  reference->add_option("--replay", reference_replay,
+                        "a journal the master recorded (--record): draw the live instances its last run shows then");
 
   std::string compose_config;
   std::uint64_t compose_frame_number = 0;
@@ -202,6 +206,16 @@ int run_cli(int argc, char** argv) {
   if (!loaded) {
     std::cerr << loaded.error() << "\n";
     return kExitUsage;
+  }
+  std::optional<master::Journal> journal;
+  if (!reference_replay.empty()) {
+    auto read = master::read_journal_file(reference_replay);
+    if (!read) {
+      std::cerr << "--replay: " << read.error() << "\n";
+      return kExitUsage;
+    }
+    journal = std::move(read).value();
+    reference_options.replay = &*journal;
   }
   auto logger = log::make_logger("reference", log_level, log_file, log::FileMode::append);
   if (auto done = render_reference(loaded.value().config, loaded.value().scene, reference_frame, reference_out, *logger,

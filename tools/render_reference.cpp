@@ -24,7 +24,13 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
   const auto& installation = config.installation;
   const master::SceneAuthority authority(scene.definition.objects, installation.viewer, installation.master.frame_rate,
                                          master::LightSwitches::from_config(installation.scene));
-  const scene::SceneState state = authority.state_at_frame(frame);
+  scene::SceneState state = authority.state_at_frame(frame);
+  if (options.replay != nullptr) {
+    auto instances = master::replayed_instances(*options.replay, scene.definition.asset_id,
+                                                master::live_scene_limits(installation.master.api), frame);
+    if (!instances) return Error{"the replayed journal: " + instances.error()};
+    state.instances = std::move(instances).value();
+  }
 
   auto context = render::make_headless_context();
   if (!context) return Error{"cannot render: " + context.error()};

@@ -10,6 +10,7 @@
 #include <spdlog/logger.h>
 
 #include "config/load.h"
+#include "master/session/journal.h"
 #include "scene_load/load_scene.h"
 #include "util/result.h"
 
@@ -21,6 +22,9 @@ struct ReferenceOptions {
   // that each pixel holds the light over its footprint as screen composites do.
   // 1 = one sample per pixel centre.
   int supersample = 1;
+  // A recorded session (the master's --record): the frame shows the live
+  // instances its last run, played again, puts in it (the master's --replay).
+  const master::Journal* replay = nullptr;
 };
 
 // Writes OUT/reference/<screen-id>/frame-NNNNNN.exr and .png for every screen.

@@ -49,6 +49,7 @@ int run_cli(int argc, char** argv) {
   int port = -1;
   bool no_status = false;
   int status_port = -1;
+  int api_port = -1;
   bool print_status_token = false;
   app.add_option("-c,--config", config_path, "installation file (configs/*.json)");
   app.add_flag("--local", options.local, "start one optique-node per projector on this machine (127.0.0.1)");
@@ -72,8 +73,17 @@ int run_cli(int argc, char** argv) {
       ->check(CLI::Range(0, 65535));
   app.add_option("--status-port-file", options.status_port_file,
                  "write the status server's port once listening (for scripts)");
+  app.add_option("--api-port", api_port,
+                 "take applications' scene sessions on this port (0: ephemeral); overrides master.api.port, and "
+                 "turns it on (on 127.0.0.1) if the config does not")
+      ->check(CLI::Range(0, 65535));
   app.add_option("--api-port-file", options.api_port_file,
                  "write the scene session's port (master.api) once listening (for scripts)");
+  app.add_option("--record", options.record_path,
+                 "journal every transaction applications make (master.api) in FILE; a master started again with "
+                 "the same FILE comes back with the live scene it leaves");
+  app.add_option("--replay", options.replay_path,
+                 "play the last run of a --record journal again, each transaction in its frame, with no application");
   app.add_flag("--print-status-token", print_status_token,
                "print the status server's bearer token (derived from master.secret_file) and exit");
   app.add_option("--capture-every", options.run.capture_every,
@@ -137,6 +147,10 @@ int run_cli(int argc, char** argv) {
   if (status_port >= 0) {
     if (!settings.status) settings.status.emplace();
     settings.status->port = static_cast<std::uint16_t>(status_port);
+  }
+  if (api_port >= 0) {
+    if (!settings.api) settings.api.emplace();
+    settings.api->port = static_cast<std::uint16_t>(api_port);
   }
   if (options.local) {
     settings.listen = "127.0.0.1";

@@ -109,12 +109,7 @@ Result<void> Master::start() {
     if (!head_csv_) return Error{"cannot write " + head_path.string()};
     head_csv_ << head_csv_header();
   }
-  if (settings.api) {
-    session_port_.emplace(io_, *settings.api, options_.run.secret, settings.max_message_bytes, log_);
-    // For now the one asset is the installation's own scene, by name.
-    session_port_->live().add_asset(options_.scene.definition.asset_id);
-    run.live = &session_port_->live();
-  }
+  if (auto made = make_live_scene(run); !made) return made;
   protocol_.emplace(installation, options_.scene, std::move(run), *recorder_);
 
   // Listen.

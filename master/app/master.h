@@ -56,6 +56,8 @@ struct MasterOptions {
   std::shared_ptr<WarningSink> warnings;
   std::string status_port_file;  // write the status server's port once listening
   std::string api_port_file;     // write the scene session's port (master.api) once listening
+  std::string record_path;       // journal the live scene's transactions here (restored from it first)
+  std::string replay_path;       // play the last run of this journal again
 };
 
 class Master {
@@ -83,6 +85,9 @@ class Master {
   void on_signal(int signal);
   void update_status();
   [[nodiscard]] Result<void> start_status_service(const config::StatusServer& settings);
+  // The live scene, with master.api or --replay: its journal restored or
+  // replayed, its session port made (not yet listening).
+  [[nodiscard]] Result<void> make_live_scene(RunSettings& run);
   void publish_status();
   void finish(int exit_code);
   void write_outputs();
@@ -97,7 +102,9 @@ class Master {
   std::ofstream csv_;
   std::ofstream head_csv_;  // the head shown each frame, with tracking
   std::optional<RunRecorder> recorder_;
-  std::optional<SessionPort> session_port_;  // master.api; its live scene outlives the protocol
+  std::optional<LiveScene> live_;                // outlives the session port and the protocol
+  std::optional<JournalReplay> journal_replay_;  // --replay
+  std::optional<SessionPort> session_port_;      // master.api
   std::optional<MasterProtocol> protocol_;
 
   TcpListener listener_;  // the nodes'

@@ -9,21 +9,16 @@ namespace {
 // Before its hello an application has said nothing worth more.
 constexpr std::uint32_t kMaxHelloBytes = 4096;
 
-LiveSceneLimits limits_of(const config::ApiServer& settings) {
-  LiveSceneLimits limits;
-  limits.max_instances = settings.max_instances;
-  limits.max_edits_per_frame = settings.max_edits_per_frame;
-  return limits;
-}
-
 }  // namespace
 
-SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings, std::optional<net::Secret> secret,
+SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings, LiveScene& live,
+                         std::optional<JournalFile> journal, std::optional<net::Secret> secret,
                          std::uint32_t max_message_bytes, spdlog::logger& log)
     : settings_(settings),
       log_(log),
-      live_(limits_of(settings)),
-      sessions_(live_, SceneSessionSettings{settings.max_sessions, max_message_bytes, std::move(secret)}),
+      journal_(std::move(journal)),
+      sessions_(live, SceneSessionSettings{settings.max_sessions, max_message_bytes, std::move(secret),
+                                           journal_.has_value()}),
       listener_(io, log) {}
 
 Result<std::uint16_t> SessionPort::start(std::function<std::uint64_t()> next_frame) {
@@ -88,6 +83,14 @@ void SessionPort::carry_out(SessionActions actions) {
                    [&](session_action::Protect& a) {
                      if (auto found = connections_.find(a.session); found != connections_.end()) {
                        found->second->protect(a.keys.to_node, a.keys.to_master, false);
+                     }
+                   },
+                   [&](session_action::Journal& a) {
+                     if (!journal_) return;
+                     if (auto wrote = journal_->append(a.entry); !wrote) {
+                       // The show goes on; what follows is not recorded, and the operator is told.
+                       log_.error("the journal: {}; transactions from now on are not recorded", wrote.error());
+                       journal_.reset();
                      }
                    },
                    [&](session_action::Log& a) { log_.log(a.level, "{}", a.text); },

@@ -14,6 +14,7 @@
 #include <string>
 
 #include "config/installation.h"
+#include "master/app/journal_file.h"
 #include "master/app/tcp_listener.h"
 #include "master/session/live_scene.h"
 #include "master/session/scene_sessions.h"
@@ -24,11 +25,12 @@ namespace optique::master {
 
 class SessionPort {
  public:
-  SessionPort(asio::io_context& io, const config::ApiServer& settings, std::optional<net::Secret> secret,
-              std::uint32_t max_message_bytes, spdlog::logger& log);
-
-  // What the frame loop reads (RunSettings::live).
-  [[nodiscard]] LiveScene& live() { return live_; }
+  // Applications edit `live` (which the frame loop reads: RunSettings::live;
+  // it must outlive this); with `journal`, each transaction applied is
+  // appended to it before the application hears so.
+  SessionPort(asio::io_context& io, const config::ApiServer& settings, LiveScene& live,
+              std::optional<JournalFile> journal, std::optional<net::Secret> secret, std::uint32_t max_message_bytes,
+              spdlog::logger& log);
   // Listens and accepts; `next_frame` says which frame the master begins next.
   // The port bound.
   [[nodiscard]] Result<std::uint16_t> start(std::function<std::uint64_t()> next_frame);
@@ -41,7 +43,7 @@ class SessionPort {
 
   const config::ApiServer settings_;
   spdlog::logger& log_;
-  LiveScene live_;
+  std::optional<JournalFile> journal_;
   SceneSessions sessions_;
   TcpListener listener_;
   std::function<std::uint64_t()> next_frame_;

@@ -295,6 +295,36 @@ std::optional<Refusal> LiveScene::apply(const session::Transaction& transaction)
   return std::nullopt;
 }
 
+session::SceneContents scene_contents(const LiveScene& live, std::uint64_t frame) {
+  session::SceneContents contents;
+  contents.set_frame(frame);
+  for (const std::string& asset : live.assets()) contents.add_assets(asset);
+  for (const auto& [id, instance] : live.instances()) {
+    session::InstanceView& view = *contents.add_instances();
+    view.set_instance(id);
+    view.set_asset(instance.asset);
+    view.set_parent(instance.parent);
+    view.set_hidden(!instance.visible);
+    session::Transform& t = *view.mutable_transform();
+    const scene::Pose& pose = instance.pose;
+    for (int i = 0; i < 3; ++i) t.add_position(pose.position[i]);
+    for (double q : {pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z}) t.add_rotation(q);
+    for (int i = 0; i < 3; ++i) t.add_scale(pose.scale[i]);
+    for (int i = 0; i < 4; ++i) view.add_base_color(instance.base_color[i]);
+    for (int i = 0; i < 3; ++i) view.add_emissive(instance.emissive[i]);
+  }
+  return contents;
+}
+
+LiveSceneLimits live_scene_limits(const std::optional<config::ApiServer>& api) {
+  LiveSceneLimits limits;
+  if (api) {
+    limits.max_instances = api->max_instances;
+    limits.max_edits_per_frame = api->max_edits_per_frame;
+  }
+  return limits;
+}
+
 std::map<std::string, scene::InstanceState> frame_instances(const LiveScene& live) {
   std::map<std::string, scene::InstanceState> states;
   for (const auto& [id, instance] : live.instances()) {

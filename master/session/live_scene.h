@@ -20,6 +20,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include "config/installation.h"
 #include "optique/session.pb.h"
 #include "scene/state.h"
 
@@ -41,6 +42,9 @@ struct LiveSceneLimits {
   std::size_t max_depth = scene::kMaxInstanceDepth;  // instances above an instance, the world not counted
 };
 
+// The limits master.api sets (none: the defaults, as for a replay without it).
+[[nodiscard]] LiveSceneLimits live_scene_limits(const std::optional<config::ApiServer>& api);
+
 // Why a transaction was refused: its first edit that could not be applied.
 struct Refusal {
   std::size_t edit = 0;
@@ -55,6 +59,7 @@ class LiveScene {
   // An asset the nodes can draw (loaded and shipped by the scene transfer).
   void add_asset(const std::string& id) { assets_.insert(id); }
   [[nodiscard]] bool has_asset(const std::string& id) const { return assets_.count(id) != 0; }
+  [[nodiscard]] const std::set<std::string>& assets() const { return assets_; }
 
   // Applies every edit, or none and says which and why.
   [[nodiscard]] std::optional<Refusal> apply(const session::Transaction& transaction);
@@ -76,6 +81,10 @@ class LiveScene {
   std::map<std::string, std::set<std::string>> children_;  // parent → its children; "" → the world's
   std::size_t edits_this_frame_ = 0;
 };
+
+// The live scene as an application reads it (session::ReadScene), as frame
+// `frame` will show it.
+[[nodiscard]] session::SceneContents scene_contents(const LiveScene& live, std::uint64_t frame);
 
 // The instances as a frame shows them (scene/state.h): each at its pose, the
 // same now and at the next frame time, as an edit between them is not known

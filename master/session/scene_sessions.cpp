@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "master/session/journal.h"
 #include "net/envelope.h"
 #include "net/hello_proof.h"
 
@@ -146,8 +147,15 @@ void SceneSessions::on_request(SessionId id, const session::Request& request, st
         refused.set_field(refusal->field);
         refused.set_reason(refusal->reason);
       } else {
+        if (settings_.journal) {
+          out.push_back(session_action::Journal{
+              journal_transaction(next_frame, sessions_.at(id).application, request.transaction())});
+        }
         answer.mutable_session_reply()->mutable_applied()->set_frame(next_frame);
       }
+      break;
+    case session::Request::kReadScene:
+      *answer.mutable_session_reply()->mutable_scene() = scene_contents(live_, next_frame);
       break;
     case session::Request::REQUEST_NOT_SET:
       answer.mutable_session_reply()->mutable_refused()->set_field("request");

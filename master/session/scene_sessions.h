@@ -46,6 +46,11 @@ struct Protect {
   SessionId session = 0;
   net::SessionKeys keys;
 };
+// Append this entry to the journal (journal.h); comes before the reply that
+// tells the application its transaction was applied.
+struct Journal {
+  std::string entry;
+};
 struct Log {
   spdlog::level::level_enum level = spdlog::level::info;
   std::string text;
@@ -53,7 +58,7 @@ struct Log {
 }  // namespace session_action
 
 using SessionAction = std::variant<session_action::Send, session_action::Close, session_action::SetMaxPayload,
-                                   session_action::Protect, session_action::Log>;
+                                   session_action::Protect, session_action::Journal, session_action::Log>;
 using SessionActions = std::vector<SessionAction>;
 
 // The capability an application's Hello names.
@@ -66,6 +71,8 @@ struct SceneSessionSettings {
   std::uint32_t max_message_bytes = 16u << 20;
   // Applications must prove they hold it; without one only loopback peers are accepted.
   std::optional<net::Secret> secret;
+  // Journal every transaction applied (the master's --record).
+  bool journal = false;
 };
 
 class SceneSessions {

@@ -6,6 +6,7 @@
 #include <map>
 #include <vector>
 
+#include "master/session/journal.h"
 #include "master/session/scene_sessions.h"
 #include "net/envelope.h"
 #include "net/framing.h"
@@ -334,7 +335,9 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
   master::LiveScene live(limits);
   live.add_asset("torus");
   live.add_asset("duck");
-  master::SceneSessions sessions(live, {});
+  master::SceneSessionSettings settings;
+  settings.journal = true;
+  master::SceneSessions sessions(live, settings);
   (void)sessions.accepted(1, "127.0.0.1:1", true, std::vector<std::uint8_t>(net::kNonceBytes, 1));
   wire::Envelope hello;
   hello.set_protocol_version(net::kProtocolVersion);
@@ -356,17 +359,41 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
     const master::SessionActions actions = sessions.message(1, message, frame);
     bool closed = false;
     int replies = 0;
+    int journalled = 0;
     for (const master::SessionAction& action : actions) {
       closed = closed || std::holds_alternative<master::session_action::Close>(action);
+      if (const auto* entry = std::get_if<master::session_action::Journal>(&action)) {
+        // What is journalled reads back as the transaction, in this frame, before its reply.
+        OPTIQUE_FUZZ_REQUIRE(replies == 0);
+        auto read =
+            master::read_journal(std::string(master::kJournalMagic) + master::journal_start(0, "torus") + entry->entry);
+        OPTIQUE_FUZZ_REQUIRE(read.ok() && read.value().runs.size() == 1 && read.value().torn.empty());
+        const auto& transactions = read.value().runs[0].transactions;
+        OPTIQUE_FUZZ_REQUIRE(transactions.size() == 1 && transactions[0].frame() == frame);
+        OPTIQUE_FUZZ_REQUIRE(transactions[0].transaction().SerializeAsString() ==
+                             message.session_request().transaction().SerializeAsString());
+        ++journalled;
+        continue;
+      }
       const auto* sent = std::get_if<master::session_action::Send>(&action);
       if (sent == nullptr || !sent->message.has_session_reply()) continue;
       ++replies;
-      OPTIQUE_FUZZ_REQUIRE(sent->message.session_reply().id() == message.session_request().id());
-      if (sent->message.session_reply().has_applied()) {
-        OPTIQUE_FUZZ_REQUIRE(sent->message.session_reply().applied().frame() == frame);
+      const session::Reply& reply = sent->message.session_reply();
+      OPTIQUE_FUZZ_REQUIRE(reply.id() == message.session_request().id());
+      if (reply.has_scene()) {
+        // The scene as it is: every instance, nothing changed by reading it.
+        OPTIQUE_FUZZ_REQUIRE(message.session_request().has_read_scene());
+        OPTIQUE_FUZZ_REQUIRE(reply.scene().frame() == frame);
+        OPTIQUE_FUZZ_REQUIRE(static_cast<std::size_t>(reply.scene().instances_size()) == live.instances().size());
+        OPTIQUE_FUZZ_REQUIRE(live.instances() == before);
+        continue;
+      }
+      if (reply.has_applied()) {
+        OPTIQUE_FUZZ_REQUIRE(reply.applied().frame() == frame);
+        OPTIQUE_FUZZ_REQUIRE(journalled == 1);
         ++out.applied;
       } else {
-        OPTIQUE_FUZZ_REQUIRE(sent->message.session_reply().has_refused());
+        OPTIQUE_FUZZ_REQUIRE(reply.has_refused());
         OPTIQUE_FUZZ_REQUIRE(live.instances() == before);  // nothing of a refused transaction stays
         ++out.refused;
       }

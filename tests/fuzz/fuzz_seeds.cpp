@@ -708,6 +708,14 @@ std::function<void(session::Edit&)> remove(const std::string& id) {
 
 const Bytes kNextFrame{0};
 
+Bytes read_scene(std::uint64_t id) {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  e.mutable_session_request()->set_id(id);
+  e.mutable_session_request()->mutable_read_scene();
+  return serialize(e);
+}
+
 }  // namespace
 
 std::vector<Seed> session_seeds() {
@@ -725,6 +733,8 @@ std::vector<Seed> session_seeds() {
                                        for (double v : {2.0, 0.0, 0.0}) e.mutable_factors()->add_emissive(v);
                                      }}),
                          kNextFrame, request(3, {remove("table")}), request(4, {create("table", "duck")})})});
+  seeds.push_back({"read_the_scene", join({request(1, {create("table", "torus"), create("cup", "torus", "table", 0.5)}),
+                                           read_scene(2), kNextFrame, request(3, {remove("cup")}), read_scene(4)})});
   const double nan = std::numeric_limits<double>::quiet_NaN();
   seeds.push_back({"refusals", join({request(1, {create("a", "torus"), create("b", "teapot")}),
                                      request(2, {create("a", "torus"), move("a", {0, nan, 0})}),

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "master/session/journal.h"
 #include "master/session/scene_sessions.h"
 #include "net/envelope.h"
 
@@ -155,6 +156,93 @@ TEST_F(SceneSessionsTest, FromAnotherMachineOnlyWithTheSecret) {
   const auto admitted = guarded.message(4, with_mac(*settings.secret), 0);
   EXPECT_EQ(of<session_action::Protect>(admitted).size(), 1u) << "everything after the hello is sealed";
   EXPECT_EQ(of<session_action::Send>(guarded.message(4, create(1, "t", "torus"), 5)).size(), 1u);
+}
+
+// With a journal (--record), an applied transaction is journalled, with its
+// frame and the application's name, before the reply says it was applied; a
+// refused one is not. Without, nothing is.
+TEST_F(SceneSessionsTest, AppliedTransactionsAreJournalledBeforeTheReply) {
+  for (const bool journal : {true, false}) {
+    LiveScene live;
+    live.add_asset("torus");
+    SceneSessionSettings settings;
+    settings.journal = journal;
+    SceneSessions sessions(live, settings);
+    (void)sessions.accepted(1, "127.0.0.1:5000", true, kNonce);
+    (void)sessions.message(1, hello("design-review"), 0);
+    const auto applied = sessions.message(1, create(4, "t1", "torus"), 12);
+    ASSERT_EQ(applied.size(), journal ? 2u : 1u);
+    if (journal) {
+      const auto* entry = std::get_if<session_action::Journal>(&applied[0]);
+      ASSERT_NE(entry, nullptr) << "the journal entry comes first";
+      ASSERT_TRUE(std::holds_alternative<session_action::Send>(applied[1]));
+      auto read = read_journal(std::string(kJournalMagic) + journal_start(0, "torus") + entry->entry);
+      ASSERT_TRUE(read.ok()) << read.error();
+      ASSERT_EQ(read.value().runs.size(), 1u);
+      ASSERT_EQ(read.value().runs[0].transactions.size(), 1u);
+      const auto& t = read.value().runs[0].transactions[0];
+      EXPECT_EQ(t.frame(), 12u);
+      EXPECT_EQ(t.application(), "design-review");
+      EXPECT_EQ(t.transaction().edits(0).create().instance(), "t1");
+    }
+    const auto refused = sessions.message(1, create(5, "t2", "teapot"), 13);
+    EXPECT_TRUE(of<session_action::Journal>(refused).empty());
+    EXPECT_EQ(of<session_action::Send>(refused).size(), 1u);
+  }
+}
+
+// An application that (re)connects reads the live scene as it is: the assets,
+// and each instance with the values its edits gave it.
+TEST_F(SceneSessionsTest, AnApplicationReadsTheSceneAsItIs) {
+  SceneSessions sessions(live_, {});
+  (void)sessions.accepted(1, "127.0.0.1:5000", true, kNonce);
+  (void)sessions.message(1, hello("design-review"), 0);
+  wire::Envelope edits = create(1, "table", "torus");
+  auto& transaction = *edits.mutable_session_request()->mutable_transaction();
+  auto& cup = *transaction.add_edits()->mutable_create();
+  cup.set_instance("cup");
+  cup.set_asset("torus");
+  cup.set_parent("table");
+  cup.set_hidden(true);
+  for (double v : {1.0, 2.0, 3.0}) cup.mutable_transform()->add_position(v);
+  for (double v : {0.0, 0.0, 2.0, 0.0}) cup.mutable_transform()->add_rotation(v);  // normalized: a half turn about y
+  cup.mutable_transform()->add_scale(0.5);
+  auto& factors = *transaction.add_edits()->mutable_factors();
+  factors.set_instance("cup");
+  for (double v : {0.5, 0.25, 1.0, 1.0}) factors.add_base_color(v);
+  ASSERT_EQ(of<session_action::Send>(sessions.message(1, edits, 3))[0].message.session_reply().reply_case(),
+            session::Reply::kApplied);
+
+  wire::Envelope read;
+  read.set_protocol_version(net::kProtocolVersion);
+  read.mutable_session_request()->set_id(9);
+  read.mutable_session_request()->mutable_read_scene();
+  const auto sent = of<session_action::Send>(sessions.message(1, read, 4));
+  ASSERT_EQ(sent.size(), 1u);
+  const session::Reply& reply = sent[0].message.session_reply();
+  EXPECT_EQ(reply.id(), 9u);
+  ASSERT_TRUE(reply.has_scene());
+  const session::SceneContents& scene = reply.scene();
+  EXPECT_EQ(scene.frame(), 4u);
+  ASSERT_EQ(scene.assets_size(), 1);
+  EXPECT_EQ(scene.assets(0), "torus");
+  ASSERT_EQ(scene.instances_size(), 2);
+  const session::InstanceView& c = scene.instances(0);  // by id: "cup" before "table"
+  EXPECT_EQ(c.instance(), "cup");
+  EXPECT_EQ(c.parent(), "table");
+  EXPECT_TRUE(c.hidden());
+  EXPECT_EQ(std::vector<double>(c.transform().position().begin(), c.transform().position().end()),
+            (std::vector<double>{1.0, 2.0, 3.0}));
+  EXPECT_EQ(std::vector<double>(c.transform().rotation().begin(), c.transform().rotation().end()),
+            (std::vector<double>{0.0, 0.0, 1.0, 0.0}));
+  EXPECT_EQ(std::vector<double>(c.transform().scale().begin(), c.transform().scale().end()),
+            (std::vector<double>{0.5, 0.5, 0.5}));
+  EXPECT_EQ(std::vector<double>(c.base_color().begin(), c.base_color().end()),
+            (std::vector<double>{0.5, 0.25, 1.0, 1.0}));
+  EXPECT_EQ(std::vector<double>(c.emissive().begin(), c.emissive().end()), (std::vector<double>{1.0, 1.0, 1.0}));
+  EXPECT_EQ(scene.instances(1).instance(), "table");
+  EXPECT_EQ(scene.instances(1).parent(), "");
+  EXPECT_FALSE(scene.instances(1).hidden());
 }
 
 TEST_F(SceneSessionsTest, TheNumberOfSessionsIsBounded) {

@@ -87,6 +87,41 @@ TEST_P(LiveEdits, AnEditBeforeAFrameBeginsIsInThatFrameOnEveryNode) {
 
 INSTANTIATE_TEST_SUITE_P(Configs, LiveEdits, ::testing::Values("powerwall-2x2.json", "stacked-upconversion.json"));
 
+// A recorded session played again (--replay): each transaction in the frame
+// it was in, on every node, with no application connected.
+TEST(SimCluster, AReplayedJournalPutsEachTransactionInItsFrame) {
+  const master::RunConfig run = load("powerwall-2x2.json");
+  session::Transaction create;
+  create.add_edits()->mutable_create()->set_instance("t1");
+  create.mutable_edits(0)->mutable_create()->set_asset("torus");
+  session::Transaction remove;
+  remove.add_edits()->mutable_remove()->set_instance("t1");
+  auto journal = master::read_journal(std::string(master::kJournalMagic) + master::journal_start(0, "torus") +
+                                      master::journal_transaction(4, "app", create) +
+                                      master::journal_transaction(11, "app", remove));
+  ASSERT_TRUE(journal.ok()) << journal.error();
+  master::LiveScene live;
+  live.add_asset("torus");
+  auto replay = master::JournalReplay::start(journal.value(), live);
+  ASSERT_TRUE(replay.ok()) << replay.error();
+  master::RunSettings settings = for_frames(20);
+  settings.live = &live;
+  settings.journal_replay = &replay.value();
+  SimCluster cluster(run, settings);
+  cluster.start();
+  cluster.run_promptly(cluster.now() + 10 * kSecond);
+  EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
+  for (std::size_t i = 0; i < cluster.nodes(); ++i) {
+    EXPECT_EQ(cluster.presented(i), frames(0, 20)) << i;
+    EXPECT_EQ(cluster.master().report().nodes(static_cast<int>(i)).hash_mismatches(), 0u) << i;
+    for (std::uint64_t frame = 0; frame < 20; ++frame) {
+      const auto& drawn = cluster.instances_drawn(i);
+      const bool has = drawn.contains(frame) && drawn.at(frame).contains("t1");
+      EXPECT_EQ(has, frame >= 4 && frame < 11) << "node " << i << ", frame " << frame;
+    }
+  }
+}
+
 TEST(SimCluster, AWrongStateIsRepairedTheNextFrame) {
   const master::RunConfig run = load("powerwall-2x2.json");
   SimCluster cluster(run, for_frames(20), 5);

@@ -1,0 +1,70 @@
+// The master's live scene: made with master.api or --replay; its journal
+// restored (--record) or replayed (--replay); its session port.
+
+#include <chrono>
+
+#include "master/app/master.h"
+
+namespace optique::master {
+
+Result<void> Master::make_live_scene(RunSettings& run) {
+  const config::MasterSettings& settings = options_.config.installation.master;
+  const std::string& record = options_.record_path;
+  const std::string& replay = options_.replay_path;
+  if (!record.empty() && !replay.empty()) {
+    return Error{"--record and --replay: a master records a session or replays one, not both at once"};
+  }
+  if (!record.empty() && !settings.api) {
+    return Error{"--record " + record + ": the config has no master.api, so no application can change the scene"};
+  }
+  if (!settings.api && replay.empty()) return {};
+
+  live_.emplace(live_scene_limits(settings.api));
+  // For now the one asset is the installation's own scene, by name.
+  const std::string& asset = options_.scene.definition.asset_id;
+  live_->add_asset(asset);
+  run.live = &*live_;
+
+  if (!replay.empty()) {
+    auto journal = read_journal_file(replay);
+    if (!journal) return Error{"--replay: " + journal.error()};
+    auto replaying = JournalReplay::start(journal.value(), *live_);
+    if (!replaying) return Error{"--replay " + replay + ": " + replaying.error()};
+    journal_replay_.emplace(std::move(replaying).value());
+    run.journal_replay = &*journal_replay_;
+    log_.info("replaying {}: {} transaction(s) of its last run, over {} instance(s) from the {} run(s) before it",
+              replay, journal_replay_->total(), live_->instances().size(), journal.value().runs.size() - 1);
+  }
+
+  std::optional<JournalFile> journal_file;
+  if (!record.empty()) {
+    Journal journal;
+    auto file = JournalFile::open(record, journal);
+    if (!file) return Error{"--record: " + file.error()};
+    if (!journal.torn.empty()) {
+      log_.warn("{}: cut away its torn last entry ({}): a write the last master's end cut short, never acknowledged",
+                record, journal.torn);
+    }
+    auto restored = restore(*live_, journal);
+    if (!restored) return Error{"--record " + record + ": " + restored.error()};
+    if (!journal.runs.empty()) {
+      log_.info("restored the live scene from {}: {} transaction(s) of {} run(s), {} instance(s)", record,
+                restored.value(), journal.runs.size(), live_->instances().size());
+    }
+    const auto now = std::chrono::system_clock::now().time_since_epoch();
+    if (auto started = file.value().append(
+            journal_start(std::chrono::duration_cast<std::chrono::milliseconds>(now).count(), asset));
+        !started) {
+      return Error{"--record: " + started.error()};
+    }
+    log_.info("recording the live scene's transactions into {}", record);
+    journal_file.emplace(std::move(file).value());
+  }
+  if (settings.api) {
+    session_port_.emplace(io_, *settings.api, *live_, std::move(journal_file), options_.run.secret,
+                          settings.max_message_bytes, log_);
+  }
+  return {};
+}
+
+}  // namespace optique::master
