@@ -4,6 +4,7 @@
 
 #include <algorithm>
 
+#include "net/hello_proof.h"
 #include "util/overloaded.h"
 
 namespace optique::node {
@@ -270,13 +271,9 @@ void NodeProtocol::on_challenge(const wire::Envelope& message, Actions& out) {
   std::optional<net::SessionKeys> keys;
   if (settings_.secret) {
     const std::string& theirs = challenge.nonce();
-    std::vector<std::uint8_t> both(theirs.begin(), theirs.end());
-    both.insert(both.end(), nonce_.begin(), nonce_.end());
-    const auto mac = net::hello_mac(*settings_.secret, both, settings_.id, settings_.faults.protocol_version);
-    hello.mutable_hello()->set_nonce_mac(mac.data(), mac.size());
-    hello.mutable_hello()->set_node_nonce(nonce_.data(), nonce_.size());
-    keys = net::derive_session_keys(*settings_.secret, std::span(both).first(net::kNonceBytes), nonce_, settings_.id,
-                                    settings_.faults.protocol_version);
+    keys = net::prove_hello(*settings_.secret,
+                            std::span(reinterpret_cast<const std::uint8_t*>(theirs.data()), theirs.size()), nonce_,
+                            settings_.faults.protocol_version, *hello.mutable_hello());
   }
   out.push_back(Send{std::move(hello)});
   if (keys) out.push_back(Protect{keys->to_master, keys->to_node});

@@ -24,4 +24,14 @@ Result<SessionKeys> check_hello(const Secret& secret, std::span<const std::uint8
   return derive_session_keys(secret, master_nonce, peer_bytes, hello.node_id(), protocol_version);
 }
 
+SessionKeys prove_hello(const Secret& secret, std::span<const std::uint8_t> master_nonce,
+                        std::span<const std::uint8_t> own_nonce, std::uint32_t protocol_version, wire::Hello& hello) {
+  std::vector<std::uint8_t> both(master_nonce.begin(), master_nonce.end());
+  both.insert(both.end(), own_nonce.begin(), own_nonce.end());
+  const auto mac = hello_mac(secret, both, hello.node_id(), protocol_version);
+  hello.set_nonce_mac(mac.data(), mac.size());
+  hello.set_node_nonce(own_nonce.data(), own_nonce.size());
+  return derive_session_keys(secret, master_nonce, own_nonce, hello.node_id(), protocol_version);
+}
+
 }  // namespace optique::net

@@ -1,20 +1,21 @@
-// The scene session on a real master with real local nodes: an application
-// connects to master.api over TCP, says hello, and its transactions are
-// answered with the frame from which every node shows them, or refused with
-// the field and why; the nodes' states keep the master's hash throughout.
+// The scene session on a real master with real local nodes, through the C++
+// client (clients/cpp): an application connects to master.api over TCP, says
+// hello, and its transactions are answered with the frame from which every
+// node shows them, or refused with the field and why; the nodes' states keep
+// the master's hash throughout. A master killed mid-session comes back from
+// its journal; the journal replays; the C++ example runs.
 
 #include <gtest/gtest.h>
-#include <sys/socket.h>
-#include <sys/time.h>
 
-#include <boost/asio.hpp>
-#include <filesystem>
+#include <csignal>
 #include <fstream>
-#include <nlohmann/json.hpp>
+#include <memory>
+#include <string>
+#include <vector>
 
+#include "clients/cpp/session.h"
 #include "cluster_run.h"
-#include "net/envelope.h"
-#include "net/framing.h"
+#include "master/session/journal.h"
 #include "process.h"
 #include "scratch.h"
 
@@ -22,113 +23,176 @@ namespace optique::testing {
 namespace {
 
 using namespace std::chrono_literals;
-namespace asio = boost::asio;
 
 const std::string kMaster = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
-const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
+const std::string kExample = std::string(OPTIQUE_BIN_DIR) + "/optique-example-circle";
+// The power wall; its scene session on an ephemeral port (--api-port 0).
+const std::string kWall = std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-2x2.json";
 
-// A blocking application: one envelope out, one in.
-class Application {
- public:
-  explicit Application(int port) : socket_(io_) {
-    socket_.connect({asio::ip::make_address("127.0.0.1"), static_cast<std::uint16_t>(port)});
-    // A master that does not answer fails the test, not hangs it.
-    const timeval timeout{10, 0};
-    setsockopt(socket_.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
-  }
-  void send(wire::Envelope message) {
-    message.set_protocol_version(net::kProtocolVersion);
-    message.set_sequence(next_sequence_++);
-    std::vector<std::uint8_t> bytes;
-    net::append_envelope(bytes, message);
-    asio::write(socket_, asio::buffer(bytes));
-  }
-  wire::Envelope receive() {
-    for (;;) {
-      net::DecodedFrame frame = reader_.next();
-      if (frame.status == net::DecodeStatus::good) {
-        auto envelope = net::parse_envelope(frame.payload);
-        EXPECT_TRUE(envelope) << (envelope ? "" : envelope.error());
-        return envelope ? envelope.value() : wire::Envelope{};
-      }
-      if (frame.status == net::DecodeStatus::bad) return {};
-      std::array<std::uint8_t, 4096> chunk{};
-      boost::system::error_code ec;
-      const std::size_t got = socket_.read_some(asio::buffer(chunk), ec);
-      if (ec) return {};
-      reader_.append(std::span(chunk.data(), got));
-    }
-  }
-
- private:
-  asio::io_context io_;
-  asio::ip::tcp::socket socket_;
-  net::FrameReader reader_;
-  std::uint64_t next_sequence_ = 1;
-};
-
-wire::Envelope hello(const std::string& name) {
-  wire::Envelope e;
-  e.mutable_hello()->set_node_id(name);
-  e.mutable_hello()->add_capabilities("scene-session");
-  return e;
+// A master on that wall with null local nodes: `frames` frames, the rest of
+// its arguments `more`; its output in DIR/NAME, its api port in DIR/NAME.port.
+std::unique_ptr<Process> wall_master(const ScratchDir& dir, const std::string& name, const std::string& frames,
+                                     const std::vector<std::string>& more = {}) {
+  std::vector<std::string> argv{kMaster,
+                                "--config",
+                                kWall,
+                                "--local",
+                                "--frames",
+                                frames,
+                                "--out",
+                                dir.file(name),
+                                "--no-status",
+                                "--node-arg=--renderer=null",
+                                "--api-port",
+                                "0",
+                                "--api-port-file",
+                                dir.file(name + ".port")};
+  argv.insert(argv.end(), more.begin(), more.end());
+  return std::make_unique<Process>(argv, dir.file(name + ".log"));
 }
 
-wire::Envelope create(std::uint64_t id, const std::string& instance, const std::string& asset, double x) {
-  wire::Envelope e;
-  e.mutable_session_request()->set_id(id);
-  auto& c = *e.mutable_session_request()->mutable_transaction()->add_edits()->mutable_create();
-  c.set_instance(instance);
-  c.set_asset(asset);
-  c.mutable_transform()->add_position(x);
-  c.mutable_transform()->add_position(1.0);
-  c.mutable_transform()->add_position(0.0);
-  return e;
+std::uint16_t api_port(const ScratchDir& dir, const std::string& name, const Process& master) {
+  EXPECT_TRUE(wait_for_file(dir.file(name + ".port"), 15s)) << master.output();
+  return static_cast<std::uint16_t>(std::stoi(read_file(dir.file(name + ".port"))));
+}
+
+std::unique_ptr<client::Session> connect(std::uint16_t port, const std::string& name = "session-test") {
+  client::Options options;
+  options.port = port;
+  options.name = name;
+  auto session = client::Session::connect(options);
+  EXPECT_TRUE(session.ok()) << session.error();
+  return session.ok() ? std::move(session).value() : nullptr;
+}
+
+client::Placement at(double x) { return {{{x, 1.0, 0.0}}, std::nullopt, std::nullopt}; }
+
+// What became of a transaction: "applied", or the refusal's reason.
+std::string outcome(client::Session& app, const client::Transaction& transaction) {
+  auto done = app.apply(transaction);
+  if (!done) return "error: " + done.error();
+  return done.value().applied() ? "applied" : done.value().refused->reason();
 }
 
 TEST(SceneSession, AnApplicationPlacesAnInstanceAndEveryNodeShowsItFromTheFrameNamed) {
   ScratchDir dir("optique-session");
-  // The power wall with the scene session on an ephemeral port.
-  auto config = nlohmann::json::parse(std::ifstream(kConfigs + "/powerwall-2x2.json"));
-  config["master"]["api"] = {{"port", 0}};
-  config["master"]["port"] = 0;
-  std::ofstream(dir.file("wall.json")) << config.dump(2);
-  Process master({kMaster, "--config", dir.file("wall.json"), "--local", "--frames", "240", "--out", dir.file("out"),
-                  "--no-status", "--node-arg=--renderer=null", "--api-port-file", dir.file("api.port")},
-                 dir.file("master.log"));
-  ASSERT_TRUE(wait_for_file(dir.file("api.port"), 15s)) << master.output();
-  Application app(std::stoi(read_file(dir.file("api.port"))));
+  auto master = wall_master(dir, "out", "240");
+  auto app = connect(api_port(dir, "out", *master), "wall-test");
+  ASSERT_NE(app, nullptr) << master->output();
+  ASSERT_TRUE(master->wait_for_output("application 'wall-test' connected from 127.0.0.1", 10s)) << master->output();
+  EXPECT_EQ(app->scene().assets_size(), 1);
+  EXPECT_EQ(app->scene().assets(0), "cubes");
 
-  const wire::Envelope challenge = app.receive();
-  ASSERT_TRUE(challenge.has_challenge()) << master.output();
-  EXPECT_FALSE(challenge.challenge().secret_required());
-  app.send(hello("wall-test"));
-  ASSERT_TRUE(master.wait_for_output("application 'wall-test' connected from 127.0.0.1", 10s)) << master.output();
+  auto applied = app->apply(client::Transaction().create("c1", "cubes", at(0.5)));
+  ASSERT_TRUE(applied.ok()) << applied.error();
+  ASSERT_TRUE(applied.value().applied()) << applied.value().refused->reason();
+  EXPECT_LT(applied.value().frame, 240u);
 
-  app.send(create(1, "c1", "cubes", 0.5));
-  const wire::Envelope applied = app.receive();
-  ASSERT_TRUE(applied.has_session_reply()) << master.output();
-  EXPECT_EQ(applied.session_reply().id(), 1u);
-  ASSERT_TRUE(applied.session_reply().has_applied()) << applied.session_reply().refused().reason();
-  EXPECT_LT(applied.session_reply().applied().frame(), 240u);
-
-  app.send(create(2, "c2", "teapot", 0.0));
-  const wire::Envelope refused = app.receive();
-  ASSERT_TRUE(refused.session_reply().has_refused());
-  EXPECT_EQ(refused.session_reply().id(), 2u);
-  EXPECT_EQ(refused.session_reply().refused().field(), "edits[0].create.asset");
-  EXPECT_EQ(refused.session_reply().refused().reason(), "no asset 'teapot' is loaded");
+  auto refused = app->apply(client::Transaction().create("c2", "teapot"));
+  ASSERT_TRUE(refused.ok()) << refused.error();
+  ASSERT_FALSE(refused.value().applied());
+  EXPECT_EQ(refused.value().refused->field(), "edits[0].create.asset");
+  EXPECT_EQ(refused.value().refused->reason(), "no asset 'teapot' is loaded");
 
   // The run ends in order, the application is told goodbye, and no node's
   // state left the master's: the instance was in every node's delta.
-  ASSERT_EQ(master.wait(60s), 0) << master.output();
-  EXPECT_TRUE(app.receive().has_goodbye());
+  ASSERT_EQ(master->wait(60s), 0) << master->output();
+  auto after = app->read_scene();
+  ASSERT_FALSE(after.ok());
+  EXPECT_NE(after.error().find("the master said goodbye"), std::string::npos) << after.error();
   const ClusterRun run = read_cluster_run(dir.file("out"));
   ASSERT_EQ(run.error, "");
   EXPECT_EQ(run.report.frames(), 240u);
   ASSERT_EQ(run.report.nodes_size(), 4);
   for (const auto& node : run.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
   EXPECT_EQ(run.report.instances(), 1u) << "the instance is in the last frame's state";
+}
+
+// The master killed (-9) mid-session comes back, started again with the same
+// --record file, with every transaction it acknowledged; the application
+// reconnects and reads the scene; a replay of the journal plays the last run.
+TEST(SceneSession, AKilledMasterComesBackWithTheLiveSceneFromItsJournal) {
+  ScratchDir dir("optique-journal");
+  const std::string journal = dir.file("session.journal");
+  {
+    auto first = wall_master(dir, "first", "100000", {"--record", journal});
+    auto app = connect(api_port(dir, "first", *first));
+    ASSERT_NE(app, nullptr) << first->output();
+    ASSERT_EQ(outcome(*app, client::Transaction().create("c1", "cubes", at(0.5))), "applied") << first->output();
+    ASSERT_EQ(outcome(*app, client::Transaction().create("c2", "cubes", at(-0.5))), "applied");
+    ASSERT_EQ(outcome(*app, client::Transaction().create("c3", "teapot")), "no asset 'teapot' is loaded");
+    ASSERT_EQ(outcome(*app, client::Transaction().remove("c1")), "applied");
+    first->signal(SIGKILL);
+    ASSERT_TRUE(first->wait(10s).has_value());
+  }
+
+  auto second = wall_master(dir, "second", "90", {"--record", journal});
+  ASSERT_TRUE(second->wait_for_output(
+      "restored the live scene from " + journal + ": 3 transaction(s) of 1 run(s), 1 instance(s)", 15s))
+      << second->output();
+  auto app = connect(api_port(dir, "second", *second));
+  ASSERT_NE(app, nullptr) << second->output();
+  ASSERT_EQ(app->scene().instances_size(), 1);
+  EXPECT_EQ(app->scene().instances(0).instance(), "c2");
+  EXPECT_EQ(app->scene().instances(0).transform().position(0), -0.5);
+  ASSERT_EQ(outcome(*app, client::Transaction().create("c4", "cubes", at(0.0), "c2")), "applied");
+  ASSERT_EQ(second->wait(60s), 0) << second->output();
+  const ClusterRun run = read_cluster_run(dir.file("second"));
+  ASSERT_EQ(run.error, "");
+  for (const auto& node : run.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
+  EXPECT_EQ(run.report.instances(), 2u) << "c2 restored, c4 made";
+
+  // Both runs are in the journal; a replay plays the second over the first.
+  auto read = master::read_journal_file(journal);
+  ASSERT_TRUE(read.ok()) << read.error();
+  ASSERT_EQ(read.value().runs.size(), 2u);
+  EXPECT_EQ(read.value().runs[0].transactions.size(), 3u);
+  EXPECT_EQ(read.value().runs[1].transactions.size(), 1u);
+  Process replay({kMaster, "--config", kWall, "--local", "--frames", "90", "--out", dir.file("replay"), "--no-status",
+                  "--node-arg=--renderer=null", "--replay", journal},
+                 dir.file("replay.log"));
+  ASSERT_EQ(replay.wait(60s), 0) << replay.output();
+  EXPECT_NE(replay.output().find("replaying " + journal + ": 1 transaction(s) of its last run"), std::string::npos)
+      << replay.output();
+  const ClusterRun replayed = read_cluster_run(dir.file("replay"));
+  ASSERT_EQ(replayed.error, "");
+  EXPECT_EQ(replayed.report.instances(), 2u);
+  for (const auto& node : replayed.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
+}
+
+// What a master refuses to start with: a file that is not a journal (left as
+// it was), --record and --replay at once.
+TEST(SceneSession, AJournalThatIsNotOneStopsTheStartWithWhy) {
+  ScratchDir dir("optique-journal-bad");
+  std::ofstream(dir.file("bad.journal")) << "not a journal at all";
+  auto bad = wall_master(dir, "bad", "10", {"--record", dir.file("bad.journal")});
+  EXPECT_NE(bad->wait(15s), 0);
+  EXPECT_NE(bad->output().find("--record: " + dir.file("bad.journal") +
+                               ": does not begin with \"optique journal 1\": not a journal"),
+            std::string::npos)
+      << bad->output();
+  EXPECT_EQ(read_file(dir.file("bad.journal")), "not a journal at all") << "left as it was";
+  auto both = wall_master(dir, "both", "10", {"--record", dir.file("a"), "--replay", dir.file("b")});
+  EXPECT_NE(both->wait(15s), 0);
+  EXPECT_NE(both->output().find("--record and --replay: a master records a session or replays one, not both"),
+            std::string::npos)
+      << both->output();
+}
+
+// The C++ example, as a user runs it against a --local wall.
+TEST(SceneSession, TheCppExampleMovesItsInstanceOnTheWall) {
+  ScratchDir dir("optique-example");
+  auto master = wall_master(dir, "wall", "240");
+  const std::uint16_t port = api_port(dir, "wall", *master);
+  Process example({kExample, "--port", std::to_string(port), "--seconds", "1"}, dir.file("example.log"));
+  ASSERT_EQ(example.wait(30s), 0) << example.output() << master->output();
+  EXPECT_NE(example.output().find("placed from frame"), std::string::npos) << example.output();
+  EXPECT_NE(example.output().find("moved it"), std::string::npos) << example.output();
+  ASSERT_EQ(master->wait(60s), 0) << master->output();
+  const ClusterRun run = read_cluster_run(dir.file("wall"));
+  ASSERT_EQ(run.error, "");
+  EXPECT_EQ(run.report.instances(), 2u) << "orbit-cpp and beacon-cpp";
+  for (const auto& node : run.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
 }
 
 }  // namespace

@@ -1,0 +1,186 @@
+#include "clients/cpp/session.h"
+
+#include <sys/socket.h>
+#include <sys/time.h>
+
+#include <array>
+#include <boost/asio.hpp>
+#include <vector>
+
+#include "net/auth.h"
+#include "net/envelope.h"
+#include "net/framing.h"
+#include "net/hello_proof.h"
+#include "net/session_seal.h"
+
+namespace optique::client {
+namespace {
+
+namespace asio = boost::asio;
+
+// A whole scene of 100,000 instances is about 15 MB.
+constexpr std::uint32_t kMaxReplyBytes = 256u << 20;
+
+}  // namespace
+
+// The socket, the framing, and (with the secret) the seal both ways.
+struct Session::Link {
+  asio::io_context io;
+  asio::ip::tcp::socket socket{io};
+  net::FrameReader reader{kMaxReplyBytes};
+  std::optional<net::Sealer> sealer;
+  std::optional<net::Opener> opener;
+  std::uint64_t sequence = 0;
+
+  Result<void> send(wire::Envelope message) {
+    message.set_protocol_version(net::kProtocolVersion);
+    message.set_sequence(++sequence);
+    std::vector<std::uint8_t> payload(message.ByteSizeLong());
+    message.SerializeToArray(payload.data(), static_cast<int>(payload.size()));
+    if (sealer) payload = sealer->seal(payload);
+    std::vector<std::uint8_t> bytes;
+    net::append_frame(bytes, payload);
+    boost::system::error_code ec;
+    asio::write(socket, asio::buffer(bytes), ec);
+    if (ec) return Error{"cannot send to the master: " + ec.message()};
+    return {};
+  }
+
+  Result<wire::Envelope> receive() {
+    for (;;) {
+      net::DecodedFrame frame = reader.next();
+      if (frame.status == net::DecodeStatus::bad) return Error{"the master sent a bad frame: " + frame.error};
+      if (frame.status == net::DecodeStatus::good) {
+        std::vector<std::uint8_t> payload(frame.payload.begin(), frame.payload.end());
+        if (opener) {
+          auto opened = opener->open(payload);
+          if (!opened) {
+            // A refusal of the hello comes before the sealing starts: in the clear.
+            auto plain = net::parse_envelope(payload);
+            if (plain && plain.value().has_refuse()) return refused(plain.value());
+            return Error{opened.error()};
+          }
+          payload = std::move(opened).value();
+        }
+        auto envelope = net::parse_envelope(payload);
+        if (!envelope) return Error{"the master sent what is not a message: " + envelope.error()};
+        if (envelope.value().has_refuse()) return refused(envelope.value());
+        if (envelope.value().has_goodbye()) {
+          return Error{"the master said goodbye: " + envelope.value().goodbye().reason()};
+        }
+        return envelope;
+      }
+      std::array<std::uint8_t, 65536> chunk{};
+      boost::system::error_code ec;
+      const std::size_t got = socket.read_some(asio::buffer(chunk), ec);
+      if (ec == asio::error::eof) return Error{"the master closed the session"};
+      if (ec) return Error{"no answer from the master: " + ec.message()};
+      reader.append(std::span(chunk.data(), got));
+    }
+  }
+
+  static Error refused(const wire::Envelope& refusal) {
+    return Error{"the master refused the session: " + refusal.refuse().reason()};
+  }
+};
+
+Session::Session(std::unique_ptr<Link> link) : link_(std::move(link)) {}
+
+Session::~Session() { close(); }
+
+Result<std::unique_ptr<Session>> Session::connect(const Options& options) {
+  auto link = std::make_unique<Link>();
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(options.host, ec);
+  if (ec) return Error{"'" + options.host + "' is not an IP address"};
+  link->socket.connect({address, options.port}, ec);
+  if (ec) return Error{"cannot connect to " + options.host + ":" + std::to_string(options.port) + ": " + ec.message()};
+  link->socket.set_option(asio::ip::tcp::no_delay(true));
+  // A master that does not answer is an error after the timeout, not a hang.
+  const auto micros = std::chrono::duration_cast<std::chrono::microseconds>(options.timeout).count();
+  const timeval timeout{static_cast<time_t>(micros / 1000000), static_cast<suseconds_t>(micros % 1000000)};
+  setsockopt(link->socket.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+
+  auto challenge = link->receive();
+  if (!challenge) return Error{challenge.error()};
+  if (!challenge.value().has_challenge()) return Error{"the master did not begin with a challenge"};
+  wire::Envelope hello;
+  hello.mutable_hello()->set_node_id(options.name);
+  hello.mutable_hello()->add_capabilities("scene-session");
+  std::optional<net::SessionKeys> keys;
+  if (challenge.value().challenge().secret_required()) {
+    if (options.secret_file.empty()) {
+      return Error{"this master requires the installation's shared secret: set Options::secret_file"};
+    }
+    auto secret = net::load_secret_file(options.secret_file);
+    if (!secret) return Error{secret.error()};
+    const std::string& theirs = challenge.value().challenge().nonce();
+    keys =
+        net::prove_hello(secret.value(), std::span(reinterpret_cast<const std::uint8_t*>(theirs.data()), theirs.size()),
+                         net::random_nonce(), net::kProtocolVersion, *hello.mutable_hello());
+  }
+  if (auto sent = link->send(hello); !sent) return Error{sent.error()};
+  if (keys) {
+    link->sealer.emplace(keys->to_master);
+    link->opener.emplace(keys->to_node);
+  }
+  std::unique_ptr<Session> session(new Session(std::move(link)));
+  // The master answers a hello only to refuse it: the first reply opens the session.
+  auto scene = session->read_scene();
+  if (!scene) return Error{scene.error()};
+  session->scene_ = std::move(scene).value();
+  return session;
+}
+
+Result<session::Reply> Session::ask(session::Request request) {
+  if (!link_) return Error{"the session is closed"};
+  const std::uint64_t id = next_request_++;
+  request.set_id(id);
+  wire::Envelope envelope;
+  *envelope.mutable_session_request() = std::move(request);
+  if (auto sent = link_->send(std::move(envelope)); !sent) return Error{sent.error()};
+  for (;;) {
+    auto got = link_->receive();
+    if (!got) return Error{got.error()};
+    if (got.value().has_session_reply() && got.value().session_reply().id() == id) {
+      return std::move(*got.value().mutable_session_reply());
+    }
+  }
+}
+
+Result<Outcome> Session::apply(const Transaction& transaction) {
+  session::Request request;
+  *request.mutable_transaction() = transaction.message();
+  auto reply = ask(std::move(request));
+  if (!reply) return Error{reply.error()};
+  Outcome outcome;
+  if (reply.value().has_refused()) {
+    outcome.refused = reply.value().refused();
+  } else if (reply.value().has_applied()) {
+    outcome.frame = reply.value().applied().frame();
+  } else {
+    return Error{"the master answered a transaction with something else"};
+  }
+  return outcome;
+}
+
+Result<session::SceneContents> Session::read_scene() {
+  session::Request request;
+  request.mutable_read_scene();
+  auto reply = ask(std::move(request));
+  if (!reply) return Error{reply.error()};
+  if (!reply.value().has_scene()) return Error{"the master answered ReadScene with something else"};
+  return std::move(*reply.value().mutable_scene());
+}
+
+void Session::close() {
+  if (!link_) return;
+  wire::Envelope goodbye;
+  goodbye.mutable_goodbye()->set_reason("the application is done");
+  (void)link_->send(std::move(goodbye));
+  boost::system::error_code ignored;
+  link_->socket.shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+  link_.reset();
+}
+
+}  // namespace optique::client

@@ -1,0 +1,65 @@
+#include "clients/cpp/transaction.h"
+
+namespace optique::client {
+namespace {
+
+void place(session::Transform& out, const Placement& placement) {
+  if (placement.position) out.mutable_position()->Add(placement.position->begin(), placement.position->end());
+  if (placement.rotation) out.mutable_rotation()->Add(placement.rotation->begin(), placement.rotation->end());
+  if (placement.scale) out.mutable_scale()->Add(placement.scale->begin(), placement.scale->end());
+}
+
+}  // namespace
+
+Transaction& Transaction::create(const std::string& instance, const std::string& asset, const Placement& placement,
+                                 const std::string& parent, bool hidden) {
+  auto& c = *message_.add_edits()->mutable_create();
+  c.set_instance(instance);
+  c.set_asset(asset);
+  c.set_parent(parent);
+  c.set_hidden(hidden);
+  place(*c.mutable_transform(), placement);
+  return *this;
+}
+
+Transaction& Transaction::move(const std::string& instance, const Placement& placement) {
+  auto& t = *message_.add_edits()->mutable_transform();
+  t.set_instance(instance);
+  place(*t.mutable_transform(), placement);
+  return *this;
+}
+
+Transaction& Transaction::reparent(const std::string& instance, const std::string& parent) {
+  auto& p = *message_.add_edits()->mutable_parent();
+  p.set_instance(instance);
+  p.set_parent(parent);
+  return *this;
+}
+
+Transaction& Transaction::show(const std::string& instance, bool visible) {
+  auto& v = *message_.add_edits()->mutable_visible();
+  v.set_instance(instance);
+  v.set_visible(visible);
+  return *this;
+}
+
+Transaction& Transaction::tint(const std::string& instance, const std::array<double, 4>& base_color) {
+  auto& f = *message_.add_edits()->mutable_factors();
+  f.set_instance(instance);
+  f.mutable_base_color()->Add(base_color.begin(), base_color.end());
+  return *this;
+}
+
+Transaction& Transaction::glow(const std::string& instance, const std::array<double, 3>& emissive) {
+  auto& f = *message_.add_edits()->mutable_factors();
+  f.set_instance(instance);
+  f.mutable_emissive()->Add(emissive.begin(), emissive.end());
+  return *this;
+}
+
+Transaction& Transaction::remove(const std::string& instance) {
+  message_.add_edits()->mutable_remove()->set_instance(instance);
+  return *this;
+}
+
+}  // namespace optique::client
