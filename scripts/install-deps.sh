@@ -33,6 +33,7 @@ test_packages=(
   chromium fonts-dejavu-core         # the operator's page in a real browser (headless), with a font
   prometheus                         # promtool checks /metrics as a site's Prometheus reads it
   systemd                            # systemd-analyze verifies the service units
+  python3-protobuf python3-venv python3-setuptools python3-pip python3-cryptography  # the Python client, installed and run
 )
 packages=("${run_packages[@]}" "${test_packages[@]}")
 case "${1:-}" in

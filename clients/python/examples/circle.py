@@ -1,0 +1,52 @@
+#!/usr/bin/env python3
+"""Places two copies of the installation's scene and moves one on a circle in
+front of the wall, once a frame, for a few seconds; the other turns red and
+back. Run it against a master with master.api on, e.g.:
+
+    optique-master --config configs/powerwall-2x2-api.json --local
+    python3 circle.py --seconds 10
+"""
+
+import argparse
+import math
+import time
+
+import optique
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--host", default="127.0.0.1")
+    parser.add_argument("--port", type=int, default=7490)
+    parser.add_argument("--secret-file", help="the installation's shared secret, where the master needs it")
+    parser.add_argument("--seconds", type=float, default=5.0)
+    parser.add_argument("--radius", type=float, default=0.4, help="metres")
+    args = parser.parse_args()
+
+    with optique.connect(args.host, args.port, name="circle", secret_file=args.secret_file) as wall:
+        asset = wall.scene.assets[0]  # the installation's own scene
+        print(f"connected; {len(wall.scene.instances)} instance(s) already placed; placing '{asset}'")
+        with wall.transaction() as t:
+            # Replace what an earlier run of this example left (a master restarted from its journal keeps it).
+            for instance in wall.scene.instances:
+                if instance.instance in ("orbit", "beacon"):
+                    t.remove(instance.instance)
+            t.create("orbit", asset, position=(args.radius, 0.0, 0.3), scale=0.25)
+            t.create("beacon", asset, position=(0.0, 0.0, 0.3), scale=0.15)
+        print(f"placed from frame {t.frame}")
+        start = time.monotonic()
+        frames = []
+        while (now := time.monotonic() - start) < args.seconds:
+            angle = now * 2.0 * math.pi / 4.0  # one turn every 4 s
+            with wall.transaction() as t:
+                t.move("orbit", position=(args.radius * math.cos(angle), args.radius * math.sin(angle), 0.3),
+                       rotation=(math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0))
+                red = 0.5 + 0.5 * math.sin(3.0 * now)
+                t.tint("beacon", base_color=(1.0, 1.0 - red, 1.0 - red, 1.0))
+            frames.append(t.frame)
+            time.sleep(1.0 / 60.0)
+        print(f"moved it {len(frames)} times, frames {frames[0]} to {frames[-1]}")
+
+
+if __name__ == "__main__":
+    main()

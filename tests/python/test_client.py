@@ -1,0 +1,165 @@
+"""The Python client (clients/python) against real masters with local nodes:
+sessions, transactions, refusals, reading the scene, the shared secret with
+sealing, and the examples. Run by run.sh inside a virtual environment the
+client was pip-installed into."""
+
+import json
+import os
+import pathlib
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+import unittest
+
+import optique
+
+BIN = pathlib.Path(os.environ["OPTIQUE_BIN_DIR"])
+SOURCE = pathlib.Path(os.environ["OPTIQUE_SOURCE_DIR"])
+WALL = SOURCE / "configs" / "powerwall-2x2.json"
+EXAMPLES = SOURCE / "clients" / "python" / "examples"
+
+
+class Master:
+    """optique-master --local on `config` with null nodes and the scene session
+    on a free port; stopped (SIGTERM) and waited for on exit."""
+
+    def __init__(self, folder: pathlib.Path, config=WALL, frames=36000, more=()):
+        self.folder = folder
+        self.port_file = folder / "api.port"
+        self.log = open(folder / "master.log", "w")
+        self.process = subprocess.Popen(
+            [str(BIN / "optique-master"), "--config", str(config), "--local", "--frames", str(frames),
+             "--out", str(folder / "out"), "--no-status", "--node-arg=--renderer=null", "--api-port", "0",
+             "--api-port-file", str(self.port_file), *more],
+            stdout=self.log, stderr=subprocess.STDOUT)
+        deadline = time.monotonic() + 20
+        while not (self.port_file.exists() and self.port_file.read_text().strip()):
+            if self.process.poll() is not None or time.monotonic() > deadline:
+                raise RuntimeError("the master did not open its scene session:\n" + self.output())
+            time.sleep(0.05)
+        self.port = int(self.port_file.read_text())
+
+    def output(self) -> str:
+        return (self.folder / "master.log").read_text()
+
+    def report(self) -> dict:
+        return json.loads((self.folder / "out" / "run.json").read_text())
+
+    def wait(self, timeout=60) -> int:
+        code = self.process.wait(timeout)
+        self.log.close()
+        return code
+
+    def stop(self) -> int:
+        if self.process.poll() is None:
+            self.process.send_signal(signal.SIGTERM)
+        return self.wait()
+
+
+class OnAWall(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.folder = tempfile.TemporaryDirectory(prefix="optique-client-")
+        cls.master = Master(pathlib.Path(cls.folder.name))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.master.stop()
+        cls.folder.cleanup()
+
+    def connect(self, name="client-test"):
+        return optique.connect(port=self.master.port, name=name)
+
+    def test_a_transaction_lands_whole_in_the_frame_the_reply_names(self):
+        with self.connect() as wall:
+            self.assertEqual(list(wall.scene.assets), ["cubes"])
+            with wall.transaction() as t:
+                t.create("table", "cubes", position=(0.5, 0.0, 0.0))
+                t.create("cup", "cubes", parent="table", position=(0.0, 0.2, 0.0), scale=0.1)
+                t.tint("cup", base_color=(1.0, 0.0, 0.0, 1.0))
+            self.assertGreater(t.frame, 0)
+            with wall.transaction() as later:
+                later.move("table", position=(-0.5, 0.0, 0.0))
+            self.assertGreaterEqual(later.frame, t.frame)
+            scene = {i.instance: i for i in wall.read_scene().instances}
+            self.assertEqual(scene["table"].transform.position[:], [-0.5, 0.0, 0.0])
+            self.assertEqual(scene["cup"].parent, "table")
+            self.assertEqual(scene["cup"].base_color[:], [1.0, 0.0, 0.0, 1.0])
+            with wall.transaction() as t:
+                t.remove("table")
+            self.assertEqual(len(wall.read_scene().instances), 0, "the cup went with its table")
+
+    def test_a_refused_transaction_names_the_edit_and_changes_nothing(self):
+        with self.connect() as wall:
+            with self.assertRaises(optique.Refused) as refused:
+                with wall.transaction() as t:
+                    t.create("ok", "cubes")
+                    t.create("bad", "cubes", scale=0.0)
+            self.assertEqual(refused.exception.edit, 1)
+            self.assertEqual(refused.exception.field, "edits[1].create.transform.scale[0]")
+            self.assertIn("must be in [0.0001, 10000] (got 0)", refused.exception.reason)
+            self.assertEqual(len(wall.read_scene().instances), 0)
+            with self.assertRaises(optique.Refused) as unknown:
+                with wall.transaction() as t:
+                    t.create("pot", "teapot")
+            self.assertEqual(unknown.exception.reason, "no asset 'teapot' is loaded")
+            with wall.transaction() as t:  # the session goes on
+                t.create("after", "cubes")
+                t.remove("after")
+
+    def test_a_bad_name_or_bad_numbers_never_reach_the_master(self):
+        with self.assertRaises(optique.SessionRefused) as refused:
+            self.connect(name="two words")
+        self.assertIn("name the application", refused.exception.reason)
+        with self.connect() as wall:
+            with self.assertRaises(ValueError):
+                wall.transaction().create("x", "cubes", position=(1.0, 2.0))
+
+    def test_the_circle_example(self):
+        run = subprocess.run([sys.executable, str(EXAMPLES / "circle.py"), "--port", str(self.master.port),
+                              "--seconds", "1.5"], capture_output=True, text=True, timeout=60)
+        self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
+        self.assertIn("placed from frame", run.stdout)
+        with self.connect() as wall:
+            names = {i.instance for i in wall.read_scene().instances}
+            self.assertEqual(names & {"orbit", "beacon"}, {"orbit", "beacon"})
+            with wall.transaction() as t:
+                t.remove("orbit").remove("beacon")
+
+
+class WithTheSharedSecret(unittest.TestCase):
+    """With master.secret_file every application proves it holds the secret,
+    and everything after its hello is sealed."""
+
+    def test_only_the_secret_opens_a_session(self):
+        with tempfile.TemporaryDirectory(prefix="optique-secret-") as folder:
+            folder = pathlib.Path(folder)
+            secret = folder / "secret"
+            secret.write_text("correct horse battery staple\n")
+            secret.chmod(0o600)
+            wrong = folder / "wrong"
+            wrong.write_text("not the installation's secret")
+            wrong.chmod(0o600)
+            config = json.loads(WALL.read_text())
+            config["master"]["secret_file"] = str(secret)
+            (folder / "wall.json").write_text(json.dumps(config))
+            master = Master(folder, config=folder / "wall.json")
+            try:
+                with optique.connect(port=master.port, name="sealed", secret_file=str(secret)) as wall:
+                    with wall.transaction() as t:
+                        t.create("c", "cubes", position=(0.0, 1.0, 0.0))
+                    self.assertEqual([i.instance for i in wall.read_scene().instances], ["c"])
+                with self.assertRaises(optique.SessionRefused) as without:
+                    optique.connect(port=master.port, name="open")
+                self.assertIn("requires the installation's shared secret", without.exception.reason)
+                with self.assertRaises(optique.SessionRefused) as mistaken:
+                    optique.connect(port=master.port, name="guess", secret_file=str(wrong))
+                self.assertIn("secret", mistaken.exception.reason)
+            finally:
+                master.stop()
+
+
+if __name__ == "__main__":
+    unittest.main()
