@@ -16,8 +16,8 @@
 #include <vector>
 
 #include "clock/clock.h"
-#include "master/run/exit_codes.h"
 #include "master/frame_rows.h"
+#include "master/run/exit_codes.h"
 #include "master/viewer_head.h"
 #include "net/session_seal.h"
 #include "optique/wire.pb.h"
@@ -97,9 +97,15 @@ struct Log {
   spdlog::level::level_enum level = spdlog::level::info;
   std::string text;
 };
+// Something applications may subscribe to (a frame begun, the head shown, the
+// run paused, a node down): for the scene session's subscribers. Raised only
+// when there is a live scene (RunSettings::live).
+struct AppEvent {
+  session::Event event;
+};
 
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Protect, Arm, Disarm,
-                            StopAccepting, SignalLocalNodes, HeadShown, FrameRows, Finish, Log>;
+                            StopAccepting, SignalLocalNodes, HeadShown, FrameRows, Finish, Log, AppEvent>;
 using Actions = std::vector<Action>;
 
 }  // namespace optique::master

@@ -78,6 +78,26 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   wait_for(frame, std::move(waited), captured, now, out);
 }
 
+// For the scene session's subscribers: the frame begun and the head in it.
+void MasterProtocol::notify_frame(std::uint64_t frame, clock::Nanos display, const scene::SceneState& state,
+                                  bool tracked, Actions& out) const {
+  session::Event begun;
+  begun.mutable_frame_begun()->set_frame(frame);
+  begun.mutable_frame_begun()->set_display_ns(display);
+  begun.mutable_frame_begun()->set_period_ns(frame_period_);
+  out.push_back(AppEvent{std::move(begun)});
+  session::Event head;
+  auto& shown = *head.mutable_head();
+  shown.set_frame(frame);
+  const glm::dvec3 right = glm::normalize(state.head_now * installation_.viewer.head_right);
+  for (int i = 0; i < 3; ++i) {
+    shown.add_eyes(state.eye_now[i]);
+    shown.add_right(right[i]);
+  }
+  shown.set_tracked(tracked);
+  out.push_back(AppEvent{std::move(head)});
+}
+
 // The scene at `frame` (the head where it will be at `display`), as the
 // FrameBegin every node is sent: the change from the frame before, its hash,
 // when to show it, the focus; the automatic groups' lights planned anew where
@@ -95,12 +115,15 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
     state.instances = frame_instances(*settings_.live);
     settings_.live->begin_frame();
   }
+  bool tracked = false;
   if (head_) {
     std::vector<std::string> said;
     const HeadShown shown = head_->track(state, frame, display, now, said);
     for (std::string& text : said) out.push_back(Log{spdlog::level::warn, std::move(text)});
+    tracked = shown.tracker == tracking::TrackerState::tracking;
     out.push_back(shown);
   }
+  if (settings_.live != nullptr) notify_frame(frame, display, state, tracked, out);
   wire::Envelope envelope;
   auto& begin = *envelope.mutable_frame_begin();
   begin.set_frame_id(frame);

@@ -297,6 +297,7 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
                                         static_cast<double>(std::min(configured.warm_up_ns(), kLongestRender)) / 1e6)
                           : "",
                       nodes_up(), slots_.size())});
+  notify_node(*session.slot, true, "", out);
   if (state_ == RunState::starting && (nodes_up() == slots_.size() || (startup_passed_ && slots_configuring().empty())))
     start_frames(now, out);
 }
@@ -332,6 +333,9 @@ Actions MasterProtocol::closed(PeerId peer, const std::string& reason, clock::Na
     if (live) {
       out.push_back(Log{spdlog::level::warn, fmt::format("node '{}' left: {} ({}/{} up)", slot_id(slot), reason,
                                                          nodes_up(), slots_.size())});
+      if (session.phase != Phase::handshake && session.phase != Phase::configuring) {
+        notify_node(slot, false, reason, out);  // it was up
+      }
     } else {
       out.push_back(Log{spdlog::level::debug, "node '" + slot_id(slot) + "' closed: " + reason});
     }

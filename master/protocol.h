@@ -183,6 +183,11 @@ class MasterProtocol {
   // went: `force`); the changes go out with the next FrameBegin.
   void rebalance_lights(bool force);
   void log_light_switches(std::uint64_t frame, const wire::StateDelta& delta, Actions& out) const;
+  // Events for the scene session's subscribers (AppEvent), raised only with a live scene.
+  void notify_frame(std::uint64_t frame, clock::Nanos display, const scene::SceneState& state, bool tracked,
+                    Actions& out) const;
+  void notify_run(session::RunChanged::State run, const std::string& reason, Actions& out) const;
+  void notify_node(std::size_t slot, bool up, const std::string& reason, Actions& out) const;
   [[nodiscard]] bool up(const Slot& slot) const;  // through the handshake and configured
   // The projectors whose node has said hello and is setting up (GL, scene, shaders).
   [[nodiscard]] std::vector<std::size_t> slots_configuring() const;

@@ -26,6 +26,7 @@ void MasterProtocol::drain(const std::string& reason, clock::Nanos now, Actions&
   out.push_back(Disarm{Timer::next_frame});
   out.push_back(Disarm{Timer::startup});
   out.push_back(Log{spdlog::level::info, "stopping: " + reason});
+  notify_run(session::RunChanged::STOPPING, reason, out);
   // A frame in its barrier finishes first (swap() then comes back here).
   if (!barrier_.active()) wait_for_last_presents(frames_ran, now, out);
 }
@@ -147,6 +148,27 @@ LiveStatus MasterProtocol::live(clock::Nanos now) const {
   return status;
 }
 
+void MasterProtocol::notify_run(session::RunChanged::State run, const std::string& reason, Actions& out) const {
+  if (settings_.live == nullptr) return;
+  session::Event event;
+  event.mutable_run()->set_state(run);
+  event.mutable_run()->set_frame(next_frame_);
+  event.mutable_run()->set_reason(reason);
+  out.push_back(AppEvent{std::move(event)});
+}
+
+void MasterProtocol::notify_node(std::size_t slot, bool up, const std::string& reason, Actions& out) const {
+  if (settings_.live == nullptr) return;
+  session::Event event;
+  auto& node = *event.mutable_node();
+  node.set_projector(slot_id(slot));
+  node.set_up(up);
+  node.set_reason(reason);
+  node.set_nodes_up(static_cast<std::uint32_t>(nodes_up()));
+  node.set_nodes(static_cast<std::uint32_t>(slots_.size()));
+  out.push_back(AppEvent{std::move(event)});
+}
+
 Actions MasterProtocol::operator_command(OperatorCommand command, const std::string& from, clock::Nanos now) {
   Actions out;
   const std::string who = "the operator (" + from + ")";
@@ -162,6 +184,7 @@ Actions MasterProtocol::operator_command(OperatorCommand command, const std::str
         say(spdlog::level::warn, fmt::format("paused by {}: no frame after frame {}; every projector keeps showing "
                                              "its last",
                                              who, next_frame_ == 0 ? 0 : next_frame_ - 1));
+        notify_run(session::RunChanged::PAUSED, "paused by " + who, out);
       }
       break;
     case OperatorCommand::resume:
@@ -175,6 +198,7 @@ Actions MasterProtocol::operator_command(OperatorCommand command, const std::str
       }
       paused_ = false;
       say(spdlog::level::warn, fmt::format("resumed by {} at frame {}", who, next_frame_));
+      notify_run(session::RunChanged::RUNNING, "resumed by " + who, out);
       if (begin_on_resume_) {
         // The schedule starts again from now: no rush of frames to catch up.
         begin_on_resume_ = false;

@@ -46,7 +46,16 @@ struct Session::Link {
     return {};
   }
 
+  // Replies wait at most `timeout`; receive() then fails, with timed_out set.
+  void set_timeout(std::chrono::milliseconds timeout) {
+    const auto micros = std::chrono::duration_cast<std::chrono::microseconds>(timeout).count();
+    const timeval value{static_cast<time_t>(micros / 1000000), static_cast<suseconds_t>(micros % 1000000)};
+    setsockopt(socket.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &value, sizeof value);
+  }
+  bool timed_out = false;  // the last receive() failed for want of an answer in time
+
   Result<wire::Envelope> receive() {
+    timed_out = false;
     for (;;) {
       net::DecodedFrame frame = reader.next();
       if (frame.status == net::DecodeStatus::bad) return Error{"the master sent a bad frame: " + frame.error};
@@ -74,6 +83,10 @@ struct Session::Link {
       boost::system::error_code ec;
       const std::size_t got = socket.read_some(asio::buffer(chunk), ec);
       if (ec == asio::error::eof) return Error{"the master closed the session"};
+      if (ec == asio::error::would_block || ec == asio::error::try_again) {
+        timed_out = true;
+        return Error{"no answer from the master in time"};
+      }
       if (ec) return Error{"no answer from the master: " + ec.message()};
       reader.append(std::span(chunk.data(), got));
     }
@@ -97,9 +110,7 @@ Result<std::unique_ptr<Session>> Session::connect(const Options& options) {
   if (ec) return Error{"cannot connect to " + options.host + ":" + std::to_string(options.port) + ": " + ec.message()};
   link->socket.set_option(asio::ip::tcp::no_delay(true));
   // A master that does not answer is an error after the timeout, not a hang.
-  const auto micros = std::chrono::duration_cast<std::chrono::microseconds>(options.timeout).count();
-  const timeval timeout{static_cast<time_t>(micros / 1000000), static_cast<suseconds_t>(micros % 1000000)};
-  setsockopt(link->socket.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+  link->set_timeout(options.timeout);
 
   auto challenge = link->receive();
   if (!challenge) return Error{challenge.error()};
@@ -125,6 +136,7 @@ Result<std::unique_ptr<Session>> Session::connect(const Options& options) {
     link->opener.emplace(keys->to_node);
   }
   std::unique_ptr<Session> session(new Session(std::move(link)));
+  session->timeout_ = options.timeout;
   // The master answers a hello only to refuse it: the first reply opens the session.
   auto scene = session->read_scene();
   if (!scene) return Error{scene.error()};
@@ -142,7 +154,9 @@ Result<session::Reply> Session::ask(session::Request request) {
   for (;;) {
     auto got = link_->receive();
     if (!got) return Error{got.error()};
-    if (got.value().has_session_reply() && got.value().session_reply().id() == id) {
+    if (got.value().has_session_event()) {
+      events_.push_back(std::move(*got.value().mutable_session_event()));
+    } else if (got.value().has_session_reply() && got.value().session_reply().id() == id) {
       return std::move(*got.value().mutable_session_reply());
     }
   }
@@ -171,6 +185,37 @@ Result<session::SceneContents> Session::read_scene() {
   if (!reply) return Error{reply.error()};
   if (!reply.value().has_scene()) return Error{"the master answered ReadScene with something else"};
   return std::move(*reply.value().mutable_scene());
+}
+
+Result<void> Session::subscribe(const session::Subscribe& kinds) {
+  session::Request request;
+  *request.mutable_subscribe() = kinds;
+  auto reply = ask(std::move(request));
+  if (!reply) return Error{reply.error()};
+  if (!reply.value().has_subscribed()) return Error{"the master answered Subscribe with something else"};
+  return {};
+}
+
+Result<std::optional<session::Event>> Session::next_event(std::chrono::milliseconds timeout) {
+  if (!events_.empty()) {
+    session::Event event = std::move(events_.front());
+    events_.pop_front();
+    return std::optional<session::Event>(std::move(event));
+  }
+  if (!link_) return Error{"the session is closed"};
+  link_->set_timeout(timeout);
+  for (;;) {
+    auto got = link_->receive();
+    if (!got && link_->timed_out) {
+      link_->set_timeout(timeout_);
+      return std::optional<session::Event>();
+    }
+    if (!got) return Error{got.error()};
+    if (got.value().has_session_event()) {
+      link_->set_timeout(timeout_);
+      return std::optional<session::Event>(std::move(*got.value().mutable_session_event()));
+    }
+  }
 }
 
 void Session::close() {

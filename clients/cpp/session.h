@@ -9,6 +9,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <deque>
 #include <memory>
 #include <optional>
 #include <string>
@@ -46,6 +47,12 @@ class Session {
 
   [[nodiscard]] Result<Outcome> apply(const Transaction& transaction);
   [[nodiscard]] Result<session::SceneContents> read_scene();
+  // From now on the master sends these kinds of events (all off at first);
+  // read them with next_event. An application that stops reading them is
+  // closed by the master after a while.
+  [[nodiscard]] Result<void> subscribe(const session::Subscribe& kinds);
+  // The next event, or nullopt when none came within `timeout`.
+  [[nodiscard]] Result<std::optional<session::Event>> next_event(std::chrono::milliseconds timeout);
   // The scene as it was when the session opened.
   [[nodiscard]] const session::SceneContents& scene() const { return scene_; }
   // Says goodbye and closes.
@@ -57,7 +64,9 @@ class Session {
   [[nodiscard]] Result<session::Reply> ask(session::Request request);
 
   std::unique_ptr<Link> link_;
+  std::deque<session::Event> events_;  // those that came while a reply was awaited
   session::SceneContents scene_;
+  std::chrono::milliseconds timeout_{10000};  // for replies (Options::timeout)
   std::uint64_t next_request_ = 1;
 };
 

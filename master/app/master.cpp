@@ -288,6 +288,9 @@ void Master::carry_out(Action& action) {
                  },
                  [&](Finish& a) { finish(a.exit_code); },
                  [&](Log& a) { log_.log(a.level, "{}", a.text); },
+                 [&](AppEvent& a) {
+                   if (session_port_) session_port_->publish(a.event);
+                 },
              },
              action);
 }

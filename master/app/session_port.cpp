@@ -8,6 +8,9 @@ namespace {
 
 // Before its hello an application has said nothing worth more.
 constexpr std::uint32_t kMaxHelloBytes = 4096;
+// The kernel's share of what waits for an application that stopped reading
+// (Linux doubles it for its bookkeeping); the rest is bounded by SceneSessions.
+constexpr int kSendBufferBytes = 128 * 1024;
 
 }  // namespace
 
@@ -46,6 +49,8 @@ void SessionPort::close(const std::string& reason) {
 
 void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback) {
   const SessionId id = next_id_++;
+  boost::system::error_code ignored;  // the kernel's default is then the bound
+  socket.set_option(asio::socket_base::send_buffer_size(kSendBufferBytes), ignored);
   auto connection = net::Connection::create(std::move(socket), kMaxHelloBytes);
   connections_[id] = connection;
   connection->start({
@@ -56,6 +61,19 @@ void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& p
       },
   });
   carry_out(sessions_.accepted(id, peer_text, loopback, net::random_nonce()));
+}
+
+void SessionPort::publish(const session::Event& event) {
+  SessionActions sends = sessions_.publish(event);
+  const clock::Nanos now = clock::monotonic_now();
+  for (SessionAction& action : sends) {
+    auto* send = std::get_if<session_action::Send>(&action);
+    const auto found = send != nullptr ? connections_.find(send->session) : connections_.end();
+    if (found == connections_.end()) continue;
+    const std::shared_ptr<net::Connection> connection = found->second;
+    connection->send(send->message);
+    carry_out(sessions_.queued(send->session, connection->queued_bytes(), now));
+  }
 }
 
 void SessionPort::carry_out(SessionActions actions) {

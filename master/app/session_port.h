@@ -34,6 +34,10 @@ class SessionPort {
   // Listens and accepts; `next_frame` says which frame the master begins next.
   // The port bound.
   [[nodiscard]] Result<std::uint16_t> start(std::function<std::uint64_t()> next_frame);
+  // Sends `event` to the applications that subscribed to its kind. One that
+  // has more than max_queued_bytes waiting (it stopped reading) is closed:
+  // it never holds the frames back.
+  void publish(const session::Event& event);
   // No more sessions; the open ones are told goodbye.
   void close(const std::string& reason);
 

@@ -87,6 +87,57 @@ SessionActions SceneSessions::closed(SessionId id, const std::string& reason) {
   return out;
 }
 
+SessionActions SceneSessions::publish(const session::Event& event) const {
+  SessionActions out;
+  for (const auto& [id, session] : sessions_) {
+    if (session.application.empty() || session.refused) continue;
+    const session::Subscribe& wants = session.subscribed;
+    bool wanted = false;
+    switch (event.event_case()) {
+      case session::Event::kFrameBegun:
+        wanted = wants.frames();
+        break;
+      case session::Event::kHead:
+        wanted = wants.head();
+        break;
+      case session::Event::kRun:
+        wanted = wants.run();
+        break;
+      case session::Event::kNode:
+        wanted = wants.nodes();
+        break;
+      case session::Event::EVENT_NOT_SET:
+        break;
+    }
+    if (!wanted) continue;
+    wire::Envelope envelope;
+    *envelope.mutable_session_event() = event;
+    out.push_back(Send{id, std::move(envelope)});
+  }
+  return out;
+}
+
+SessionActions SceneSessions::queued(SessionId id, std::size_t bytes, clock::Nanos now) {
+  SessionActions out;
+  const auto found = sessions_.find(id);
+  if (found == sessions_.end() || found->second.refused) return out;
+  Session& session = found->second;
+  if (bytes <= settings_.max_queued_bytes) {
+    session.over_since.reset();
+    return out;
+  }
+  if (!session.over_since) session.over_since = now;
+  if (now - *session.over_since < settings_.stalled_for.count()) return out;
+  const std::string reason =
+      "it stopped reading: " + std::to_string(bytes) + " bytes have waited for it for " +
+      std::to_string(std::chrono::duration_cast<std::chrono::seconds>(settings_.stalled_for).count()) + " s";
+  out.push_back(Log{spdlog::level::warn,
+                    "closed application '" + session.application + "' at " + session.peer_text + ": " + reason});
+  session.refused = true;  // nothing more is sent to it
+  out.push_back(Close{id, reason});
+  return out;
+}
+
 void SceneSessions::refuse(SessionId id, Session& session, const std::string& reason, bool retriable,
                            SessionActions& out) {
   out.push_back(Log{spdlog::level::warn, "refused an application at " + session.peer_text + ": " + reason});
@@ -153,6 +204,10 @@ void SceneSessions::on_request(SessionId id, const session::Request& request, st
         }
         answer.mutable_session_reply()->mutable_applied()->set_frame(next_frame);
       }
+      break;
+    case session::Request::kSubscribe:
+      sessions_.at(id).subscribed = request.subscribe();
+      *answer.mutable_session_reply()->mutable_subscribed() = request.subscribe();
       break;
     case session::Request::kReadScene:
       *answer.mutable_session_reply()->mutable_scene() = scene_contents(live_, next_frame);

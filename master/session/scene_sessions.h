@@ -4,11 +4,13 @@
 // naming itself (capability "scene-session"; with the installation's shared
 // secret, its MAC, and every message after it sealed), then sends requests;
 // each transaction is applied to the live scene (live_scene.h) and answered
-// with the frame from which every node shows it, or why it was refused. The
-// master's shell carries out the actions on its connections.
+// with the frame from which every node shows it, or why it was refused; the
+// events it subscribed to are sent as they happen. The master's shell carries
+// out the actions on its connections.
 
 #include <spdlog/common.h>
 
+#include <chrono>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -16,6 +18,7 @@
 #include <variant>
 #include <vector>
 
+#include "clock/clock.h"
 #include "master/session/live_scene.h"
 #include "net/auth.h"
 #include "net/session_seal.h"
@@ -73,6 +76,12 @@ struct SceneSessionSettings {
   std::optional<net::Secret> secret;
   // Journal every transaction applied (the master's --record).
   bool journal = false;
+  // An application with more than this waiting to be sent to it (the kernel's
+  // send buffer aside) for longer than `stalled_for` has stopped reading: it
+  // is closed, so that its events do not pile up without end. A slow link
+  // that drains a large reply within that time is not.
+  std::size_t max_queued_bytes = 1u << 20;
+  std::chrono::nanoseconds stalled_for = std::chrono::seconds(5);
 };
 
 class SceneSessions {
@@ -87,6 +96,11 @@ class SceneSessions {
   // `next_frame`: the frame the master begins next, which shows what is applied now.
   [[nodiscard]] SessionActions message(SessionId session, const wire::Envelope& message, std::uint64_t next_frame);
   [[nodiscard]] SessionActions closed(SessionId session, const std::string& reason);
+  // `event` sent to every application that subscribed to its kind.
+  [[nodiscard]] SessionActions publish(const session::Event& event) const;
+  // How much waits to be sent to `session` at `now` (after an event was
+  // queued for it): closes it when it has stopped reading.
+  [[nodiscard]] SessionActions queued(SessionId session, std::size_t bytes, clock::Nanos now);
 
   [[nodiscard]] std::size_t open() const { return sessions_.size(); }
 
@@ -96,6 +110,8 @@ class SceneSessions {
     std::vector<std::uint8_t> nonce;
     std::string application;  // from its hello; empty before
     bool refused = false;
+    session::Subscribe subscribed;           // the events it takes
+    std::optional<clock::Nanos> over_since;  // when its queue went over max_queued_bytes
   };
 
   void on_hello(SessionId id, Session& session, const wire::Envelope& message, SessionActions& out);

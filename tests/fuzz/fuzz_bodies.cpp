@@ -346,6 +346,7 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
   (void)sessions.message(1, hello, 0);
   scene::SceneState previous;
   std::uint64_t frame = 0;
+  session::Subscribe subscribed;
   for (std::span<const std::uint8_t> chunk : split_chunks(input)) {
     if (chunk.size() == 1) {
       live.begin_frame();
@@ -388,6 +389,11 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
         OPTIQUE_FUZZ_REQUIRE(live.instances() == before);
         continue;
       }
+      if (reply.has_subscribed()) {
+        OPTIQUE_FUZZ_REQUIRE(message.session_request().has_subscribe());
+        subscribed = reply.subscribed();
+        continue;
+      }
       if (reply.has_applied()) {
         OPTIQUE_FUZZ_REQUIRE(reply.applied().frame() == frame);
         OPTIQUE_FUZZ_REQUIRE(journalled == 1);
@@ -403,6 +409,10 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
     OPTIQUE_FUZZ_REQUIRE(request || closed || message.has_heartbeat());
     if (auto broken = check_live(live, limits, previous); !broken.empty()) return broken;
     if (closed) break;
+    // A frame event reaches the application only while it subscribes to frames.
+    session::Event begun;
+    begun.mutable_frame_begun()->set_frame(frame);
+    OPTIQUE_FUZZ_REQUIRE(sessions.publish(begun).size() == (subscribed.frames() ? 1u : 0u));
   }
   return {};
 }

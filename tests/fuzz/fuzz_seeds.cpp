@@ -708,6 +708,15 @@ std::function<void(session::Edit&)> remove(const std::string& id) {
 
 const Bytes kNextFrame{0};
 
+Bytes subscribe(std::uint64_t id, bool frames) {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  e.mutable_session_request()->set_id(id);
+  e.mutable_session_request()->mutable_subscribe()->set_frames(frames);
+  e.mutable_session_request()->mutable_subscribe()->set_nodes(true);
+  return serialize(e);
+}
+
 Bytes read_scene(std::uint64_t id) {
   wire::Envelope e;
   e.set_protocol_version(net::kProtocolVersion);
@@ -735,6 +744,8 @@ std::vector<Seed> session_seeds() {
                          kNextFrame, request(3, {remove("table")}), request(4, {create("table", "duck")})})});
   seeds.push_back({"read_the_scene", join({request(1, {create("table", "torus"), create("cup", "torus", "table", 0.5)}),
                                            read_scene(2), kNextFrame, request(3, {remove("cup")}), read_scene(4)})});
+  seeds.push_back({"subscribe", join({subscribe(1, true), kNextFrame, request(2, {create("a", "torus")}), kNextFrame,
+                                      subscribe(3, false), kNextFrame})});
   const double nan = std::numeric_limits<double>::quiet_NaN();
   seeds.push_back({"refusals", join({request(1, {create("a", "torus"), create("b", "teapot")}),
                                      request(2, {create("a", "torus"), move("a", {0, nan, 0})}),

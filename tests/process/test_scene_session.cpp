@@ -13,9 +13,13 @@
 #include <string>
 #include <vector>
 
+#include <boost/asio.hpp>
+
 #include "clients/cpp/session.h"
 #include "cluster_run.h"
 #include "master/session/journal.h"
+#include "net/envelope.h"
+#include "net/framing.h"
 #include "process.h"
 #include "scratch.h"
 
@@ -96,6 +100,27 @@ TEST(SceneSession, AnApplicationPlacesAnInstanceAndEveryNodeShowsItFromTheFrameN
 
   // The run ends in order, the application is told goodbye, and no node's
   // state left the master's: the instance was in every node's delta.
+  // Events once subscribed: each frame as it begins, and the run stopping.
+  session::Subscribe kinds;
+  kinds.set_frames(true);
+  kinds.set_run(true);
+  ASSERT_TRUE(app->subscribe(kinds).ok());
+  std::vector<std::uint64_t> begun;
+  std::string stopping;
+  while (stopping.empty()) {
+    auto event = app->next_event(10s);
+    ASSERT_TRUE(event.ok()) << event.error();
+    ASSERT_TRUE(event.value().has_value()) << "an event within 10 s";
+    if (event.value()->has_frame_begun()) begun.push_back(event.value()->frame_begun().frame());
+    if (event.value()->has_run()) {
+      EXPECT_EQ(event.value()->run().state(), session::RunChanged::STOPPING);
+      stopping = event.value()->run().reason();
+    }
+  }
+  EXPECT_EQ(stopping, "ran 240 frames");
+  ASSERT_GT(begun.size(), 10u);
+  for (std::size_t i = 1; i < begun.size(); ++i) EXPECT_EQ(begun[i], begun[i - 1] + 1);
+  EXPECT_EQ(begun.back(), 239u);
   ASSERT_EQ(master->wait(60s), 0) << master->output();
   auto after = app->read_scene();
   ASSERT_FALSE(after.ok());
@@ -177,6 +202,63 @@ TEST(SceneSession, AJournalThatIsNotOneStopsTheStartWithWhy) {
   EXPECT_NE(both->output().find("--record and --replay: a master records a session or replays one, not both"),
             std::string::npos)
       << both->output();
+}
+
+// An application that subscribes to events and then stops reading is closed
+// once what waits for it has stayed over the bound (1 MiB beside the kernel's
+// buffer) for 5 s; the frames never wait for it, and the others go on. Here
+// it asks for a scene of 10,000 instances (about 1 MB a reply) five times and
+// reads nothing.
+TEST(SceneSession, AnApplicationThatStopsReadingIsClosedAndTheFramesGoOn) {
+  ScratchDir dir("optique-slow-reader");
+  auto master = wall_master(dir, "wall", "600");
+  const std::uint16_t port = api_port(dir, "wall", *master);
+  auto busy = connect(port, "busy");
+  ASSERT_NE(busy, nullptr) << master->output();
+  client::Transaction many;
+  for (int i = 0; i < 10000; ++i) many.create("i" + std::to_string(i), "cubes", at(0.001 * i));
+  ASSERT_EQ(outcome(*busy, many), "applied") << master->output();
+
+  namespace asio = boost::asio;
+  asio::io_context io;
+  asio::ip::tcp::socket slow(io);
+  slow.connect({asio::ip::make_address("127.0.0.1"), port});
+  const auto send = [&](wire::Envelope message, std::uint64_t sequence) {
+    message.set_protocol_version(net::kProtocolVersion);
+    message.set_sequence(sequence);
+    std::vector<std::uint8_t> bytes;
+    net::append_envelope(bytes, message);
+    asio::write(slow, asio::buffer(bytes));
+  };
+  wire::Envelope hello;
+  hello.mutable_hello()->set_node_id("slow");
+  hello.mutable_hello()->add_capabilities("scene-session");
+  send(hello, 1);
+  wire::Envelope subscribe;
+  subscribe.mutable_session_request()->set_id(1);
+  subscribe.mutable_session_request()->mutable_subscribe()->set_frames(true);
+  subscribe.mutable_session_request()->mutable_subscribe()->set_head(true);
+  send(subscribe, 2);
+  for (std::uint64_t i = 0; i < 5; ++i) {
+    wire::Envelope read;
+    read.mutable_session_request()->set_id(2 + i);
+    read.mutable_session_request()->mutable_read_scene();
+    send(read, 3 + i);
+  }
+  ASSERT_TRUE(master->wait_for_output("closed application 'slow' at 127.0.0.1", scaled(20s))) << master->output();
+  EXPECT_TRUE(master->wait_for_output("it stopped reading", 1s));
+  // The other application was not held up.
+  client::Transaction move;
+  move.move("i0", at(1.0));
+  EXPECT_EQ(outcome(*busy, move), "applied");
+  ASSERT_EQ(master->wait(60s), 0) << master->output();
+  const ClusterRun run = read_cluster_run(dir.file("wall"));
+  ASSERT_EQ(run.error, "");
+  EXPECT_EQ(run.report.frames(), 600u);
+  for (const auto& node : run.report.nodes()) {
+    EXPECT_EQ(node.frames_presented(), 600u) << node.id();
+    EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
+  }
 }
 
 // The C++ example, as a user runs it against a --local wall.

@@ -79,7 +79,7 @@ class OnAWall(unittest.TestCase):
                 t.create("table", "cubes", position=(0.5, 0.0, 0.0))
                 t.create("cup", "cubes", parent="table", position=(0.0, 0.2, 0.0), scale=0.1)
                 t.tint("cup", base_color=(1.0, 0.0, 0.0, 1.0))
-            self.assertGreater(t.frame, 0)
+            self.assertIsInstance(t.frame, int)  # 0 when the frames have not begun yet
             with wall.transaction() as later:
                 later.move("table", position=(-0.5, 0.0, 0.0))
             self.assertGreaterEqual(later.frame, t.frame)
@@ -117,6 +117,29 @@ class OnAWall(unittest.TestCase):
             with self.assertRaises(ValueError):
                 wall.transaction().create("x", "cubes", position=(1.0, 2.0))
 
+    def test_frames_arrive_as_events_once_subscribed(self):
+        with self.connect(name="listener") as wall:
+            self.assertIsNone(wall.next_event(timeout=0.2), "nothing before subscribing")
+            wall.subscribe(frames=True)
+            frames = []
+            while len(frames) < 10:
+                event = wall.next_event(timeout=5)
+                self.assertIsNotNone(event, "a frame event within 5 s")
+                self.assertEqual(event.WhichOneof("event"), "frame_begun")
+                frames.append(event.frame_begun)
+            self.assertEqual([f.frame for f in frames], list(range(frames[0].frame, frames[0].frame + 10)))
+            self.assertAlmostEqual(frames[0].period_ns, 1e9 / 60, delta=1)
+            for a, b in zip(frames, frames[1:]):
+                self.assertGreater(b.display_ns, a.display_ns)
+            # Events that come while a reply is awaited are kept for next_event.
+            with wall.transaction() as t:
+                t.create("stamp", "cubes")
+                t.remove("stamp")
+            wall.subscribe()
+            while wall.next_event(timeout=0.2) is not None:
+                pass
+            self.assertIsNone(wall.next_event(timeout=0.2), "none after unsubscribing")
+
     def test_the_circle_example(self):
         run = subprocess.run([sys.executable, str(EXAMPLES / "circle.py"), "--port", str(self.master.port),
                               "--seconds", "1.5"], capture_output=True, text=True, timeout=60)
@@ -127,6 +150,24 @@ class OnAWall(unittest.TestCase):
             self.assertEqual(names & {"orbit", "beacon"}, {"orbit", "beacon"})
             with wall.transaction() as t:
                 t.remove("orbit").remove("beacon")
+
+
+class AtTheEnd(unittest.TestCase):
+    def test_the_run_says_it_stops(self):
+        with tempfile.TemporaryDirectory(prefix="optique-end-") as folder:
+            master = Master(pathlib.Path(folder), frames=120)
+            try:
+                with optique.connect(port=master.port, name="watcher") as wall:
+                    wall.subscribe(run=True)
+                    event = wall.next_event(timeout=20)
+                    self.assertIsNotNone(event)
+                    self.assertEqual(event.WhichOneof("event"), "run")
+                    self.assertEqual(event.run.state, optique.session_pb2.RunChanged.STOPPING)
+                    self.assertIn("120 frames", event.run.reason)
+                    with self.assertRaises(optique.ConnectionClosed):
+                        wall.next_event(timeout=20)
+            finally:
+                self.assertEqual(master.wait(), 0, master.output())
 
 
 class WithTheSharedSecret(unittest.TestCase):

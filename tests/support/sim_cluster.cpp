@@ -247,6 +247,7 @@ void SimCluster::master_actions(master::Actions actions) {
                    [&](master::FrameRows&) {},
                    [&](master::Finish& a) { finished_ = a.exit_code; },
                    [&](master::Log&) {},
+                   [&](master::AppEvent& a) { app_events_.push_back(std::move(a.event)); },
                },
                action);
   }

@@ -61,6 +61,8 @@ class SimCluster {
   [[nodiscard]] const std::map<std::uint64_t, std::set<std::string>>& instances_drawn(std::size_t node) const;
   // The same in the state sent ahead with each frame (a node that interpolates).
   [[nodiscard]] const std::map<std::uint64_t, std::set<std::string>>& instances_ahead(std::size_t node) const;
+  // The events the master raised for applications (AppEvent), in order.
+  [[nodiscard]] const std::vector<session::Event>& app_events() const { return app_events_; }
   [[nodiscard]] const master::MasterProtocol& master() const { return *master_; }
   [[nodiscard]] const master::RunRecorder& recorder() const { return *recorder_; }
 
@@ -87,6 +89,7 @@ class SimCluster {
   master::PeerId next_peer_ = 1;
   clock::Nanos now_ = 1'000'000'000'000;
   std::vector<std::string> violations_;
+  std::vector<session::Event> app_events_;
 };
 
 }  // namespace optique::testing

@@ -245,6 +245,82 @@ TEST_F(SceneSessionsTest, AnApplicationReadsTheSceneAsItIs) {
   EXPECT_FALSE(scene.instances(1).hidden());
 }
 
+wire::Envelope subscribe(std::uint64_t id, bool frames, bool head, bool run, bool nodes) {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  e.mutable_session_request()->set_id(id);
+  auto& s = *e.mutable_session_request()->mutable_subscribe();
+  s.set_frames(frames);
+  s.set_head(head);
+  s.set_run(run);
+  s.set_nodes(nodes);
+  return e;
+}
+
+// Each application gets the events of the kinds it subscribed to, and no
+// other; one that has not said hello gets none.
+TEST_F(SceneSessionsTest, EventsGoToTheirSubscribersOnly) {
+  SceneSessions sessions(live_, {});
+  for (SessionId id : {1, 2, 3}) (void)sessions.accepted(id, "127.0.0.1:500" + std::to_string(id), true, kNonce);
+  (void)sessions.message(1, hello("frames-only"), 0);
+  (void)sessions.message(2, hello("nodes-and-run"), 0);
+  const auto answer = of<session_action::Send>(sessions.message(1, subscribe(7, true, false, false, false), 0));
+  ASSERT_EQ(answer.size(), 1u);
+  EXPECT_EQ(answer[0].message.session_reply().id(), 7u);
+  EXPECT_TRUE(answer[0].message.session_reply().subscribed().frames());
+  (void)sessions.message(2, subscribe(1, false, false, true, true), 0);
+
+  const auto sent_to = [&](const session::Event& event) {
+    std::vector<SessionId> to;
+    for (const auto& send : of<session_action::Send>(sessions.publish(event))) {
+      EXPECT_TRUE(send.message.has_session_event());
+      to.push_back(send.session);
+    }
+    return to;
+  };
+  session::Event frame;
+  frame.mutable_frame_begun()->set_frame(12);
+  session::Event head;
+  head.mutable_head()->set_frame(12);
+  session::Event run;
+  run.mutable_run()->set_state(session::RunChanged::PAUSED);
+  session::Event node;
+  node.mutable_node()->set_projector("top-left");
+  EXPECT_EQ(sent_to(frame), std::vector<SessionId>{1});
+  EXPECT_EQ(sent_to(head), std::vector<SessionId>{});
+  EXPECT_EQ(sent_to(run), std::vector<SessionId>{2});
+  EXPECT_EQ(sent_to(node), std::vector<SessionId>{2});
+  (void)sessions.message(1, subscribe(8, false, false, false, false), 0);  // all off again
+  EXPECT_EQ(sent_to(frame), std::vector<SessionId>{});
+}
+
+// An application with more than max_queued_bytes waiting for longer than
+// stalled_for has stopped reading: it is closed, and sent nothing more. A
+// queue that drains in time is no fault.
+TEST_F(SceneSessionsTest, ASubscriberThatStopsReadingIsClosed) {
+  SceneSessionSettings settings;
+  settings.max_queued_bytes = 1000;
+  settings.stalled_for = std::chrono::seconds(5);
+  SceneSessions sessions(live_, settings);
+  (void)sessions.accepted(1, "127.0.0.1:5000", true, kNonce);
+  (void)sessions.message(1, hello("slow"), 0);
+  (void)sessions.message(1, subscribe(1, true, false, false, false), 0);
+  constexpr clock::Nanos kSecond = 1'000'000'000;
+  EXPECT_TRUE(sessions.queued(1, 5000, 0).empty());
+  EXPECT_TRUE(sessions.queued(1, 900, 4 * kSecond).empty()) << "drained in time";
+  EXPECT_TRUE(sessions.queued(1, 5000, 6 * kSecond).empty()) << "over again from 6 s";
+  EXPECT_TRUE(sessions.queued(1, 5000, 10 * kSecond).empty());
+  const auto closed = sessions.queued(1, 6000, 11 * kSecond);
+  ASSERT_EQ(of<session_action::Close>(closed).size(), 1u);
+  EXPECT_EQ(of<session_action::Close>(closed)[0].reason, "it stopped reading: 6000 bytes have waited for it for 5 s");
+  ASSERT_EQ(of<session_action::Log>(closed).size(), 1u);
+  EXPECT_EQ(of<session_action::Log>(closed)[0].text,
+            "closed application 'slow' at 127.0.0.1:5000: it stopped reading: 6000 bytes have waited for it for 5 s");
+  session::Event frame;
+  frame.mutable_frame_begun()->set_frame(1);
+  EXPECT_TRUE(sessions.publish(frame).empty());
+}
+
 TEST_F(SceneSessionsTest, TheNumberOfSessionsIsBounded) {
   SceneSessionSettings settings;
   settings.max_sessions = 2;

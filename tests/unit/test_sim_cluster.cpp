@@ -122,6 +122,51 @@ TEST(SimCluster, AReplayedJournalPutsEachTransactionInItsFrame) {
   }
 }
 
+// With a live scene the master raises, for applications, every frame it
+// begins (its display time a period after the last) and the head in it, and
+// a node that leaves and comes back.
+TEST(SimCluster, TheMasterRaisesFramesHeadsAndNodesForApplications) {
+  const master::RunConfig run = load("powerwall-2x2.json");
+  master::LiveScene live;
+  master::RunSettings settings = for_frames(30);
+  settings.live = &live;
+  SimCluster cluster(run, settings);
+  cluster.start();
+  cluster.run_promptly(cluster.now() + kSecond / 4);
+  cluster.reset_link(1);
+  cluster.run_promptly(cluster.now() + 10 * kSecond);
+  EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
+  std::vector<std::uint64_t> begun;
+  std::vector<clock::Nanos> displays;
+  std::size_t heads = 0;
+  std::vector<std::string> nodes;
+  for (const session::Event& event : cluster.app_events()) {
+    if (event.has_frame_begun()) {
+      begun.push_back(event.frame_begun().frame());
+      displays.push_back(event.frame_begun().display_ns());
+      EXPECT_NEAR(static_cast<double>(event.frame_begun().period_ns()), 1e9 / 60.0, 1.0);
+    }
+    if (event.has_head()) {
+      ++heads;
+      EXPECT_EQ(event.head().frame(), begun.back()) << "after its frame";
+      EXPECT_NEAR(event.head().eyes(1), 1.6, 1e-9);  // the config's eyes
+      EXPECT_NEAR(event.head().right(0), 1.0, 1e-9);
+      EXPECT_FALSE(event.head().tracked());
+    }
+    if (event.has_node()) {
+      nodes.push_back(event.node().projector() + (event.node().up() ? " up " : " down ") +
+                      std::to_string(event.node().nodes_up()) + "/" + std::to_string(event.node().nodes()));
+    }
+  }
+  EXPECT_EQ(begun, frames(0, 30));
+  EXPECT_EQ(heads, 30u);
+  for (std::size_t i = 1; i < displays.size(); ++i) EXPECT_GT(displays[i], displays[i - 1]) << i;
+  const std::string id = run.config.installation.projectors[1].id;
+  ASSERT_GE(nodes.size(), 6u) << ::testing::PrintToString(nodes);
+  EXPECT_EQ(std::vector<std::string>(nodes.end() - 2, nodes.end()),
+            (std::vector<std::string>{id + " down 3/4", id + " up 4/4"}));
+}
+
 TEST(SimCluster, AWrongStateIsRepairedTheNextFrame) {
   const master::RunConfig run = load("powerwall-2x2.json");
   SimCluster cluster(run, for_frames(20), 5);

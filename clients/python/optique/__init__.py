@@ -11,11 +11,14 @@ one frame on every node, or not at all::
         with wall.transaction() as t:
             t.create("spinner", asset="torus", position=(0.0, 1.2, -0.5), scale=0.5)
         print("shown from frame", t.frame)
+        wall.subscribe(frames=True)
+        event = wall.next_event(timeout=1.0)   # session_pb2.Event: event.frame_begun.frame, ...
 
 The messages are those of proto/optique/session.proto; docs/applications.md
 in the repository lists every one, with its fields and errors.
 """
 
+from optique import session_pb2  # the messages: session_pb2.Event, RunChanged, ...
 from optique.client import (
     PROTOCOL_VERSION,
     ConnectionClosed,
@@ -34,4 +37,5 @@ __all__ = [
     "Session",
     "Transaction",
     "connect",
+    "session_pb2",
 ]

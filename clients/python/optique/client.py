@@ -4,6 +4,7 @@ and their replies. Blocking and single-threaded: one request at a time."""
 
 import hashlib
 import hmac
+import collections
 import os
 import socket
 import struct
@@ -180,6 +181,7 @@ class Session:
         self._request = 0
         self._sealing: Optional[_Sealing] = None
         self._buffer = b""
+        self._events = collections.deque()  # events that came while a reply was awaited
         self._socket = socket.create_connection((host, port), timeout=timeout)
         self._socket.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         try:
@@ -267,7 +269,9 @@ class Session:
         self._send(envelope)
         while True:
             reply = self._receive()
-            if reply.WhichOneof("body") == "session_reply" and reply.session_reply.id == self._request:
+            if reply.WhichOneof("body") == "session_event":
+                self._events.append(reply.session_event)
+            elif reply.WhichOneof("body") == "session_reply" and reply.session_reply.id == self._request:
                 return reply.session_reply
 
     def transaction(self) -> Transaction:
@@ -290,6 +294,38 @@ class Session:
         if reply.WhichOneof("reply") != "scene":
             raise ConnectionClosed(f"the master answered ReadScene with {reply.WhichOneof('reply')}")
         return reply.scene
+
+    def subscribe(self, frames: bool = False, head: bool = False, run: bool = False,
+                  nodes: bool = False) -> None:
+        """From now on the master sends these kinds of events (all off at first):
+        ``frames`` each frame it begins (FrameBegun: frame, display_ns, period_ns),
+        ``head`` the viewer's eyes in each frame (HeadShown), ``run`` paused,
+        resumed or stopping (RunChanged), ``nodes`` a projector's node up or down
+        (NodeChanged). Read them with ``next_event``; an application that stops
+        reading them is closed by the master after a while."""
+        def fill(request):
+            request.subscribe.frames, request.subscribe.head = frames, head
+            request.subscribe.run, request.subscribe.nodes = run, nodes
+        reply = self._ask(fill)
+        if reply.WhichOneof("reply") != "subscribed":
+            raise ConnectionClosed(f"the master answered Subscribe with {reply.WhichOneof('reply')}")
+
+    def next_event(self, timeout: Optional[float] = None) -> Optional[session_pb2.Event]:
+        """The next event (session_pb2.Event: its ``WhichOneof('event')`` says
+        which kind), or None when none came within `timeout` seconds."""
+        if self._events:
+            return self._events.popleft()
+        previous = self._socket.gettimeout()
+        self._socket.settimeout(timeout)
+        try:
+            while True:
+                message = self._receive()
+                if message.WhichOneof("body") == "session_event":
+                    return message.session_event
+        except socket.timeout:
+            return None
+        finally:
+            self._socket.settimeout(previous)
 
     def close(self) -> None:
         try:
