@@ -63,6 +63,86 @@ bool is_rotation(const glm::dmat3& r) {
   return glm::determinant(r) > 0.0;
 }
 
+// A body's position and rotation blocks, `[x y z (η θ φ)][b0 … b8]`, checked.
+// `unseen_is_no_pose`: a quality below 0 says the cameras do not see it (a
+// flystick's buttons still count), and DTrack writes zeros for its pose: read,
+// not checked, and taken as the origin, unturned.
+Result<void> parse_pose(Cursor& c, const std::string& which, DTrackBody& body, bool unseen_is_no_pose = false) {
+  if (!c.expect('[') || !c.number(body.position.x) || !c.number(body.position.y) || !c.number(body.position.z)) {
+    return Error{which + ": expected [x y z] in millimetres"};
+  }
+  // DTrack 1 also gives three angles; they say what the matrix says.
+  if (!c.peek(']')) {
+    double angle = 0.0;
+    if (!c.number(angle) || !c.number(angle) || !c.number(angle)) return Error{which + ": expected [x y z η θ φ]"};
+  }
+  if (!c.expect(']') || !c.expect('[')) return Error{which + ": expected the rotation matrix after the position"};
+  for (int i = 0; i < 9; ++i) {
+    if (!c.number(body.rotation[i / 3][i % 3])) return Error{which + ": expected nine numbers of rotation matrix"};
+  }
+  if (!c.expect(']')) return Error{which + ": expected ] after the rotation matrix"};
+  if (!(body.quality >= -1.0 && body.quality <= 1.0)) {
+    return Error{which + ": quality " + std::to_string(body.quality) + " is outside -1…1"};
+  }
+  if (unseen_is_no_pose && body.quality < 0.0) {
+    body.position = glm::dvec3(0.0);
+    body.rotation = glm::dmat3(1.0);
+    return {};
+  }
+  if (!is_rotation(body.rotation)) return Error{which + ": the rotation matrix is not a rotation"};
+  if (!(glm::length(body.position) <= kMostDTrackPosition)) {
+    return Error{which + ": a position more than " + std::to_string(static_cast<int>(kMostDTrackPosition / 1000)) +
+                 " m from the tracker's origin"};
+  }
+  return {};
+}
+
+Result<std::vector<DTrackFlystick>> parse_6df2(Cursor& c) {
+  std::uint32_t defined = 0;
+  std::uint32_t count = 0;
+  if (!c.number(defined) || !c.number(count)) return Error{"expected the numbers of flysticks defined and listed"};
+  if (count > kMaxDTrackBodies) {
+    return Error{std::to_string(count) + " flysticks (at most " + std::to_string(kMaxDTrackBodies) + ")"};
+  }
+  std::vector<DTrackFlystick> sticks;
+  sticks.reserve(count);
+  for (std::uint32_t s = 0; s < count; ++s) {
+    const std::string which = "flystick " + std::to_string(s + 1) + " of " + std::to_string(count);
+    DTrackFlystick stick;
+    std::uint32_t buttons = 0;
+    std::uint32_t controllers = 0;
+    if (!c.expect('[') || !c.number(stick.body.id) || !c.number(stick.body.quality) || !c.number(buttons) ||
+        !c.number(controllers) || !c.expect(']')) {
+      return Error{which + ": expected [id quality buttons controllers]"};
+    }
+    if (buttons > kMaxFlystickButtons || controllers > kMaxFlystickControllers) {
+      return Error{which + ": " + std::to_string(buttons) + " buttons and " + std::to_string(controllers) +
+                   " controllers (at most " + std::to_string(kMaxFlystickButtons) + " and " +
+                   std::to_string(kMaxFlystickControllers) + ")"};
+    }
+    if (auto pose = parse_pose(c, which, stick.body, true); !pose) return Error{pose.error()};
+    if (!c.expect('[')) return Error{which + ": expected [buttons controllers] after the rotation matrix"};
+    stick.buttons.resize(buttons);
+    for (std::uint32_t word = 0; word < (buttons + 31) / 32; ++word) {
+      std::uint32_t bits = 0;
+      if (!c.number(bits))
+        return Error{which + ": expected the buttons as " + std::to_string((buttons + 31) / 32) + " whole number(s)"};
+      for (std::uint32_t b = 0; b < 32 && 32 * word + b < buttons; ++b)
+        stick.buttons[32 * word + b] = ((bits >> b) & 1u) != 0;
+    }
+    stick.controllers.resize(controllers);
+    for (double& value : stick.controllers) {
+      if (!c.number(value) || value < -1.0 || value > 1.0) {
+        return Error{which + ": expected " + std::to_string(controllers) + " controller values in -1…1"};
+      }
+    }
+    if (!c.expect(']')) return Error{which + ": expected ] after the controllers"};
+    sticks.push_back(std::move(stick));
+  }
+  if (!c.done()) return Error{"more after the " + std::to_string(count) + " flysticks"};
+  return sticks;
+}
+
 Result<std::vector<DTrackBody>> parse_6d(Cursor& c) {
   std::uint32_t count = 0;
   if (!c.number(count)) return Error{"expected the number of bodies"};
@@ -77,27 +157,7 @@ Result<std::vector<DTrackBody>> parse_6d(Cursor& c) {
     if (!c.expect('[') || !c.number(body.id) || !c.number(body.quality) || !c.expect(']')) {
       return Error{which + ": expected [id quality]"};
     }
-    if (!c.expect('[') || !c.number(body.position.x) || !c.number(body.position.y) || !c.number(body.position.z)) {
-      return Error{which + ": expected [x y z] in millimetres"};
-    }
-    // DTrack 1 also gives three angles; they say what the matrix says.
-    if (!c.peek(']')) {
-      double angle = 0.0;
-      if (!c.number(angle) || !c.number(angle) || !c.number(angle)) return Error{which + ": expected [x y z η θ φ]"};
-    }
-    if (!c.expect(']') || !c.expect('[')) return Error{which + ": expected the rotation matrix after the position"};
-    for (int i = 0; i < 9; ++i) {
-      if (!c.number(body.rotation[i / 3][i % 3])) return Error{which + ": expected nine numbers of rotation matrix"};
-    }
-    if (!c.expect(']')) return Error{which + ": expected ] after the rotation matrix"};
-    if (!(body.quality >= -1.0 && body.quality <= 1.0)) {
-      return Error{which + ": quality " + std::to_string(body.quality) + " is outside -1…1"};
-    }
-    if (!is_rotation(body.rotation)) return Error{which + ": the rotation matrix is not a rotation"};
-    if (!(glm::length(body.position) <= kMostDTrackPosition)) {
-      return Error{which + ": a position more than " + std::to_string(static_cast<int>(kMostDTrackPosition / 1000)) +
-                   " m from the tracker's origin"};
-    }
+    if (auto pose = parse_pose(c, which, body); !pose) return Error{pose.error()};
     bodies.push_back(body);
   }
   if (!c.done()) return Error{"more after the " + std::to_string(count) + " bodies"};
@@ -110,6 +170,7 @@ Result<DTrackFrame> parse_dtrack(std::string_view datagram) {
   if (datagram.size() > kMaxDTrackDatagram) return Error{"a datagram of " + std::to_string(datagram.size()) + " bytes"};
   DTrackFrame frame;
   bool bodies_seen = false;
+  bool flysticks_seen = false;
   bool known_seen = false;  // a line DTrack writes in every frame
   std::size_t line_number = 0;
   while (!datagram.empty()) {
@@ -155,6 +216,12 @@ Result<DTrackFrame> parse_dtrack(std::string_view datagram) {
       if (!bodies) return wrong(bodies.error());
       frame.bodies = std::move(bodies).value();
       bodies_seen = true;
+    } else if (kind == "6df2") {
+      if (flysticks_seen) return wrong("a second 6df2 line");
+      auto sticks = parse_6df2(c);
+      if (!sticks) return wrong(sticks.error());
+      frame.flysticks = std::move(sticks).value();
+      flysticks_seen = true;
     }
   }
   if (!known_seen) return Error{"no fr, ts or 6d line: not DTrack's ASCII output"};

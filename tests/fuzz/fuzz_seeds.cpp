@@ -654,6 +654,10 @@ std::vector<Seed> tracker_seeds() {
                    join({datagram(100, "fr 1\nts2 0 0 0\n6d 1 [0 1][-99000 0 0][1 0 0 0 1 0 0 0 1]"),
                          datagram(5, "fr 2\nts2 0 0 499\n6d 1 [0 1][99000 0 0][1 0 0 0 1 0 0 0 1]"),
                          datagram(200, "fr 3\nts2 0 0 0\n6d 1 [0 1][99000 0 0][0 1 0 -1 0 0 0 0 1]")})});
+  const std::string flysticks =
+      "6df2 2 2 [0 1.000 6 2][100 200 300][1 0 0 0 1 0 0 0 1][5 0.5 -1.0] "
+      "[1 -1.000 40 1][0 0 0][0 0 0 0 0 0 0 0 0][2147483649 2 0.25]\n";
+  seeds.push_back({"flystick", join({datagram(167, frame_text(1, 0.0) + flysticks)})});
   seeds.push_back({"empty", {}});
   return seeds;
 }

@@ -102,6 +102,52 @@ TEST(DTrack, MalformedDatagramsAreRefusedNamingTheLine) {
   EXPECT_FALSE(parse_dtrack(std::string(kMaxDTrackDatagram + 1, ' ')));
 }
 
+// A flystick (6df2): its pose as a body's, its buttons as bits of 32-bit
+// words, its joystick's axes; one the cameras do not see (quality -1, a pose
+// of zeros) still gives its buttons.
+TEST(DTrack, FlysticksGiveTheirButtonsAndJoystick) {
+  const auto parsed = parse_dtrack(
+      "fr 7\n6df2 2 2 [0 1.000 6 2][100 200 300][1 0 0 0 1 0 0 0 1][5 0.5 -1.0] "
+      "[1 -1.000 40 1][0 0 0][0 0 0 0 0 0 0 0 0][2147483649 2 0.25]\n");
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  ASSERT_EQ(parsed.value().flysticks.size(), 2u);
+  const DTrackFlystick& first = parsed.value().flysticks[0];
+  EXPECT_EQ(first.body.id, 0u);
+  EXPECT_EQ(first.body.position, glm::dvec3(100.0, 200.0, 300.0));
+  EXPECT_EQ(first.buttons, (std::vector<bool>{true, false, true, false, false, false}));
+  EXPECT_EQ(first.controllers, (std::vector<double>{0.5, -1.0}));
+  const DTrackFlystick& unseen = parsed.value().flysticks[1];
+  EXPECT_EQ(unseen.body.quality, -1.0);
+  EXPECT_EQ(unseen.body.rotation, glm::dmat3(1.0));
+  ASSERT_EQ(unseen.buttons.size(), 40u);
+  for (std::size_t b = 0; b < 40; ++b) {
+    EXPECT_EQ(unseen.buttons[b], b == 0 || b == 31 || b == 33) << "button " << b;  // 2^31 + 1, then 2 = bit 1 of word 2
+  }
+  EXPECT_EQ(unseen.controllers, std::vector<double>{0.25});
+  EXPECT_TRUE(parsed.value().bodies.empty());
+}
+
+TEST(DTrack, MalformedFlysticksAreRefusedNamingWhat) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"6df2 1 1 [0 1 6 2][0 0 0][1 0 0 0 1 0 0 0 1][5 0.5]\n",
+       "flystick 1 of 1: expected 2 controller values in -1…1"},
+      {"6df2 1 1 [0 1 6 2][0 0 0][1 0 0 0 1 0 0 0 1][5 0.5 1.5]\n", "expected 2 controller values in -1…1"},
+      {"6df2 1 1 [0 1 6 2][0 0 0][1 0 0 0 1 0 0 0 1][x 0 0]\n", "expected the buttons as 1 whole number(s)"},
+      {"6df2 1 1 [0 1 6 2][0 0 0][1 0 0 0 1 0 0 0 1]\n", "expected [buttons controllers] after the rotation matrix"},
+      {"6df2 1 1 [0 1 6000 2][0 0 0][1 0 0 0 1 0 0 0 1][0 0 0]\n",
+       "6000 buttons and 2 controllers (at most 64 and 16)"},
+      {"6df2 1 1 [0 1 6 2][0 0 0][0 0 0 0 0 0 0 0 0][0 0 0]\n", "the rotation matrix is not a rotation"},
+      {"6df2 1 1 [0 1 0 0][0 0 0][1 0 0 0 1 0 0 0 1][] junk\n", "more after the 1 flysticks"},
+      {"6df2 1 1 [0 1 0 0][0 0 0][1 0 0 0 1 0 0 0 1][]\n6df2 1 0\n", "a second 6df2 line"},
+  };
+  for (const auto& [datagram, error] : cases) {
+    const auto parsed = parse_dtrack("fr 1\n" + datagram);
+    ASSERT_FALSE(parsed.ok()) << datagram;
+    EXPECT_NE(parsed.error().find(error), std::string::npos) << parsed.error();
+  }
+  EXPECT_TRUE(parse_dtrack("fr 1\n6df2 1 1 [0 1 0 0][0 0 0][1 0 0 0 1 0 0 0 1][]\n").ok()) << "no buttons at all";
+}
+
 TEST(DTrack, DTrackOnesPositionBlockWithAnglesIsRead) {
   const auto parsed = parse_dtrack("6d 1 [2 1.0][10 20 30 1 2 3][1 0 0 0 1 0 0 0 1]");
   ASSERT_TRUE(parsed) << parsed.error();
@@ -414,8 +460,9 @@ TEST(DTrack, APositionMoreThan100MetresAwayIsRefused) {
 std::string large_frame(std::uint64_t frame, std::size_t bytes) {
   std::string bodies;
   int count = 1;
-  bodies += " [4 1.000][100.000 1600.000 0.000][1.000000 0.000000 0.000000 0.000000 1.000000 0.000000 0.000000 "
-            "0.000000 1.000000]";
+  bodies +=
+      " [4 1.000][100.000 1600.000 0.000][1.000000 0.000000 0.000000 0.000000 1.000000 0.000000 0.000000 "
+      "0.000000 1.000000]";
   while (bodies.size() + 200 < bytes && count < static_cast<int>(kMaxDTrackBodies)) {
     bodies += " [" + std::to_string(10 + count) +
               " 1.000][-1234.567 2345.678 -3456.789][0.000000 1.000000 0.000000 -1.000000 0.000000 0.000000 "
