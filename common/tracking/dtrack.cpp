@@ -97,13 +97,22 @@ Result<void> parse_pose(Cursor& c, const std::string& which, DTrackBody& body, b
   return {};
 }
 
+// How many `what` a line lists: at most kMaxDTrackBodies.
+Result<std::uint32_t> listed(Cursor& c, const std::string& what) {
+  std::uint32_t count = 0;
+  if (!c.number(count)) return Error{"expected the number of " + what};
+  if (count > kMaxDTrackBodies) {
+    return Error{std::to_string(count) + " " + what + " (at most " + std::to_string(kMaxDTrackBodies) + ")"};
+  }
+  return count;
+}
+
 Result<std::vector<DTrackFlystick>> parse_6df2(Cursor& c) {
   std::uint32_t defined = 0;
-  std::uint32_t count = 0;
-  if (!c.number(defined) || !c.number(count)) return Error{"expected the numbers of flysticks defined and listed"};
-  if (count > kMaxDTrackBodies) {
-    return Error{std::to_string(count) + " flysticks (at most " + std::to_string(kMaxDTrackBodies) + ")"};
-  }
+  if (!c.number(defined)) return Error{"expected the number of flysticks defined"};
+  auto listed_count = listed(c, "flysticks");
+  if (!listed_count) return Error{listed_count.error()};
+  const std::uint32_t count = listed_count.value();
   std::vector<DTrackFlystick> sticks;
   sticks.reserve(count);
   for (std::uint32_t s = 0; s < count; ++s) {
@@ -144,11 +153,9 @@ Result<std::vector<DTrackFlystick>> parse_6df2(Cursor& c) {
 }
 
 Result<std::vector<DTrackBody>> parse_6d(Cursor& c) {
-  std::uint32_t count = 0;
-  if (!c.number(count)) return Error{"expected the number of bodies"};
-  if (count > kMaxDTrackBodies) {
-    return Error{std::to_string(count) + " bodies (at most " + std::to_string(kMaxDTrackBodies) + ")"};
-  }
+  auto listed_count = listed(c, "bodies");
+  if (!listed_count) return Error{listed_count.error()};
+  const std::uint32_t count = listed_count.value();
   std::vector<DTrackBody> bodies;
   bodies.reserve(count);
   for (std::uint32_t b = 0; b < count; ++b) {

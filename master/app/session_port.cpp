@@ -64,15 +64,13 @@ void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& p
 }
 
 void SessionPort::publish(const session::Event& event) {
-  SessionActions sends = sessions_.publish(event);
   const clock::Nanos now = clock::monotonic_now();
-  for (SessionAction& action : sends) {
-    auto* send = std::get_if<session_action::Send>(&action);
-    const auto found = send != nullptr ? connections_.find(send->session) : connections_.end();
-    if (found == connections_.end()) continue;
-    const std::shared_ptr<net::Connection> connection = found->second;
-    connection->send(send->message);
-    carry_out(sessions_.queued(send->session, connection->queued_bytes(), now));
+  for (SessionAction& action : sessions_.publish(event)) {
+    const SessionId to = std::get<session_action::Send>(action).session;
+    carry_out({std::move(action)});
+    if (const auto found = connections_.find(to); found != connections_.end()) {
+      carry_out(sessions_.queued(to, found->second->queued_bytes(), now));
+    }
   }
 }
 

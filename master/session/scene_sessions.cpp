@@ -88,31 +88,31 @@ SessionActions SceneSessions::closed(SessionId id, const std::string& reason) {
 }
 
 SessionActions SceneSessions::publish(const session::Event& event) const {
+  // Which subscription takes this kind of event (none: a kind not set).
+  bool (session::Subscribe::*wants)() const = nullptr;
+  switch (event.event_case()) {
+    case session::Event::kFrameBegun:
+      wants = &session::Subscribe::frames;
+      break;
+    case session::Event::kHead:
+      wants = &session::Subscribe::head;
+      break;
+    case session::Event::kRun:
+      wants = &session::Subscribe::run;
+      break;
+    case session::Event::kNode:
+      wants = &session::Subscribe::nodes;
+      break;
+    case session::Event::EVENT_NOT_SET:
+      break;
+  }
   SessionActions out;
+  if (wants == nullptr) return out;
+  wire::Envelope envelope;
+  *envelope.mutable_session_event() = event;
   for (const auto& [id, session] : sessions_) {
-    if (session.application.empty() || session.refused) continue;
-    const session::Subscribe& wants = session.subscribed;
-    bool wanted = false;
-    switch (event.event_case()) {
-      case session::Event::kFrameBegun:
-        wanted = wants.frames();
-        break;
-      case session::Event::kHead:
-        wanted = wants.head();
-        break;
-      case session::Event::kRun:
-        wanted = wants.run();
-        break;
-      case session::Event::kNode:
-        wanted = wants.nodes();
-        break;
-      case session::Event::EVENT_NOT_SET:
-        break;
-    }
-    if (!wanted) continue;
-    wire::Envelope envelope;
-    *envelope.mutable_session_event() = event;
-    out.push_back(Send{id, std::move(envelope)});
+    if (session.application.empty() || session.refused || !(session.subscribed.*wants)()) continue;
+    out.push_back(Send{id, envelope});
   }
   return out;
 }
