@@ -5,6 +5,7 @@
 
 #include <glm/geometric.hpp>
 
+#include "scene/instance_tree.h"
 #include "scene/raycast.h"
 #include "scene/scripted_path.h"
 
@@ -37,8 +38,14 @@ protocol::Focus FocusSchedule::at(double seconds, const scene::SceneDefinition& 
     // What the viewer looks at; nothing there: the far end of the depth of field.
     const glm::dvec3 target = screen_.point(gaze);
     const glm::dvec3 towards_viewer = glm::cross(screen_.right, screen_.up);
-    if (const auto hit = scene::cast_ray(scene, state, 0.0, {eye, target - eye})) {
-      depth = glm::dot(eye - hit->point, towards_viewer);
+    // The ray goes through the world, where the navigation has carried the
+    // installation; the hit comes back to measure its depth in the room.
+    const glm::dmat4 to_world = scene::installation_to_world(state, 0.0);
+    const glm::dvec3 from = glm::dvec3(to_world * glm::dvec4(eye, 1.0));
+    const glm::dvec3 along = glm::dvec3(to_world * glm::dvec4(target - eye, 0.0));
+    if (const auto hit = scene::cast_ray(scene, state, 0.0, {from, along})) {
+      const glm::dvec3 in_room = glm::dvec3(glm::inverse(to_world) * glm::dvec4(hit->point, 1.0));
+      depth = glm::dot(eye - in_room, towards_viewer);
     }
   }
   if (!std::isfinite(depth)) depth = settings_.far;

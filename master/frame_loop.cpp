@@ -11,6 +11,7 @@
 #include "master/protocol.h"
 #include "protocol/focus.h"
 #include "protocol/welcome.h"
+#include "scene/instance_tree.h"
 
 namespace optique::master {
 
@@ -95,6 +96,7 @@ void MasterProtocol::notify_frame(std::uint64_t frame, clock::Nanos display, con
     shown.add_right(right[i]);
   }
   shown.set_tracked(tracked);
+  to_transform(state.navigation.now, *shown.mutable_navigation());
   out.push_back(AppEvent{std::move(head)});
 }
 
@@ -112,7 +114,7 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
       }
     }
     // Every edit made until now is in this frame; the next frame's budget of edits starts.
-    state.instances = frame_instances(*settings_.live);
+    put_live(*settings_.live, state);
     settings_.live->begin_frame();
   }
   bool tracked = false;
@@ -123,7 +125,12 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
     tracked = shown.tracker == tracking::TrackerState::tracking;
     out.push_back(shown);
   }
-  if (settings_.live != nullptr) notify_frame(frame, display, state, tracked, out);
+  std::vector<session::Event> flysticks;
+  navigation_->step(frame, state, settings_.live != nullptr ? settings_.live->navigation().sets : 0, flysticks);
+  if (settings_.live != nullptr) {
+    notify_frame(frame, display, state, tracked, out);
+    for (session::Event& event : flysticks) out.push_back(AppEvent{std::move(event)});
+  }
   wire::Envelope envelope;
   auto& begin = *envelope.mutable_frame_begin();
   begin.set_frame_id(frame);
@@ -380,7 +387,9 @@ void MasterProtocol::present_owed(std::size_t slot, clock::Nanos now, Actions& o
 void MasterProtocol::rebalance_lights(bool force) {
   std::vector<bool> live(slots_.size(), false);
   for (std::size_t i = 0; i < slots_.size(); ++i) live[i] = up(slots_[i]);
-  light_plan_.rebalance(live, current_state_, current_state_.eye_now, force);
+  // The lights' costs are judged from where the eyes are in the world.
+  const glm::dvec3 eye(scene::installation_to_world(current_state_, 0.0) * glm::dvec4(current_state_.eye_now, 1.0));
+  light_plan_.rebalance(live, current_state_, eye, force);
 }
 
 void MasterProtocol::log_light_switches(std::uint64_t frame, const wire::StateDelta& delta, Actions& out) const {

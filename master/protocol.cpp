@@ -33,6 +33,7 @@ MasterProtocol::MasterProtocol(const config::Installation& installation, const s
     head_.emplace(*installation.viewer.tracking, installation.viewer.head_right, frame_period_,
                   std::move(settings_.replay));
   }
+  navigation_.emplace(installation.viewer.navigation, installation.viewer.tracking, frame_period_);
   current_state_ = authority_.state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
   // Until nodes come, plan as if all were up: each node's welcome then carries a

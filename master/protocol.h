@@ -31,6 +31,7 @@
 #include "master/barrier.h"
 #include "master/focus_schedule.h"
 #include "master/live_status.h"
+#include "master/navigation.h"
 #include "master/operator_command.h"
 #include "master/render_pace.h"
 #include "master/run/exit_codes.h"
@@ -207,7 +208,8 @@ class MasterProtocol {
   SceneServer scene_server_;
   LightPlan light_plan_;
   std::optional<FocusSchedule> focus_;
-  std::optional<ViewerHead> head_;  // viewer.tracking
+  std::optional<ViewerHead> head_;              // viewer.tracking
+  std::optional<ViewerNavigation> navigation_;  // always made: flysticks, what applications set
   scene::SceneState current_state_;
   std::uint64_t current_hash_ = 0;
   Barrier barrier_;

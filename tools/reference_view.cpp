@@ -40,7 +40,7 @@ Result<image::FloatImage> ReferenceView::draw(const scene::SceneState& state, do
   const glm::dvec3 eye = viewer.eye_in(state, fraction, eye_);
   auto frustum = geometry::off_axis_frustum(screen_->world(), eye, viewer.near, viewer.far);
   if (!frustum) return Error{frustum.error()};
-  renderer_->draw(state, {fraction, eye, frustum.value()});
+  renderer_->draw(state, render::seen_in_world(state, fraction, eye, frustum.value()));
   if (!reduce_) return renderer_->read_rendered();
   return reduce_->read(renderer_->rendered_framebuffer());
 }

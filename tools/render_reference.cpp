@@ -26,10 +26,11 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
                                          master::LightSwitches::from_config(installation.scene));
   scene::SceneState state = authority.state_at_frame(frame);
   if (options.replay != nullptr) {
-    auto instances = master::replayed_instances(*options.replay, scene.definition.asset_id,
-                                                master::live_scene_limits(installation.master.api), frame);
-    if (!instances) return Error{"the replayed journal: " + instances.error()};
-    state.instances = std::move(instances).value();
+    if (auto replayed = master::replay_into(*options.replay, scene.definition,
+                                            master::live_scene_limits(installation.master.api), frame, state);
+        !replayed) {
+      return Error{"the replayed journal: " + replayed.error()};
+    }
   }
 
   auto context = render::make_headless_context();

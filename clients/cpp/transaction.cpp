@@ -29,6 +29,18 @@ Transaction& Transaction::move(const std::string& instance, const Placement& pla
   return *this;
 }
 
+Transaction& Transaction::navigate(const Placement& placement) {
+  place(*message_.add_edits()->mutable_navigation()->mutable_transform(), placement);
+  return *this;
+}
+
+Transaction& Transaction::switch_light(std::uint32_t light, bool on) {
+  auto& l = *message_.add_edits()->mutable_light();
+  l.set_light(light);
+  l.set_on(on);
+  return *this;
+}
+
 Transaction& Transaction::reparent(const std::string& instance, const std::string& parent) {
   auto& p = *message_.add_edits()->mutable_parent();
   p.set_instance(instance);

@@ -3,6 +3,7 @@
 // applies whole in one frame, or not at all (proto/optique/session.proto).
 
 #include <array>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -31,6 +32,11 @@ class Transaction {
   Transaction& glow(const std::string& instance, const std::array<double, 3>& emissive);
   // The instance and everything under it.
   Transaction& remove(const std::string& instance);
+  // Where the installation is in the world (world ← installation): the viewer
+  // travels. A uniform scale only ([s, s, s]).
+  Transaction& navigate(const Placement& placement);
+  // One of the scene's point lights, by its index, on or off.
+  Transaction& switch_light(std::uint32_t light, bool on);
 
   [[nodiscard]] const session::Transaction& message() const { return message_; }
   [[nodiscard]] bool empty() const { return message_.edits_size() == 0; }

@@ -25,6 +25,10 @@ inline constexpr double kEyeSeparation = 0.065;
 inline constexpr double kNear = 0.05;
 inline constexpr double kFar = 100.0;
 inline constexpr double kPixelsPerMetre = 200.0;
+inline constexpr double kNavigationSpeed = 1.5;       // m/s: a brisk walk
+inline constexpr double kNavigationTurnSpeed = 45.0;  // degrees/s
+inline constexpr std::uint32_t kNavigationResetButton = 1;
+inline constexpr double kNavigationDeadZone = 0.1;
 inline constexpr double kBlurRadius = 8.0;  // a defocus projector's, screen pixels
 
 }  // namespace optique::config::defaults

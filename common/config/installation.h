@@ -18,6 +18,7 @@
 
 #include "config/color_fields.h"
 #include "config/defaults.h"
+#include "config/navigation.h"
 #include "config/response.h"
 #include "config/tracking.h"
 #include "config/up_conversion.h"
@@ -139,6 +140,8 @@ struct Viewer {
   // A tracked head: the master predicts it at each frame's display time, and
   // eye/path are where it rests while the tracker is lost.
   std::optional<Tracking> tracking;
+  // Built-in navigation (none unless viewer.navigation says flystick).
+  std::optional<Navigation> navigation;
 
   [[nodiscard]] glm::dvec3 eye_at(double seconds) const;
   [[nodiscard]] bool moves() const { return path.size() > 1; }

@@ -20,8 +20,10 @@ ProjectorJob job_for(const Installation& installation, std::size_t projector) {
     part.projectors.back().screen = 0;
   }
   part.viewer = installation.viewer;
-  // A tracked head reaches the node in the scene state; the tracker is the master's.
+  // A tracked head and the navigation reach the node in the scene state; the
+  // tracker and the flystick are the master's.
   part.viewer.tracking.reset();
+  part.viewer.navigation.reset();
   part.scene = installation.scene;
   if (installation.depth_of_field) {
     DepthOfField range;

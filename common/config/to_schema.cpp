@@ -116,6 +116,18 @@ schema::Viewer to_schema(const Viewer& viewer) {
   out.set_far(viewer.far);
   put(*out.mutable_head_right(), viewer.head_right);
   if (viewer.tracking) *out.mutable_tracking() = to_schema(*viewer.tracking);
+  if (viewer.navigation) {
+    const Navigation& n = *viewer.navigation;
+    auto& to = *out.mutable_navigation();
+    to.set_mode(std::string(to_string(n.mode)));
+    to.set_flystick(n.flystick);
+    to.set_speed(n.speed);
+    to.set_turn_speed(n.turn_speed);
+    to.set_reset_button(n.reset_button);
+    to.set_dead_zone(n.dead_zone);
+    put(*to.mutable_up(), n.up);
+    put(*to.mutable_pointer(), n.pointer);
+  }
   return out;
 }
 

@@ -5,6 +5,7 @@
 #include <glm/geometric.hpp>
 
 #include "config/asset_path.h"
+#include "config/navigation.h"
 #include "config/sections.h"
 #include "config/tracking.h"
 #include "util/number_text.h"
@@ -54,6 +55,16 @@ Viewer parse_viewer(const schema::Viewer& v, const std::string& config_dir, Chec
   if (v.has_tracking()) {
     viewer.tracking = parse_tracking(v.tracking(), "viewer.tracking", check.problems());
     if (!viewer.tracking->file.empty()) viewer.tracking->file = resolve_asset(viewer.tracking->file, config_dir);
+  }
+  if (v.has_navigation()) {
+    const Navigation navigation = parse_navigation(v.navigation(), "viewer.navigation", check.problems());
+    if (navigation.mode == NavigationMode::flystick) {
+      if (!viewer.tracking || viewer.tracking->source != TrackingSource::dtrack) {
+        check.fail("viewer.navigation.mode",
+                   "flystick needs viewer.tracking with source dtrack: the flystick's lines come from DTrack");
+      }
+      viewer.navigation = navigation;
+    }
   }
   return viewer;
 }

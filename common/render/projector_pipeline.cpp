@@ -97,16 +97,13 @@ glm::dvec3 ProjectorPipeline::eye(const scene::SceneState& state, double fractio
 }
 
 Result<Viewpoint> ProjectorPipeline::moment(const scene::SceneState& state, double fraction) const {
-  Viewpoint pass;
-  pass.fraction = fraction;
   // A still viewer is exactly where it stands at every moment: mix() would
   // round it differently per fraction, and the fields would no longer share one
   // view (what lets still objects be drawn once).
-  pass.eye = eye(state, fraction);
-  auto frustum = view_.frustum(pass.eye, viewer_.near, viewer_.far);
+  const glm::dvec3 at = eye(state, fraction);
+  auto frustum = view_.frustum(at, viewer_.near, viewer_.far);
   if (!frustum) return Error{frustum.error()};
-  pass.frustum = frustum.value();
-  return pass;
+  return seen_in_world(state, fraction, at, frustum.value());
 }
 
 Result<void> ProjectorPipeline::draw(const scene::SceneState& state, double fraction) {

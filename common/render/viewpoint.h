@@ -6,6 +6,7 @@
 #include <glm/vec3.hpp>
 
 #include "geometry/projection.h"
+#include "scene/state.h"
 
 namespace optique::render {
 
@@ -23,6 +24,14 @@ struct Viewpoint {
     return eye == other.eye && frustum.view == other.frustum.view && frustum.projection == other.frustum.projection;
   }
 };
+
+// What an eye at `eye` sees through `frustum` (both in the installation's
+// space) `fraction` of a frame after the frame time, in the world: carried
+// there by the state's navigation (scene/instance_tree.h), so that the scene,
+// its lights and its instances are drawn as the travelling viewer sees them.
+// Every pass's viewpoint is made here.
+[[nodiscard]] Viewpoint seen_in_world(const scene::SceneState& state, double fraction, const glm::dvec3& eye,
+                                      const geometry::Frustum& frustum);
 
 // Which light terms a renderer draws (a node of a stacked group may carry only
 // some of them); the point lights are chosen with SceneRenderer::set_lights.

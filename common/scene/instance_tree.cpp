@@ -18,4 +18,9 @@ std::optional<glm::dmat4> instance_world(const SceneState& state, const std::str
   return std::nullopt;
 }
 
+glm::dmat4 installation_to_world(const SceneState& state, double fraction) {
+  const ObjectState& n = state.navigation;
+  return model_matrix(n.now == n.next ? n.now : interpolate(n, fraction));
+}
+
 }  // namespace optique::scene

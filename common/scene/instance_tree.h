@@ -3,7 +3,8 @@
 // relative to its parent's, so its place in the world is the chain of poses
 // from the world down to it, each at the same moment. An instance is drawn
 // only when it and every instance above it are visible: hiding a group hides
-// what it holds.
+// what it holds. The installation itself has a place in the world too: the
+// navigation.
 
 #include <optional>
 #include <string>
@@ -20,5 +21,10 @@ namespace optique::scene {
 // passed apply_delta has no cycle and no missing parent; a chain that has one
 // anyway is not drawn (nullopt), never followed for ever.
 [[nodiscard]] std::optional<glm::dmat4> instance_world(const SceneState& state, const std::string& id, double fraction);
+
+// The navigation `fraction` of a frame after the frame time: world ←
+// installation. Exactly the same matrix at every fraction when it does not
+// change within the frame (a still viewer's fields share one view).
+[[nodiscard]] glm::dmat4 installation_to_world(const SceneState& state, double fraction);
 
 }  // namespace optique::scene

@@ -130,6 +130,7 @@ void to_wire(const std::string& id, const InstanceState& i, wire::InstanceState&
 }
 
 const glm::dquat kNoTurn{1.0, 0.0, 0.0, 0.0};
+const ObjectState kUnmoved{};
 
 void to_wire(const SceneState& s, wire::ViewerState& out) {
   to_wire(s.eye_now, *out.mutable_eye_now());
@@ -138,6 +139,11 @@ void to_wire(const SceneState& s, wire::ViewerState& out) {
   if (!identical(s.head_now, kNoTurn) || !identical(s.head_next, kNoTurn)) {
     to_wire(s.head_now, *out.mutable_head_now());
     to_wire(s.head_next, *out.mutable_head_next());
+  }
+  // The same for the navigation: a viewer who does not travel writes none.
+  if (!identical(s.navigation, kUnmoved)) {
+    to_wire(s.navigation.now, *out.mutable_navigation_now());
+    to_wire(s.navigation.next, *out.mutable_navigation_next());
   }
 }
 
@@ -249,7 +255,20 @@ struct ViewerPair {
   glm::dvec3 eye_next;
   glm::dquat head_now{kNoTurn};
   glm::dquat head_next{kNoTurn};
+  ObjectState navigation;
 };
+
+// A navigation pose: finite, turned by a unit quaternion, scaled alike on
+// every axis within the bounds.
+Result<Pose> navigation_from_wire(const wire::Pose& p, const std::string& what) {
+  auto pose = from_wire(p, what);
+  if (!pose) return pose;
+  const glm::dvec3& s = pose.value().scale;
+  if (s.x != s.y || s.x != s.z || !(s.x >= kLeastNavigationScale && s.x <= kMostNavigationScale)) {
+    return Error{what + " scale must be the same on every axis and in [1e-4, 1e4]"};
+  }
+  return pose;
+}
 
 Result<ViewerPair> viewer_from_wire(const wire::ViewerState& v) {
   ViewerPair out;
@@ -268,6 +287,16 @@ Result<ViewerPair> viewer_from_wire(const wire::ViewerState& v) {
     if (!head_next) return Error{head_next.error()};
     out.head_next = head_next.value();
   }
+  if (v.has_navigation_now() != v.has_navigation_next()) {
+    return Error{"viewer navigation: give it now and next, or neither"};
+  }
+  if (v.has_navigation_now()) {
+    auto now_pose = navigation_from_wire(v.navigation_now(), "viewer navigation (now)");
+    if (!now_pose) return Error{now_pose.error()};
+    auto next_pose = navigation_from_wire(v.navigation_next(), "viewer navigation (next)");
+    if (!next_pose) return Error{next_pose.error()};
+    out.navigation = {now_pose.value(), next_pose.value()};
+  }
   return out;
 }
 
@@ -276,6 +305,7 @@ void set_viewer(SceneState& state, const ViewerPair& viewer) {
   state.eye_next = viewer.eye_next;
   state.head_now = viewer.head_now;
   state.head_next = viewer.head_next;
+  state.navigation = viewer.navigation;
 }
 
 }  // namespace
@@ -307,6 +337,8 @@ std::uint64_t state_hash(const SceneState& state) {
   h.add(state.eye_next);
   h.add(state.head_now);
   h.add(state.head_next);
+  h.add(state.navigation.now);
+  h.add(state.navigation.next);
   h.add(static_cast<std::uint64_t>(state.lights_off.size()));
   for (std::uint32_t light : state.lights_off) h.add(static_cast<std::uint64_t>(light));
   h.add(static_cast<std::uint64_t>(state.instances.size()));
@@ -370,7 +402,8 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
     if (!after.objects.contains(id)) delta.add_removed(id);
   }
   if (!identical(before.eye_now, after.eye_now) || !identical(before.eye_next, after.eye_next) ||
-      !identical(before.head_now, after.head_now) || !identical(before.head_next, after.head_next)) {
+      !identical(before.head_now, after.head_now) || !identical(before.head_next, after.head_next) ||
+      !identical(before.navigation, after.navigation)) {
     to_wire(after, *delta.mutable_viewer());
   }
   for (std::uint32_t light : after.lights_off) {
@@ -404,7 +437,7 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
     if (!state.objects.contains(id))
       return Error{"delta removes object " + std::to_string(id) + ", which does not exist"};
   }
-  ViewerPair viewer{state.eye_now, state.eye_next, state.head_now, state.head_next};
+  ViewerPair viewer{state.eye_now, state.eye_next, state.head_now, state.head_next, state.navigation};
   if (delta.has_viewer()) {
     auto moved = viewer_from_wire(delta.viewer());
     if (!moved) return Error{"delta: " + moved.error()};

@@ -1,7 +1,8 @@
 #pragma once
 // The scene state every node must agree on: dynamic objects, each with its pose at
-// the frame time and at the next frame time, the viewer's eyes and head at both times, and
-// which of the scene's point lights are switched off.
+// the frame time and at the next frame time, the viewer's eyes and head at both times, where
+// the installation is in the world (the navigation), and which of the scene's point lights
+// are switched off.
 // A snapshot on join, then per frame only what changed; a hash both sides compare.
 
 #include <cstdint>
@@ -64,6 +65,11 @@ struct SceneState {
   // viewer's head_right, the axis from the left eye to the right.
   glm::dquat head_now{1.0, 0.0, 0.0, 0.0};
   glm::dquat head_next{1.0, 0.0, 0.0, 0.0};
+  // The navigation: world ← installation (the room's screens, eyes and tracker
+  // are in the installation's space; the scene is in the world's). Identity
+  // but for a viewer who travels (viewer.navigation, or an application's
+  // SetNavigation); a rigid move and a uniform scale.
+  ObjectState navigation;
   // Indices into the scene's lights. A light that goes dark costs nothing: no node
   // draws it, and the automatic light split shares out only the others.
   std::set<std::uint32_t> lights_off;
@@ -77,6 +83,10 @@ struct SceneState {
 // frame time (linear, and spherical between the turns).
 [[nodiscard]] glm::dvec3 eyes_at(const SceneState& state, double fraction);
 [[nodiscard]] glm::dquat head_at(const SceneState& state, double fraction);
+
+// The navigation's scale: uniform, and within these bounds (the wire's check).
+inline constexpr double kLeastNavigationScale = 1e-4;
+inline constexpr double kMostNavigationScale = 1e4;
 
 // FNV-1a over a canonical encoding (ids in order, the bits of every double), so
 // equal states hash equally on every machine.

@@ -8,6 +8,11 @@
 
 namespace optique::tracking {
 
+void TrackerInput::newest(FlystickSample sample) {
+  std::erase_if(flysticks, [&](const FlystickSample& had) { return had.id == sample.id; });
+  flysticks.push_back(std::move(sample));
+}
+
 DTrackReader::DTrackReader(const config::Tracking& settings, Nanos period)
     : body_(settings.body), from_(settings.from), period_(std::max<Nanos>(period, 1)) {}
 
@@ -84,6 +89,11 @@ void DTrackReader::read(std::string_view bytes, Nanos arrival, std::string_view 
     return;
   }
   const DTrackFrame& f = frame.value();
+  // The flysticks first: a frame without the head still carries the wand.
+  for (const DTrackFlystick& stick : f.flysticks) {
+    into.newest({arrival, stick.body.id, stick.body.quality >= 0.0, stick.body.position, stick.body.rotation,
+                 stick.buttons, stick.controllers});
+  }
   const auto body = std::find_if(f.bodies.begin(), f.bodies.end(), [&](const DTrackBody& b) { return b.id == body_; });
   if (body == f.bodies.end()) {
     ++counts.without_body;

@@ -1,6 +1,6 @@
 #pragma once
 // The receiving side of DTrack's output, without IO: which datagrams are read at
-// all, parsed, and reduced to the configured body's sample, before the head
+// all, parsed, and reduced to the configured body's sample and the flysticks', before the head
 // tracker (tracking/head_tracker.h) decides what a sample means. The master runs
 // it on its own receive thread, so that the frame loop never parses; tests feed
 // it bytes and times.
@@ -54,14 +54,34 @@ struct DTrackSample {
   glm::dmat3 rotation{1.0};            // body → tracker space
 };
 
+// A flystick in one datagram (DTrack's 6df2), as the tracker sent it: its
+// pose (none when the cameras do not see it), its buttons and joystick.
+struct FlystickSample {
+  Nanos arrival = 0;  // master clock
+  std::uint32_t id = 0;
+  bool seen = false;
+  glm::dvec3 position{0.0};  // millimetres, tracker space
+  glm::dmat3 rotation{1.0};  // flystick → tracker space
+  std::vector<bool> buttons;
+  std::vector<double> controllers;  // −1…1: the joystick's x is [0], y [1]
+
+  friend bool operator==(const FlystickSample&, const FlystickSample&) = default;
+};
+
 // What the receiving side hands the tracker: the samples in the order they
-// arrived, what it dropped (counted), and what is worth a log line.
+// arrived, the newest of each flystick, what it dropped (counted), and what is
+// worth a log line.
 struct TrackerInput {
   std::vector<DTrackSample> samples;
+  std::vector<FlystickSample> flysticks;  // by arrival of their newest; one per id
   TrackingCounts counted;
   std::vector<std::string> said;
 
-  [[nodiscard]] bool empty() const { return samples.empty() && said.empty() && counted == TrackingCounts{}; }
+  // Keeps `sample` as its flystick's newest (the one before it goes).
+  void newest(FlystickSample sample);
+  [[nodiscard]] bool empty() const {
+    return samples.empty() && flysticks.empty() && said.empty() && counted == TrackingCounts{};
+  }
 };
 
 class DTrackReader {
@@ -90,9 +110,9 @@ class DTrackReader {
   Nanos period_;
   std::map<std::string, Sender, std::less<>> senders_;
   std::uint64_t current_period_ = 0;
-  std::size_t spent_ = 0;                 // bytes read in the current period, every sender
-  std::size_t senders_now_ = 0;           // heard in the current period
-  std::size_t senders_before_ = 0;        // heard in the one before
+  std::size_t spent_ = 0;           // bytes read in the current period, every sender
+  std::size_t senders_now_ = 0;     // heard in the current period
+  std::size_t senders_before_ = 0;  // heard in the one before
   bool said_malformed_ = false;
   bool said_without_body_ = false;
   bool said_flood_ = false;

@@ -106,10 +106,14 @@ void HeadTracker::sample(Nanos time, const glm::dvec3& position, const glm::dqua
   take(time, time, position, orientation);
 }
 
+InstallationPose to_installation(const config::Tracking& settings, const glm::dvec3& position,
+                                 const glm::dquat& orientation) {
+  const glm::dmat3& axes = settings.tracker_axes;
+  return {axes * position + settings.tracker_origin, glm::normalize(glm::quat_cast(axes) * orientation)};
+}
+
 void HeadTracker::take(Nanos time, Nanos arrival, const glm::dvec3& position, const glm::dquat& orientation) {
-  const glm::dmat3& axes = settings_.tracker_axes;
-  const glm::dvec3 body = axes * position + settings_.tracker_origin;
-  const glm::dquat turn = glm::normalize(glm::quat_cast(axes) * orientation);
+  const auto [body, turn] = to_installation(settings_, position, orientation);
   HeadPose pose;
   pose.position = body + turn * settings_.eye_offset;
   pose.orientation = turn;

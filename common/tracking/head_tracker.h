@@ -83,8 +83,8 @@ class HeadTracker {
   config::Tracking settings_;
   glm::dquat rest_turn_;
   HeadPredictor predictor_;
-  HeadPose held_;       // where the eyes were shown as the tracker went quiet
-  double eased_ = 0.0;  // how far from held_ to the rest, as of the last notice (smoothstep)
+  HeadPose held_;        // where the eyes were shown as the tracker went quiet
+  double eased_ = 0.0;   // how far from held_ to the rest, as of the last notice (smoothstep)
   DTrackReader reader_;  // for datagram() only
   FrameSequence sequence_;
   TrackingCounts counts_;
@@ -98,6 +98,16 @@ class HeadTracker {
   bool said_backwards_ = false;
   bool said_flood_ = false;
 };
+
+// A tracked pose (tracker space: metres, and the body's turn) carried into the
+// installation by the tracker's placement (viewer.tracking.tracker_axes and
+// tracker_origin): the body's position and its turn there.
+struct InstallationPose {
+  glm::dvec3 position{0.0};
+  glm::dquat turn{1.0, 0.0, 0.0, 0.0};
+};
+[[nodiscard]] InstallationPose to_installation(const config::Tracking& settings, const glm::dvec3& position,
+                                               const glm::dquat& orientation);
 
 // The turn that carries `head_right` (a unit vector in the tracked body's
 // frame) onto the world's x: the rest turn of a tracked head whose eyes, at

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cmath>
 
 #include <glm/geometric.hpp>
 
@@ -28,6 +29,15 @@ bool same_side(const scene::SceneState& key, const scene::SceneState& state, std
   }
   if (glm::distance(key.eye_now, state.eye_now) > kCutEyeJump) {
     if (why) *why = "viewer jumped";
+    return false;
+  }
+  // A navigation that jumps (a reset, an application that sets it) is a cut
+  // too; one that glides is a moving viewpoint, which the motion fields follow.
+  const scene::Pose& a = key.navigation.now;
+  const scene::Pose& b = state.navigation.now;
+  if (glm::distance(a.position, b.position) > kCutEyeJump || a.scale != b.scale ||
+      std::abs(glm::dot(a.rotation, b.rotation)) < kCutTurnCosine) {
+    if (why) *why = "navigation jumped";
     return false;
   }
   return true;

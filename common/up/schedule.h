@@ -9,7 +9,8 @@
 // the state the master sent ahead, as soon as the last one is shown, and the
 // frames between come from both. Either way a key frame is drawn at once,
 // whatever the ratio, where a kept one would mix two sides of a cut: a light
-// switched on or off, or the viewer's eye moved farther than kCutEyeJump.
+// switched on or off, the viewer's eye moved farther than kCutEyeJump, or the
+// navigation moved as far, turned more than 10° or scaled.
 //
 // spread: each key frame is drawn a band of rows a frame over the frames before
 // it is needed, so that no frame pays for a whole key frame. extrapolate: the
@@ -44,6 +45,9 @@ namespace optique::up {
 // Farther than this (metres) between a key frame's eye and a frame's, the key
 // frame shows another view: a cut, not motion.
 inline constexpr double kCutEyeJump = 0.5;
+// A navigation turned by more than 10° (the quaternions' dot product: the
+// cosine of half the angle).
+inline constexpr double kCutTurnCosine = 0.99619469809174555;  // cos(5°)
 // dB above the floor before the key frames come further apart again.
 inline constexpr double kRaiseMargin = 3.0;
 

@@ -50,6 +50,7 @@ int run_cli(int argc, char** argv) {
   bool no_status = false;
   int status_port = -1;
   int api_port = -1;
+  int tracking_port = -1;
   bool print_status_token = false;
   app.add_option("-c,--config", config_path, "installation file (configs/*.json)");
   app.add_flag("--local", options.local, "start one optique-node per projector on this machine (127.0.0.1)");
@@ -77,6 +78,9 @@ int run_cli(int argc, char** argv) {
                  "take applications' scene sessions on this port (0: ephemeral); overrides master.api.port, and "
                  "turns it on (on 127.0.0.1) if the config does not")
       ->check(CLI::Range(0, 65535));
+  app.add_option("--tracking-port", tracking_port,
+                 "receive DTrack's output on this UDP port; overrides viewer.tracking.port (a dtrack source)")
+      ->check(CLI::Range(1, 65535));
   app.add_option("--api-port-file", options.api_port_file,
                  "write the scene session's port (master.api) once listening (for scripts)");
   app.add_option("--record", options.record_path,
@@ -147,6 +151,15 @@ int run_cli(int argc, char** argv) {
   if (status_port >= 0) {
     if (!settings.status) settings.status.emplace();
     settings.status->port = static_cast<std::uint16_t>(status_port);
+  }
+  if (tracking_port > 0) {
+    auto& tracking = options.config.installation.viewer.tracking;
+    if (!tracking || tracking->source != config::TrackingSource::dtrack) {
+      std::cerr << "optique-master: --tracking-port: " << config_path
+                << " has no viewer.tracking with source dtrack to receive\n";
+      return kExitUsage;
+    }
+    tracking->port = static_cast<std::uint16_t>(tracking_port);
   }
   if (api_port >= 0) {
     if (!settings.api) settings.api.emplace();

@@ -19,10 +19,9 @@ Result<void> Master::make_live_scene(RunSettings& run) {
   }
   if (!settings.api && replay.empty()) return {};
 
-  live_.emplace(live_scene_limits(settings.api));
   // For now the one asset is the installation's own scene, by name.
+  live_.emplace(LiveScene::of(options_.scene.definition, live_scene_limits(settings.api)));
   const std::string& asset = options_.scene.definition.asset_id;
-  live_->add_asset(asset);
   run.live = &*live_;
 
   if (!replay.empty()) {

@@ -55,8 +55,11 @@ bool TrackerReceiver::hand_over(tracking::TrackerInput& batch, clock::Nanos now)
       ++waiting_.counted.flood;
     }
   }
+  for (tracking::FlystickSample& flystick : batch.flysticks) waiting_.newest(std::move(flystick));
   if (announced_ || waiting_.empty()) return false;
-  if (waiting_.samples.empty() && waiting_.said.empty() && now - last_announced_ < kCountsEvery) return false;
+  if (waiting_.samples.empty() && waiting_.flysticks.empty() && waiting_.said.empty() &&
+      now - last_announced_ < kCountsEvery)
+    return false;
   announced_ = true;
   return true;
 }

@@ -152,15 +152,15 @@ std::vector<std::string> JournalReplay::apply_due(LiveScene& live, std::uint64_t
   return problems;
 }
 
-Result<std::map<std::string, scene::InstanceState>> replayed_instances(const Journal& journal, const std::string& asset,
-                                                                       LiveSceneLimits limits, std::uint64_t frame) {
-  LiveScene live(limits);
-  live.add_asset(asset);
+Result<void> replay_into(const Journal& journal, const scene::SceneDefinition& scene, LiveSceneLimits limits,
+                         std::uint64_t frame, scene::SceneState& state) {
+  LiveScene live = LiveScene::of(scene, limits);
   auto replay = JournalReplay::start(journal, live);
   if (!replay) return Error{replay.error()};
   const std::vector<std::string> problems = replay.value().apply_due(live, frame);
   if (!problems.empty()) return Error{problems.front()};
-  return frame_instances(live);
+  put_live(live, state);
+  return {};
 }
 
 }  // namespace optique::master

@@ -86,12 +86,11 @@ class JournalReplay {
   std::size_t next_ = 0;
 };
 
-// The live instances frame `frame` of a journal's last run shows when played
-// again (what the master's frame loop puts in that frame with --replay): for
-// render-reference --replay. `asset`: the installation's scene's id.
-[[nodiscard]] Result<std::map<std::string, scene::InstanceState>> replayed_instances(const Journal& journal,
-                                                                                     const std::string& asset,
-                                                                                     LiveSceneLimits limits,
-                                                                                     std::uint64_t frame);
+// The live scene frame `frame` of a journal's last run shows when played
+// again (what the master's frame loop puts in that frame with --replay), put
+// into `state` (put_live): for render-reference --replay. `scene`: the
+// installation's.
+[[nodiscard]] Result<void> replay_into(const Journal& journal, const scene::SceneDefinition& scene,
+                                       LiveSceneLimits limits, std::uint64_t frame, scene::SceneState& state);
 
 }  // namespace optique::master

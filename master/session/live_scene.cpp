@@ -79,6 +79,12 @@ Check read_transform(const session::Transform& t, scene::Pose& pose) {
 
 }  // namespace
 
+void to_transform(const scene::Pose& pose, session::Transform& t) {
+  for (int i = 0; i < 3; ++i) t.add_position(pose.position[i]);
+  for (double q : {pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z}) t.add_rotation(q);
+  for (int i = 0; i < 3; ++i) t.add_scale(pose.scale[i]);
+}
+
 // One transaction's edits, applied to the scene as they come, with what each
 // instance was before its first change, to put back if a later edit fails.
 class LiveScene::Edits {
@@ -104,16 +110,23 @@ class LiveScene::Edits {
         return named("remove", remove(edit.remove()));
       case session::Edit::kFactors:
         return named("factors", factors(edit.factors()));
+      case session::Edit::kNavigation:
+        return named("navigation", navigation(edit.navigation()));
+      case session::Edit::kLight:
+        return named("light", light(edit.light()));
       case session::Edit::EDIT_NOT_SET:
         break;
     }
     return Wrong{"", "is empty or of a kind this master does not know"};
   }
 
-  // Puts every changed instance back as it was, the last change first.
+  // Puts every changed instance back as it was, the last change first, and
+  // the navigation and the light switches.
   void undo() {
     for (auto it = before_.rbegin(); it != before_.rend(); ++it) scene_.put(it->first, it->second);
     before_.clear();
+    if (navigation_before_) scene_.navigation_ = *navigation_before_;
+    if (lights_before_) scene_.light_switches_ = std::move(*lights_before_);
   }
 
  private:
@@ -234,6 +247,29 @@ class LiveScene::Edits {
     });
   }
 
+  Check navigation(const session::SetNavigation& n) {
+    scene::Pose pose = scene_.navigation_.pose;
+    if (auto wrong = read_transform(n.transform(), pose)) return wrong;
+    if (pose.scale.x != pose.scale.y || pose.scale.x != pose.scale.z) {
+      return Wrong{"transform.scale", "must be the same on every axis: give [s]"};
+    }
+    if (!navigation_before_) navigation_before_ = scene_.navigation_;
+    scene_.navigation_ = {pose, scene_.navigation_.sets + 1};
+    return std::nullopt;
+  }
+
+  Check light(const session::SwitchLight& l) {
+    if (l.light() >= scene_.light_count_) {
+      return Wrong{"light", scene_.light_count_ == 0
+                                ? "the scene has no point lights"
+                                : "the scene's point lights are 0 to " + std::to_string(scene_.light_count_ - 1) +
+                                      " (got " + std::to_string(l.light()) + ")"};
+    }
+    if (!lights_before_) lights_before_ = scene_.light_switches_;
+    scene_.light_switches_[l.light()] = l.on();
+    return std::nullopt;
+  }
+
   // The depth of `id`'s deepest descendant, below `parent`.
   Check subtree_depth_problem(const std::string& id, const std::string& parent) const {
     std::size_t above = 1;  // `id` itself
@@ -254,7 +290,16 @@ class LiveScene::Edits {
   LiveScene& scene_;
   std::set<std::string> touched_;
   std::vector<std::pair<std::string, std::optional<Instance>>> before_;
+  std::optional<NavigationSet> navigation_before_;
+  std::optional<std::map<std::uint32_t, bool>> lights_before_;
 };
+
+LiveScene LiveScene::of(const scene::SceneDefinition& scene, LiveSceneLimits limits) {
+  LiveScene live(limits);
+  live.add_asset(scene.asset_id);
+  live.set_light_count(scene.lights.size());
+  return live;
+}
 
 const std::set<std::string>& LiveScene::children(const std::string& parent) const {
   static const std::set<std::string> kNone;
@@ -305,13 +350,16 @@ session::SceneContents scene_contents(const LiveScene& live, std::uint64_t frame
     view.set_asset(instance.asset);
     view.set_parent(instance.parent);
     view.set_hidden(!instance.visible);
-    session::Transform& t = *view.mutable_transform();
-    const scene::Pose& pose = instance.pose;
-    for (int i = 0; i < 3; ++i) t.add_position(pose.position[i]);
-    for (double q : {pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z}) t.add_rotation(q);
-    for (int i = 0; i < 3; ++i) t.add_scale(pose.scale[i]);
+    to_transform(instance.pose, *view.mutable_transform());
     for (int i = 0; i < 4; ++i) view.add_base_color(instance.base_color[i]);
     for (int i = 0; i < 3; ++i) view.add_emissive(instance.emissive[i]);
+  }
+  to_transform(live.navigation().pose, *contents.mutable_navigation());
+  contents.set_light_count(static_cast<std::uint32_t>(live.light_count()));
+  for (const auto& [light, on] : live.light_switches()) {
+    session::SwitchLight& l = *contents.add_lights();
+    l.set_light(light);
+    l.set_on(on);
   }
   return contents;
 }
@@ -325,18 +373,25 @@ LiveSceneLimits live_scene_limits(const std::optional<config::ApiServer>& api) {
   return limits;
 }
 
-std::map<std::string, scene::InstanceState> frame_instances(const LiveScene& live) {
-  std::map<std::string, scene::InstanceState> states;
+void put_live(const LiveScene& live, scene::SceneState& state) {
+  state.instances.clear();
   for (const auto& [id, instance] : live.instances()) {
-    scene::InstanceState& state = states[id];
-    state.asset = instance.asset;
-    state.parent = instance.parent;
-    state.pose = {instance.pose, instance.pose};
-    state.visible = instance.visible;
-    state.base_color = instance.base_color;
-    state.emissive = instance.emissive;
+    scene::InstanceState& placed = state.instances[id];
+    placed.asset = instance.asset;
+    placed.parent = instance.parent;
+    placed.pose = {instance.pose, instance.pose};
+    placed.visible = instance.visible;
+    placed.base_color = instance.base_color;
+    placed.emissive = instance.emissive;
   }
-  return states;
+  for (const auto& [light, on] : live.light_switches()) {
+    if (on) {
+      state.lights_off.erase(light);
+    } else {
+      state.lights_off.insert(light);
+    }
+  }
+  state.navigation = {live.navigation().pose, live.navigation().pose};
 }
 
 }  // namespace optique::master

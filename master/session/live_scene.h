@@ -22,6 +22,7 @@
 
 #include "config/installation.h"
 #include "optique/session.pb.h"
+#include "scene/definition.h"
 #include "scene/state.h"
 
 namespace optique::master {
@@ -52,9 +53,20 @@ struct Refusal {
   std::string reason;  // "must be in [1e-4, 1e4] (got 0)"
 };
 
+// The navigation as applications set it (SetNavigation), and how many times
+// they have: a set to where it already was still brings a flown viewer back.
+struct NavigationSet {
+  scene::Pose pose;  // world ← installation; a uniform scale
+  std::uint64_t sets = 0;
+  friend bool operator==(const NavigationSet&, const NavigationSet&) = default;
+};
+
 class LiveScene {
  public:
   explicit LiveScene(LiveSceneLimits limits = {}) : limits_(limits) {}
+  // The live scene of an installation whose scene is `scene`: its one asset
+  // the scene itself (by its asset id), its point lights switchable.
+  [[nodiscard]] static LiveScene of(const scene::SceneDefinition& scene, LiveSceneLimits limits);
 
   // An asset the nodes can draw (loaded and shipped by the scene transfer).
   void add_asset(const std::string& id) { assets_.insert(id); }
@@ -66,7 +78,14 @@ class LiveScene {
   // A new frame: the budget of edits starts again.
   void begin_frame() { edits_this_frame_ = 0; }
 
+  // How many point lights the scene has (SwitchLight's bound).
+  void set_light_count(std::size_t count) { light_count_ = count; }
+  [[nodiscard]] std::size_t light_count() const { return light_count_; }
+
   [[nodiscard]] const std::map<std::string, Instance>& instances() const { return instances_; }
+  [[nodiscard]] const NavigationSet& navigation() const { return navigation_; }
+  // The lights applications switched: index → on.
+  [[nodiscard]] const std::map<std::uint32_t, bool>& light_switches() const { return light_switches_; }
   [[nodiscard]] const std::set<std::string>& children(const std::string& parent) const;
 
  private:
@@ -80,15 +99,24 @@ class LiveScene {
   std::map<std::string, Instance> instances_;
   std::map<std::string, std::set<std::string>> children_;  // parent → its children; "" → the world's
   std::size_t edits_this_frame_ = 0;
+  std::size_t light_count_ = 0;
+  NavigationSet navigation_;
+  std::map<std::uint32_t, bool> light_switches_;
 };
+
+// A pose as the session writes it (InstanceView, SceneContents, HeadShown):
+// every field given, the scale as three numbers.
+void to_transform(const scene::Pose& pose, session::Transform& t);
 
 // The live scene as an application reads it (session::ReadScene), as frame
 // `frame` will show it.
 [[nodiscard]] session::SceneContents scene_contents(const LiveScene& live, std::uint64_t frame);
 
-// The instances as a frame shows them (scene/state.h): each at its pose, the
-// same now and at the next frame time, as an edit between them is not known
-// yet.
-[[nodiscard]] std::map<std::string, scene::InstanceState> frame_instances(const LiveScene& live);
+// The live scene into the state a frame shows (scene/state.h): the instances,
+// each at its pose, the same now and at the next frame time, as an edit
+// between them is not known yet; the lights applications switched, over the
+// config's switches; the navigation applications set (the flystick's, if any,
+// comes after: master/navigation.h).
+void put_live(const LiveScene& live, scene::SceneState& state);
 
 }  // namespace optique::master

@@ -103,6 +103,9 @@ SessionActions SceneSessions::publish(const session::Event& event) const {
     case session::Event::kNode:
       wants = &session::Subscribe::nodes;
       break;
+    case session::Event::kFlystick:
+      wants = &session::Subscribe::flysticks;
+      break;
     case session::Event::EVENT_NOT_SET:
       break;
   }

@@ -299,6 +299,8 @@ std::string tracker(std::span<const std::uint8_t> input, Outcome& out) {
   return {};
 }
 
+constexpr std::size_t kFuzzLights = 4;
+
 // The live scene after any transactions: whole, and what the nodes accept.
 std::string check_live(const master::LiveScene& live, const master::LiveSceneLimits& limits,
                        scene::SceneState& previous) {
@@ -318,7 +320,9 @@ std::string check_live(const master::LiveScene& live, const master::LiveSceneLim
   listed += live.children("").size();
   OPTIQUE_FUZZ_REQUIRE(listed == live.instances().size());
   scene::SceneState state;
-  state.instances = master::frame_instances(live);
+  master::put_live(live, state);
+  // A navigation the nodes accept: SetNavigation's checks are the wire's.
+  OPTIQUE_FUZZ_REQUIRE(live.light_switches().empty() || live.light_switches().rbegin()->first < kFuzzLights);
   if (auto broken = check_state(state); !broken.empty()) return broken;
   scene::SceneState node = previous;
   OPTIQUE_FUZZ_REQUIRE(scene::apply_delta(node, scene::make_delta(previous, state)).ok());
@@ -335,6 +339,7 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
   master::LiveScene live(limits);
   live.add_asset("torus");
   live.add_asset("duck");
+  live.set_light_count(kFuzzLights);
   master::SceneSessionSettings settings;
   settings.journal = true;
   master::SceneSessions sessions(live, settings);

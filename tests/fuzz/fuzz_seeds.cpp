@@ -348,6 +348,21 @@ std::vector<Seed> delta_seeds() {
     set(*d.mutable_viewer()->mutable_eye_next(), 0.05, 1.6, 2.0);
     seeds.push_back(delta_seed("move_add_remove_view", {d}));
   }
+  {
+    wire::StateDelta d;
+    set(*d.mutable_viewer()->mutable_eye_now(), 0.0, 1.6, 2.0);
+    set(*d.mutable_viewer()->mutable_eye_next(), 0.0, 1.6, 2.0);
+    for (wire::Pose* pose :
+         {d.mutable_viewer()->mutable_navigation_now(), d.mutable_viewer()->mutable_navigation_next()}) {
+      set(*pose->mutable_position(), 10.0, 0.0, -4.0);
+      set(*pose->mutable_scale(), 2.0, 2.0, 2.0);
+    }
+    wire::StateDelta stretched = d;
+    set(*stretched.mutable_viewer()->mutable_navigation_next()->mutable_scale(), 2.0, 1.0, 2.0);
+    wire::StateDelta half = d;
+    half.mutable_viewer()->clear_navigation_next();
+    seeds.push_back(delta_seed("navigation", {d, stretched, half}));
+  }
   seeds.push_back(delta_seed("lights_off_then_on", {lights({3}, {}), lights({}, {2}), lights({}, {3, 7})}));
   seeds.push_back(delta_seed("light_off_twice", {lights({2}, {})}));
   seeds.push_back(delta_seed("light_on_not_off", {lights({}, {4})}));
@@ -748,6 +763,24 @@ std::vector<Seed> session_seeds() {
                          kNextFrame, request(3, {remove("table")}), request(4, {create("table", "duck")})})});
   seeds.push_back({"read_the_scene", join({request(1, {create("table", "torus"), create("cup", "torus", "table", 0.5)}),
                                            read_scene(2), kNextFrame, request(3, {remove("cup")}), read_scene(4)})});
+  seeds.push_back(
+      {"navigate_and_switch", join({request(1, {[](session::Edit& e) {
+                                                  auto& t = *e.mutable_navigation()->mutable_transform();
+                                                  for (double v : {0.0, 0.0, -10.0}) t.add_position(v);
+                                                  t.add_scale(2.0);
+                                                },
+                                                [](session::Edit& e) {
+                                                  e.mutable_light()->set_light(1);
+                                                  e.mutable_light()->set_on(false);
+                                                }}),
+                                    kNextFrame,
+                                    request(2, {[](session::Edit& e) {
+                                                  for (double v : {1.0, 2.0, 1.0}) {
+                                                    e.mutable_navigation()->mutable_transform()->add_scale(v);
+                                                  }
+                                                },
+                                                [](session::Edit& e) { e.mutable_light()->set_light(99); }}),
+                                    read_scene(3)})});
   seeds.push_back({"subscribe", join({subscribe(1, true), kNextFrame, request(2, {create("a", "torus")}), kNextFrame,
                                       subscribe(3, false), kNextFrame})});
   const double nan = std::numeric_limits<double>::quiet_NaN();

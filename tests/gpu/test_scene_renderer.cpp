@@ -357,5 +357,35 @@ TEST_F(SceneRendererTest, LiveInstancesAreDrawnInEveryColourField) {
   }
 }
 
+// The navigation carries the viewer through the world (render/viewpoint.h):
+// world ← installation turned a quarter about the screen's normal, the
+// world's (-0.5, 0.5) is in front of the room's (0.5, 0.5), while the world's
+// origin stays at the room's. Without one, the view is the room's to the bit.
+TEST_F(SceneRendererTest, TheNavigationCarriesTheViewerThroughTheWorld) {
+  auto renderer = SceneRenderer::create(emissive_square(), kSize, kSize);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  scene::SceneState state;
+  state.instances["copy"] = square_at(-0.5, 0.5);
+  const Viewpoint room{0.0, kEye, view_of_unit_square()};
+  EXPECT_EQ(seen_in_world(state, 0.0, kEye, room.frustum).frustum.view, room.frustum.view);
+  scene::Pose turned;
+  turned.rotation = glm::angleAxis(glm::radians(90.0), glm::dvec3(0.0, 0.0, 1.0));
+  state.navigation = {turned, turned};
+  renderer.value()->draw(state, seen_in_world(state, 0.0, kEye, room.frustum));
+  const auto image = renderer.value()->read_rendered();
+  EXPECT_NEAR(image.at(kFar, kNear, 1), 0.5f, kTolerance) << "the world's (-0.5, 0.5) at the room's (0.5, 0.5)";
+  EXPECT_NEAR(image.at(kNear, kFar, 1), 0.0f, kTolerance);
+  EXPECT_NEAR(image.at(kSize / 2, kSize / 2, 1), 0.5f, kTolerance) << "the world's origin where the room's is";
+  // Carried half a metre along the world's x: what was at the centre moves left.
+  scene::Pose moved;
+  moved.position = {0.5, 0.0, 0.0};
+  state.navigation = {moved, moved};
+  state.instances.clear();
+  renderer.value()->draw(state, seen_in_world(state, 0.0, kEye, room.frustum));
+  const auto shifted = renderer.value()->read_rendered();
+  EXPECT_NEAR(shifted.at(kSize / 2, kSize / 2, 1), 0.0f, kTolerance);
+  EXPECT_NEAR(shifted.at(kSize / 2 - 16, kSize / 2, 1), 0.5f, kTolerance) << "the world's origin at the room's -0.5";
+}
+
 }  // namespace
 }  // namespace optique::render

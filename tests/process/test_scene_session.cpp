@@ -17,6 +17,8 @@
 
 #include "clients/cpp/session.h"
 #include "cluster_run.h"
+#include "dtrack_sender.h"
+#include "head_walk.h"
 #include "master/session/journal.h"
 #include "net/envelope.h"
 #include "net/framing.h"
@@ -30,16 +32,17 @@ using namespace std::chrono_literals;
 
 const std::string kMaster = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
 const std::string kExample = std::string(OPTIQUE_BIN_DIR) + "/optique-example-circle";
+const std::string kFlystickCave = std::string(OPTIQUE_SOURCE_DIR) + "/configs/cave-flystick.json";
 // The power wall; its scene session on an ephemeral port (--api-port 0).
 const std::string kWall = std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-2x2.json";
 
 // A master on that wall with null local nodes: `frames` frames, the rest of
 // its arguments `more`; its output in DIR/NAME, its api port in DIR/NAME.port.
 std::unique_ptr<Process> wall_master(const ScratchDir& dir, const std::string& name, const std::string& frames,
-                                     const std::vector<std::string>& more = {}) {
+                                     const std::vector<std::string>& more = {}, const std::string& config = kWall) {
   std::vector<std::string> argv{kMaster,
                                 "--config",
-                                kWall,
+                                config,
                                 "--local",
                                 "--frames",
                                 frames,
@@ -271,10 +274,83 @@ TEST(SceneSession, TheCppExampleMovesItsInstanceOnTheWall) {
   ASSERT_EQ(example.wait(30s), 0) << example.output() << master->output();
   EXPECT_NE(example.output().find("placed from frame"), std::string::npos) << example.output();
   EXPECT_NE(example.output().find("moved it"), std::string::npos) << example.output();
+  // A second of it: the cubes' first light dark, then back on.
+  EXPECT_NE(example.output().find("switched a light 1 times"), std::string::npos) << example.output();
   ASSERT_EQ(master->wait(60s), 0) << master->output();
   const ClusterRun run = read_cluster_run(dir.file("wall"));
   ASSERT_EQ(run.error, "");
   EXPECT_EQ(run.report.instances(), 2u) << "orbit-cpp and beacon-cpp";
+  for (const auto& node : run.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
+}
+
+// The flystick CAVE (configs/cave-flystick.json) with a synthetic DTrack: the
+// joystick pushed forward flies the viewer along the wand (here the room's -z)
+// at the config's 1.5 m/s, the reset button brings it back; an application
+// hears the flystick's buttons and joystick, and where the head is in the
+// world. Every node keeps the master's state (the navigation in it) throughout.
+TEST(SceneSession, AFlystickFliesTheCaveAndApplicationsHearIt) {
+  ScratchDir dir("optique-flystick");
+  const int udp = free_udp_port();
+  auto master = wall_master(dir, "out", "360", {"--tracking-port", std::to_string(udp)}, kFlystickCave);
+  auto app = connect(api_port(dir, "out", *master), "flystick-test");
+  ASSERT_NE(app, nullptr) << master->output();
+  session::Subscribe kinds;
+  kinds.set_head(true);
+  kinds.set_flysticks(true);
+  ASSERT_TRUE(app->subscribe(kinds).ok());
+
+  const DTrackSender tracker(udp);
+  std::uint64_t tracker_frame = 1;
+  // One tracker frame: the head at the room's centre, the flystick in front of
+  // it pointing ahead (-z), its joystick at `y`, its buttons `buttons`.
+  const auto send = [&](double y, unsigned buttons) {
+    tracker.send("fr " + std::to_string(tracker_frame++) + "\r\n6d 1 " +
+                 dtrack_body(0, {0.0, 1.6, 0.0}, {1.0, 0.0, 0.0, 0.0}) + "\r\n6df2 1 1 " +
+                 dtrack_flystick(0, {0.2, 1.2, -0.3}, {1.0, 0.0, 0.0, 0.0}, buttons, 0.0, y) + "\r\n");
+  };
+  std::optional<session::FlystickChanged> heard;
+  double furthest = 0.0;  // along -z, metres
+  double travelled_at_reset = 0.0;
+  std::optional<double> after_reset;
+  enum class Phase { flying, resetting, done } phase = Phase::flying;
+  const auto start = std::chrono::steady_clock::now();
+  while (phase != Phase::done && std::chrono::steady_clock::now() - start < 20s) {
+    const bool reset = phase == Phase::resetting;
+    send(reset ? 0.0 : 1.0, reset ? 0b10u : 0u);  // button 1: the config's reset
+    auto event = app->next_event(16ms);
+    ASSERT_TRUE(event.ok()) << event.error() << master->output();
+    if (!event.value()) continue;
+    if (event.value()->has_flystick() && !heard) heard = event.value()->flystick();
+    if (!event.value()->has_head()) continue;
+    const session::Transform& navigation = event.value()->head().navigation();
+    ASSERT_EQ(navigation.position_size(), 3);
+    const double travelled = -navigation.position(2);
+    furthest = std::max(furthest, travelled);
+    if (phase == Phase::flying && travelled > 1.0) {
+      phase = Phase::resetting;
+      travelled_at_reset = travelled;
+    } else if (phase == Phase::resetting && travelled < 0.1) {
+      after_reset = travelled;
+      phase = Phase::done;
+    }
+  }
+  ASSERT_TRUE(heard) << "a FlystickChanged event\n" << master->output();
+  EXPECT_EQ(heard->flystick(), 0u);
+  EXPECT_TRUE(heard->seen());
+  ASSERT_EQ(heard->joystick_size(), 2);
+  EXPECT_DOUBLE_EQ(heard->joystick(1), 1.0);
+  ASSERT_EQ(heard->buttons_size(), 6);
+  ASSERT_EQ(heard->position_size(), 3);
+  EXPECT_NEAR(heard->position(2), -0.3, 1e-6) << "in installation metres";
+  EXPECT_GT(travelled_at_reset, 1.0) << "flew a metre along the wand";
+  ASSERT_TRUE(after_reset) << "the reset button brought the viewer back (furthest " << furthest << " m)\n"
+                           << master->output();
+  EXPECT_EQ(*after_reset, 0.0) << "back where it began, to the bit";
+  app.reset();
+  ASSERT_EQ(master->wait(60s), 0) << master->output();
+  const ClusterRun run = read_cluster_run(dir.file("out"));
+  ASSERT_EQ(run.error, "");
+  ASSERT_EQ(run.report.nodes_size(), 4);
   for (const auto& node : run.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
 }
 

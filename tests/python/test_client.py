@@ -7,6 +7,7 @@ import json
 import os
 import pathlib
 import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -140,16 +141,67 @@ class OnAWall(unittest.TestCase):
                 pass
             self.assertIsNone(wall.next_event(timeout=0.2), "none after unsubscribing")
 
+    def test_the_viewer_travels_and_lights_switch(self):
+        with self.connect() as wall:
+            with wall.transaction() as t:
+                t.navigate(position=(0.0, 0.0, -10.0), scale=2).switch_light(0, False)
+            contents = wall.read_scene()
+            self.assertEqual(list(contents.navigation.position), [0.0, 0.0, -10.0])
+            self.assertEqual(list(contents.navigation.scale), [2.0, 2.0, 2.0])
+            self.assertIn((0, False), [(l.light, l.on) for l in contents.lights])
+            with self.assertRaises(optique.Refused) as refused:
+                with wall.transaction() as t:
+                    t.navigate(scale=(1, 2, 1))
+            self.assertEqual(refused.exception.field, "edits[0].navigation.transform.scale")
+            with self.assertRaises(optique.Refused) as refused:
+                with wall.transaction() as t:
+                    t.switch_light(contents.light_count, True)
+            self.assertEqual(refused.exception.field, "edits[0].light.light")
+            with wall.transaction() as t:
+                t.navigate(position=(0, 0, 0), scale=1).switch_light(0, True)
+
     def test_the_circle_example(self):
         run = subprocess.run([sys.executable, str(EXAMPLES / "circle.py"), "--port", str(self.master.port),
                               "--seconds", "1.5"], capture_output=True, text=True, timeout=60)
         self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
         self.assertIn("placed from frame", run.stdout)
+        self.assertIn("switched a light 2 times", run.stdout)  # at 0 s and at 1 s
         with self.connect() as wall:
-            names = {i.instance for i in wall.read_scene().instances}
+            contents = wall.read_scene()
+            self.assertTrue(all(light.on for light in contents.lights), "every light on again at the end")
+            names = {i.instance for i in contents.instances}
             self.assertEqual(names & {"orbit", "beacon"}, {"orbit", "beacon"})
             with wall.transaction() as t:
                 t.remove("orbit").remove("beacon")
+
+
+def free_udp_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class InTheFlystickCave(unittest.TestCase):
+    def test_the_flystick_example_flies_turns_and_comes_back(self):
+        udp = free_udp_port()
+        with tempfile.TemporaryDirectory(prefix="optique-flystick-") as folder:
+            master = Master(pathlib.Path(folder), config=SOURCE / "configs" / "cave-flystick.json",
+                            more=("--tracking-port", str(udp)))
+            try:
+                run = subprocess.run([sys.executable, str(EXAMPLES / "flystick.py"), "--port", str(master.port),
+                                      "--tracking-port", str(udp), "--seconds", "0.8"],
+                                     capture_output=True, text=True, timeout=60)
+            finally:
+                master.stop()
+            self.assertEqual(run.returncode, 0, run.stdout + run.stderr + master.output())
+            lines = run.stdout.splitlines()
+            self.assertEqual(len(lines), 3, run.stdout)
+            forward = [float(v) for v in lines[0].split("(")[1].split(")")[0].split(",")]
+            self.assertLess(forward[2], -0.5, lines[0])  # 1.5 m/s along -z for most of 0.8 s
+            self.assertIn("turned", lines[1])
+            self.assertGreater(int(lines[1].split("turned ")[1].split(" ")[0]), 10, lines[1])
+            self.assertIn("reset: the room is at (0.00, 0.00, 0.00) in the world, turned 0 degrees", lines[2])
+            self.assertIn("buttons down [1]", lines[2])
 
 
 class AtTheEnd(unittest.TestCase):

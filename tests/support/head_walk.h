@@ -35,6 +35,19 @@ inline std::string dtrack_body(unsigned id, const glm::dvec3& position, const gl
   return text;
 }
 
+// Flystick `id` as DTrack writes it in a 6df2 line (6 buttons, a joystick):
+// its pose, the buttons down as bits, the joystick's x and y.
+inline std::string dtrack_flystick(unsigned id, const glm::dvec3& position, const glm::dquat& turn, unsigned buttons,
+                                   double x, double y) {
+  const glm::dmat3 r = glm::mat3_cast(turn);
+  char text[400];
+  std::snprintf(text, sizeof text,
+                "[%u 1.000 6 2][%.3f %.3f %.3f][%.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f %.6f][%u %.3f %.3f]", id,
+                position.x * 1000.0, position.y * 1000.0, position.z * 1000.0, r[0][0], r[0][1], r[0][2], r[1][0],
+                r[1][1], r[1][2], r[2][0], r[2][1], r[2][2], buttons, x, y);
+  return text;
+}
+
 // One DTrack frame: its counter, ts2 with the tracker's latency, and the body.
 inline std::string dtrack_frame(unsigned long long frame, double latency_seconds, const std::string& body) {
   return "fr " + std::to_string(frame) + "\r\nts2 0 0 " + std::to_string(std::lround(latency_seconds * 1e6)) +

@@ -208,14 +208,15 @@ TEST(ParseInstallation, ValuesOfTheWrongKindAreAllListedWithTheirPaths) {
   text = replaced(text, R"("eye": [0.0, 1.6, 2.0])", R"("eye": 3)");
   const auto parsed = parse(text);
   ASSERT_FALSE(parsed.ok());
-  EXPECT_EQ(lines_of(parsed.error()), (std::vector<std::string>{
-                                          "test.json: projectors[0].id: expected text in quotes (got the number 5)",
-                                          "test.json: projectors[0].width: must be 0 or more (got -640)",
-                                          "test.json: projectors[1].height: expected a whole number (got 1.5)",
-                                          "test.json: viewer.eye: expected a list [ … ] (got the number 3)",
-                                          "test.json: master.port: expected a whole number, not text (got \"x\"; write it without quotes)",
-                                          "test.json: master.secret_file: expected text in quotes (got true)",
-                                      }))
+  EXPECT_EQ(lines_of(parsed.error()),
+            (std::vector<std::string>{
+                "test.json: projectors[0].id: expected text in quotes (got the number 5)",
+                "test.json: projectors[0].width: must be 0 or more (got -640)",
+                "test.json: projectors[1].height: expected a whole number (got 1.5)",
+                "test.json: viewer.eye: expected a list [ … ] (got the number 3)",
+                "test.json: master.port: expected a whole number, not text (got \"x\"; write it without quotes)",
+                "test.json: master.secret_file: expected text in quotes (got true)",
+            }))
       << parsed.error();
   EXPECT_EQ(parsed.error().find("TYPE_"), std::string::npos);
 }
@@ -325,7 +326,8 @@ TEST(ParseInstallation, ViewerWithBothEyeAndPath) {
 TEST(ParseInstallation, ATrackerListensOnLoopbackUnlessItsAddressIsGiven) {
   const std::string viewer = R"("viewer": {"eye": [0.0, 1.6, 2.0]})";
   const auto tracked = [&](const std::string& tracking) {
-    return parse(with(viewer, R"("viewer": {"eye": [0.0, 1.6, 2.0], "tracking": {"source": "dtrack")" + tracking + "}}"));
+    return parse(
+        with(viewer, R"("viewer": {"eye": [0.0, 1.6, 2.0], "tracking": {"source": "dtrack")" + tracking + "}}"));
   };
   const auto by_default = tracked("");
   ASSERT_TRUE(by_default) << by_default.error();
@@ -345,6 +347,42 @@ TEST(ParseInstallation, ATrackerListensOnLoopbackUnlessItsAddressIsGiven) {
   // A replay listens nowhere.
   EXPECT_TRUE(parse(with(viewer, R"("viewer": {"eye": [0.0, 1.6, 2.0], "tracking": {"source": "replay", )"
                                  R"("file": "head.csv", "listen": "0.0.0.0"}})")));
+}
+
+// Built-in navigation: a flystick's, which needs DTrack to hear it; every bad
+// setting named, all at once; left out, none.
+TEST(ParseInstallation, AFlystickNavigatesWithDTrackAndEveryBadSettingIsNamed) {
+  const std::string viewer = R"("viewer": {"eye": [0.0, 1.6, 2.0]})";
+  const auto navigated = [&](const std::string& tracking, const std::string& navigation) {
+    return parse(
+        with(viewer, R"("viewer": {"eye": [0.0, 1.6, 2.0])" + tracking + R"(, "navigation": )" + navigation + "}"));
+  };
+  const std::string dtrack = R"(, "tracking": {"source": "dtrack"})";
+  const auto flown = navigated(dtrack, R"({"mode": "flystick", "flystick": 2, "reset_button": 0})");
+  ASSERT_TRUE(flown) << flown.error();
+  ASSERT_TRUE(flown.value().viewer.navigation);
+  const Navigation& n = *flown.value().viewer.navigation;
+  EXPECT_EQ(n.flystick, 2u);
+  EXPECT_EQ(n.reset_button, 0u) << "button 0 is a button";
+  EXPECT_EQ(n.speed, defaults::kNavigationSpeed);
+  EXPECT_EQ(n.dead_zone, defaults::kNavigationDeadZone);
+  EXPECT_EQ(n.up, glm::dvec3(0.0, 1.0, 0.0));
+
+  const auto none = navigated(dtrack, R"({"mode": "none"})");
+  ASSERT_TRUE(none) << none.error();
+  EXPECT_FALSE(none.value().viewer.navigation);
+
+  expect_problem(navigated("", R"({"mode": "flystick"})"), "viewer.navigation.mode",
+                 {"flystick needs viewer.tracking with source dtrack"});
+  const auto bad = navigated(dtrack, R"({"mode": "flystick", "speed": -1, "turn_speed": 1000, "dead_zone": 0.95,
+                                         "reset_button": 64, "up": [0, 2, 0], "pointer": [1, 0]})");
+  expect_problem(bad, "viewer.navigation.speed", {"must be in (0, 100] m/s (got -1)"});
+  expect_problem(bad, "viewer.navigation.turn_speed", {"must be in (0, 360] degrees/s"});
+  expect_problem(bad, "viewer.navigation.dead_zone", {"must be in [0, 0.9]"});
+  expect_problem(bad, "viewer.navigation.reset_button", {"must be below 64"});
+  expect_problem(bad, "viewer.navigation.up", {"unit"});
+  expect_problem(bad, "viewer.navigation.pointer", {"[x, y, z]"});
+  expect_problem(navigated(dtrack, R"({"mode": "walk"})"), "viewer.navigation.mode", {"unknown value 'walk'"});
 }
 
 TEST(ParseInstallation, ViewerPathTimesMustIncrease) {

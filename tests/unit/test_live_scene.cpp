@@ -189,5 +189,72 @@ TEST(LiveScene, TheNumberOfInstancesIsBounded) {
   accept(scene, R"(edits { remove { instance: "a" } } edits { create { instance: "c" asset: "torus" } })");
 }
 
+TEST(LiveScene, TheNavigationIsSetWholeAndUniformlyScaled) {
+  LiveScene scene = with_torus();
+  EXPECT_EQ(scene.navigation().sets, 0u);
+  accept(scene, R"(edits { navigation { transform { position: [10, 0, -5] rotation: [0, 0, 3, 0] scale: [2] } } })");
+  EXPECT_EQ(scene.navigation().sets, 1u);
+  EXPECT_EQ(scene.navigation().pose.position, glm::dvec3(10, 0, -5));
+  EXPECT_DOUBLE_EQ(scene.navigation().pose.rotation.y, 1.0);
+  EXPECT_EQ(scene.navigation().pose.scale, glm::dvec3(2.0));
+
+  const Refusal stretched = refused(scene, R"(edits { navigation { transform { scale: [1, 2, 1] } } })");
+  EXPECT_EQ(stretched.field, "edits[0].navigation.transform.scale");
+  EXPECT_EQ(stretched.reason, "must be the same on every axis: give [s]");
+  EXPECT_EQ(refused(scene, R"(edits { navigation { transform { position: [nan, 0, 0] } } })").field,
+            "edits[0].navigation.transform.position[0]");
+
+  // A later edit's refusal takes the navigation back too.
+  refused(scene, R"(edits { navigation { transform { position: [0, 0, 0] } } }
+                    edits { visible { instance: "none" visible: false } })");
+  EXPECT_EQ(scene.navigation().pose.position, glm::dvec3(10, 0, -5));
+  EXPECT_EQ(scene.navigation().sets, 1u);
+  // Set again where it is: still a set (a flown viewer comes back).
+  accept(scene, R"(edits { navigation { transform { position: [10, 0, -5] } } })");
+  EXPECT_EQ(scene.navigation().sets, 2u);
+
+  scene::SceneState state;
+  put_live(scene, state);
+  EXPECT_EQ(state.navigation.now, scene.navigation().pose);
+  EXPECT_EQ(state.navigation.next, scene.navigation().pose);
+  const session::SceneContents contents = scene_contents(scene, 7);
+  ASSERT_EQ(contents.navigation().position_size(), 3);
+  EXPECT_EQ(contents.navigation().position(0), 10.0);
+  EXPECT_EQ(contents.navigation().scale(2), 2.0);
+}
+
+TEST(LiveScene, LightsAreSwitchedOverTheConfigsSwitches) {
+  LiveScene scene = with_torus();
+  EXPECT_EQ(refused(scene, R"(edits { light { light: 0 on: false } })").reason, "the scene has no point lights");
+  scene.set_light_count(3);
+  const Refusal beyond = refused(scene, R"(edits { light { light: 3 on: false } })");
+  EXPECT_EQ(beyond.field, "edits[0].light.light");
+  EXPECT_EQ(beyond.reason, "the scene's point lights are 0 to 2 (got 3)");
+  refused(scene, R"(edits { light { light: 1 on: false } } edits { remove { instance: "none" } })");
+  EXPECT_TRUE(scene.light_switches().empty()) << "a refused transaction switches nothing";
+  accept(scene, R"(edits { light { light: 1 on: false } } edits { light { light: 2 on: true } })");
+
+  scene::SceneState state;
+  state.lights_off = {0, 2};  // the config's script switched 0 and 2 off
+  put_live(scene, state);
+  EXPECT_EQ(state.lights_off, (std::set<std::uint32_t>{0, 1})) << "1 switched off, 2 on; 0 as the script has it";
+  const session::SceneContents contents = scene_contents(scene, 0);
+  EXPECT_EQ(contents.light_count(), 3u);
+  ASSERT_EQ(contents.lights_size(), 2);
+  EXPECT_EQ(contents.lights(0).light(), 1u);
+  EXPECT_FALSE(contents.lights(0).on());
+  EXPECT_TRUE(contents.lights(1).on());
+}
+
+TEST(LiveScene, OfAnInstallationsSceneHasItsAssetAndLights) {
+  scene::SceneDefinition definition;
+  definition.asset_id = "cubes";
+  definition.lights.resize(2);
+  LiveScene scene = LiveScene::of(definition, {});
+  EXPECT_TRUE(scene.has_asset("cubes"));
+  accept(scene, R"(edits { light { light: 1 on: false } })");
+  EXPECT_FALSE(scene.apply(transaction(R"(edits { light { light: 2 on: false } })"))->reason.empty());
+}
+
 }  // namespace
 }  // namespace optique::master

@@ -145,6 +145,66 @@ TEST(ApplyDelta, AHeadTurnThatIsNoRotationIsRefused) {
   EXPECT_EQ(state, kept);
 }
 
+// The navigation travels as the head does: in the delta, the snapshot and the
+// hash; a viewer who does not travel writes none; back to where the world is,
+// the delta says so.
+TEST(SceneDelta, TheNavigationTravelsWithTheViewer) {
+  const SceneState before = before_state();
+  SceneState travelled = before;
+  Pose there;
+  there.position = {100.0, 0.0, -20.0};
+  there.rotation = glm::angleAxis(0.5, glm::dvec3(0.0, 1.0, 0.0));
+  there.scale = glm::dvec3(3.0);
+  Pose further = there;
+  further.position.z -= 0.1;
+  travelled.navigation = {there, further};
+  EXPECT_NE(state_hash(travelled), state_hash(before));
+  const wire::StateDelta delta = make_delta(before, travelled);
+  ASSERT_TRUE(delta.has_viewer());
+  EXPECT_TRUE(delta.viewer().has_navigation_now());
+  SceneState applied = before;
+  ASSERT_TRUE(apply_delta(applied, delta));
+  EXPECT_EQ(applied, travelled);
+  auto back = from_snapshot(to_snapshot(travelled));
+  ASSERT_TRUE(back) << back.error();
+  EXPECT_EQ(back.value(), travelled);
+  EXPECT_FALSE(to_snapshot(before).viewer().has_navigation_now()) << "not travelling: none written";
+  const wire::StateDelta home = make_delta(travelled, before);
+  ASSERT_TRUE(home.has_viewer());
+  ASSERT_TRUE(apply_delta(applied, home));
+  EXPECT_EQ(applied, before);
+}
+
+TEST(ApplyDelta, ANavigationThatStretchesOrIsHalfGivenIsRefused) {
+  SceneState state = before_state();
+  const SceneState kept = state;
+  SceneState travelled = state;
+  travelled.navigation.now.position = {1.0, 0.0, 0.0};
+  wire::StateDelta delta = make_delta(state, travelled);
+  auto& viewer = *delta.mutable_viewer();
+  viewer.mutable_navigation_now()->mutable_scale()->set_x(1.0);
+  viewer.mutable_navigation_now()->mutable_scale()->set_y(2.0);
+  viewer.mutable_navigation_now()->mutable_scale()->set_z(1.0);
+  auto applied = apply_delta(state, delta);
+  ASSERT_FALSE(applied);
+  EXPECT_NE(applied.error().find("viewer navigation (now) scale must be the same on every axis"), std::string::npos)
+      << applied.error();
+  for (double s : {0.0, 1e5}) {
+    wire::Vec3& scale = *viewer.mutable_navigation_now()->mutable_scale();
+    scale.set_x(s);
+    scale.set_y(s);
+    scale.set_z(s);
+    EXPECT_FALSE(apply_delta(state, delta)) << "scale " << s;
+  }
+  viewer.clear_navigation_next();
+  viewer.mutable_navigation_now()->clear_scale();
+  applied = apply_delta(state, delta);
+  ASSERT_FALSE(applied);
+  EXPECT_NE(applied.error().find("viewer navigation: give it now and next, or neither"), std::string::npos)
+      << applied.error();
+  EXPECT_EQ(state, kept);
+}
+
 TEST(SceneDelta, RemovingEveryObject) {
   const SceneState before = before_state();
   SceneState after = before;
@@ -294,7 +354,9 @@ TEST(SceneHash, ChangesWhenAnySingleDoubleChanges) {
   check("eye_now.y", [&](SceneState& s) { bump(s.eye_now.y); });
   check("eye_next.z", [&](SceneState& s) { bump(s.eye_next.z); });
   check("a light off", [&](SceneState& s) { s.lights_off.insert(0); });
-  EXPECT_EQ(variants, 11);
+  check("navigation.now.position.x", [&](SceneState& s) { bump(s.navigation.now.position.x); });
+  check("navigation.next.scale.y", [&](SceneState& s) { bump(s.navigation.next.scale.y); });
+  EXPECT_EQ(variants, 13);
 }
 
 TEST(SceneHash, DependsOnIdsAndNowNextOrder) {

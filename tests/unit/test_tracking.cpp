@@ -472,6 +472,31 @@ std::string large_frame(std::uint64_t frame, std::size_t bytes) {
   return "fr " + std::to_string(frame) + "\n6d " + std::to_string(count) + bodies + "\n";
 }
 
+// The reader hands over every flystick, the newest of each, also from a frame
+// without the head's body (which is still counted as such).
+TEST(DTrackReader, FlysticksAreTakenNewestFirstWithOrWithoutTheHead) {
+  DTrackReader reader(settings(), 10 * kMs);
+  TrackerInput in;
+  reader.read(
+      "fr 1\n6df2 2 2 [0 1.000 6 2][100 200 300][1 0 0 0 1 0 0 0 1][1 0.5 -1.0] "
+      "[3 -1.000 6 2][0 0 0][0 0 0 0 0 0 0 0 0][0 0 0]\n",
+      5 * kMs, "127.0.0.1", in);
+  EXPECT_EQ(in.counted.without_body, 1u) << "no head in it";
+  ASSERT_EQ(in.flysticks.size(), 2u);
+  EXPECT_TRUE(in.flysticks[0].seen);
+  EXPECT_EQ(in.flysticks[0].position, glm::dvec3(100.0, 200.0, 300.0));
+  EXPECT_EQ(in.flysticks[0].buttons[0], true);
+  EXPECT_EQ(in.flysticks[0].controllers, (std::vector<double>{0.5, -1.0}));
+  EXPECT_FALSE(in.flysticks[1].seen) << "quality -1";
+  EXPECT_EQ(in.flysticks[1].id, 3u);
+  reader.read("fr 2\n6df2 1 1 [0 1.000 6 2][110 200 300][1 0 0 0 1 0 0 0 1][0 0 0]\n", 15 * kMs, "127.0.0.1", in);
+  ASSERT_EQ(in.flysticks.size(), 2u) << "one a flystick";
+  EXPECT_EQ(in.flysticks[1].id, 0u);
+  EXPECT_EQ(in.flysticks[1].arrival, 15 * kMs);
+  EXPECT_EQ(in.flysticks[1].position.x, 110.0);
+  EXPECT_FALSE(in.empty());
+}
+
 // Sixteen hosts each sending valid 36 KB frames as fast as the flood rule lets
 // them read (2 kHz), the tracker's 2 KB frames at 60 Hz among them: no more than
 // the budget is parsed in any frame, and every frame of the tracker is read.

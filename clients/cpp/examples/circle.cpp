@@ -1,6 +1,7 @@
 // Places two copies of the installation's scene and moves one on a circle in
 // front of the wall, a step every frame, for a few seconds, while the other
-// turns red and back: the C++ twin of clients/python/examples/circle.py.
+// turns red and back and the scene's point lights go dark one at a time, a
+// second each: the C++ twin of clients/python/examples/circle.py.
 //   optique-master --config configs/powerwall-2x2.json --local --api-port 7490
 //   optique-example-circle --seconds 10
 
@@ -69,6 +70,9 @@ int main(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
   std::uint64_t last = first;
   int moves = 0;
+  int switches = 0;
+  const std::uint32_t lights = wall.scene().light_count();
+  std::uint32_t dark = 0;  // the light off now, counting from 1 (0: none yet)
   for (;;) {
     const double now = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (now >= seconds) break;
@@ -79,10 +83,22 @@ int main(int argc, char** argv) {
                             {{std::cos(angle / 2), 0.0, std::sin(angle / 2), 0.0}},
                             std::nullopt});
     step.tint("beacon-cpp", {1.0, 1.0 - red, 1.0 - red, 1.0});
+    if (const auto second = static_cast<std::uint32_t>(now); lights > 0 && second + 1 != dark) {
+      if (dark != 0) step.switch_light((dark - 1) % lights, true);
+      step.switch_light(second % lights, false);
+      dark = second + 1;
+      ++switches;
+    }
     if (!applied(wall.apply(step), last)) return 1;
     ++moves;
     std::this_thread::sleep_for(std::chrono::milliseconds(16));
   }
-  std::cout << "moved it " << moves << " times, frames " << first << " to " << last << "\n";
+  if (dark != 0) {  // every light as the config has it again
+    optique::client::Transaction lit;
+    lit.switch_light((dark - 1) % lights, true);
+    if (!applied(wall.apply(lit), last)) return 1;
+  }
+  std::cout << "moved it " << moves << " times, frames " << first << " to " << last << "; switched a light " << switches
+            << " times\n";
   return 0;
 }

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Places two copies of the installation's scene and moves one on a circle in
 front of the wall, once a frame, for a few seconds; the other turns red and
-back. Run it against a master with master.api on, e.g.:
+back, and the scene's point lights go dark one at a time, a second each. Run it against a master with master.api on, e.g.:
 
     optique-master --config configs/powerwall-2x2-api.json --local
     python3 circle.py --seconds 10
@@ -36,6 +36,9 @@ def main() -> None:
         print(f"placed from frame {t.frame}")
         start = time.monotonic()
         frames = []
+        lights = wall.scene.light_count
+        dark = None  # the second whose light is off
+        switches = 0
         while (now := time.monotonic() - start) < args.seconds:
             angle = now * 2.0 * math.pi / 4.0  # one turn every 4 s
             with wall.transaction() as t:
@@ -43,9 +46,18 @@ def main() -> None:
                        rotation=(math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0))
                 red = 0.5 + 0.5 * math.sin(3.0 * now)
                 t.tint("beacon", base_color=(1.0, 1.0 - red, 1.0 - red, 1.0))
+                if lights and int(now) != dark:
+                    if dark is not None:
+                        t.switch_light(dark % lights, True)
+                    dark = int(now)
+                    t.switch_light(dark % lights, False)
+                    switches += 1
             frames.append(t.frame)
             time.sleep(1.0 / 60.0)
-        print(f"moved it {len(frames)} times, frames {frames[0]} to {frames[-1]}")
+        if dark is not None:  # every light as the config has it again
+            with wall.transaction() as t:
+                t.switch_light(dark % lights, True)
+        print(f"moved it {len(frames)} times, frames {frames[0]} to {frames[-1]}; switched a light {switches} times")
 
 
 if __name__ == "__main__":

@@ -164,6 +164,18 @@ class Transaction:
         self.message.edits.add().remove.instance = instance
         return self
 
+    def navigate(self, position=None, rotation=None, scale=None) -> "Transaction":
+        """Where the installation is in the world (world <- installation): the
+        viewer travels. `scale` is one number, or three equal ones."""
+        _transform(self.message.edits.add().navigation.transform, position, rotation, scale)
+        return self
+
+    def switch_light(self, light: int, on: bool) -> "Transaction":
+        """One of the scene's point lights, by its index, on or off."""
+        edit = self.message.edits.add().light
+        edit.light, edit.on = light, on
+        return self
+
     def __enter__(self) -> "Transaction":
         return self
 
@@ -296,16 +308,18 @@ class Session:
         return reply.scene
 
     def subscribe(self, frames: bool = False, head: bool = False, run: bool = False,
-                  nodes: bool = False) -> None:
+                  nodes: bool = False, flysticks: bool = False) -> None:
         """From now on the master sends these kinds of events (all off at first):
         ``frames`` each frame it begins (FrameBegun: frame, display_ns, period_ns),
         ``head`` the viewer's eyes in each frame (HeadShown), ``run`` paused,
         resumed or stopping (RunChanged), ``nodes`` a projector's node up or down
-        (NodeChanged). Read them with ``next_event``; an application that stops
+        (NodeChanged), ``flysticks`` a flystick's buttons, joystick or pose
+        (FlystickChanged, with a DTrack tracker). Read them with ``next_event``; an application that stops
         reading them is closed by the master after a while."""
         def fill(request):
             request.subscribe.frames, request.subscribe.head = frames, head
             request.subscribe.run, request.subscribe.nodes = run, nodes
+            request.subscribe.flysticks = flysticks
         reply = self._ask(fill)
         if reply.WhichOneof("reply") != "subscribed":
             raise ConnectionClosed(f"the master answered Subscribe with {reply.WhichOneof('reply')}")
