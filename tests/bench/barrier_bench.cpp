@@ -108,7 +108,8 @@ int main(int argc, char** argv) {
   std::string master_bin = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
   app.option("--out", out, "folder for barrier.md, barrier.csv and barrier.png");
   app.option("--frames", frames, "frames (and baseline rounds) per run", optique::bench::Bounds::more_than_zero());
-  app.option("--rate", rate, "frame rate in Hz (both barriers are paced at it)", optique::bench::Bounds::more_than_zero());
+  app.option("--rate", rate, "frame rate in Hz (both barriers are paced at it)",
+             optique::bench::Bounds::more_than_zero());
   app.option("--repeats", repeats, "runs per node count; the table shows the median and the min–max",
              optique::bench::Bounds::more_than_zero());
   app.list("--nodes", node_counts, "node counts");
@@ -122,7 +123,9 @@ int main(int argc, char** argv) {
   }
   std::sort(node_counts.begin(), node_counts.end());
 
-  const std::string work = testing::make_temp_dir("optique-bench");
+  const testing::ScratchDir work_scratch("optique-bench");
+
+  const std::string work = work_scratch.string();
   std::filesystem::create_directories(out);
   std::ofstream csv(out + "/barrier.csv");
   csv << "nodes,repeat,frames,rate_hz,barrier_median_us,barrier_p99_us,present_skew_median_us,present_skew_p99_us,"

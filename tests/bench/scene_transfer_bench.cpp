@@ -168,7 +168,8 @@ double optique_fetch(const std::string& config, const fs::path& cache, const fs:
 }
 
 int run(const std::string& out, std::size_t mib, int runs) {
-  const fs::path work = testing::make_temp_dir("optique-bench-transfer");
+  const testing::ScratchDir work_folder("optique-bench-transfer");
+  const fs::path work = work_folder.path();
   const std::size_t big = mib << 20;
   const std::string gltf = make_scene(work, big);
   const std::string config = make_config(work, gltf);

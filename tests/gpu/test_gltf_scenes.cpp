@@ -27,23 +27,25 @@ const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
 const std::string kTorus = kConfigs + "/assets/torus/";
 constexpr std::uint64_t kFrame = 2;
 
-// configs/gltf-torus.json showing `gltf` (absolute), written to a temp file.
-std::string torus_config(const std::string& gltf) {
+// configs/gltf-torus.json showing `gltf` (absolute), written into `folder`.
+std::string torus_config(const ScratchDir& folder, const std::string& gltf) {
   std::ifstream in(kConfigs + "/gltf-torus.json");
   nlohmann::json config = nlohmann::json::parse(in);
   config["scene"]["gltf"] = gltf;
-  const std::string path = make_temp_dir("optique-gltf-scene") + "/torus.json";
+  const std::string path = folder.file("torus.json");
   std::ofstream(path) << config.dump(1);
   return path;
 }
 
 image::FloatImage torus_capture(const std::string& form) {
-  const std::string out = run_and_capture(torus_config(kTorus + form), static_cast<int>(kFrame) + 1, 1);
+  const ScratchDir folder("optique-gltf-scene");
+  const std::string out = run_and_capture(torus_config(folder, kTorus + form), static_cast<int>(kFrame) + 1, 1);
   return capture(out, "wall", kFrame);
 }
 
 void keep_on_failure(const std::string& what, const image::FloatImage& actual, const image::FloatImage& expected) {
-  const std::string dir = make_temp_dir("optique-gltf-failure");
+  const ScratchDir dir_scratch("optique-gltf-failure");
+  const std::string dir = dir_scratch.string();
   (void)image::write_exr(dir + "/actual.exr", actual);
   (void)image::write_exr(dir + "/expected.exr", expected);
   (void)image::write_exr(dir + "/difference-x10.exr", image::difference(actual, expected, 10.0f));

@@ -101,7 +101,8 @@ std::multiset<std::uint32_t> range(std::uint32_t first, std::uint32_t last) {
 }
 
 TEST(LightRepartition, LightsSwitchedAndANodeKilledAreSharedOutAnewAndTheScreenShowsIt) {
-  const std::string dir = make_temp_dir("optique-repartition");
+  const ScratchDir dir_scratch("optique-repartition");
+  const std::string dir = dir_scratch.string();
   const std::string config = write_config_variant(
       kConfig,
       [](schema::Installation& installation) {

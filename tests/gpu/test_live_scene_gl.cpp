@@ -203,7 +203,8 @@ TEST(LiveSceneOnGlNodes, RandomTransactionsStayCoherentAndTheJournalDrawsTheSame
   std::printf("frame %llu, stitched tiles vs the journal's reference: PSNR R/G/B %.1f/%.1f/%.1f dB\n",
               static_cast<unsigned long long>(kCompared), c.psnr_r, c.psnr_g, c.psnr_b);
   if (std::min({c.psnr_r, c.psnr_g, c.psnr_b}) < 40.0) {
-    const std::string kept = make_temp_dir("optique-live-gl-failure");
+    const ScratchDir kept_scratch("optique-live-gl-failure");
+    const std::string kept = kept_scratch.string();
     (void)image::write_exr(kept + "/stitched.exr", tiles);
     (void)image::write_exr(kept + "/reference.exr", drawn.value());
     (void)image::write_exr(kept + "/difference.exr", image::difference(tiles, drawn.value(), 10.0f));

@@ -117,7 +117,8 @@ TEST(ObliqueWall, ComposedScreenMatchesTheReferenceWithoutSeams) {
   const config::Installation& installation = loaded.value().installation;
   schema::Installation patient = config::to_schema(installation);
   patient.mutable_master()->set_frame_timeout_ms(20000);
-  const std::string dir = make_temp_dir("optique-wall");
+  const ScratchDir dir_scratch("optique-wall");
+  const std::string dir = dir_scratch.string();
   std::string json;
   ASSERT_TRUE(google::protobuf::util::MessageToJsonString(patient, &json).ok());
   const std::string config_path = dir + "/wall.json";

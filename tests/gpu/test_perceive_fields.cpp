@@ -60,7 +60,8 @@ Seen perceive(const std::string& config, const std::string& track, const std::st
 }
 
 TEST(PerceiveFields, PerFieldRemovesTheFringesThatOneMomentPerFrameShows) {
-  const std::string dir = testing::make_temp_dir("optique-perceive");
+  const testing::ScratchDir dir_scratch("optique-perceive");
+  const std::string dir = dir_scratch.string();
   const Seen fields = perceive(config_with(dir, "per-field"), "square", dir + "/per-field");
   const Seen one_moment = perceive(config_with(dir, "off"), "square", dir + "/off");
   const double speed = fields.screen.velocity.x / 120.0;
@@ -89,7 +90,8 @@ TEST(PerceiveFields, PerFieldRemovesTheFringesThatOneMomentPerFrameShows) {
 // The gather method: one render with each pixel's screen velocity, every field
 // gathered from it along the motion.
 TEST(PerceiveFields, GatherFromOneRenderIsCloseToARenderPerField) {
-  const std::string dir = testing::make_temp_dir("optique-perceive");
+  const testing::ScratchDir dir_scratch("optique-perceive");
+  const std::string dir = dir_scratch.string();
   const Seen gathered = perceive(config_with(dir, "gather"), "square", dir + "/gather");
   const Seen fields = perceive(config_with(dir, "per-field"), "square", dir + "/per-field");
   const Seen one_moment = perceive(config_with(dir, "off"), "square", dir + "/off");
@@ -120,7 +122,8 @@ TEST(PerceiveFields, GatherFromOneRenderIsCloseToARenderPerField) {
 // their seam at frame 60: each draws its half of every field at the same moments,
 // so the eye sees what one projector of the whole wall would show it.
 TEST(PerceiveFields, TheSquareCrossesTheSeamOfTwoDlpTilesWithoutABreak) {
-  const std::string dir = testing::make_temp_dir("optique-perceive");
+  const testing::ScratchDir dir_scratch("optique-perceive");
+  const std::string dir = dir_scratch.string();
   const std::string configs = std::string(OPTIQUE_SOURCE_DIR) + "/configs/";
   const Seen tiles = perceive(configs + "dlp-wall-2.json", "square", dir + "/tiles");
   const Seen single = perceive(configs + "dlp-120hz.json", "square", dir + "/single");
@@ -146,7 +149,8 @@ TEST(PerceiveFields, TheSquareCrossesTheSeamOfTwoDlpTilesWithoutABreak) {
 // frame later. Drawn at one moment, the same frame shows twice: each channel
 // lands twice, and the channels apart.
 TEST(PerceiveFields, AStereoProjectorUsedAsMonoShowsEachOfItsSixFieldsAtItsMoment) {
-  const std::string dir = testing::make_temp_dir("optique-perceive");
+  const testing::ScratchDir dir_scratch("optique-perceive");
+  const std::string dir = dir_scratch.string();
   std::ifstream in(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-stereo-as-mono.json");
   std::stringstream text;
   text << in.rdbuf();

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 
 #include "cluster_run.h"
 #include "config/load.h"
@@ -18,6 +19,7 @@
 #include "image/image_io.h"
 #include "local_capture.h"
 #include "process.h"
+#include "scratch.h"
 
 namespace optique::testing {
 namespace {
@@ -27,17 +29,25 @@ using namespace std::chrono_literals;
 const std::string kMaster = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
 const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
 
+// A config written to a scratch folder, which goes with it.
+struct WrittenConfig {
+  std::unique_ptr<ScratchDir> folder;
+  std::string path;
+  operator const std::string&() const { return path; }  // NOLINT: used where a config path is
+};
+
 // A shipped config with another scene and a fixed eye, written to a temp file.
-std::string variant(const std::string& shipped, const std::function<void(schema::Installation&)>& change) {
+WrittenConfig variant(const std::string& shipped, const std::function<void(schema::Installation&)>& change) {
   auto loaded = config::load_installation(kConfigs + "/" + shipped);
   EXPECT_TRUE(loaded.ok());
   schema::Installation installation = config::to_schema(loaded.value().installation);
   change(installation);
   std::string json;
   EXPECT_TRUE(google::protobuf::util::MessageToJsonString(installation, &json).ok());
-  const std::string path = make_temp_dir("optique-gl") + "/" + shipped;
-  std::ofstream(path) << json;
-  return path;
+  WrittenConfig written{std::make_unique<ScratchDir>("optique-gl"), {}};
+  written.path = written.folder->file(shipped);
+  std::ofstream(written.path) << json;
+  return written;
 }
 
 double largest_difference(const image::FloatImage& a, const image::FloatImage& b) {
@@ -82,7 +92,8 @@ TEST(Rendering, TheFourTilesOfThePowerWallEqualTheSingleWall) {
   std::printf("stitched tiles vs single wall: PSNR R/G/B %.1f/%.1f/%.1f dB, max abs error %.4f\n", c.psnr_r, c.psnr_g,
               c.psnr_b, c.max_abs_error);
   if (worst < 40.0) {
-    const std::string dir = make_temp_dir("optique-gl-failure");
+    const ScratchDir dir_scratch("optique-gl-failure");
+    const std::string dir = dir_scratch.string();
     (void)image::write_exr(dir + "/stitched.exr", stitched);
     (void)image::write_exr(dir + "/reference.exr", reference);
     (void)image::write_exr(dir + "/difference.exr", image::difference(stitched, reference, 10.0f));
@@ -96,7 +107,7 @@ TEST(Rendering, TheFourTilesOfThePowerWallEqualTheSingleWall) {
 }
 
 TEST(Rendering, GeometryCrossingACaveCornerLinesUpOnBothWalls) {
-  const std::string config = variant("cave-4wall.json", [](schema::Installation& inst) {
+  const WrittenConfig config = variant("cave-4wall.json", [](schema::Installation& inst) {
     inst.mutable_scene()->set_builtin("corner-probe");
     inst.mutable_viewer()->clear_path();
     for (double v : {0.1, 1.6, 0.2}) inst.mutable_viewer()->add_eye(v);  // off centre: walls see it differently
@@ -141,7 +152,7 @@ double centroid_x(const image::FloatImage& image) {
 }
 
 TEST(Rendering, LeftAndRightEyesDifferByTheParallaxOfTheDepth) {
-  const std::string config = variant("single-wall.json", [](schema::Installation& inst) {
+  const WrittenConfig config = variant("single-wall.json", [](schema::Installation& inst) {
     inst.mutable_scene()->set_builtin("stereo-probe");  // a square 1 m behind the wall, at eye height
     schema::Projector left = inst.projectors(0);
     left.set_width(2560);  // 640 px/m: pixel edges quantize the measurement less
@@ -173,10 +184,11 @@ TEST(Rendering, LeftAndRightEyesDifferByTheParallaxOfTheDepth) {
 
 TEST(Rendering, AWindowOnAProjectorShowsWhatHeadlessRenders) {
   // A window needs a display: a virtual X server stands in for the projector.
-  const std::string windowed = variant("single-wall.json", [](schema::Installation& inst) {
+  const WrittenConfig windowed = variant("single-wall.json", [](schema::Installation& inst) {
     inst.mutable_projectors(0)->mutable_output()->set_kind("window");
   });
-  const std::string dir = make_temp_dir("optique-gl");
+  const ScratchDir dir_scratch("optique-gl");
+  const std::string dir = dir_scratch.string();
   Process master({"/usr/bin/xvfb-run", "-a", "-s", "-screen 0 1280x720x24", kMaster, "--config", windowed, "--local",
                   "--frames", "11", "--capture-every", "10", "--out", dir + "/out", "--no-status"},
                  dir + "/master.log");
@@ -238,7 +250,7 @@ TEST(Rendering, AStereoProjectorUsedAsMonoCapturesBothImagesOfAFrame) {
 const std::string kAnimatedCubes = kConfigs + "/assets/animated-cubes.gltf";
 
 TEST(Rendering, AnAnimatedGltfRendersTheSameOnStackedNodes) {
-  const std::string config = variant("single-wall.json", [](schema::Installation& inst) {
+  const WrittenConfig config = variant("single-wall.json", [](schema::Installation& inst) {
     inst.mutable_scene()->clear_builtin();
     inst.mutable_scene()->set_gltf(kAnimatedCubes);
     schema::Projector a = inst.projectors(0);
@@ -265,7 +277,7 @@ TEST(Rendering, AnAnimatedGltfRendersTheSameOnStackedNodes) {
   }
 }
 
-std::string with_gltf(const std::string& gltf) {
+WrittenConfig with_gltf(const std::string& gltf) {
   return variant("single-wall.json", [&gltf](schema::Installation& inst) {
     inst.mutable_scene()->clear_builtin();
     inst.mutable_scene()->set_gltf(gltf);
@@ -273,7 +285,8 @@ std::string with_gltf(const std::string& gltf) {
 }
 
 TEST(Rendering, BadGltfInputStartsNothingAndSaysWhy) {
-  const std::string dir = make_temp_dir("optique-gl");
+  const ScratchDir dir_scratch("optique-gl");
+  const std::string dir = dir_scratch.string();
   const std::string malformed = dir + "/malformed.gltf";
   std::ofstream(malformed) << "{ \"asset\": { \"version\": \"2.0\" }, \"nodes\": [ ";
   // The shipped asset with a skin added: a feature we cannot draw.

@@ -20,7 +20,8 @@ namespace {
 using namespace std::chrono_literals;
 
 TEST(SlowNode, AStoppedGlNodeSlowerThanThePeriodComesBackAndShowsTheFramesAfter) {
-  const std::string dir = make_temp_dir("optique-slow");
+  const ScratchDir dir_scratch("optique-slow");
+  const std::string dir = dir_scratch.string();
   const std::string config = write_config_variant(
       std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json",
       [](schema::Installation& installation) { installation.mutable_scene()->set_builtin("many-lights"); },
@@ -30,8 +31,7 @@ TEST(SlowNode, AStoppedGlNodeSlowerThanThePeriodComesBackAndShowsTheFramesAfter)
   auto node = master.node("wall", {"--renderer", "gl"});
   // Said after its first frame: it draws slower than the period, so the run
   // lasts long enough after the stop to tell, however fast this machine draws.
-  ASSERT_TRUE(master.process->wait_for_output("longer than the 16.7 ms frame period", 60s))
-      << master.process->output();
+  ASSERT_TRUE(master.process->wait_for_output("longer than the 16.7 ms frame period", 60s)) << master.process->output();
   std::this_thread::sleep_for(300ms);
   node->signal(SIGSTOP);
   std::this_thread::sleep_for(1s);

@@ -57,7 +57,8 @@ StackedRun run_cluster(const std::string& lagging_node, const std::string& shipp
                        std::uint64_t frames = kFrames, std::uint64_t capture_every = kCaptureEvery,
                        bool spread = false) {
   StackedRun run;
-  const std::string dir = make_temp_dir("optique-coherence");
+  const ScratchDir dir_scratch("optique-coherence");
+  const std::string dir = dir_scratch.string();
   const std::string config = slow_config(dir, shipped, rate, spread);
   run.out = dir + "/out";
   Process master(

@@ -157,7 +157,8 @@ class UpConversion : public ::testing::Test {
     EXPECT_TRUE(c.ok());
     if (!c.ok()) return 0.0;
     if (c.value().psnr_y_weighted < bar) {
-      const std::string dir = testing::make_temp_dir("optique-up-conversion");
+      const testing::ScratchDir dir_scratch("optique-up-conversion");
+      const std::string dir = dir_scratch.string();
       (void)image::write_exr(dir + "/" + name + "-actual.exr", actual);
       (void)image::write_exr(dir + "/" + name + "-expected.exr", expected);
       (void)image::write_exr(dir + "/" + name + "-difference.exr", image::difference(actual, expected, 4.0f));

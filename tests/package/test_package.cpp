@@ -26,7 +26,8 @@ int run(const std::vector<std::string>& argv, const std::string& log, std::chron
 }
 
 TEST(Package, CmakeInstallPutsTheProgramsConfigsAndDocsUnderThePrefix) {
-  const std::string dir = make_temp_dir("optique-install");
+  const ScratchDir dir_scratch("optique-install");
+  const std::string dir = dir_scratch.string();
   const std::string prefix = dir + "/prefix";
   ASSERT_EQ(run({"/usr/bin/cmake", "--install", kBuild, "--prefix", prefix}, dir + "/install.log"), 0)
       << read_file(dir + "/install.log");
@@ -52,7 +53,8 @@ TEST(Package, CmakeInstallPutsTheProgramsConfigsAndDocsUnderThePrefix) {
 // prefix and read <prefix>/etc/optique; with prefix /usr they are the package's,
 // /etc/optique and all, staged under DESTDIR.
 TEST(Package, TheServiceComponentFollowsThePrefix) {
-  const std::string dir = make_temp_dir("optique-service");
+  const ScratchDir dir_scratch("optique-service");
+  const std::string dir = dir_scratch.string();
   const std::string prefix = dir + "/local";
   ASSERT_EQ(
       run({"/usr/bin/cmake", "--install", kBuild, "--prefix", prefix, "--component", "service"}, dir + "/local.log"), 0)
@@ -78,7 +80,8 @@ TEST(Package, TheServiceComponentFollowsThePrefix) {
 }
 
 TEST(Package, TheDebianPackageHoldsEverythingAndRunsFromAnExtractedCopy) {
-  const std::string dir = make_temp_dir("optique-deb");
+  const ScratchDir dir_scratch("optique-deb");
+  const std::string dir = dir_scratch.string();
   ASSERT_EQ(run({"/usr/bin/cpack", "--config", kBuild + "/CPackConfig.cmake", "-G", "DEB", "-B", dir + "/out"},
                 dir + "/cpack.log", 240s),
             0)

@@ -52,7 +52,8 @@ std::string write(const std::string& path, const std::string& text) {
 
 class CalibrateCli : public ::testing::Test {
  protected:
-  std::string dir = make_temp_dir("optique-calibrate");
+  ScratchDir dir_scratch{"optique-calibrate"};
+  const std::string dir = dir_scratch.string();
   PinholeProjector projector = projector_cases()[1];  // strong oblique
   glm::dmat3 truth = projector.homography();
   std::vector<geometry::Correspondence> noisy() const {

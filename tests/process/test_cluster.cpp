@@ -41,7 +41,8 @@ class ShippedConfig : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(ShippedConfig, RunsSixtyFramesInSyncWithLocalNodes) {
   const std::string config = kConfigs + "/" + GetParam();
-  const std::string dir = make_temp_dir("optique-it");
+  const ScratchDir dir_scratch("optique-it");
+  const std::string dir = dir_scratch.string();
   Process master({kMaster, "--config", config, "--local", "--frames", "60", "--out", dir + "/out", "--no-status"},
                  dir + "/master.log");
   const auto status = master.wait(60s);
@@ -162,7 +163,8 @@ TEST(Cluster, AStoppedNodeAloneComesBackAfterSigcont) {
 
 // A user reads the defaults in --help, not in the source.
 TEST(Cluster, NodeHelpShowsTheDefaults) {
-  const std::string dir = make_temp_dir("optique-help");
+  const ScratchDir dir_scratch("optique-help");
+  const std::string dir = dir_scratch.string();
   Process help({kNode, "--help"}, dir + "/help.log");
   ASSERT_EQ(help.wait(10s), 0) << help.output();
   const std::string said = help.output();
@@ -201,7 +203,8 @@ TEST(Cluster, ProtocolVersionMismatchIsRefusedOnBothSides) {
 }
 
 TEST(Cluster, ConfigErrorStartsNothing) {
-  const std::string dir = make_temp_dir("optique-it");
+  const ScratchDir dir_scratch("optique-it");
+  const std::string dir = dir_scratch.string();
   const std::string config = dir + "/broken.json";
   std::ofstream(config) << R"({
     "screens": [{"id": "front", "origin": [0, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0], "width": 2, "height": 1}],
@@ -218,7 +221,8 @@ TEST(Cluster, ConfigErrorStartsNothing) {
 }
 
 TEST(Cluster, NodeWaitsForALateMasterThenJoins) {
-  const std::string dir = make_temp_dir("optique-it");
+  const ScratchDir dir_scratch("optique-it");
+  const std::string dir = dir_scratch.string();
   const std::string port = free_port();
   Process node({kNode, "--master", "127.0.0.1:" + port, "--id", "wall"}, dir + "/node.log");
   // The node says it is waiting (however long a loaded machine takes to start it).
@@ -234,7 +238,8 @@ TEST(Cluster, NodeWaitsForALateMasterThenJoins) {
 }
 
 TEST(Cluster, NodeGivesUpWhenNoMasterComes) {
-  const std::string dir = make_temp_dir("optique-it");
+  const ScratchDir dir_scratch("optique-it");
+  const std::string dir = dir_scratch.string();
   Process node({kNode, "--master", "127.0.0.1:" + free_port(), "--id", "wall", "--give-up-after-ms", "500"},
                dir + "/node.log");
   const auto status = node.wait(10s);
@@ -244,7 +249,8 @@ TEST(Cluster, NodeGivesUpWhenNoMasterComes) {
 }
 
 TEST(Cluster, InterruptStopsTheLocalClusterCleanly) {
-  const std::string dir = make_temp_dir("optique-it");
+  const ScratchDir dir_scratch("optique-it");
+  const std::string dir = dir_scratch.string();
   Process master({kMaster, "--config", kConfigs + "/powerwall-2x2.json", "--local", "--port-file", dir + "/port",
                   "--out", dir + "/out", "--no-status"},
                  dir + "/master.log");

@@ -74,7 +74,8 @@ TEST(FrameSync, AStateHashMismatchIsRepairedWithinOneFrame) {
 // twice the timeout, the frame it holds up is shown by nobody, it leaves the
 // barrier, and after SIGCONT it answers again and shows frames once more.
 TEST(FrameSync, AStragglerIsWaitedForThenItsFrameIsDroppedEverywhere) {
-  const std::string dir = make_temp_dir("optique-straggler");
+  const ScratchDir dir_scratch("optique-straggler");
+  const std::string dir = dir_scratch.string();
   const std::string config = write_config_variant(
       kConfigs + "/powerwall-2x2.json",
       [](schema::Installation& installation) {
@@ -129,7 +130,8 @@ TEST(FrameSync, AStragglerIsWaitedForThenItsFrameIsDroppedEverywhere) {
 TEST(FrameSync, NodesShowBlackWhileTheMasterIsGoneAndARestartedMasterTakesThemBack) {
   const std::string config = kConfigs + "/powerwall-2x2.json";
   const std::string port = free_port();
-  const std::string dir = make_temp_dir("optique-restart");
+  const ScratchDir dir_scratch("optique-restart");
+  const std::string dir = dir_scratch.string();
   const auto start_master = [&](const std::string& name, const std::string& frames) {
     return std::make_unique<Process>(
         std::vector<std::string>{master_binary(), "--config", config, "--listen", "127.0.0.1", "--port", port,
@@ -364,7 +366,8 @@ std::string mac_text(const net::Secret& secret, const std::string& nonce, const 
 
 // A two-projector wall whose master requires the secret in DIR/secret (mode 0600).
 struct SecretWall {
-  std::string dir = make_temp_dir("optique-secret");
+  ScratchDir dir_scratch{"optique-secret"};
+  const std::string dir = dir_scratch.string();
   std::string config = dir + "/wall.json";
   std::string secret_file = dir + "/secret";
   net::Secret secret;
@@ -577,7 +580,8 @@ TEST(Security, WithoutASecretOnlyLoopbackPeersAreAccepted) {
   }
   if (address.empty()) GTEST_SKIP() << "this machine has no non-loopback IPv4 address";
   const std::string config = kConfigs + "/single-wall.json";
-  const std::string dir = make_temp_dir("optique-loopback");
+  const ScratchDir dir_scratch("optique-loopback");
+  const std::string dir = dir_scratch.string();
   Process master({master_binary(), "--config", config, "--listen", "0.0.0.0", "--port", "0", "--port-file",
                   dir + "/port", "--frames", "60", "--no-status"},
                  dir + "/master.log");

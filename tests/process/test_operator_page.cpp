@@ -27,7 +27,8 @@ const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
 
 // A master with local null nodes and its status server on an ephemeral port.
 struct StatusRun {
-  std::string dir = make_temp_dir("optique-status");
+  ScratchDir dir_scratch{"optique-status"};
+  const std::string dir = dir_scratch.string();
   std::unique_ptr<Process> master;
   int port = 0;
 
@@ -113,7 +114,8 @@ TEST(OperatorPage, ChromiumSeesEveryNodeUpAndTheFramesAdvance) {
 // Beyond loopback, everything but the page needs the token; the token is not
 // the secret; controls pause, resume and stop the show.
 TEST(OperatorPage, TheTokenGuardsTheDataAndTheControls) {
-  const std::string dir = make_temp_dir("optique-status-token");
+  const ScratchDir dir_scratch("optique-status-token");
+  const std::string dir = dir_scratch.string();
   std::ofstream(dir + "/secret") << "correct horse battery staple\n";
   ASSERT_EQ(chmod((dir + "/secret").c_str(), 0600), 0);
   std::ifstream source(kConfigs + "/powerwall-2x2.json");

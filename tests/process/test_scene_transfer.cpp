@@ -88,7 +88,8 @@ struct ClusterOutcome {
 ClusterOutcome run(const std::string& config, const std::string& cache, const std::string& host,
                    const std::vector<std::string>& prefix = {}, bool secret = false,
                    const std::function<void()>& before_node = {}) {
-  const std::string dir = make_temp_dir("optique-transfer-run");
+  const ScratchDir dir_scratch("optique-transfer-run");
+  const std::string dir = dir_scratch.string();
   Process master(
       {master_binary(), "--config", config, "--port-file", dir + "/port", "--frames", std::to_string(kFrames),
        "--capture-every", std::to_string(kCapturedFrame), "--no-status", "--out", dir + "/out"},
@@ -144,7 +145,8 @@ std::vector<fs::path> copies_in(const std::string& cache) {
 }
 
 TEST(SceneTransfer, ANodeWithAnEmptyCacheFetchesTheSceneAndARestartedOneDoesNot) {
-  const std::string dir = make_temp_dir("optique-transfer");
+  const ScratchDir dir_scratch("optique-transfer");
+  const std::string dir = dir_scratch.string();
   const std::string config = torus_config(dir, torus_scene(dir), "127.0.0.1", false);
   const std::string cache = dir + "/cache";
   const ClusterOutcome fetched = run(config, cache, "127.0.0.1");
@@ -169,7 +171,8 @@ TEST(SceneTransfer, ANodeWithAnEmptyCacheFetchesTheSceneAndARestartedOneDoesNot)
 }
 
 TEST(SceneTransfer, TheMasterSendsTheFilesAsItLoadedThemNotAsTheyAreLater) {
-  const std::string dir = make_temp_dir("optique-transfer");
+  const ScratchDir dir_scratch("optique-transfer");
+  const std::string dir = dir_scratch.string();
   const std::string gltf = torus_scene(dir);
   const std::string config = torus_config(dir, gltf, "127.0.0.1", false);
   const std::string cache = dir + "/cache";
@@ -189,7 +192,8 @@ TEST(SceneTransfer, TheMasterSendsTheFilesAsItLoadedThemNotAsTheyAreLater) {
 }
 
 TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
-  const std::string dir = make_temp_dir("optique-transfer");
+  const ScratchDir dir_scratch("optique-transfer");
+  const std::string dir = dir_scratch.string();
   const std::size_t big = 3u << 20;
   const std::string config = torus_config(dir, torus_scene(dir, big), "127.0.0.1", false);
   const std::string cache = dir + "/cache";
@@ -224,7 +228,8 @@ TEST(SceneTransfer, AChunkSpoiltOnTheWayIsRefusedAndFetchedAgain) {
 // fetch lasts) fetches,
 // the second waits for its copy, and both draw.
 TEST(SceneTransfer, TwoNodesOfOneHostSharingACacheFetchTheSceneOnce) {
-  const std::string dir = make_temp_dir("optique-transfer");
+  const ScratchDir dir_scratch("optique-transfer");
+  const std::string dir = dir_scratch.string();
   const std::string config_path = torus_config(dir, torus_scene(dir, 6u << 20), "127.0.0.1", false);
   {
     std::ifstream in(config_path);
@@ -316,7 +321,8 @@ class OtherHost {
 TEST(SceneTransfer, ANodeOnAnotherHostWithTheSecretFetchesTheSceneAndDrawsWhatANodeThatHadItDraws) {
   const OtherHost host;
   if (!host.problem().empty()) GTEST_SKIP() << host.problem();
-  const std::string dir = make_temp_dir("optique-transfer");
+  const ScratchDir dir_scratch("optique-transfer");
+  const std::string dir = dir_scratch.string();
   const std::string config = torus_config(dir, torus_scene(dir), host.master_address(), true);
   const std::string cache = dir + "/cache";
   const ClusterOutcome fetched = run(config, cache, host.master_address(), host.prefix(), true);

@@ -93,7 +93,8 @@ const report::NodeReport* find_node(const report::RunReport& report, const std::
 }
 
 StandInStart start_with_stand_in_nodes(const std::string& master_binary, const std::string& config) {
-  const std::string dir = make_temp_dir("optique-it");
+  const ScratchDir dir_scratch("optique-it");
+  const std::string dir = dir_scratch.string();
   const std::string stand_in = dir + "/stand-in-node";
   std::ofstream(stand_in) << "#!/bin/sh\ntouch " << dir << "/node-started\n";
   std::filesystem::permissions(stand_in, std::filesystem::perms::owner_all);

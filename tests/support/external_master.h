@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "process.h"
+#include "scratch.h"
 
 namespace optique::testing {
 
@@ -17,7 +18,8 @@ namespace optique::testing {
 [[nodiscard]] std::string node_binary();
 
 struct ExternalMaster {
-  std::string dir = make_temp_dir("optique-it");
+  ScratchDir scratch{"optique-it"};  // kept when the test fails
+  std::string dir = scratch.string();
   std::unique_ptr<Process> process;
   std::string port;  // empty if the master never wrote its port file
 

@@ -14,7 +14,8 @@ using namespace std::chrono_literals;
 
 std::string run_and_capture(const std::string& config, int frames, int capture_every,
                             const std::vector<std::string>& extra) {
-  const std::string dir = make_temp_dir("optique-gl");
+  const ScratchDir dir_scratch("optique-gl");
+  const std::string dir = dir_scratch.string();
   std::vector<std::string> command{std::string(OPTIQUE_BIN_DIR) + "/optique-master",
                                    "--config",
                                    config,

@@ -5,8 +5,8 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <iostream>
 #include <iterator>
-#include <random>
 #include <system_error>
 
 namespace optique::testing {
@@ -22,16 +22,12 @@ ScratchDir::ScratchDir(const std::string& prefix) {
 
 ScratchDir::~ScratchDir() {
   if (path_.empty()) return;
+  if (::testing::Test::HasFailure()) {
+    std::cerr << "the test failed: its files are kept in " << path_.string() << "\n";
+    return;
+  }
   std::error_code ignored;
   std::filesystem::remove_all(path_, ignored);
-}
-
-std::string make_temp_dir(const std::string& prefix) {
-  std::random_device device;
-  const auto dir = std::filesystem::temp_directory_path() /
-                   (prefix + "-" + std::to_string(getpid()) + "-" + std::to_string(device()));
-  std::filesystem::create_directories(dir);
-  return dir.string();
 }
 
 std::string read_file(const std::filesystem::path& path) {

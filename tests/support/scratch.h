@@ -8,8 +8,10 @@
 namespace optique::testing {
 
 // A fresh, empty folder under the system's temp folder, named `prefix`-XXXXXX;
-// removed with everything in it when the value goes. Fails the test (and holds
-// an empty path) when it cannot be made.
+// removed with everything in it when the value goes, unless the test has
+// failed by then: a failing test's outputs (logs, run reports, captures) stay,
+// and where is said. Fails the test (and holds an empty path) when it cannot be
+// made.
 class ScratchDir {
  public:
   explicit ScratchDir(const std::string& prefix = "optique-test");
@@ -24,10 +26,6 @@ class ScratchDir {
  private:
   std::filesystem::path path_;
 };
-
-// A fresh empty folder that stays (for a run's outputs a failing test leaves
-// behind to be looked at).
-[[nodiscard]] std::string make_temp_dir(const std::string& prefix);
 
 // The file's bytes as they are (binary); empty when it cannot be read.
 [[nodiscard]] std::string read_file(const std::filesystem::path& path);

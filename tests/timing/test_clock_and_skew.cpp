@@ -64,7 +64,8 @@ TEST(FrameSync, SkewedAndDriftingClocksAreEstimatedWithin50MicrosecondsAfterTwoS
 // every node but for such stalls — and reports p99; docs/bench/barrier.md has
 // the distribution over repeated runs.
 TEST(FrameSync, EightNodesPresentTogetherAt60HzFor10Seconds) {
-  const std::string dir = make_temp_dir("optique-eight");
+  const ScratchDir dir_scratch("optique-eight");
+  const std::string dir = dir_scratch.string();
   const std::string config = write_config_variant(
       kConfigs + "/powerwall-2x2.json",
       [](schema::Installation& installation) {

@@ -112,10 +112,12 @@ struct Outcome {
 // kFrames of the 2×2 wall with local null nodes, its status server on, polled
 // by `clients` for kPollFor from the moment it listens.
 Outcome run_wall(int clients) {
-  const std::string dir = make_temp_dir("optique-status-load");
-  Process master({kMaster, "--config", kConfig, "--local", "--frames", std::to_string(kFrames), "--out", dir + "/out", "--no-status",
-                  "--node-arg=--renderer=null", "--status-port", "0", "--status-port-file", dir + "/status.port"},
-                 dir + "/master.log");
+  const ScratchDir dir_scratch("optique-status-load");
+  const std::string dir = dir_scratch.string();
+  Process master(
+      {kMaster, "--config", kConfig, "--local", "--frames", std::to_string(kFrames), "--out", dir + "/out",
+       "--no-status", "--node-arg=--renderer=null", "--status-port", "0", "--status-port-file", dir + "/status.port"},
+      dir + "/master.log");
   Outcome out;
   EXPECT_TRUE(wait_for_file(dir + "/status.port", 15s)) << master.output();
   const int port = std::atoi(read_file(dir + "/status.port").c_str());

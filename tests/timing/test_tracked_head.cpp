@@ -95,7 +95,8 @@ struct Errors {
 // tracked after the first second.
 Errors run_walk(const std::string& prediction, int frames, report::RunReport* report = nullptr,
                 const std::function<void(const DTrackSender&, std::uint64_t)>& extra = {}, int port = 0) {
-  const std::string dir = make_temp_dir("optique-tracking");
+  const ScratchDir dir_scratch("optique-tracking");
+  const std::string dir = dir_scratch.string();
   if (port == 0) port = free_udp_port();
   const std::string config = tracked_config(dir, port, prediction);
   const clock::Nanos origin = clock::monotonic_now();

@@ -25,7 +25,8 @@ constexpr std::uint32_t kFrameTimeoutMs = 20;
 class UnderLoad : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(UnderLoad, NearlyEveryFrameIsShownByEveryProjector) {
-  const std::string dir = make_temp_dir("optique-load");
+  const ScratchDir dir_scratch("optique-load");
+  const std::string dir = dir_scratch.string();
   std::vector<std::unique_ptr<Process>> busy;
   for (int i = 0; i < 2; ++i) {
     busy.push_back(std::make_unique<Process>(std::vector<std::string>{"/bin/sh", "-c", "while :; do :; done"},
@@ -38,8 +39,8 @@ TEST_P(UnderLoad, NearlyEveryFrameIsShownByEveryProjector) {
       kConfigs + "/" + GetParam(),
       [](schema::Installation& installation) { installation.mutable_master()->set_frame_timeout_ms(kFrameTimeoutMs); },
       dir + "/" + GetParam());
-  Process master({std::string(OPTIQUE_BIN_DIR) + "/optique-master", "--config", config,
-                  "--local", "--frames", std::to_string(kFrames), "--out", dir + "/out", "--no-status"},
+  Process master({std::string(OPTIQUE_BIN_DIR) + "/optique-master", "--config", config, "--local", "--frames",
+                  std::to_string(kFrames), "--out", dir + "/out", "--no-status"},
                  dir + "/master.log");
   const auto status = master.wait(scaled(240s));
   for (auto& loop : busy) loop->signal(SIGKILL);
