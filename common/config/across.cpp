@@ -9,8 +9,6 @@ namespace {
 
 using util::number_text;
 
-std::string path_of(std::size_t i) { return "projectors[" + std::to_string(i) + "]"; }
-
 // A defocus projector shows only the blurred share of the image: without a focus
 // partner on the same screen for the same eye, the sharp share is missing, and
 // the other way round.
@@ -24,10 +22,10 @@ void stacked_pairs(const Installation& built, Checker& check) {
       return other.content.role == wanted && other.screen == p.screen && other.eye == p.eye;
     });
     if (!partnered) {
-      check.fail(path_of(i) + ".content.role", "a '" + std::string(to_string(role)) + "' projector needs a '" +
-                                                   std::string(to_string(wanted)) + "' partner on screen '" +
-                                                   built.screen_of(p).id + "' for the same eye, and '" + p.id +
-                                                   "' has none: the pair shows depth of field together");
+      check.fail(projector_path(i) + ".content.role", "a '" + std::string(to_string(role)) + "' projector needs a '" +
+                                                          std::string(to_string(wanted)) + "' partner on screen '" +
+                                                          built.screen_of(p).id + "' for the same eye, and '" + p.id +
+                                                          "' has none: the pair shows depth of field together");
     }
   }
 }
@@ -40,7 +38,7 @@ void preset_frame_rate(const schema::Projector& p, const Projector& built, std::
   }
   const auto preset_rate = config::preset_frame_rate(p.color_fields().preset());
   if (!preset_rate || std::abs(*preset_rate - rate) <= 0.01) return;
-  check.fail(path_of(i) + ".color_fields.preset",
+  check.fail(projector_path(i) + ".color_fields.preset",
              "'" + p.color_fields().preset() + "' is the field timing of a " + number_text(*preset_rate) +
                  " Hz projector, but master.frame_rate is " + number_text(rate) + " Hz: each field would last " +
                  number_text(*preset_rate / rate) + " times as long (set master.frame_rate, or give the fields)");
@@ -53,7 +51,7 @@ void interpolation_and_live_head(const Projector& p, std::size_t i, const Viewer
       viewer.tracking->source == TrackingSource::replay) {
     return;
   }
-  check.fail(path_of(i) + ".up_conversion.mode",
+  check.fail(projector_path(i) + ".up_conversion.mode",
              "interpolate draws key frames from the scene ratio − 1 frames ahead, but the head is tracked live "
              "(viewer.tracking): it cannot be known ahead; use extrapolate");
 }

@@ -9,11 +9,7 @@
 #include "config/sections.h"
 
 namespace optique::config {
-namespace {
-
-std::string path_of(std::size_t i) { return "projectors[" + std::to_string(i) + "]"; }
-
-}  // namespace
+namespace {}  // namespace
 
 void resolve_homographies(const schema::Installation& installation, Installation& built, const std::string& config_dir,
                           std::vector<Problem>& problems) {
@@ -28,7 +24,7 @@ void resolve_homographies(const schema::Installation& installation, Installation
         auto h = read_calibration_homography((std::filesystem::path(config_dir) / p.calibration()).string(), p.width(),
                                              p.height());
         if (!h) {
-          problems.push_back({path_of(i) + ".calibration", h.error()});
+          problems.push_back({projector_path(i) + ".calibration", h.error()});
           continue;
         }
         projector.homography = h.value();
@@ -53,9 +49,9 @@ void resolve_homographies(const schema::Installation& installation, Installation
              q.camera->camera == p.camera->camera && q.screen == p.screen;
     });
     if (partner == built.projectors.end()) {
-      problems.push_back({path_of(i) + ".camera", "no projector on screen '" + built.screen_of(p).id +
-                                                      "' seen by camera '" + p.camera->camera +
-                                                      "' has a homography or calibration to relate this one to"});
+      problems.push_back({projector_path(i) + ".camera",
+                          "no projector on screen '" + built.screen_of(p).id + "' seen by camera '" + p.camera->camera +
+                              "' has a homography or calibration to relate this one to"});
       continue;
     }
     // Partner pixels → camera → this projector's pixels.
@@ -68,11 +64,11 @@ void resolve_homographies(const schema::Installation& installation, Installation
     const Projector& p = built.projectors[i];
     auto geometry = geometry::ProjectorGeometry::make(p.homography, p.width, p.height);
     if (!geometry) {
-      problems.push_back({path_of(i) + ".homography", geometry.error()});
+      problems.push_back({projector_path(i) + ".homography", geometry.error()});
       continue;
     }
     if (auto oblique = geometry::oblique_projection(geometry.value(), built.screen_of(p).area()); !oblique) {
-      problems.push_back({path_of(i), oblique.error() + " (screen '" + built.screen_of(p).id + "')"});
+      problems.push_back({projector_path(i), oblique.error() + " (screen '" + built.screen_of(p).id + "')"});
     }
   }
 }

@@ -30,7 +30,7 @@ std::optional<std::uint32_t> parse_index(std::string_view text) {
 
 // `text` in double quotes. Built by appending: GCC 12 warns falsely (-Wrestrict)
 // on "literal" + std::string.
-std::string quoted(std::string_view text) {
+std::string in_quotes(std::string_view text) {
   std::string q;
   q.reserve(text.size() + 2);
   q += '"';
@@ -59,22 +59,22 @@ Result<std::vector<std::uint32_t>> parse_light_list(std::string_view text) {
     start = comma + 1;
     ++item_number;
     if (item.empty()) {
-      return Error{"item " + std::to_string(item_number) + " of the light list " + quoted(text) +
+      return Error{"item " + std::to_string(item_number) + " of the light list " + in_quotes(text) +
                    " is empty: remove the extra comma"};
     }
     const std::size_t dash = item.find('-');
     const auto low = parse_index(trim(item.substr(0, dash)));
     const auto high = dash == std::string_view::npos ? low : parse_index(trim(item.substr(dash + 1)));
     if (!low || !high) {
-      return Error{quoted(item) + " in the light list is not a light index or range (write 7 or 7-9)"};
+      return Error{in_quotes(item) + " in the light list is not a light index or range (write 7 or 7-9)"};
     }
     if (*high >= kMaxLights) {
-      return Error{quoted(item) + " in the light list goes beyond light " + std::to_string(kMaxLights - 1) +
+      return Error{in_quotes(item) + " in the light list goes beyond light " + std::to_string(kMaxLights - 1) +
                    ", more than a scene may have"};
     }
     if (*high < *low) {
-      return Error{"the range " + quoted(item) + " is reversed: write " +
-                   quoted(std::to_string(*high) + '-' + std::to_string(*low))};
+      return Error{"the range " + in_quotes(item) + " is reversed: write " +
+                   in_quotes(std::to_string(*high) + '-' + std::to_string(*low))};
     }
     for (std::uint64_t light = *low; light <= *high; ++light) {
       if (!listed.insert(static_cast<std::uint32_t>(light)).second) {

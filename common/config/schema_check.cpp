@@ -57,9 +57,9 @@ const FieldDescriptor* by_name(const Descriptor& type, const std::string& key) {
 
 std::string child(const std::string& path, const std::string& name) { return path.empty() ? name : path + "." + name; }
 
-class Checker {
+class SchemaChecker {
  public:
-  explicit Checker(std::vector<Problem>& problems) : problems_(problems) {}
+  explicit SchemaChecker(std::vector<Problem>& problems) : problems_(problems) {}
 
   void message(const Descriptor& type, const Json& object, const std::string& path) {
     if (!object.is_object()) {
@@ -193,7 +193,7 @@ class Checker {
 
 std::vector<Problem> schema_problems(const nlohmann::ordered_json& document, const Descriptor& type) {
   std::vector<Problem> problems;
-  Checker(problems).message(type, document, "");
+  SchemaChecker(problems).message(type, document, "");
   return problems;
 }
 

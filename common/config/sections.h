@@ -17,6 +17,9 @@
 
 namespace optique::config {
 
+// Where projector `i` is in the file: "projectors[i]".
+[[nodiscard]] inline std::string projector_path(std::size_t i) { return "projectors[" + std::to_string(i) + "]"; }
+
 [[nodiscard]] std::vector<Screen> parse_screens(const schema::Installation& installation, Checker& check);
 // The screen a section names (the last of that id: a duplicate is a problem of its own).
 [[nodiscard]] std::optional<std::size_t> find_screen(const std::vector<Screen>& screens, const std::string& id);

@@ -19,6 +19,7 @@
 #include <string>
 
 #include "net/openssl_error.h"
+#include "util/big_endian.h"
 
 namespace optique::net {
 namespace {
@@ -50,13 +51,6 @@ std::string octal_mode(mode_t mode) {
 
 bool is_trailing_space(std::uint8_t byte) { return byte == '\n' || byte == '\r' || byte == ' ' || byte == '\t'; }
 
-void append_be32(std::vector<std::uint8_t>& out, std::uint32_t value) {
-  out.push_back(static_cast<std::uint8_t>(value >> 24));
-  out.push_back(static_cast<std::uint8_t>(value >> 16));
-  out.push_back(static_cast<std::uint8_t>(value >> 8));
-  out.push_back(static_cast<std::uint8_t>(value));
-}
-
 // A length that does not fit the 4-byte prefix would make the encoding ambiguous;
 // frames are far smaller, so reaching this is a caller's bug, refused in release
 // builds too rather than truncated.
@@ -64,7 +58,7 @@ void append_field(std::vector<std::uint8_t>& out, const std::uint8_t* data, std:
   if (size > std::numeric_limits<std::uint32_t>::max()) {
     throw std::invalid_argument("hello_mac: field longer than 4 GiB");
   }
-  append_be32(out, static_cast<std::uint32_t>(size));
+  util::append_be32(out, static_cast<std::uint32_t>(size));
   out.insert(out.end(), data, data + size);
 }
 
@@ -175,7 +169,7 @@ std::array<std::uint8_t, kHelloMacBytes> hello_mac(const Secret& secret, std::sp
   message.insert(message.end(), kHelloLabel.begin(), kHelloLabel.end());
   append_field(message, nonce.data(), nonce.size());
   append_field(message, reinterpret_cast<const std::uint8_t*>(node_id.data()), node_id.size());
-  append_be32(message, protocol_version);
+  util::append_be32(message, protocol_version);
   return hmac_sha256(secret, message, "hello_mac");
 }
 

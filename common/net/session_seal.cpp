@@ -10,6 +10,7 @@
 #include <string>
 
 #include "net/openssl_error.h"
+#include "util/big_endian.h"
 
 namespace optique::net {
 namespace {
@@ -25,12 +26,9 @@ struct ContextFree {
 // does not wrap, which 2^64 frames do not.
 std::array<std::uint8_t, kIvBytes> iv_for(std::uint64_t count) {
   std::array<std::uint8_t, kIvBytes> iv{};
-  for (int i = 0; i < 8; ++i) iv[kIvBytes - 1 - static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(count >> (8 * i));
+  for (int i = 0; i < 8; ++i)
+    iv[kIvBytes - 1 - static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(count >> (8 * i));
   return iv;
-}
-
-void append_be32(std::vector<std::uint8_t>& out, std::uint32_t value) {
-  for (int shift = 24; shift >= 0; shift -= 8) out.push_back(static_cast<std::uint8_t>(value >> shift));
 }
 
 }  // namespace
@@ -42,9 +40,9 @@ SessionKeys derive_session_keys(const Secret& secret, std::span<const std::uint8
   std::vector<std::uint8_t> salt(master_nonce.begin(), master_nonce.end());
   salt.insert(salt.end(), node_nonce.begin(), node_nonce.end());
   std::vector<std::uint8_t> info(kSessionLabel.begin(), kSessionLabel.end());
-  append_be32(info, static_cast<std::uint32_t>(node_id.size()));
+  util::append_be32(info, static_cast<std::uint32_t>(node_id.size()));
   info.insert(info.end(), node_id.begin(), node_id.end());
-  append_be32(info, protocol_version);
+  util::append_be32(info, protocol_version);
   if (secret.bytes.size() > INT_MAX || salt.size() > INT_MAX || info.size() > INT_MAX) {
     throw std::invalid_argument("derive_session_keys: input too long");
   }
@@ -79,10 +77,9 @@ namespace {
 
 CipherContextPtr keyed_context(const SessionKey& key, bool encrypt) {
   CipherContextPtr c(new CipherContext{EVP_CIPHER_CTX_new()});
-  const bool keyed =
-      c->context != nullptr &&
-      (encrypt ? EVP_EncryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr)
-               : EVP_DecryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr)) == 1;
+  const bool keyed = c->context != nullptr &&
+                     (encrypt ? EVP_EncryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr)
+                              : EVP_DecryptInit_ex(c->context, EVP_aes_256_gcm(), nullptr, key.data(), nullptr)) == 1;
   if (!keyed) throw std::runtime_error("AES-256-GCM set-up failed: " + openssl_error());
   return c;
 }

@@ -248,7 +248,6 @@ SceneDefinition pinball() {
 // object each (the falling ring has a static plinth too), turning or moving at a
 // known rate, under one or two point lights.
 
-constexpr double kTau = 2.0 * std::numbers::pi;
 constexpr double kFastTurnsPerSecond = 2.0;
 constexpr double kSlowTurnsPerSecond = 0.25;
 // "Zoom in/out": z swings kZoomSwing either side of kZoomCentre (−1.2 to −0.2),

@@ -11,8 +11,6 @@
 namespace optique::scene {
 namespace {
 
-constexpr double kTau = 2.0 * std::numbers::pi;
-
 // Appends a flat quad a-b-c-d (counter-clockwise seen from outside).
 void add_face(Mesh& mesh, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c, const glm::vec3& d,
               const glm::vec3& normal) {

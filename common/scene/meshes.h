@@ -4,12 +4,15 @@
 // Triangles are counter-clockwise seen from outside; every normal is unit length.
 
 #include <cstdint>
+#include <numbers>
 
 #include "scene/definition.h"
 
 namespace optique::scene {
 
-[[nodiscard]] Mesh make_box(const glm::vec3& size);  // axis-aligned, centred
+inline constexpr double kTau = 2.0 * std::numbers::pi;  // a whole turn, radians
+
+[[nodiscard]] Mesh make_box(const glm::vec3& size);       // axis-aligned, centred
 [[nodiscard]] Mesh make_quad(float width, float height);  // in the xy plane, facing +z
 
 // A sphere of `radius` in `segments` slices around the y axis (at least 3) and

@@ -7,7 +7,7 @@ namespace optique::master {
 namespace {
 
 // Before its hello an application has said nothing worth more.
-constexpr std::uint32_t kMaxHelloBytes = 4096;
+constexpr std::uint32_t kMaxApplicationHelloBytes = 4096;
 // The kernel's share of what waits for an application that stopped reading
 // (Linux doubles it for its bookkeeping); the rest is bounded by SceneSessions.
 constexpr int kSendBufferBytes = 128 * 1024;
@@ -51,7 +51,7 @@ void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& p
   const SessionId id = next_id_++;
   boost::system::error_code ignored;  // the kernel's default is then the bound
   socket.set_option(asio::socket_base::send_buffer_size(kSendBufferBytes), ignored);
-  auto connection = net::Connection::create(std::move(socket), kMaxHelloBytes);
+  auto connection = net::Connection::create(std::move(socket), kMaxApplicationHelloBytes);
   connections_[id] = connection;
   connection->start({
       [this, id](wire::Envelope& message, clock::Nanos) { carry_out(sessions_.message(id, message, next_frame_())); },

@@ -39,7 +39,7 @@ std::string torus_config(const ScratchDir& folder, const std::string& gltf) {
 
 image::FloatImage torus_capture(const std::string& form) {
   const ScratchDir folder("optique-gltf-scene");
-  const std::string out = run_and_capture(torus_config(folder, kTorus + form), static_cast<int>(kFrame) + 1, 1);
+  const CapturedRun out = run_and_capture(torus_config(folder, kTorus + form), static_cast<int>(kFrame) + 1, 1);
   return capture(out, "wall", kFrame);
 }
 

@@ -213,12 +213,12 @@ TEST(LiveSceneOnGlNodes, RandomTransactionsStayCoherentAndTheJournalDrawsTheSame
 
   // The journal replayed with no application: the same captures, byte for
   // byte, up to the frame compared with the reference.
-  const std::string replayed =
+  const CapturedRun replayed =
       run_and_capture(kWall, static_cast<int>(kCompared) + 1, kCaptureEvery, {"--replay", journal});
   for (const char* projector : {"top-left", "top-right", "bottom-left", "bottom-right"}) {
     for (std::uint64_t frame = 0; frame <= kCompared; frame += kCaptureEvery) {
       const std::string a = read_file(image::frame_path(live_out + "/nodes/" + projector, frame, "png"));
-      const std::string b = read_file(image::frame_path(replayed + "/nodes/" + projector, frame, "png"));
+      const std::string b = read_file(image::frame_path(replayed.out + "/nodes/" + projector, frame, "png"));
       EXPECT_FALSE(a.empty());
       EXPECT_TRUE(a == b) << projector << " frame " << frame << ": the replay's capture differs";
     }

@@ -73,8 +73,8 @@ std::vector<std::pair<int, int>> lit_runs_in_column(const image::FloatImage& ima
 }
 
 TEST(Rendering, TheFourTilesOfThePowerWallEqualTheSingleWall) {
-  const std::string tiles = run_and_capture(kConfigs + "/powerwall-2x2.json", 31, 30);
-  const std::string whole = run_and_capture(kConfigs + "/single-wall.json", 31, 30);
+  const CapturedRun tiles = run_and_capture(kConfigs + "/powerwall-2x2.json", 31, 30);
+  const CapturedRun whole = run_and_capture(kConfigs + "/single-wall.json", 31, 30);
   const image::FloatImage reference = capture(whole, "wall", 30);
   ASSERT_EQ(reference.width, 640);
   ASSERT_EQ(reference.height, 360);
@@ -112,7 +112,7 @@ TEST(Rendering, GeometryCrossingACaveCornerLinesUpOnBothWalls) {
     inst.mutable_viewer()->clear_path();
     for (double v : {0.1, 1.6, 0.2}) inst.mutable_viewer()->add_eye(v);  // off centre: walls see it differently
   });
-  const std::string out = run_and_capture(config, 1, 1);
+  const CapturedRun out = run_and_capture(config, 1, 1);
   const image::FloatImage front = capture(out, "front", 0);
   const image::FloatImage left = capture(out, "left", 0);
   const image::FloatImage right = capture(out, "right", 0);
@@ -166,7 +166,7 @@ TEST(Rendering, LeftAndRightEyesDifferByTheParallaxOfTheDepth) {
     *inst.add_projectors() = left;
     *inst.add_projectors() = right;
   });
-  const std::string out = run_and_capture(config, 1, 1);
+  const CapturedRun out = run_and_capture(config, 1, 1);
   const double left_x = centroid_x(capture(out, "left-eye", 0));
   const double right_x = centroid_x(capture(out, "right-eye", 0));
   ASSERT_GT(left_x, 0.0);
@@ -195,7 +195,7 @@ TEST(Rendering, AWindowOnAProjectorShowsWhatHeadlessRenders) {
   ASSERT_EQ(master.wait(120s), 0) << master.output();
   EXPECT_NE(read_file(dir + "/out/logs/wall.log").find(", window"), std::string::npos)
       << read_file(dir + "/out/logs/wall.log");
-  const std::string headless = run_and_capture(kConfigs + "/single-wall.json", 11, 10);
+  const CapturedRun headless = run_and_capture(kConfigs + "/single-wall.json", 11, 10);
   const image::FloatImage sent = capture(dir + "/out", "wall", 10);
   EXPECT_EQ(largest_difference(sent, capture(headless, "wall", 10)), 0.0);
   // What the window itself showed (read back from it before the swap): the same
@@ -217,9 +217,9 @@ TEST(Rendering, AWindowOnAProjectorShowsWhatHeadlessRenders) {
 // fields: blue at −5/12 of the frame in the first, +1/12 in the second. On black,
 // each channel's centroid is where the square is at its field.
 TEST(Rendering, AStereoProjectorUsedAsMonoCapturesBothImagesOfAFrame) {
-  const std::string out = run_and_capture(kConfigs + "/dlp-stereo-as-mono.json", 31, 30);
+  const CapturedRun out = run_and_capture(kConfigs + "/dlp-stereo-as-mono.json", 31, 30);
   const image::FloatImage first = capture(out, "dlp", 30);
-  auto second = image::read_image(image::frame_path(out + "/nodes/dlp/second-image", 30, "png"));
+  auto second = image::read_image(image::frame_path(out.out + "/nodes/dlp/second-image", 30, "png"));
   ASSERT_TRUE(second.ok()) << second.error();
   ASSERT_EQ(second.value().width, first.width);
   ASSERT_EQ(second.value().height, first.height);
@@ -261,7 +261,7 @@ TEST(Rendering, AnAnimatedGltfRendersTheSameOnStackedNodes) {
     *inst.add_projectors() = a;
     *inst.add_projectors() = b;
   });
-  const std::string out = run_and_capture(config, 31, 30);
+  const CapturedRun out = run_and_capture(config, 31, 30);
   for (std::uint64_t frame : {0u, 30u}) {
     EXPECT_EQ(largest_difference(capture(out, "stack-a", frame), capture(out, "stack-b", frame)), 0.0)
         << "stacked duplicates differ at frame " << frame;

@@ -12,10 +12,10 @@ namespace optique::testing {
 
 using namespace std::chrono_literals;
 
-std::string run_and_capture(const std::string& config, int frames, int capture_every,
+CapturedRun run_and_capture(const std::string& config, int frames, int capture_every,
                             const std::vector<std::string>& extra) {
-  const ScratchDir dir_scratch("optique-gl");
-  const std::string dir = dir_scratch.string();
+  CapturedRun run{std::make_unique<ScratchDir>("optique-gl"), {}};
+  const std::string dir = run.folder->string();
   std::vector<std::string> command{std::string(OPTIQUE_BIN_DIR) + "/optique-master",
                                    "--config",
                                    config,
@@ -32,7 +32,8 @@ std::string run_and_capture(const std::string& config, int frames, int capture_e
   const auto status = master.wait(120s);
   EXPECT_TRUE(status.has_value()) << "master still running:\n" << master.output();
   EXPECT_EQ(status.value_or(-1), 0) << master.output();
-  return dir + "/out";
+  run.out = dir + "/out";
+  return run;
 }
 
 image::FloatImage capture(const std::string& out, const std::string& projector, std::uint64_t frame) {

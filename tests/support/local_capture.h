@@ -4,17 +4,27 @@
 // gpu tests compare.
 
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "image/image.h"
+#include "scratch.h"
 
 namespace optique::testing {
+
+// A run's output folder, in a scratch folder that goes with the value (kept
+// when the test has failed by then).
+struct CapturedRun {
+  std::unique_ptr<ScratchDir> folder;
+  std::string out;
+  operator const std::string&() const { return out; }  // NOLINT: where an output folder is
+};
 
 // Runs `config` for `frames` frames, capturing every `capture_every`-th, with
 // `extra` arguments for the master; expects it to succeed and returns its
 // output folder (in a fresh temporary folder).
-[[nodiscard]] std::string run_and_capture(const std::string& config, int frames, int capture_every,
+[[nodiscard]] CapturedRun run_and_capture(const std::string& config, int frames, int capture_every,
                                           const std::vector<std::string>& extra = {});
 
 // What node `projector` captured of `frame` (the projector's signal, PNG).
