@@ -126,7 +126,7 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
     out.push_back(shown);
   }
   std::vector<session::Event> flysticks;
-  navigation_->step(frame, state, settings_.live != nullptr ? settings_.live->navigation().sets : 0, flysticks);
+  navigation_.step(frame, state, settings_.live != nullptr ? settings_.live->navigation().sets : 0, flysticks);
   if (settings_.live != nullptr) {
     notify_frame(frame, display, state, tracked, out);
     for (session::Event& event : flysticks) out.push_back(AppEvent{std::move(event)});

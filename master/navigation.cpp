@@ -42,15 +42,13 @@ void ViewerNavigation::input(const std::vector<tracking::FlystickSample>& flysti
     auto found = sticks_.find(sample.id);
     if (found == sticks_.end()) {
       if (sticks_.size() >= kMostFlysticks) continue;
-      found = sticks_.emplace(sample.id, Stick{}).first;
+      found = sticks_.emplace(sample.id, Stick{sample, std::nullopt, true}).first;
     }
     Stick& stick = found->second;
-    const tracking::FlystickSample& had = stick.newest;
-    // New to the master, or anything but its arrival differs.
-    const bool fresh = had.arrival == 0 || had.seen != sample.seen || had.buttons != sample.buttons ||
-                       had.controllers != sample.controllers || had.position != sample.position ||
-                       had.rotation != sample.rotation;
-    stick.changed = stick.changed || fresh;
+    // Anything but its arrival differs: worth an event.
+    tracking::FlystickSample as_before = sample;
+    as_before.arrival = stick.newest.arrival;
+    stick.changed = stick.changed || !(as_before == stick.newest);
     stick.newest = sample;
     if (sample.seen && tracking_) {
       stick.seen = tracking::to_installation(*tracking_, sample.position * 0.001, glm::quat_cast(sample.rotation));

@@ -27,13 +27,13 @@ MasterProtocol::MasterProtocol(const config::Installation& installation, const s
                  LightSwitches::from_config(installation.scene)),
       scene_server_(scene),
       light_plan_(installation, scene.definition),
-      focus_(FocusSchedule::make(installation)) {
+      focus_(FocusSchedule::make(installation)),
+      navigation_(installation.viewer.navigation, installation.viewer.tracking, authority_.frame_period()) {
   frame_period_ = authority_.frame_period();
   if (installation.viewer.tracking) {
     head_.emplace(*installation.viewer.tracking, installation.viewer.head_right, frame_period_,
                   std::move(settings_.replay));
   }
-  navigation_.emplace(installation.viewer.navigation, installation.viewer.tracking, frame_period_);
   current_state_ = authority_.state_at_frame(0);
   current_hash_ = scene::state_hash(current_state_);
   // Until nodes come, plan as if all were up: each node's welcome then carries a

@@ -208,8 +208,8 @@ class MasterProtocol {
   SceneServer scene_server_;
   LightPlan light_plan_;
   std::optional<FocusSchedule> focus_;
-  std::optional<ViewerHead> head_;              // viewer.tracking
-  std::optional<ViewerNavigation> navigation_;  // always made: flysticks, what applications set
+  std::optional<ViewerHead> head_;  // viewer.tracking
+  ViewerNavigation navigation_;     // flysticks, and what applications set
   scene::SceneState current_state_;
   std::uint64_t current_hash_ = 0;
   Barrier barrier_;

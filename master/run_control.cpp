@@ -224,7 +224,7 @@ Actions MasterProtocol::operator_command(OperatorCommand command, const std::str
 Actions MasterProtocol::tracker_input(tracking::TrackerInput input) {
   Actions out;
   if (!head_) return out;
-  navigation_->input(input.flysticks);
+  navigation_.input(input.flysticks);
   std::vector<std::string> said;
   head_->input(std::move(input), said);
   for (std::string& text : said) out.push_back(Log{spdlog::level::warn, std::move(text)});

@@ -321,7 +321,8 @@ std::string check_live(const master::LiveScene& live, const master::LiveSceneLim
   OPTIQUE_FUZZ_REQUIRE(listed == live.instances().size());
   scene::SceneState state;
   master::put_live(live, state);
-  // A navigation the nodes accept: SetNavigation's checks are the wire's.
+  // Only the scene's lights are switched; the navigation must pass the nodes'
+  // checks, which apply_delta below makes.
   OPTIQUE_FUZZ_REQUIRE(live.light_switches().empty() || live.light_switches().rbegin()->first < kFuzzLights);
   if (auto broken = check_state(state); !broken.empty()) return broken;
   scene::SceneState node = previous;
