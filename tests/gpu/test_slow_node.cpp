@@ -23,7 +23,7 @@ TEST(SlowNode, AStoppedGlNodeSlowerThanThePeriodComesBackAndShowsTheFramesAfter)
   const ScratchDir dir_scratch("optique-slow");
   const std::string dir = dir_scratch.string();
   const std::string config = write_config_variant(
-      std::string(OPTIQUE_SOURCE_DIR) + "/configs/single-wall.json",
+      OPTIQUE_SOURCE_DIR "/configs/single-wall.json",
       [](schema::Installation& installation) { installation.mutable_scene()->set_builtin("many-lights"); },
       dir + "/slow.json");
   ExternalMaster master(config, {"--frames", "60"});

@@ -36,7 +36,7 @@ glm::dvec2 mean_place(const image::FloatImage& image) {
 }
 
 TEST(TrackedEyes, TheStereoAxisTurnsWithTheHead) {
-  auto opened = testing::open_gl_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/cave-tracked.json");
+  auto opened = testing::open_gl_installation(OPTIQUE_SOURCE_DIR "/configs/cave-tracked.json");
   ASSERT_TRUE(opened) << opened.error();
   testing::GlInstallation gl = std::move(opened).value();
   const config::Installation& installation = gl.config.installation;

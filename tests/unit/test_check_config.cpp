@@ -13,7 +13,7 @@ namespace optique::tools {
 namespace {
 
 config::LoadedConfig pinball() {
-  auto loaded = config::load_installation(std::string(OPTIQUE_SOURCE_DIR) + "/configs/dlp-pinball.json");
+  auto loaded = config::load_installation(OPTIQUE_SOURCE_DIR "/configs/dlp-pinball.json");
   EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
   return loaded ? std::move(loaded).value() : config::LoadedConfig{};
 }

@@ -102,7 +102,9 @@ TEST(SceneAssetId, TheBuiltinNameOrTheFilesStem) {
   EXPECT_EQ(scene_asset_id("", "models/milk truck.glb"), "milk-truck");
   EXPECT_EQ(scene_asset_id("", "models/.hidden"), ".hidden");
   EXPECT_EQ(scene_asset_id("", "dir/"), "scene");
-  EXPECT_EQ(scene_asset_id("", std::string(100, 'x') + ".gltf"), std::string(kMaxInstanceIdLength, 'x'));
+  std::string long_name(100, 'x');
+  long_name += ".gltf";
+  EXPECT_EQ(scene_asset_id("", long_name), std::string(kMaxInstanceIdLength, 'x'));
   EXPECT_TRUE(is_instance_id(scene_asset_id("", "ünïcode ✓.gltf")));
 }
 
