@@ -1,8 +1,11 @@
 #include "clients/cpp/session.h"
 
-#include <sys/socket.h>
-#include <sys/time.h>
+#include <poll.h>
 
+#include <cerrno>
+#include <cstring>
+
+#include <algorithm>
 #include <array>
 #include <boost/asio.hpp>
 #include <vector>
@@ -47,15 +50,29 @@ struct Session::Link {
   }
 
   // Replies wait at most `timeout`; receive() then fails, with timed_out set.
+  // (A socket's SO_RCVTIMEO would not do: Asio's blocking read waits again,
+  // for ever, when the kernel's read times out.)
   void set_timeout(std::chrono::milliseconds timeout) {
-    const auto micros = std::chrono::duration_cast<std::chrono::microseconds>(timeout).count();
-    const timeval value{static_cast<time_t>(micros / 1000000), static_cast<suseconds_t>(micros % 1000000)};
-    setsockopt(socket.native_handle(), SOL_SOCKET, SO_RCVTIMEO, &value, sizeof value);
+    wait_at_most = std::max(timeout, std::chrono::milliseconds(0));
   }
+  std::chrono::milliseconds wait_at_most{10000};
   bool timed_out = false;  // the last receive() failed for want of an answer in time
+
+  // Whether bytes came before `deadline`; an error other than none says why not.
+  Result<bool> readable_by(std::chrono::steady_clock::time_point deadline) {
+    for (;;) {
+      const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+      pollfd polled{socket.native_handle(), POLLIN, 0};
+      const int ready = ::poll(&polled, 1, static_cast<int>(std::clamp<std::int64_t>(left.count(), 0, 1 << 30)));
+      if (ready > 0) return true;
+      if (ready == 0) return false;
+      if (errno != EINTR) return Error{std::string("cannot wait for the master: ") + std::strerror(errno)};
+    }
+  }
 
   Result<wire::Envelope> receive() {
     timed_out = false;
+    const auto deadline = std::chrono::steady_clock::now() + wait_at_most;
     for (;;) {
       net::DecodedFrame frame = reader.next();
       if (frame.status == net::DecodeStatus::bad) return Error{"the master sent a bad frame: " + frame.error};
@@ -79,14 +96,16 @@ struct Session::Link {
         }
         return envelope;
       }
+      auto readable = readable_by(deadline);
+      if (!readable) return Error{readable.error()};
+      if (!readable.value()) {
+        timed_out = true;
+        return Error{"no answer from the master in time"};
+      }
       std::array<std::uint8_t, 65536> chunk{};
       boost::system::error_code ec;
       const std::size_t got = socket.read_some(asio::buffer(chunk), ec);
       if (ec == asio::error::eof) return Error{"the master closed the session"};
-      if (ec == asio::error::would_block || ec == asio::error::try_again) {
-        timed_out = true;
-        return Error{"no answer from the master in time"};
-      }
       if (ec) return Error{"no answer from the master: " + ec.message()};
       reader.append(std::span(chunk.data(), got));
     }

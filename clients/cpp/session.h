@@ -51,7 +51,8 @@ class Session {
   // read them with next_event. An application that stops reading them is
   // closed by the master after a while.
   [[nodiscard]] Result<void> subscribe(const session::Subscribe& kinds);
-  // The next event, or nullopt when none came within `timeout`.
+  // The next event, or nullopt when none came within `timeout` (0: only what
+  // has come already, without waiting).
   [[nodiscard]] Result<std::optional<session::Event>> next_event(std::chrono::milliseconds timeout);
   // The scene as it was when the session opened.
   [[nodiscard]] const session::SceneContents& scene() const { return scene_; }

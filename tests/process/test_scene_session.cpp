@@ -89,6 +89,12 @@ TEST(SceneSession, AnApplicationPlacesAnInstanceAndEveryNodeShowsItFromTheFrameN
   ASSERT_TRUE(master->wait_for_output("application 'wall-test' connected from 127.0.0.1", 10s)) << master->output();
   EXPECT_EQ(app->scene().assets_size(), 1);
   EXPECT_EQ(app->scene().assets(0), "cubes");
+  // Subscribed to nothing, no event comes: a timeout of 0 returns at once.
+  const auto asked = std::chrono::steady_clock::now();
+  auto none = app->next_event(0ms);
+  ASSERT_TRUE(none.ok()) << none.error();
+  EXPECT_FALSE(none.value().has_value());
+  EXPECT_LT(std::chrono::steady_clock::now() - asked, 1s);
 
   auto applied = app->apply(client::Transaction().create("c1", "cubes", at(0.5)));
   ASSERT_TRUE(applied.ok()) << applied.error();
