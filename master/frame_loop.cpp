@@ -73,7 +73,7 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     sent.push_back(i);
     if (session_of(i)->phase == Phase::in_barrier) waited.push_back(i);
   }
-  recorder_.frame_begun(frame, begin_sent, sent);
+  recorder_.frame_begun(frame, begin_sent, sent, envelope.ByteSizeLong());
   next_frame_ = frame + 1;
   ready_for_swap_.clear();
   wait_for(frame, std::move(waited), captured, now, out);

@@ -9,6 +9,7 @@
 
 #include "master/protocol.h"
 #include "master/run_verdict.h"
+#include "scene/state.h"
 
 namespace optique::master {
 
@@ -86,6 +87,7 @@ report::RunReport MasterProtocol::report() const {
   report.set_connections_refused(refused_connections_);
   if (head_) *report.mutable_tracking() = head_->report();
   report.set_instances(current_state_.instances.size());
+  report.set_snapshot_bytes(scene::to_snapshot(current_state_).ByteSizeLong());
   return report;
 }
 

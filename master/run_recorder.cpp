@@ -28,7 +28,8 @@ RunRecorder::FrameRecord* RunRecorder::find(std::uint64_t frame) {
   return nullptr;
 }
 
-void RunRecorder::frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes) {
+void RunRecorder::frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes,
+                              std::size_t bytes) {
   FrameRecord record;
   record.id = frame;
   record.begin_sent = sent;
@@ -37,6 +38,7 @@ void RunRecorder::frame_begun(std::uint64_t frame, clock::Nanos sent, const std:
   open_.push_back(std::move(record));
   if (first_begin_ == 0) first_begin_ = sent;
   last_begin_ = sent;
+  if (bytes > 0) frame_begin_bytes_.add(static_cast<double>(bytes));
 }
 
 void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time,
@@ -207,6 +209,7 @@ report::RunReport RunRecorder::report() const {
     if (t.clock_true_error_us.count() > 0)
       *node.mutable_clock()->mutable_true_error_us() = t.clock_true_error_us.summary();
   }
+  if (frame_begin_bytes_.count() > 0) *r.mutable_frame_begin_bytes() = frame_begin_bytes_.summary();
   auto& sync = *r.mutable_sync();
   *sync.mutable_barrier_round_us() = barrier_round_us_.summary();
   *sync.mutable_present_skew_us() = present_skew_us_.summary();

@@ -81,7 +81,10 @@ class RunRecorder {
  public:
   explicit RunRecorder(std::vector<std::string> node_ids);
 
-  void frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes);
+  // `bytes`: the size of the FrameBegin the nodes were sent (before what is
+  // each node's own: its share of the lights, a frame ahead).
+  void frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes,
+                   std::size_t bytes = 0);
   // `drawn_as`: how a node that up-converts drew it (key frame, between…). A
   // render time beyond kLongestRender (or negative) is counted, not recorded.
   void ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time,
@@ -149,6 +152,7 @@ class RunRecorder {
   std::vector<NodeTotals> totals_;
   metrics::Reservoir barrier_round_us_;
   metrics::Reservoir present_skew_us_;
+  metrics::Reservoir frame_begin_bytes_;
   RunTotals run_;
   clock::Nanos first_begin_ = 0;
   clock::Nanos last_begin_ = 0;

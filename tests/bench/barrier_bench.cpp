@@ -21,35 +21,11 @@
 #include "process.h"
 #include "ready_go_baseline.h"
 #include "spread.h"
+#include "strip_wall.h"
 
 namespace {
 
 using namespace optique;
-
-// `sealed`: with master.secret_file "secret" (beside the config), so every
-// message after the hello is sealed.
-std::string installation_json(std::size_t nodes, double rate, bool sealed = false) {
-  // One wall cut into vertical strips, one small projector each.
-  std::ostringstream json;
-  const double width = 4.0;
-  json << R"({"screens": [{"id": "wall", "origin": [-2, 0, 0], "right": [1, 0, 0], "up": [0, 1, 0], "width": )" << width
-       << R"(, "height": 2.25}], "projectors": [)";
-  for (std::size_t i = 0; i < nodes; ++i) {
-    json << (i ? "," : "") << R"({"id": "n)" << i
-         << R"(", "width": 160, "height": 90, "screen": "wall", "region": {"x": )"
-         << width * static_cast<double>(i) / static_cast<double>(nodes) << R"(, "y": 0, "width": )"
-         << width / static_cast<double>(nodes) << R"(, "height": 2.25}})";
-  }
-  // All nodes start at once: let every one through the handshake together rather
-  // than refusing those past the default 16, and wait for all of them (64 node
-  // processes take ~18 s to start on 2 cores), so the run measures steady frames,
-  // not late joins.
-  json << R"(], "viewer": {"eye": [0, 1.6, 2]}, "master": {"frame_rate": )" << rate
-       << R"(, "max_pending_connections": )" << std::max<std::size_t>(16, nodes + 1)
-       << R"(, "startup_timeout_ms": 120000)" << (sealed ? R"(, "secret_file": "secret")" : "")
-       << R"(}, "scene": {"builtin": "cubes"}})";
-  return json.str();
-}
 
 struct Sample {
   double barrier_median = 0, barrier_p99 = 0, skew_median = 0, skew_p99 = 0;
@@ -71,7 +47,7 @@ double presented_by_all(const testing::ClusterRun& run, std::size_t nodes, std::
 Sample run_once(const std::string& master_bin, const std::string& work, std::size_t nodes, std::size_t frames,
                 double rate, bool sealed = false) {
   const std::string config = work + "/bench-" + std::to_string(nodes) + ".json";
-  std::ofstream(config) << installation_json(nodes, rate, sealed);
+  std::ofstream(config) << bench::strip_wall_json(nodes, rate, sealed);
   const std::string out = work + "/run-" + std::to_string(nodes);
   std::filesystem::remove_all(out);
   testing::Process master({master_bin, "--config", config, "--local", "--frames", std::to_string(frames), "--out", out,

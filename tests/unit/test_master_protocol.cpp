@@ -730,6 +730,9 @@ TEST_F(MasterTest, AfterItsFramesItSaysGoodbyeAndFinishes) {
   load("powerwall-2x2.json", {}, settings);
   Actions a = join_all();
   const std::uint64_t hash = hash_of(a, 1);
+  const std::vector<wire::Envelope> begins = sent_to(a, 1, wire::Envelope::kFrameBegin);
+  ASSERT_EQ(begins.size(), 1u);
+  const std::size_t begin_bytes = begins.front().ByteSizeLong();
   for (PeerId p = 1; p <= 4; ++p) a = ready(p, 0, hash);
   // No node says it showed frame 0: the next frame's time is a period after its deadline.
   a = master_->timer(Timer::next_frame, now_ + 19 * kMs);
@@ -750,6 +753,12 @@ TEST_F(MasterTest, AfterItsFramesItSaysGoodbyeAndFinishes) {
   EXPECT_TRUE(logged(a, "the run failed: no projector showed any of the 1 frames"));
   EXPECT_EQ(master_->report().frames(), 1u);
   EXPECT_EQ(master_->report().stopped_because(), "ran 1 frames");
+  // The FrameBegin the nodes were sent, and the scene's state whole: the
+  // nodes had the cubes from their welcome, so the frame's change is far
+  // smaller than the snapshot of every cube's pose.
+  EXPECT_EQ(master_->report().frame_begin_bytes().count(), 1u);
+  EXPECT_EQ(master_->report().frame_begin_bytes().max(), static_cast<double>(begin_bytes));
+  EXPECT_GT(master_->report().snapshot_bytes(), 10 * begin_bytes);
 }
 
 // What a run must show to succeed: by default any frame on any projector;

@@ -144,6 +144,22 @@ TEST(RunRecorder, ReportSummarizesTheFrames) {
   EXPECT_NEAR(b.render_us().max(), 500.0, kTolUs);
 }
 
+// The FrameBegin's size each frame, as the frame loop gives it; a frame begun
+// without one (0) is not counted.
+TEST(RunRecorder, FrameBeginBytesAreSummarized) {
+  RunRecorder r({"a"});
+  r.frame_begun(0, 1'000'000'000, {0}, 1000);
+  r.frame_begun(1, 1'016'666'667, {0}, 3000);
+  r.frame_begun(2, 1'033'333'333, {0}, 2000);
+  r.frame_begun(3, 1'050'000'000, {0});
+  (void)r.finalize();
+  const auto& bytes = r.report().frame_begin_bytes();
+  EXPECT_EQ(bytes.count(), 3u);
+  EXPECT_EQ(bytes.median(), 2000.0);
+  EXPECT_EQ(bytes.max(), 3000.0);
+  EXPECT_FALSE(RunRecorder({"a"}).report().has_frame_begin_bytes());
+}
+
 TEST(RunRecorder, ReportCoversOnlyFinalizedFrames) {
   RunRecorder r({"a", "b"});
   feed_three_frames(r);

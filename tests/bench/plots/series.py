@@ -6,7 +6,8 @@ lines (gnuplot's `index`), one number per column, NaN where there is none.
 
 usage: series.py NAME CSV OUT.dat   (NAME: barrier, calibration, dof, fields,
                                      lighting, oblique, oblique-depth,
-                                     scene-transfer, tracking, upconversion)
+                                     live-scene, scene-transfer, tracking,
+                                     upconversion)
 
 The drawing is tests/bench/plots/NAME.gp; scripts/plot-bench.sh runs both."""
 
@@ -289,9 +290,32 @@ def scene_transfer(rows):
     return [[[i, *spread(by[method])] for i, method in enumerate(order)]]
 
 
+def live_scene(rows):
+    """Block 0, per instance count moved each frame (the at-begin runs): the
+    count, then (median, min, max over runs) of the barrier round median, the
+    FrameBegin bytes and the snapshot bytes. Block 1: the runs without an
+    application, at x = 0.5 (the plot's 'none')."""
+    columns = ("barrier_median_us", "frame_begin_bytes_median", "snapshot_bytes")
+    by = defaultdict(list)
+    for r in rows:
+        if r["send"] in ("none", "at-begin"):
+            by[int(r["moved"])].append(r)
+    if 0 not in by:
+        fail("live-scene: no run without an application (send 'none')")
+
+    def cells(runs):
+        out = []
+        for column in columns:
+            out += spread([float(r[column]) for r in runs])
+        return out
+
+    moved = [[count, *cells(by[count])] for count in sorted(by) if count > 0]
+    return [moved, [[0.5, *cells(by[0])]]]
+
+
 SERIES = {"barrier": barrier, "calibration": calibration, "dof": dof, "fields": fields, "lighting": lighting,
-          "oblique": oblique, "oblique-depth": oblique_depth, "scene-transfer": scene_transfer, "tracking": tracking,
-          "upconversion": upconversion}
+          "live-scene": live_scene, "oblique": oblique, "oblique-depth": oblique_depth,
+          "scene-transfer": scene_transfer, "tracking": tracking, "upconversion": upconversion}
 
 
 def main():
