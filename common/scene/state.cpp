@@ -12,13 +12,16 @@
 namespace optique::scene {
 namespace {
 
-class Fnv1a {
+// A hash of 64-bit words: each word multiplied in, turned and multiplied
+// again (the round of the xxHash family), a final mix so that every bit of the
+// input reaches every bit of the value. Byte-at-a-time FNV-1a took 13 % of a
+// node's frame with 1,000 instances moving: eight multiplications a word
+// against two.
+class StateHasher {
  public:
   void add(std::uint64_t v) {
-    for (int i = 0; i < 8; ++i) {
-      hash_ ^= (v >> (8 * i)) & 0xFFu;
-      hash_ *= 0x100000001b3ull;
-    }
+    hash_ += v * kMultiplyIn;
+    hash_ = std::rotl(hash_, 31) * kTurnedBy;
   }
   void add(double v) { add(std::bit_cast<std::uint64_t>(v)); }
   void add(const glm::dvec3& v) {
@@ -43,10 +46,17 @@ class Fnv1a {
   }
   void add(std::string_view text) {
     add(static_cast<std::uint64_t>(text.size()));
-    for (char c : text) {
-      hash_ ^= static_cast<unsigned char>(c);
-      hash_ *= 0x100000001b3ull;
+    // Eight bytes a word, the first lowest: the same words on a machine of
+    // either byte order.
+    std::uint64_t word = 0;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+      word |= static_cast<std::uint64_t>(static_cast<unsigned char>(text[i])) << (8 * (i % 8));
+      if (i % 8 == 7) {
+        add(word);
+        word = 0;
+      }
     }
+    if (text.size() % 8 != 0) add(word);
   }
   void add(const InstanceState& i) {
     add(i.asset);
@@ -57,10 +67,22 @@ class Fnv1a {
     add(i.base_color);
     add(i.emissive);
   }
-  [[nodiscard]] std::uint64_t value() const { return hash_; }
+  [[nodiscard]] std::uint64_t value() const {
+    std::uint64_t v = hash_;
+    v ^= v >> 33;
+    v *= kMultiplyIn;
+    v ^= v >> 29;
+    v *= kMix;
+    v ^= v >> 32;
+    return v;
+  }
 
  private:
-  std::uint64_t hash_ = 0xcbf29ce484222325ull;
+  // Odd 64-bit constants with well-spread bits (those of xxHash64).
+  static constexpr std::uint64_t kMultiplyIn = 0xC2B2AE3D27D4EB4Full;
+  static constexpr std::uint64_t kTurnedBy = 0x9E3779B185EBCA87ull;
+  static constexpr std::uint64_t kMix = 0x165667B19E3779F9ull;
+  std::uint64_t hash_ = 0x27D4EB2F165667C5ull;
 };
 
 // Equality as the hash sees it: bit for bit (0.0 and -0.0 differ), so a change
@@ -343,7 +365,7 @@ glm::dquat head_at(const SceneState& state, double fraction) {
 }
 
 std::uint64_t state_hash(const SceneState& state) {
-  Fnv1a h;
+  StateHasher h;
   h.add(static_cast<std::uint64_t>(state.objects.size()));
   for (const auto& [id, object] : state.objects) {
     h.add(static_cast<std::uint64_t>(id));

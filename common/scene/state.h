@@ -88,8 +88,9 @@ struct SceneState {
 inline constexpr double kLeastNavigationScale = 1e-4;
 inline constexpr double kMostNavigationScale = 1e4;
 
-// FNV-1a over a canonical encoding (ids in order, the bits of every double), so
-// equal states hash equally on every machine.
+// A 64-bit hash of a canonical encoding (ids in order, the bits of every
+// double, words of eight bytes the first lowest), so equal states hash equally
+// on every machine.
 [[nodiscard]] std::uint64_t state_hash(const SceneState& state);
 
 [[nodiscard]] wire::Snapshot to_snapshot(const SceneState& state);

@@ -540,6 +540,48 @@ TEST(SceneInstances, EachFieldChangesTheHash) {
   }
 }
 
+// Ids and assets are hashed eight bytes a word: one byte changed anywhere in a
+// name (first word, past it, the last of 64), or the same letters split
+// otherwise between two names, changes the hash.
+TEST(SceneInstances, EveryByteOfANameChangesTheHash) {
+  const SceneState base = with_instances();
+  const std::string long_asset(kMaxInstanceIdLength, 'a');
+  SceneState long_named = base;
+  long_named.instances["cup"].asset = long_asset;
+  const std::uint64_t long_hash = state_hash(long_named);
+  for (const std::size_t at :
+       {std::size_t{0}, std::size_t{7}, std::size_t{8}, std::size_t{9}, kMaxInstanceIdLength - 1}) {
+    SceneState changed = long_named;
+    changed.instances["cup"].asset[at] = 'b';
+    EXPECT_NE(state_hash(changed), long_hash) << "byte " << at;
+  }
+  SceneState one = base;
+  one.instances["cup"].asset = "tablecl";
+  one.instances["cup"].parent = "oth";
+  SceneState other = base;
+  other.instances["cup"].asset = "tablec";
+  other.instances["cup"].parent = "loth";
+  EXPECT_NE(state_hash(one), state_hash(other));
+}
+
+// The hash is a function of the state alone, the same on every machine and in
+// every build: these are its values for two states (change them only with the
+// function, in a commit that says so; masters and nodes of one release agree).
+// (Built of exact numbers, nothing a maths library computes.)
+TEST(SceneHash, HasTheseValues) {
+  SceneState state;
+  state.objects[3].now.position = {0.5, 1.25, -2.0};
+  state.objects[3].next.position = {0.75, 1.25, -2.0};
+  state.eye_now = {0.0, 1.5, 2.0};
+  state.eye_next = {0.0, 1.5, 2.25};
+  state.lights_off = {1};
+  state.instances["cup"].asset = "a-teacup-of-the-long-name";
+  state.instances["cup"].pose.now.scale = {0.5, 0.5, 0.5};
+  state.instances["cup"].emissive = {2.0, 0.0, 0.0};
+  EXPECT_EQ(state_hash(SceneState{}), 0x9e4df0ed2b31c960u);
+  EXPECT_EQ(state_hash(state), 0xe74b45934fb0e1c8u);
+}
+
 // What the parents make of the instances is checked as the delta would leave
 // them, and a refused delta leaves the state as it was.
 TEST(SceneInstances, ADeltaThatBreaksTheParentsIsRefused) {
