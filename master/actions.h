@@ -11,6 +11,7 @@
 #include <array>
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <variant>
 #include <vector>
@@ -43,9 +44,15 @@ static_assert(timers_in_order(), "kTimers lists every Timer once, in the enum's 
 
 // --- actions
 
+// One message to one peer. `shared`: a message sent alike to several peers (a
+// frame's FrameBegin to every node), held once instead of copied for each
+// (copying 1,000 instances' change eight times was a third of the master's
+// time); `message` is then empty.
 struct Send {
   PeerId peer = 0;
   wire::Envelope message;
+  std::shared_ptr<const wire::Envelope> shared = nullptr;
+  [[nodiscard]] const wire::Envelope& envelope() const { return shared ? *shared : message; }
 };
 struct Close {
   PeerId peer = 0;

@@ -62,7 +62,8 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   const clock::Nanos display =
       schedule_origin_ + static_cast<clock::Nanos>(frame + 1 - schedule_origin_frame_) * frame_period_;
   const bool captured = settings_.capture_every != 0 && frame % settings_.capture_every == 0;
-  const wire::Envelope envelope = next_frame_begin(frame, display, captured, now, out);
+  // One message for every node that needs nothing of its own in it.
+  const auto envelope = std::make_shared<const wire::Envelope>(next_frame_begin(frame, display, captured, now, out));
 
   const clock::Nanos begin_sent = settings_.send_clock ? settings_.send_clock() : now;
   std::vector<std::size_t> sent;
@@ -73,7 +74,7 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
     sent.push_back(i);
     if (session_of(i)->phase == Phase::in_barrier) waited.push_back(i);
   }
-  recorder_.frame_begun(frame, begin_sent, sent, envelope.ByteSizeLong());
+  recorder_.frame_begun(frame, begin_sent, sent, envelope->ByteSizeLong());
   next_frame_ = frame + 1;
   ready_for_swap_.clear();
   wait_for(frame, std::move(waited), captured, now, out);
@@ -161,11 +162,11 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
 // Sends the FrameBegin to the node of `slot`, with what is its own: a new share
 // of the lights, the frame its key frame is drawn for ahead, or that it is to
 // skip this frame. False when it is behind (told to skip; not waited for).
-bool MasterProtocol::send_frame_begin(std::size_t slot, const wire::Envelope& envelope, clock::Nanos display,
-                                      Actions& out) {
+bool MasterProtocol::send_frame_begin(std::size_t slot, const std::shared_ptr<const wire::Envelope>& envelope,
+                                      clock::Nanos display, Actions& out) {
   const PeerId peer = *slots_[slot].peer;
   Session& session = sessions_.at(peer);
-  const std::uint64_t frame = envelope.frame_begin().frame_id();
+  const std::uint64_t frame = envelope->frame_begin().frame_id();
   // Behind: it would draw this frame only after the one it is drawing, too
   // late for either; it keeps up with the scene and draws the newest frame
   // once it has answered.
@@ -182,10 +183,10 @@ bool MasterProtocol::send_frame_begin(std::size_t slot, const wire::Envelope& en
   const config::UpConversion& up_conversion = installation_.projectors[slot].up_conversion;
   const bool interpolates = up_conversion.frames_ahead() > 0;
   if (!new_share && !interpolates && !behind) {
-    out.push_back(Send{peer, envelope});
+    out.push_back(Send{peer, {}, envelope});
     return true;
   }
-  wire::Envelope to_node = envelope;
+  wire::Envelope to_node = *envelope;
   to_node.mutable_frame_begin()->set_skip(behind);
   if (new_share) {
     // A new share applies from this frame on, on every node of the group at once.

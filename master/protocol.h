@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -168,8 +169,8 @@ class MasterProtocol {
   void begin_frame(clock::Nanos now, Actions& out);
   [[nodiscard]] wire::Envelope next_frame_begin(std::uint64_t frame, clock::Nanos display, bool captured,
                                                 clock::Nanos now, Actions& out);
-  [[nodiscard]] bool send_frame_begin(std::size_t slot, const wire::Envelope& envelope, clock::Nanos display,
-                                      Actions& out);
+  [[nodiscard]] bool send_frame_begin(std::size_t slot, const std::shared_ptr<const wire::Envelope>& envelope,
+                                      clock::Nanos display, Actions& out);
   void wait_for(std::uint64_t frame, std::vector<std::size_t> waited, bool captured, clock::Nanos now, Actions& out);
   void on_barrier_timeout(clock::Nanos now, Actions& out);
   void swap(clock::Nanos now, Actions& out);

@@ -45,6 +45,18 @@ void Connection::send(wire::Envelope& message) {
   } else {
     append_envelope(outbox_, message);
   }
+  queued();
+}
+
+void Connection::send_serialized(std::span<const std::uint8_t> body) {
+  if (!open_ || closing_) return;
+  const std::vector<std::uint8_t> plain = with_header(body, kProtocolVersion, next_send_sequence_++);
+  append_frame(outbox_, sealer_ ? sealer_->seal(plain) : plain);
+  queued();
+}
+
+// After a message was queued: closes a peer that does not read, else writes.
+void Connection::queued() {
   if (queued_bytes() > kMaxQueuedBytes) {
     // Closed from the event loop, not from inside send(): the caller may be
     // iterating over sessions, and on_closed may drop the last reference to one.

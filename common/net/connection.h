@@ -14,6 +14,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
 
   // Stamps protocol version and sequence number and queues the message.
   void send(wire::Envelope& message);
+  // The same for a message already serialized without either (with_header):
+  // one serialization for every peer it goes to.
+  void send_serialized(std::span<const std::uint8_t> body);
 
   // Closes now; queued messages are dropped.
   void close(const std::string& reason);
@@ -81,6 +85,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void wait_for_bytes();
   void read_available();
   void handle_bytes(std::size_t count, clock::Nanos received);
+  void queued();
   void write_more();
   void arm_liveness();
   void finish(const std::string& reason);

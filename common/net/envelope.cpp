@@ -14,6 +14,18 @@ void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envel
   (void)serialized;
 }
 
+std::vector<std::uint8_t> with_header(std::span<const std::uint8_t> body, std::uint32_t version,
+                                      std::uint64_t sequence) {
+  wire::Envelope header;
+  header.set_protocol_version(version);
+  header.set_sequence(sequence);
+  std::vector<std::uint8_t> payload(body.begin(), body.end());
+  const std::size_t at = payload.size();
+  payload.resize(at + header.ByteSizeLong());
+  (void)header.SerializeWithCachedSizesToArray(payload.data() + at);
+  return payload;
+}
+
 Result<wire::Envelope> parse_envelope(std::span<const std::uint8_t> payload) {
   wire::Envelope envelope;
   if (!envelope.ParseFromArray(payload.data(), static_cast<int>(payload.size()))) {

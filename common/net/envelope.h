@@ -23,6 +23,13 @@ inline constexpr std::uint32_t kProtocolVersion = 8;
 // Serializes `envelope` and appends it as one frame to `out`.
 void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envelope);
 
+// The payload of `body` (serialized, its protocol version and sequence unset)
+// sent with this version and sequence: the body's bytes, then the two fields'.
+// Protobuf reads fields that follow as set on the message, so a body shared by
+// several peers is serialized once and each peer's sequence added after it.
+[[nodiscard]] std::vector<std::uint8_t> with_header(std::span<const std::uint8_t> body, std::uint32_t version,
+                                                    std::uint64_t sequence);
+
 // Parses one frame's payload. Fails on bytes that are not an Envelope or an
 // Envelope without a body; the protocol version is left for the handshake to judge.
 [[nodiscard]] Result<wire::Envelope> parse_envelope(std::span<const std::uint8_t> payload);

@@ -243,6 +243,15 @@ void Master::carry_out(Action& action) {
                  [&](Send& a) {
                    net::Connection* c = connection(a.peer);
                    if (c == nullptr) return;
+                   if (a.shared) {
+                     if (a.shared != serialized_for_) {
+                       serialized_.resize(a.shared->ByteSizeLong());
+                       (void)a.shared->SerializeWithCachedSizesToArray(serialized_.data());
+                       serialized_for_ = a.shared;
+                     }
+                     c->send_serialized(serialized_);
+                     return;
+                   }
                    // A pong's t3 is when it leaves: stamped as late as the master can.
                    if (a.message.has_pong()) a.message.mutable_pong()->set_t3(clock::monotonic_now());
                    c->send(a.message);

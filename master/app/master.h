@@ -98,6 +98,10 @@ class Master {
   asio::io_context& io_;
   MasterOptions options_;
   spdlog::logger& log_;
+  // The last message sent to several peers (Send::shared), serialized once:
+  // held so that its bytes are those of that very message.
+  std::shared_ptr<const wire::Envelope> serialized_for_;
+  std::vector<std::uint8_t> serialized_;
 
   std::ofstream csv_;
   std::ofstream head_csv_;  // the head shown each frame, with tracking

@@ -201,6 +201,7 @@ void SimCluster::master_actions(master::Actions actions) {
                    [&](master::Send& a) {
                      Link* link = peer_link(a.peer, "a send");
                      if (link == nullptr) return;
+                     if (a.shared) a.message = *a.shared;  // the test's nodes each take their copy
                      wire::Envelope& m = a.message;
                      m.set_protocol_version(net::kProtocolVersion);
                      if (m.has_pong()) m.mutable_pong()->set_t3(now_);

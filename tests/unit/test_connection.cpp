@@ -168,9 +168,9 @@ std::vector<std::uint8_t> sealed_pings(Sealer& sealer, std::uint64_t first, int 
 }
 
 const SessionKeys& test_keys() {
-  static const SessionKeys keys = derive_session_keys(Secret{std::vector<std::uint8_t>(32, 1)},
-                                                      std::vector<std::uint8_t>(32, 2),
-                                                      std::vector<std::uint8_t>(32, 3), "wall", kProtocolVersion);
+  static const SessionKeys keys =
+      derive_session_keys(Secret{std::vector<std::uint8_t>(32, 1)}, std::vector<std::uint8_t>(32, 2),
+                          std::vector<std::uint8_t>(32, 3), "wall", kProtocolVersion);
   return keys;
 }
 
@@ -238,6 +238,58 @@ TEST(Connection, WhatAProtectedConnectionSendsIsSealed) {
   const auto parsed = parse_envelope(opened.value());
   ASSERT_TRUE(parsed);
   EXPECT_EQ(parsed.value().goodbye().reason(), "a reason anyone could read");
+}
+
+// A message serialized once for several peers: each is sent it with its own
+// sequence (one after the other here), plain or sealed, and reads it whole.
+TEST(Connection, AMessageSerializedOnceArrivesWithEachSendsSequence) {
+  wire::Envelope body;
+  body.mutable_frame_begin()->set_frame_id(42);
+  body.mutable_frame_begin()->set_state_hash(0x1234);
+  std::vector<std::uint8_t> bytes(body.ByteSizeLong());
+  (void)body.SerializeToArray(bytes.data(), static_cast<int>(bytes.size()));
+  for (const bool sealed : {false, true}) {
+    Loopback loop;
+    if (sealed) loop.server->protect(test_keys().to_node, test_keys().to_master, false);
+    wire::Envelope first;
+    first.mutable_ping()->set_t1(1);
+    loop.server->send(first);
+    loop.server->send_serialized(bytes);
+    loop.server->send_serialized(bytes);
+    std::vector<std::uint8_t> got;
+    std::vector<wire::Envelope> read;
+    Opener opener(test_keys().to_node);
+    loop.run_until([&] {
+      std::array<std::uint8_t, 4096> buffer{};
+      boost::system::error_code error;
+      loop.client.non_blocking(true);
+      const std::size_t n = loop.client.read_some(asio::buffer(buffer), error);
+      if (!error) got.insert(got.end(), buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(n));
+      for (DecodedFrame frame = decode_frame(got, kDefaultMaxPayloadBytes); frame.status == DecodeStatus::good;
+           frame = decode_frame(got, kDefaultMaxPayloadBytes)) {
+        std::vector<std::uint8_t> payload(frame.payload.begin(), frame.payload.end());
+        got.erase(got.begin(), got.begin() + static_cast<std::ptrdiff_t>(frame.consumed));
+        if (sealed) {
+          auto opened = opener.open(payload);
+          EXPECT_TRUE(opened) << opened.error();
+          if (!opened) return true;
+          payload = std::move(opened).value();
+        }
+        auto parsed = parse_envelope(payload);
+        EXPECT_TRUE(parsed) << parsed.error();
+        if (parsed) read.push_back(std::move(parsed).value());
+      }
+      return read.size() == 3;
+    });
+    ASSERT_EQ(read.size(), 3u) << (sealed ? "sealed" : "plain");
+    for (std::size_t i = 1; i < 3; ++i) {
+      EXPECT_EQ(read[i].sequence(), read[0].sequence() + i) << i;
+      EXPECT_EQ(read[i].protocol_version(), kProtocolVersion);
+      ASSERT_TRUE(read[i].has_frame_begin());
+      EXPECT_EQ(read[i].frame_begin().frame_id(), 42u);
+      EXPECT_EQ(read[i].frame_begin().state_hash(), 0x1234u);
+    }
+  }
 }
 
 }  // namespace

@@ -31,7 +31,7 @@ using testing::first;
 std::vector<wire::Envelope> sent_to(const Actions& actions, PeerId peer, wire::Envelope::BodyCase kind) {
   std::vector<wire::Envelope> out;
   for (const Send* s : all_of<Send>(actions)) {
-    if (s->peer == peer && s->message.body_case() == kind) out.push_back(s->message);
+    if (s->peer == peer && s->envelope().body_case() == kind) out.push_back(s->envelope());
   }
   return out;
 }
@@ -250,7 +250,7 @@ TEST_F(MasterTest, TheSharedSecretIsChecked) {
       EXPECT_EQ(p->keys.to_node, expected.to_node);
       EXPECT_EQ(p->keys.to_master, expected.to_master);
     }
-    if (const auto* s = std::get_if<Send>(&a[i]); s != nullptr && s->message.has_welcome()) welcome_at = i;
+    if (const auto* s = std::get_if<Send>(&a[i]); s != nullptr && s->envelope().has_welcome()) welcome_at = i;
   }
   EXPECT_LT(protect_at, welcome_at) << "the welcome is the first sealed message";
 }
