@@ -153,7 +153,8 @@ TEST(RunRecorder, FrameBeginBytesAreSummarized) {
   r.frame_begun(2, 1'033'333'333, {0}, 2000);
   r.frame_begun(3, 1'050'000'000, {0});
   (void)r.finalize();
-  const auto& bytes = r.report().frame_begin_bytes();
+  const report::RunReport rep = r.report();
+  const report::Distribution& bytes = rep.frame_begin_bytes();
   EXPECT_EQ(bytes.count(), 3u);
   EXPECT_EQ(bytes.median(), 2000.0);
   EXPECT_EQ(bytes.max(), 3000.0);
