@@ -9,7 +9,6 @@
 #include "config/sections.h"
 
 namespace optique::config {
-namespace {}  // namespace
 
 void resolve_homographies(const schema::Installation& installation, Installation& built, const std::string& config_dir,
                           std::vector<Problem>& problems) {
