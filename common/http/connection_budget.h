@@ -38,7 +38,7 @@ class ConnectionBudget {
   std::size_t per_address_;
   std::size_t loopback_reserved_;
   std::size_t open_ = 0;
-  std::size_t remote_open_ = 0;  // of them, not from loopback
+  std::size_t remote_open_ = 0;                    // of them, not from loopback
   std::map<std::string, std::size_t> by_address_;  // not loopback
 };
 

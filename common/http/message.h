@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "http/websocket.h"
+
 namespace optique::http {
 
 enum class Method { get, head, post, other };
@@ -19,7 +21,10 @@ struct Request {
   std::string query;          // after '?', as sent
   std::string authorization;  // the Authorization header; empty: none
   std::string host;           // the Host header; empty: none
+  std::string origin;         // the Origin header (a browser's page); empty: none
   std::string peer;           // "address:port"
+  bool peer_is_loopback = false;
+  bool websocket_upgrade = false;  // asks to become a WebSocket (RFC 6455)
 };
 
 struct Response {
@@ -31,6 +36,9 @@ struct Response {
   // The connection becomes a stream of server-sent events (text/event-stream):
   // every Server::publish() from now on, until either side closes it.
   bool event_stream = false;
+  // To a WebSocket upgrade, with status 101: the connection becomes this
+  // WebSocket (http/websocket.h). Ignored on any other request.
+  std::shared_ptr<WebSocketEndpoint> websocket;
 };
 
 // A plain-text answer; the text ends with a newline.

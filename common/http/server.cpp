@@ -5,9 +5,11 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/http/span_body.hpp>
+#include <boost/beast/websocket.hpp>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <deque>
 #include <optional>
 
@@ -18,6 +20,16 @@ namespace {
 
 namespace beast = boost::beast;
 namespace bhttp = boost::beast::http;
+namespace websocket = boost::beast::websocket;
+
+// A close frame's reason holds at most 123 bytes; cut at a character's start.
+std::string close_frame_reason(const std::string& reason) {
+  constexpr std::size_t kMax = 123;
+  if (reason.size() <= kMax) return reason;
+  std::size_t end = kMax;
+  while (end > 0 && (static_cast<unsigned char>(reason[end]) & 0xC0) == 0x80) --end;
+  return reason.substr(0, end);
+}
 
 Method method_of(bhttp::verb verb) {
   switch (verb) {
@@ -34,18 +46,37 @@ Method method_of(bhttp::verb verb) {
 
 }  // namespace
 
+class Server::Peer : public WebSocketPeer {
+ public:
+  Peer(asio::io_context& io, const std::shared_ptr<Session>& session, std::shared_ptr<std::atomic<std::size_t>> queued)
+      : io_(io), session_(session), queued_(std::move(queued)) {}
+
+  void send(std::string text) override;
+  void close(std::string reason) override;
+  [[nodiscard]] std::size_t queued_bytes() const override { return *queued_; }
+
+ private:
+  asio::io_context& io_;
+  std::weak_ptr<Session> session_;
+  std::shared_ptr<std::atomic<std::size_t>> queued_;
+};
+
 class Server::Session : public std::enable_shared_from_this<Session> {
  public:
   Session(Server& server, std::uint64_t id, asio::ip::tcp::socket socket)
       : server_(server), counters_(server.counters_), id_(id), stream_(std::move(socket)) {
     boost::system::error_code ec;
     const auto peer = stream_.socket().remote_endpoint(ec);
-    if (!ec) peer_ = peer.address().to_string() + ":" + std::to_string(peer.port());
+    if (!ec) {
+      peer_ = peer.address().to_string() + ":" + std::to_string(peer.port());
+      peer_is_loopback_ = peer.address().is_loopback();
+    }
     counters_->open += 1;
   }
   ~Session() {
     counters_->open -= 1;
     if (streaming_) counters_->streams -= 1;
+    if (endpoint_) counters_->websockets -= 1;
   }
 
   void start() { read_request(); }
@@ -74,17 +105,44 @@ class Server::Session : public std::enable_shared_from_this<Session> {
   // dropped now, not kept (for minutes) for a client that does not read.
   void reset() {
     beast::error_code ignored;
-    stream_.socket().set_option(asio::socket_base::linger(true, 0), ignored);
+    tcp().socket().set_option(asio::socket_base::linger(true, 0), ignored);
     close();
   }
 
   void close() {
     if (closed_) return;
     closed_ = true;
+    if (opened_) {
+      endpoint_->closed(close_reason_.empty() ? "the status server closed it" : close_reason_);
+    }
     beast::error_code ignored;
-    stream_.socket().shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
-    stream_.close();
+    tcp().socket().shutdown(asio::ip::tcp::socket::shutdown_both, ignored);
+    tcp().close();
     server_.on_closed(id_);
+  }
+
+  // From the endpoint's owner, on the server's thread (Server::Peer).
+  void websocket_send(std::string text, const std::shared_ptr<std::atomic<std::size_t>>& queued) {
+    if (closed_ || closing_) {
+      *queued -= text.size();
+      return;
+    }
+    if (*queued > endpoint_->max_queued_bytes) {
+      counters_->streams_behind += 1;
+      close_reason_ = "it stopped reading: " + std::to_string(queued->load()) + " bytes waited for it";
+      server_.log_.debug("status: closing the WebSocket of {}: {}", peer_, close_reason_);
+      reset();
+      return;
+    }
+    outbox_.push_back(std::move(text));
+    if (!writing_) write_next_message();
+  }
+  void websocket_close(std::string reason, websocket::close_code code = websocket::close_code::normal) {
+    if (closed_ || closing_) return;
+    closing_ = true;
+    close_reason_ = std::move(reason);
+    close_code_ = code;
+    if (!writing_) write_next_message();
   }
 
  private:
@@ -187,8 +245,18 @@ class Server::Session : public std::enable_shared_from_this<Session> {
     if (const auto found = message.find(bhttp::field::host); found != message.end()) {
       request.host = std::string(found->value());
     }
+    if (const auto found = message.find(bhttp::field::origin); found != message.end()) {
+      request.origin = std::string(found->value());
+    }
     request.peer = peer_;
+    request.peer_is_loopback = peer_is_loopback_;
+    request.websocket_upgrade = websocket::is_upgrade(message);
     Response response = server_.handler_(request);
+    if (response.websocket && response.status == 101 && request.websocket_upgrade) {
+      start_websocket(std::move(response.websocket));
+      return;
+    }
+    if (response.status == 101) response = text_response(500, "the status server cannot upgrade this request");
     if (response.event_stream && response.status == 200 && request.method != Method::head) {
       start_stream();
       return;
@@ -287,6 +355,106 @@ class Server::Session : public std::enable_shared_from_this<Session> {
                       });
   }
 
+  // The connection as TCP, under the WebSocket once it is one.
+  beast::tcp_stream& tcp() { return ws_ ? ws_->next_layer() : stream_; }
+
+  void start_websocket(std::shared_ptr<WebSocketEndpoint> endpoint) {
+    endpoint_ = std::move(endpoint);
+    counters_->websockets += 1;
+    stream_.expires_never();  // the WebSocket keeps its own time
+    ws_.emplace(std::move(stream_));
+    websocket::stream_base::timeout timeouts;
+    timeouts.handshake_timeout = server_.limits_.write_timeout;  // the upgrade's answer, and closing
+    timeouts.idle_timeout = server_.limits_.websocket_idle;
+    timeouts.keep_alive_pings = true;
+    ws_->set_option(timeouts);
+    ws_->set_option(websocket::stream_base::decorator(
+        [](websocket::response_type& response) { response.set(bhttp::field::server, "optique"); }));
+    ws_->read_message_max(endpoint_->max_message_bytes);
+    beast::error_code ignored;
+    tcp().socket().set_option(asio::socket_base::send_buffer_size(server_.limits_.stream_send_buffer), ignored);
+    ws_->async_accept(parser_->get(), [self = shared_from_this()](beast::error_code error) {
+      if (self->closed_) return;
+      if (error) {
+        self->close_reason_ = "its upgrade failed: " + error.message();
+        self->close();
+        return;
+      }
+      self->opened_ = true;
+      self->endpoint_->opened(std::make_shared<Peer>(self->server_.io_, self, self->queued_));
+      self->read_message();
+    });
+  }
+
+  void read_message() {
+    ws_->async_read(inbox_, [self = shared_from_this()](beast::error_code error, std::size_t) {
+      if (self->closed_) return;
+      if (error) {
+        self->websocket_ended(error);
+        return;
+      }
+      if (!self->ws_->got_text()) {
+        self->inbox_.clear();
+        self->websocket_close("this WebSocket takes text messages only", websocket::close_code::unknown_data);
+        self->read_message();  // until the client answers the close
+        return;
+      }
+      std::string text = beast::buffers_to_string(self->inbox_.data());
+      self->inbox_.clear();
+      if (!self->closing_) self->endpoint_->received(std::move(text));
+      self->read_message();
+    });
+  }
+
+  // The read ended: the client closed, went silent, broke a rule, or the close
+  // this side began is done.
+  void websocket_ended(beast::error_code error) {
+    if (close_reason_.empty()) {
+      if (error == websocket::error::closed) {
+        close_reason_ = "the client closed the WebSocket (code " + std::to_string(ws_->reason().code) + ")";
+      } else if (error == websocket::error::message_too_big) {
+        close_reason_ = "a message over " + std::to_string(endpoint_->max_message_bytes) + " bytes";
+      } else if (error == beast::error::timeout) {
+        counters_->timed_out += 1;
+        close_reason_ = "it answered nothing, not even a ping, for " +
+                        std::to_string(server_.limits_.websocket_idle.count()) + " ms";
+      } else {
+        close_reason_ = "the WebSocket broke: " + error.message();
+      }
+    }
+    close();
+  }
+
+  void write_next_message() {
+    if (closed_) return;
+    if (outbox_.empty()) {
+      writing_ = false;
+      if (closing_) {
+        writing_ = true;  // the close frame is the last write
+        ws_->async_close(websocket::close_reason(close_code_, close_frame_reason(close_reason_)),
+                         [self = shared_from_this()](beast::error_code error) {
+                           // Done: the read sees the client's answer and ends.
+                           if (error && !self->closed_) self->close();
+                         });
+      }
+      return;
+    }
+    writing_ = true;
+    ws_->text(true);
+    ws_->async_write(asio::buffer(outbox_.front()), [self = shared_from_this()](beast::error_code error, std::size_t) {
+      if (self->closed_) return;
+      *self->queued_ -= self->outbox_.front().size();
+      self->outbox_.pop_front();
+      if (error) {
+        if (error == beast::error::timeout) self->counters_->timed_out += 1;
+        self->close_reason_ = "writing to it failed: " + error.message();
+        self->reset();
+        return;
+      }
+      self->write_next_message();
+    });
+  }
+
   Server& server_;
   std::shared_ptr<Counters> counters_;
   std::uint64_t id_;
@@ -294,6 +462,7 @@ class Server::Session : public std::enable_shared_from_this<Session> {
   beast::flat_buffer buffer_;
   std::size_t header_bytes_ = 0;  // of the request being read, parsed so far
   std::string peer_;
+  bool peer_is_loopback_ = false;
   std::optional<bhttp::request_parser<bhttp::string_body>> parser_;
   std::optional<bhttp::response<bhttp::span_body<const char>>> response_;
   std::shared_ptr<const std::string> body_;  // what response_ points into, while it is written
@@ -303,7 +472,31 @@ class Server::Session : public std::enable_shared_from_this<Session> {
   bool closed_ = false;
   bool refusing_ = false;
   std::array<char, 4096> discard_{};
+  // As a WebSocket: its endpoint, what waits to be written (the count shared
+  // with its Peer, which adds as it is asked), and how it closes.
+  std::optional<websocket::stream<beast::tcp_stream>> ws_;
+  std::shared_ptr<WebSocketEndpoint> endpoint_;
+  beast::flat_buffer inbox_;
+  std::deque<std::string> outbox_;
+  std::shared_ptr<std::atomic<std::size_t>> queued_ = std::make_shared<std::atomic<std::size_t>>(0);
+  bool opened_ = false;  // told its endpoint; it is then told when it closes
+  bool closing_ = false;
+  websocket::close_code close_code_ = websocket::close_code::normal;
+  std::string close_reason_;
 };
+
+void Server::Peer::send(std::string text) {
+  *queued_ += text.size();  // now, so that a caller on another thread sees it at once
+  asio::post(io_, [session = session_, queued = queued_, text = std::move(text)]() mutable {
+    if (auto open = session.lock()) open->websocket_send(std::move(text), queued);
+  });
+}
+
+void Server::Peer::close(std::string reason) {
+  asio::post(io_, [session = session_, reason = std::move(reason)]() mutable {
+    if (auto open = session.lock()) open->websocket_close(std::move(reason));
+  });
+}
 
 Server::Server(asio::io_context& io, ServerLimits limits, Handler handler, spdlog::logger& log)
     : io_(io),
@@ -411,6 +604,7 @@ ServerCounts Server::counts() const {
   c.streams_behind = counters_->streams_behind;
   c.open = counters_->open;
   c.streams = counters_->streams;
+  c.websockets = counters_->websockets;
   return c;
 }
 

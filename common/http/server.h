@@ -7,7 +7,8 @@
 // one is answered 503 and closed), a whole request within a time (slow clients
 // are closed), header and body sizes (431/413, then closed), and event streams
 // that fall behind are closed rather than buffered without end, in the kernel
-// too. Every answer says it is not to be framed or sniffed.
+// too. Every answer says it is not to be framed or sniffed. A handler may
+// accept a WebSocket upgrade (http/websocket.h), bounded likewise.
 //
 // Runs on the io_context it is given, meant to be its own thread's, so that
 // clients never delay the frame loop; publish() and stop() may be called from
@@ -54,20 +55,24 @@ struct ServerLimits {
   // grow to 4 MiB. A stream closed for falling behind is reset, so that the
   // kernel drops what it still held for it.
   int stream_send_buffer = 32 * 1024;
+  // A WebSocket that hears nothing from its client this long is closed; it is
+  // pinged halfway, so a client that is there but quiet answers and stays.
+  std::chrono::milliseconds websocket_idle{30000};
 };
 
 // What the server did, for the status and the tests; read from any thread.
 struct ServerCounts {
   std::uint64_t accepted = 0;
   std::uint64_t requests = 0;
-  std::uint64_t refused_busy = 0;    // over max_connections (or the part of it not kept for loopback)
+  std::uint64_t refused_busy = 0;     // over max_connections (or the part of it not kept for loopback)
   std::uint64_t refused_address = 0;  // over max_per_address
-  std::uint64_t timed_out = 0;       // a request or a write took too long
-  std::uint64_t too_large = 0;       // header or body over the limit
-  std::uint64_t bad_requests = 0;    // not HTTP
-  std::uint64_t streams_behind = 0;  // event streams closed for falling behind
-  std::uint64_t open = 0;            // connections open now
-  std::uint64_t streams = 0;         // event streams open now
+  std::uint64_t timed_out = 0;        // a request or a write took too long
+  std::uint64_t too_large = 0;        // header or body over the limit
+  std::uint64_t bad_requests = 0;     // not HTTP
+  std::uint64_t streams_behind = 0;   // event streams closed for falling behind
+  std::uint64_t open = 0;             // connections open now
+  std::uint64_t streams = 0;          // event streams open now
+  std::uint64_t websockets = 0;       // WebSockets open now
 };
 
 class Server {
@@ -88,6 +93,7 @@ class Server {
   [[nodiscard]] ServerCounts counts() const;
 
   class Session;  // one connection
+  class Peer;     // a Session's WebSocket, as its endpoint's owner holds it
 
  private:
   friend class Session;
@@ -114,7 +120,7 @@ class Server {
   bool accept_failing_ = false;  // said once per streak
   struct Counters {
     std::atomic<std::uint64_t> accepted{0}, requests{0}, refused_busy{0}, refused_address{0}, timed_out{0},
-        too_large{0}, bad_requests{0}, streams_behind{0}, open{0}, streams{0};
+        too_large{0}, bad_requests{0}, streams_behind{0}, open{0}, streams{0}, websockets{0};
   };
   std::shared_ptr<Counters> counters_ = std::make_shared<Counters>();
 };

@@ -8,6 +8,7 @@
 #include <spdlog/sinks/null_sink.h>
 
 #include <memory>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -15,6 +16,7 @@
 #include "http/server.h"
 #include "http_client.h"
 #include "process.h"
+#include "websocket_client.h"
 
 namespace optique::http {
 namespace {
@@ -33,6 +35,12 @@ class HttpServerTest : public ::testing::Test {
             Response stream;
             stream.event_stream = true;
             return stream;
+          }
+          if (request.path == "/ws") {
+            Response upgrade;
+            upgrade.status = 101;
+            upgrade.websocket = websocket_endpoint(request);
+            return upgrade;
           }
           return text_response(
               200, request.method_text + " " + request.path + " " + request.query + " [" + request.authorization + "]");
@@ -63,6 +71,38 @@ class HttpServerTest : public ::testing::Test {
     EXPECT_TRUE(testing::poll_until([&] { return server_->counts().open == count; }, 2s));
     return held;
   }
+  // An echo: "close" closes it, "flood N" sends N messages of 1 KiB at once;
+  // what it heard and why it closed are kept.
+  std::shared_ptr<WebSocketEndpoint> websocket_endpoint(const Request& request) {
+    auto endpoint = std::make_shared<WebSocketEndpoint>();
+    endpoint->max_message_bytes = 1024;
+    endpoint->max_queued_bytes = 64 << 10;
+    auto peer = std::make_shared<std::shared_ptr<WebSocketPeer>>();
+    upgrades_.push_back(request.origin + " " + (request.peer_is_loopback ? "loopback" : "remote"));
+    endpoint->opened = [peer](std::shared_ptr<WebSocketPeer> opened) { *peer = std::move(opened); };
+    endpoint->received = [this, peer](std::string text) {
+      const std::string_view said(text);
+      if (said == "close") {
+        (*peer)->close("asked to");
+      } else if (said.substr(0, 6) == "flood ") {
+        for (int i = std::stoi(std::string(said.substr(6))); i > 0; --i) (*peer)->send(std::string(1024, 'f'));
+        flood_queued_ = (*peer)->queued_bytes();
+      } else {
+        (*peer)->send("echo " + text);
+      }
+    };
+    endpoint->closed = [this, peer](const std::string& reason) {
+      const std::lock_guard lock(mutex_);
+      closed_reasons_.push_back(reason);
+      peer->reset();  // the endpoint and its peer hold each other until now
+    };
+    return endpoint;
+  }
+  std::vector<std::string> closed_reasons() {
+    const std::lock_guard lock(mutex_);
+    return closed_reasons_;
+  }
+
   void TearDown() override {
     if (server_) server_->stop();
     if (thread_.joinable()) thread_.join();
@@ -74,6 +114,10 @@ class HttpServerTest : public ::testing::Test {
   std::thread thread_;
   int port_ = 0;
   std::atomic<int> handled_{0};
+  std::vector<std::string> upgrades_;  // on the server's thread
+  std::atomic<std::size_t> flood_queued_{0};
+  std::mutex mutex_;
+  std::vector<std::string> closed_reasons_;
 };
 
 TEST_F(HttpServerTest, AnswersAndKeepsTheConnection) {
@@ -290,6 +334,72 @@ TEST_F(HttpServerTest, AStreamThatIsNeverReadIsClosedBeforeItHoldsMuch) {
   // and a burst in flight: well under 512 KiB. It was about 4 MiB.
   EXPECT_LT(published * 1030, 512u << 10) << published << " events of 1 KiB published before it was closed";
   EXPECT_TRUE(stuck.closed_within(2s));
+}
+
+TEST_F(HttpServerTest, AWebSocketCarriesTextBothWaysAndClosesWithItsReason) {
+  start({});
+  testing::WebSocketClient client(port_, "/ws", {{"Origin", "http://127.0.0.1"}});
+  ASSERT_TRUE(client.open()) << client.error();
+  EXPECT_EQ(client.upgrade_status(), 101);
+  ASSERT_TRUE(client.send("hello"));
+  EXPECT_EQ(client.receive(2s).value_or("(none)"), "echo hello");
+  ASSERT_TRUE(client.send("ünïcødé"));
+  EXPECT_EQ(client.receive(2s).value_or("(none)"), "echo ünïcødé");
+  EXPECT_EQ(server_->counts().websockets, 1u);
+  ASSERT_TRUE(client.send("close"));
+  EXPECT_FALSE(client.receive(2s));
+  EXPECT_TRUE(client.closed());
+  EXPECT_EQ(client.close_code(), 1000);
+  EXPECT_EQ(client.close_reason(), "asked to");
+  ASSERT_TRUE(testing::poll_until([&] { return closed_reasons().size() == 1; }, 2s));
+  EXPECT_EQ(closed_reasons()[0], "asked to");
+  EXPECT_TRUE(testing::poll_until([&] { return server_->counts().websockets == 0; }, 2s));
+  // The client closing is heard too.
+  testing::WebSocketClient leaving(port_, "/ws");
+  ASSERT_TRUE(leaving.open()) << leaving.error();
+  leaving.close();
+  ASSERT_TRUE(testing::poll_until([&] { return closed_reasons().size() == 2; }, 2s));
+  EXPECT_EQ(closed_reasons()[1], "the client closed the WebSocket (code 1000)");
+  EXPECT_EQ(upgrades_.front(), "http://127.0.0.1 loopback") << "the handler sees the Origin and the peer";
+  // A plain request to the same path is no WebSocket.
+  EXPECT_EQ(testing::http_request(port_, "GET", "/ws").status, 500);
+}
+
+TEST_F(HttpServerTest, AWebSocketThatBreaksItsBoundsIsClosed) {
+  ServerLimits limits;
+  limits.websocket_idle = 300ms;
+  start(limits);
+  testing::WebSocketClient big(port_, "/ws");
+  ASSERT_TRUE(big.open()) << big.error();
+  ASSERT_TRUE(big.send(std::string(1025, 'b')));  // the endpoint takes 1 KiB
+  EXPECT_FALSE(big.receive(2s));
+  EXPECT_EQ(big.close_code(), 1009) << big.error();
+  testing::WebSocketClient binary(port_, "/ws");
+  ASSERT_TRUE(binary.send_binary("\x01\x02"));
+  EXPECT_FALSE(binary.receive(2s));
+  EXPECT_EQ(binary.close_code(), 1003) << binary.error();
+  EXPECT_EQ(binary.close_reason(), "this WebSocket takes text messages only");
+  // One that never reads, not even a ping, is closed after the idle time; one
+  // that reads stays (the server's pings are answered while it reads).
+  testing::WebSocketClient silent(port_, "/ws");
+  testing::WebSocketClient listening(port_, "/ws");
+  ASSERT_TRUE(silent.open() && listening.open());
+  EXPECT_FALSE(listening.receive(900ms)) << "nothing to hear, and no close";
+  EXPECT_FALSE(listening.closed()) << listening.error();
+  ASSERT_TRUE(testing::poll_until([&] { return closed_reasons().size() == 3; }, 2s));
+  const auto reasons = closed_reasons();
+  EXPECT_EQ(reasons[0], "a message over 1024 bytes");
+  EXPECT_EQ(reasons[1], "this WebSocket takes text messages only");
+  EXPECT_EQ(reasons[2], "it answered nothing, not even a ping, for 300 ms");
+  // One that stops reading while the endpoint sends is closed once 64 KiB wait
+  // beyond the kernel's buffers, rather than held without end.
+  testing::WebSocketClient stalled(port_, "/ws");
+  ASSERT_TRUE(stalled.open());
+  ASSERT_TRUE(stalled.send("flood 2000"));  // 2 MiB, never read
+  ASSERT_TRUE(testing::poll_until([&] { return closed_reasons().size() == 4; }, 3s));
+  EXPECT_EQ(closed_reasons()[3].rfind("it stopped reading: ", 0), 0u) << closed_reasons()[3];
+  EXPECT_EQ(flood_queued_, 2000u * 1024) << "counted as it was sent, for its owner to see at once";
+  EXPECT_EQ(server_->counts().streams_behind, 1u);
 }
 
 TEST_F(HttpServerTest, APeerNotOnLoopbackIsHeldToItsShareAndLoopbackAlwaysGetsIn) {
