@@ -53,6 +53,7 @@ class Server::Peer : public WebSocketPeer {
 
   void send(std::string text) override;
   void close(std::string reason) override;
+  void reset(std::string reason) override;
   [[nodiscard]] std::size_t queued_bytes() const override { return *queued_; }
 
  private:
@@ -136,6 +137,11 @@ class Server::Session : public std::enable_shared_from_this<Session> {
     }
     outbox_.push_back(std::move(text));
     if (!writing_) write_next_message();
+  }
+  void websocket_reset(std::string reason) {
+    if (closed_) return;
+    close_reason_ = std::move(reason);
+    reset();
   }
   void websocket_close(std::string reason, websocket::close_code code = websocket::close_code::normal) {
     if (closed_ || closing_) return;
@@ -489,6 +495,12 @@ void Server::Peer::send(std::string text) {
   *queued_ += text.size();  // now, so that a caller on another thread sees it at once
   asio::post(io_, [session = session_, queued = queued_, text = std::move(text)]() mutable {
     if (auto open = session.lock()) open->websocket_send(std::move(text), queued);
+  });
+}
+
+void Server::Peer::reset(std::string reason) {
+  asio::post(io_, [session = session_, reason = std::move(reason)]() mutable {
+    if (auto open = session.lock()) open->websocket_reset(std::move(reason));
   });
 }
 

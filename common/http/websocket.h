@@ -23,6 +23,8 @@ class WebSocketPeer {
   // Closes once what was sent before has gone, with `reason` in the close
   // frame (cut to what a close frame holds).
   virtual void close(std::string reason) = 0;
+  // Closes now, dropping what waits (a client that stopped reading).
+  virtual void reset(std::string reason) = 0;
   // What waits to be written to it now, not counting the kernel's buffer.
   [[nodiscard]] virtual std::size_t queued_bytes() const = 0;
 };

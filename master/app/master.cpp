@@ -124,9 +124,6 @@ Result<void> Master::start() {
     log_.info("tracking: replaying {} ({} samples), predicted {}", tracking->file, replay_samples,
               config::to_string(tracking->prediction));
   }
-  if (settings.status) {
-    if (auto serving = start_status_service(*settings.status); !serving) return serving;
-  }
   if (session_port_) {
     auto port = session_port_->start([this] { return protocol_->progress().next_frame; });
     if (!port) return Error{port.error()};
@@ -135,6 +132,10 @@ Result<void> Master::start() {
     if (auto written = write_port_file(options_.api_port_file, port.value(), "api port file"); !written) {
       return written;
     }
+  }
+  // After the session port: its WebSockets are opened through the status server.
+  if (settings.status) {
+    if (auto serving = start_status_service(*settings.status); !serving) return serving;
   }
   if (options_.run.secret) {
     log_.info("nodes must prove they hold the shared secret in {}", options_.secret_path);
@@ -179,13 +180,21 @@ Result<void> Master::start_status_service(const config::StatusServer& settings) 
   OperatorAccess access;
   access.reads_need_token = !config::is_loopback_address(settings.listen);
   if (options_.run.secret) access.token = net::status_token(*options_.run.secret);
+  access.scene_sessions = session_port_.has_value();
+  StatusService::SessionOpener open_session;
+  if (session_port_) {
+    open_session = [this](const std::string& application, const std::string& peer) {
+      return session_port_->websocket(application, peer);
+    };
+  }
   // Asked on the server's thread, carried out on this one.
   auto on_command = [this](OperatorCommand command, const std::string& from) {
     asio::post(io_, [this, command, from] {
       if (!finished_) carry_out(protocol_->operator_command(command, from, clock::monotonic_now()));
     });
   };
-  status_service_ = std::make_unique<StatusService>(settings, std::move(access), std::move(on_command), log_);
+  status_service_ = std::make_unique<StatusService>(settings, std::move(access), std::move(on_command),
+                                                    std::move(open_session), log_);
   auto port = status_service_->start();
   if (!port) return Error{port.error()};
   std::string host = settings.listen.find(':') != std::string::npos ? "[" + settings.listen + "]" : settings.listen;

@@ -1,5 +1,6 @@
 #include "master/app/session_port.h"
 
+#include "master/session/session_json.h"
 #include "net/auth.h"
 #include "util/overloaded.h"
 
@@ -11,13 +12,19 @@ constexpr std::uint32_t kMaxApplicationHelloBytes = 4096;
 // The kernel's share of what waits for an application that stopped reading
 // (Linux doubles it for its bookkeeping); the rest is bounded by SceneSessions.
 constexpr int kSendBufferBytes = 128 * 1024;
+// What may wait for one WebSocket at once, a scene read of many instances
+// included. One that stops reading is closed long before, by SceneSessions's
+// rule (SceneSessionSettings::max_queued_bytes for stalled_for).
+constexpr std::size_t kMaxWebSocketQueuedBytes = 64u << 20;
 
 }  // namespace
 
 SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings, LiveScene& live,
                          std::optional<JournalFile> journal, std::optional<net::Secret> secret,
                          std::uint32_t max_message_bytes, spdlog::logger& log)
-    : settings_(settings),
+    : io_(io),
+      settings_(settings),
+      max_message_bytes_(max_message_bytes),
       log_(log),
       journal_(std::move(journal)),
       sessions_(live, SceneSessionSettings{settings.max_sessions, max_message_bytes, std::move(secret),
@@ -45,6 +52,46 @@ void SessionPort::close(const std::string& reason) {
     connection->send(goodbye);
     connection->close_after_sending(reason);
   }
+  for (const auto& [id, peer] : websockets_) {
+    peer->send(to_application_json(goodbye));
+    peer->close(reason);
+  }
+}
+
+std::shared_ptr<http::WebSocketEndpoint> SessionPort::websocket(const std::string& application,
+                                                                const std::string& peer_text) {
+  auto endpoint = std::make_shared<http::WebSocketEndpoint>();
+  endpoint->max_message_bytes = max_message_bytes_;
+  endpoint->max_queued_bytes = kMaxWebSocketQueuedBytes;
+  // Its session id, given on this port's thread (0 until then), read only
+  // there. The callbacks run on the WebSocket's thread: they touch nothing of
+  // the port but its io_context, and what they post checks that it still is.
+  auto id = std::make_shared<SessionId>(0);
+  const std::weak_ptr<bool> alive = alive_;
+  endpoint->opened = [this, &io = io_, alive, id, application, peer_text](std::shared_ptr<http::WebSocketPeer> peer) {
+    asio::post(io, [this, alive, id, application, peer_text, peer = std::move(peer)] {
+      if (alive.expired()) return;
+      *id = next_id_++;
+      websockets_[*id] = peer;
+      carry_out(sessions_.opened(*id, peer_text + " (WebSocket)", application));
+    });
+  };
+  // Read on the WebSocket's thread: the port's thread gets a typed request.
+  endpoint->received = [this, &io = io_, alive, id](std::string text) {
+    asio::post(io, [this, alive, id, request = request_from_json(text)] {
+      if (alive.expired() || *id == 0) return;
+      carry_out(request ? sessions_.request(*id, request.value(), next_frame_())
+                        : sessions_.unreadable(*id, request.error()));
+    });
+  };
+  endpoint->closed = [this, &io = io_, alive, id](const std::string& reason) {
+    asio::post(io, [this, alive, id, reason] {
+      if (alive.expired() || *id == 0) return;
+      websockets_.erase(*id);
+      carry_out(sessions_.closed(*id, reason));
+    });
+  };
+  return endpoint;
 }
 
 void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback) {
@@ -68,10 +115,18 @@ void SessionPort::publish(const session::Event& event) {
   for (SessionAction& action : sessions_.publish(event)) {
     const SessionId to = std::get<session_action::Send>(action).session;
     carry_out({std::move(action)});
-    if (const auto found = connections_.find(to); found != connections_.end()) {
-      carry_out(sessions_.queued(to, found->second->queued_bytes(), now));
-    }
+    if (const auto bytes = queued_bytes(to)) carry_out(sessions_.queued(to, *bytes, now));
   }
+}
+
+std::optional<std::size_t> SessionPort::queued_bytes(SessionId session) const {
+  if (const auto found = connections_.find(session); found != connections_.end()) {
+    return found->second->queued_bytes();
+  }
+  if (const auto found = websockets_.find(session); found != websockets_.end()) {
+    return found->second->queued_bytes();
+  }
+  return std::nullopt;
 }
 
 void SessionPort::carry_out(SessionActions actions) {
@@ -80,9 +135,22 @@ void SessionPort::carry_out(SessionActions actions) {
                    [&](session_action::Send& a) {
                      if (auto found = connections_.find(a.session); found != connections_.end()) {
                        found->second->send(a.message);
+                     } else if (auto web = websockets_.find(a.session); web != websockets_.end()) {
+                       if (std::string json = to_application_json(a.message); !json.empty()) {
+                         web->second->send(std::move(json));
+                       }
                      }
                    },
                    [&](session_action::Close& a) {
+                     if (auto web = websockets_.find(a.session); web != websockets_.end()) {
+                       // A refusal goes after what was sent; a reader that stopped, now.
+                       if (a.after_sending) {
+                         web->second->close(a.reason);
+                       } else {
+                         web->second->reset(a.reason);
+                       }
+                       return;
+                     }
                      const auto found = connections_.find(a.session);
                      if (found == connections_.end()) return;
                      if (a.after_sending) {

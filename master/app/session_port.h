@@ -14,6 +14,7 @@
 #include <string>
 
 #include "config/installation.h"
+#include "http/websocket.h"
 #include "master/app/journal_file.h"
 #include "master/app/tcp_listener.h"
 #include "master/session/live_scene.h"
@@ -34,6 +35,13 @@ class SessionPort {
   // Listens and accepts; `next_frame` says which frame the master begins next.
   // The port bound.
   [[nodiscard]] Result<std::uint16_t> start(std::function<std::uint64_t()> next_frame);
+  // What becomes of a WebSocket to the operator's /api/session from
+  // `peer_text`, named `application`: a scene session like the port's, in
+  // JSON (master/session/session_json.h). Called on the operator server's
+  // thread, which has checked who may open one; the session lives on this
+  // port's thread.
+  [[nodiscard]] std::shared_ptr<http::WebSocketEndpoint> websocket(const std::string& application,
+                                                                   const std::string& peer_text);
   // Sends `event` to the applications that subscribed to its kind. One that
   // has more than max_queued_bytes waiting (it stopped reading) is closed:
   // it never holds the frames back.
@@ -44,15 +52,22 @@ class SessionPort {
  private:
   void on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback);
   void carry_out(SessionActions actions);
+  // How much waits to be sent to `session` (nullopt: it is gone).
+  [[nodiscard]] std::optional<std::size_t> queued_bytes(SessionId session) const;
 
+  asio::io_context& io_;
   const config::ApiServer settings_;
+  const std::uint32_t max_message_bytes_;
   spdlog::logger& log_;
   std::optional<JournalFile> journal_;
   SceneSessions sessions_;
   TcpListener listener_;
   std::function<std::uint64_t()> next_frame_;
   std::map<SessionId, std::shared_ptr<net::Connection>> connections_;
+  std::map<SessionId, std::shared_ptr<http::WebSocketPeer>> websockets_;
   SessionId next_id_ = 1;
+  // What a WebSocket's thread posts here finds the port gone once it is.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
 };
 
 }  // namespace optique::master

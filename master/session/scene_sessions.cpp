@@ -32,18 +32,58 @@ SessionActions SceneSessions::accepted(SessionId id, const std::string& peer_tex
     refuse(id, session, "this master takes applications from other machines only with the shared secret", false, out);
     return out;
   }
-  if (sessions_.size() > settings_.max_sessions) {
-    refuse(id, session,
-           "the master holds " + std::to_string(settings_.max_sessions) + " scene sessions, the most it may", true,
-           out);
-    return out;
-  }
+  if (!admit(id, session, out)) return out;
   wire::Envelope challenge;
   challenge.set_protocol_version(net::kProtocolVersion);
   challenge.mutable_challenge()->set_nonce(std::string(nonce.begin(), nonce.end()));
   challenge.mutable_challenge()->set_secret_required(settings_.secret.has_value());
   out.push_back(Send{id, std::move(challenge)});
   return out;
+}
+
+SessionActions SceneSessions::opened(SessionId id, const std::string& peer_text, const std::string& application) {
+  SessionActions out;
+  Session& session = sessions_[id];
+  session.peer_text = peer_text;
+  if (!admit(id, session, out)) return out;
+  if (!scene::is_instance_id(application)) {
+    refuse(id, session, "name the application: 1 to 64 letters, digits, '-', '_' or '.'", false, out);
+    return out;
+  }
+  connected(session, application, out);
+  return out;
+}
+
+SessionActions SceneSessions::request(SessionId id, const session::Request& request, std::uint64_t next_frame) {
+  SessionActions out;
+  const auto found = sessions_.find(id);
+  if (found == sessions_.end() || found->second.refused || found->second.application.empty()) return out;
+  on_request(id, request, next_frame, out);
+  return out;
+}
+
+SessionActions SceneSessions::unreadable(SessionId id, const std::string& reason) const {
+  SessionActions out;
+  const auto found = sessions_.find(id);
+  if (found == sessions_.end() || found->second.refused || found->second.application.empty()) return out;
+  wire::Envelope answer = reply(0);  // its id could not be read
+  answer.mutable_session_reply()->mutable_refused()->set_field("request");
+  answer.mutable_session_reply()->mutable_refused()->set_reason(reason);
+  out.push_back(Send{id, std::move(answer)});
+  return out;
+}
+
+bool SceneSessions::admit(SessionId id, Session& session, SessionActions& out) {
+  if (sessions_.size() <= settings_.max_sessions) return true;
+  refuse(id, session, "the master holds " + std::to_string(settings_.max_sessions) + " scene sessions, the most it may",
+         true, out);
+  return false;
+}
+
+void SceneSessions::connected(Session& session, const std::string& application, SessionActions& out) {
+  session.application = application;
+  out.push_back(
+      Log{spdlog::level::info, "application '" + session.application + "' connected from " + session.peer_text});
 }
 
 SessionActions SceneSessions::message(SessionId id, const wire::Envelope& message, std::uint64_t next_frame) {
@@ -184,10 +224,8 @@ void SceneSessions::on_hello(SessionId id, Session& session, const wire::Envelop
     }
     out.push_back(Protect{id, keys.value()});
   }
-  session.application = hello.node_id();
   out.push_back(session_action::SetMaxPayload{id, settings_.max_message_bytes});
-  out.push_back(
-      Log{spdlog::level::info, "application '" + session.application + "' connected from " + session.peer_text});
+  connected(session, hello.node_id(), out);
 }
 
 void SceneSessions::on_request(SessionId id, const session::Request& request, std::uint64_t next_frame,

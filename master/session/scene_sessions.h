@@ -93,8 +93,18 @@ class SceneSessions {
   // randomness for its challenge (net::random_nonce()).
   [[nodiscard]] SessionActions accepted(SessionId session, const std::string& peer_text, bool loopback,
                                         const std::vector<std::uint8_t>& nonce);
+  // An application the operator's server let in by its own rules (its
+  // WebSocket, /api/session): no challenge and no hello; `application` is the
+  // name it gave. Refused like any other when it names itself wrongly or when
+  // the master holds as many sessions as it may.
+  [[nodiscard]] SessionActions opened(SessionId session, const std::string& peer_text, const std::string& application);
   // `next_frame`: the frame the master begins next, which shows what is applied now.
   [[nodiscard]] SessionActions message(SessionId session, const wire::Envelope& message, std::uint64_t next_frame);
+  // A request from an application opened() (the binary port's come in message()).
+  [[nodiscard]] SessionActions request(SessionId session, const session::Request& request, std::uint64_t next_frame);
+  // A message from an application opened() that is no Request: it is told
+  // why, and the session goes on.
+  [[nodiscard]] SessionActions unreadable(SessionId session, const std::string& reason) const;
   [[nodiscard]] SessionActions closed(SessionId session, const std::string& reason);
   // `event` sent to every application that subscribed to its kind.
   [[nodiscard]] SessionActions publish(const session::Event& event) const;
@@ -115,6 +125,9 @@ class SceneSessions {
   };
 
   void on_hello(SessionId id, Session& session, const wire::Envelope& message, SessionActions& out);
+  // Whether the master may hold one more session; refused if not.
+  bool admit(SessionId id, Session& session, SessionActions& out);
+  void connected(Session& session, const std::string& application, SessionActions& out);
   void refuse(SessionId id, Session& session, const std::string& reason, bool retriable, SessionActions& out);
   void on_request(SessionId id, const session::Request& request, std::uint64_t next_frame, SessionActions& out);
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <string_view>
 
 #include "config/address.h"
 #include "master/status/status_metrics.h"
@@ -50,6 +51,10 @@ bool host_is_local(std::string_view host) {
   return all_digits(port) && (name == "localhost" || config::is_ip_address(std::string(name)));
 }
 
+bool token_matches(std::string_view given, const std::string& token) {
+  return given.size() == token.size() && CRYPTO_memcmp(given.data(), token.data(), token.size()) == 0;
+}
+
 // "Bearer <token>" with the right token, compared in constant time.
 bool authorized(const http::Request& request, const std::string& token) {
   constexpr std::string_view kScheme = "Bearer ";
@@ -57,7 +62,21 @@ bool authorized(const http::Request& request, const std::string& token) {
   std::string_view given = std::string_view(request.authorization).substr(kScheme.size());
   while (!given.empty() && given.front() == ' ') given.remove_prefix(1);
   while (!given.empty() && given.back() == ' ') given.remove_suffix(1);
-  return given.size() == token.size() && CRYPTO_memcmp(given.data(), token.data(), token.size()) == 0;
+  return token_matches(given, token);
+}
+
+// The value of `key` in a query ("a=1&b=2"), as sent (nullopt: not there).
+std::optional<std::string_view> query_value(std::string_view query, std::string_view key) {
+  while (!query.empty()) {
+    const auto amp = query.find('&');
+    const std::string_view pair = query.substr(0, amp);
+    if (const auto equals = pair.find('='); equals != std::string_view::npos && pair.substr(0, equals) == key) {
+      return pair.substr(equals + 1);
+    }
+    if (amp == std::string_view::npos) break;
+    query.remove_prefix(amp + 1);
+  }
+  return std::nullopt;
 }
 
 http::Response unauthorized(std::string why) {
@@ -79,6 +98,55 @@ http::Response method_not_allowed(const http::Request& request, const char* allo
       http::text_response(405, request.method_text + " " + request.path + ": not allowed (allowed: " + allow + ")");
   response.headers.emplace_back("Allow", allow);
   return response;
+}
+
+// A browser says which page opens a WebSocket; any page may try, so only this
+// server's own (the operator's page) is let in. Scripts send no Origin.
+bool same_origin(const http::Request& request) {
+  return request.origin.empty() || request.origin == "http://" + request.host ||
+         request.origin == "https://" + request.host;
+}
+
+constexpr std::string_view kDefaultApplication = "websocket";
+
+// /api/session: a scene session's WebSocket.
+Routed scene_session(const http::Request& request, const OperatorAccess& access) {
+  if (request.method != http::Method::get) return {method_not_allowed(request, "GET"), std::nullopt};
+  if (!access.scene_sessions) {
+    return {http::text_response(404,
+                                "/api/session: this master has no master.api, so no application may change "
+                                "its scene"),
+            std::nullopt};
+  }
+  if (!request.websocket_upgrade) {
+    http::Response upgrade = http::text_response(
+        426, "/api/session is the scene session's WebSocket: open ws://<this server>/api/session?application=NAME");
+    upgrade.headers.emplace_back("Upgrade", "websocket");
+    return {std::move(upgrade), std::nullopt};
+  }
+  if (!same_origin(request)) {
+    return {http::text_response(403, "Origin '" + request.origin +
+                                         "': from a browser, only this server's own page "
+                                         "may open the scene session"),
+            std::nullopt};
+  }
+  if (access.token) {
+    const auto given = query_value(request.query, "token");
+    if (!authorized(request, *access.token) && !(given && token_matches(*given, *access.token))) {
+      return {unauthorized("the scene session needs the token, as a bearer token or ?token= "
+                           "(optique-master --print-status-token)"),
+              std::nullopt};
+    }
+  } else if (!request.peer_is_loopback || !host_is_local(request.host)) {
+    return {http::text_response(403,
+                                "the scene session is open to other machines only with the token, and this "
+                                "master has none: it is derived from the shared secret (master.secret_file)"),
+            std::nullopt};
+  }
+  http::Response upgrade;
+  upgrade.status = 101;
+  return {std::move(upgrade), std::nullopt,
+          std::string(query_value(request.query, "application").value_or(kDefaultApplication))};
 }
 
 struct Control {
@@ -124,6 +192,8 @@ Routed route(const http::Request& request, const OperatorAccess& access, const S
                                                         "\",\"queued\":true}\n");
     return {std::move(accepted), control.command};
   }
+
+  if (request.path == "/api/session") return scene_session(request, access);
 
   // The page holds no data: it asks for it with the token it is given.
   if (request.path == "/" || request.path == "/index.html") {

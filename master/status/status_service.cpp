@@ -29,10 +29,11 @@ std::vector<LiveWarning> last_warnings(WarningSink& sink) {
 }
 
 StatusService::StatusService(const config::StatusServer& settings, OperatorAccess access, CommandSink on_command,
-                             spdlog::logger& log)
+                             SessionOpener open_session, spdlog::logger& log)
     : settings_(settings),
       access_(std::move(access)),
       on_command_(std::move(on_command)),
+      open_session_(std::move(open_session)),
       server_(
           io_,
           [&] {
@@ -43,6 +44,10 @@ StatusService::StatusService(const config::StatusServer& settings, OperatorAcces
           [this](const http::Request& request) {
             Routed routed = route(request, access_, board_.get());
             if (routed.command) on_command_(*routed.command, request.peer);
+            if (routed.scene_session) {
+              if (!open_session_) return http::text_response(404, "this master takes no scene sessions");
+              routed.response.websocket = open_session_(*routed.scene_session, request.peer);
+            }
             return std::move(routed.response);
           },
           log) {

@@ -32,9 +32,13 @@ using WarningSink = spdlog::sinks::ringbuffer_sink_mt;
 class StatusService {
  public:
   using CommandSink = std::function<void(OperatorCommand command, const std::string& from)>;
+  // What becomes of a scene session's WebSocket that route() let in
+  // (SessionPort::websocket), asked on the server's thread.
+  using SessionOpener =
+      std::function<std::shared_ptr<http::WebSocketEndpoint>(const std::string& application, const std::string& peer)>;
 
   StatusService(const config::StatusServer& settings, OperatorAccess access, CommandSink on_command,
-                spdlog::logger& log);
+                SessionOpener open_session, spdlog::logger& log);
   ~StatusService();  // stops the server and joins its thread
   StatusService(const StatusService&) = delete;
   StatusService& operator=(const StatusService&) = delete;
@@ -50,6 +54,7 @@ class StatusService {
   config::StatusServer settings_;
   OperatorAccess access_;
   CommandSink on_command_;
+  SessionOpener open_session_;
   StatusBoard board_;
   boost::asio::io_context io_;
   http::Server server_;

@@ -8,6 +8,7 @@
 
 #include "master/session/journal.h"
 #include "master/session/scene_sessions.h"
+#include "master/session/session_json.h"
 #include "net/envelope.h"
 #include "net/framing.h"
 #include "scene/state.h"
@@ -360,7 +361,23 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
       continue;
     }
     wire::Envelope message;
-    if (!message.ParseFromArray(chunk.data(), static_cast<int>(chunk.size()))) continue;
+    if (chunk.front() == '{') {
+      // JSON, as the operator's WebSocket takes it: a request, or one refusal
+      // with id 0 that names why, and the session goes on.
+      auto read =
+          master::request_from_json(std::string_view(reinterpret_cast<const char*>(chunk.data()), chunk.size()));
+      if (!read) {
+        const master::SessionActions answer = sessions.unreadable(1, read.error());
+        OPTIQUE_FUZZ_REQUIRE(answer.size() == 1);
+        const auto& sent = std::get<master::session_action::Send>(answer[0]).message;
+        OPTIQUE_FUZZ_REQUIRE(sent.session_reply().id() == 0 && !sent.session_reply().refused().reason().empty());
+        continue;
+      }
+      message.set_protocol_version(net::kProtocolVersion);
+      *message.mutable_session_request() = std::move(read).value();
+    } else if (!message.ParseFromArray(chunk.data(), static_cast<int>(chunk.size()))) {
+      continue;
+    }
     ++out.envelopes;
     const std::map<std::string, master::Instance> before = live.instances();
     const master::SessionActions actions = sessions.message(1, message, frame);
@@ -386,6 +403,9 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
       if (sent == nullptr || !sent->message.has_session_reply()) continue;
       ++replies;
       const session::Reply& reply = sent->message.session_reply();
+      // Its JSON, as a WebSocket hears it, is one object naming a reply.
+      const std::string json = master::to_application_json(sent->message);
+      OPTIQUE_FUZZ_REQUIRE(json.rfind("{\"reply\":{", 0) == 0);
       OPTIQUE_FUZZ_REQUIRE(reply.id() == message.session_request().id());
       if (reply.has_scene()) {
         // The scene as it is: every instance, nothing changed by reading it.

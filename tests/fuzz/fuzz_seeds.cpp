@@ -823,6 +823,20 @@ std::vector<Seed> session_seeds() {
     seeds.push_back({"noise_then_a_node_message", join({noise(40, 7), request(1, {create("a", "torus")}),
                                                         serialize(ready), request(2, {create("b", "torus")})})});
   }
+  // As JSON, from the operator's WebSocket: well formed, and not.
+  const auto json = [](std::string_view text) { return Bytes(text.begin(), text.end()); };
+  seeds.push_back(
+      {"json", join({json(R"({"id": 1, "transaction": {"edits": [{"create": {"instance": "a", "asset": "torus",
+                        "transform": {"position": [1, 2, 3], "rotation": [1, 0, 0, 0], "scale": [2]}}}]}})"),
+                     json(R"({"id": "2", "readScene": {}})"), kNextFrame,
+                     json(R"({"id": 3, "subscribe": {"frames": true, "head": true}})"),
+                     json(R"({"id": 4, "transaction": {"edits": [{"factors": {"instance": "a",
+                        "base_color": [1, 0.5, "NaN", 1]}}]}})"),
+                     json(R"({"id": 5, "transaction": {"edits": [{"remove": {"instance": "a"}}, {"light":
+                        {"light": 1, "on": false}}]}})"),
+                     json(R"({"id": 6, "teleport": {}})"), json(R"({"id": -1})"), json("{"),
+                     json(R"({"id": 7, "transaction": {"edits": [{"transform": {"instance": "a",
+                        "transform": {"position": [1e400, 0, 0]}}}]}})")})});
   return seeds;
 }
 

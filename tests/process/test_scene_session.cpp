@@ -14,6 +14,7 @@
 #include <vector>
 
 #include <boost/asio.hpp>
+#include <nlohmann/json.hpp>
 
 #include "clients/cpp/session.h"
 #include "cluster_run.h"
@@ -24,6 +25,7 @@
 #include "net/framing.h"
 #include "process.h"
 #include "scratch.h"
+#include "websocket_client.h"
 
 namespace optique::testing {
 namespace {
@@ -282,6 +284,114 @@ TEST(SceneSession, AnApplicationThatStopsReadingIsClosedAndTheFramesGoOn) {
     ++shown_after;
   }
   EXPECT_EQ(shown_after, static_cast<std::size_t>(run.report.nodes_size()) * (600 - after_close));
+}
+
+// The next reply a WebSocket hears, as JSON; the events before it are counted.
+nlohmann::json next_reply(WebSocketClient& ws, std::size_t* events = nullptr) {
+  for (int i = 0; i < 1000; ++i) {
+    const auto text = ws.receive(10s);
+    if (!text) return {{"error", ws.error()}};
+    auto message = nlohmann::json::parse(*text, nullptr, false);
+    if (message.contains("reply")) return message["reply"];
+    if (events != nullptr && message.contains("event")) ++*events;
+  }
+  return {{"error", "no reply among 1000 messages"}};
+}
+
+// The same session as JSON over the operator's WebSocket (/api/session): read
+// the scene, apply and be refused by field, subscribe and hear the frames; a
+// message that is no request is answered and the session goes on; another
+// site's page is turned away; a WebSocket that stops reading is closed by the
+// same rule as the port's applications; the master's goodbye arrives.
+TEST(SceneSession, AWebSocketSpeaksTheSessionInJson) {
+  ScratchDir dir("optique-websocket");
+  auto master = wall_master(dir, "out", "900", {"--status-port", "0", "--status-port-file", dir.file("status.port")});
+  ASSERT_TRUE(wait_for_file(dir.file("status.port"), 15s)) << master->output();
+  const int port = std::stoi(read_file(dir.file("status.port")));
+  WebSocketClient ws(port, "/api/session?application=web-test", {{"Origin", "http://127.0.0.1"}});
+  ASSERT_TRUE(ws.open()) << ws.error();
+  ASSERT_TRUE(ws.send(R"({"id": 1, "read_scene": {}})"));
+  nlohmann::json reply = next_reply(ws);
+  EXPECT_EQ(reply["id"], "1") << reply;
+  EXPECT_EQ(reply["scene"]["assets"], nlohmann::json::array({"cubes"})) << reply;
+  EXPECT_TRUE(master->wait_for_output("application 'web-test' connected from 127.0.0.1:", 5s));
+
+  nlohmann::json many = {{"id", 2}, {"transaction", {{"edits", nlohmann::json::array()}}}};
+  for (int i = 0; i < 2000; ++i) {
+    many["transaction"]["edits"].push_back({{"create",
+                                             {{"instance", "w" + std::to_string(i)},
+                                              {"asset", "cubes"},
+                                              {"transform", {{"position", {0.001 * i, 1.0, 0.0}}}}}}});
+  }
+  ASSERT_TRUE(ws.send(many.dump()));
+  reply = next_reply(ws);
+  EXPECT_EQ(reply["id"], "2") << reply;
+  ASSERT_TRUE(reply.contains("applied")) << reply;
+  EXPECT_LT(std::stoull(reply["applied"]["frame"].get<std::string>()), 900u);
+
+  ASSERT_TRUE(ws.send(R"({"id": 3, "teleport": {"to": "mars"}})"));
+  reply = next_reply(ws);
+  EXPECT_EQ(reply["id"], "0") << reply;
+  EXPECT_EQ(reply["refused"]["field"], "request");
+  EXPECT_NE(reply["refused"]["reason"].get<std::string>().find("teleport"), std::string::npos) << reply;
+  ASSERT_TRUE(ws.send(R"({"id": 4, "transaction": {"edits": [{"create": {"instance": "t", "asset": "teapot"}}]}})"));
+  reply = next_reply(ws);
+  EXPECT_EQ(reply["refused"]["field"], "edits[0].create.asset") << reply;
+  EXPECT_EQ(reply["refused"]["reason"], "no asset 'teapot' is loaded");
+
+  ASSERT_TRUE(ws.send(R"({"id": 5, "subscribe": {"frames": true}})"));
+  reply = next_reply(ws);
+  EXPECT_EQ(reply["subscribed"]["frames"], true) << reply;
+  std::vector<std::uint64_t> begun;
+  while (begun.size() < 5) {
+    const auto text = ws.receive(10s);
+    ASSERT_TRUE(text) << ws.error();
+    const auto message = nlohmann::json::parse(*text);
+    if (message.contains("event"))
+      begun.push_back(std::stoull(message["event"]["frame_begun"]["frame"].get<std::string>()));
+  }
+  for (std::size_t i = 1; i < begun.size(); ++i) EXPECT_EQ(begun[i], begun[i - 1] + 1);
+
+  WebSocketClient foreign(port, "/api/session", {{"Origin", "http://evil.example"}});
+  EXPECT_FALSE(foreign.open());
+  EXPECT_EQ(foreign.upgrade_status(), 403) << foreign.error();
+
+  // Subscribed to frames and heads, asking for the scene of 2,000 instances
+  // over and over, and never reading.
+  WebSocketClient stalled(port, "/api/session?application=stalled");
+  ASSERT_TRUE(stalled.open()) << stalled.error();
+  ASSERT_TRUE(stalled.send(R"({"id": 1, "subscribe": {"frames": true, "head": true}})"));
+  for (int i = 0; i < 25; ++i) ASSERT_TRUE(stalled.send(R"({"id": 2, "read_scene": {}})"));
+  std::size_t events = 0;
+  bool closed = false;
+  for (const auto deadline = std::chrono::steady_clock::now() + scaled(20s);
+       !closed && std::chrono::steady_clock::now() < deadline;) {
+    if (ws.receive(100ms)) ++events;  // the first one keeps reading its events
+    closed = master->output().find("closed application 'stalled'") != std::string::npos;
+  }
+  ASSERT_TRUE(closed) << master->output();
+  EXPECT_TRUE(master->wait_for_output("it stopped reading", 1s));
+  EXPECT_GT(events, 100u) << "the reader heard frames all the while";
+  ASSERT_TRUE(ws.send(R"({"id": 6, "transaction": {"edits": [{"transform": {"instance": "w0",
+      "transform": {"position": [1, 1, 0]}}}]}})"));
+  reply = next_reply(ws);
+  EXPECT_TRUE(reply.contains("applied")) << reply << "\n" << master->output();
+
+  std::string closing;
+  while (closing.empty()) {
+    const auto text = ws.receive(30s);
+    ASSERT_TRUE(text) << ws.error();
+    const auto message = nlohmann::json::parse(*text);
+    if (message.contains("closing")) closing = message["closing"]["reason"];
+  }
+  EXPECT_EQ(closing, "the master is shutting down");
+  EXPECT_FALSE(ws.receive(5s));
+  EXPECT_TRUE(ws.closed());
+  ASSERT_EQ(master->wait(60s), 0) << master->output();
+  const ClusterRun run = read_cluster_run(dir.file("out"));
+  ASSERT_EQ(run.error, "");
+  for (const auto& node : run.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
+  EXPECT_EQ(run.report.instances(), 2000u);
 }
 
 // The C++ example, as a user runs it against a --local wall.

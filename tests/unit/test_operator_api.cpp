@@ -202,5 +202,69 @@ TEST(OperatorApi, BeforeTheFirstStatusItSaysSo) {
   EXPECT_EQ(route(request(http::Method::get, "/metrics"), kLoopback, texts).response.status, 503u);
 }
 
+http::Request upgrade(const std::string& query, const std::string& origin = "", bool loopback = true) {
+  http::Request r = request(http::Method::get, "/api/session");
+  r.query = query;
+  r.origin = origin;
+  r.host = "127.0.0.1:8080";
+  r.peer_is_loopback = loopback;
+  r.websocket_upgrade = true;
+  return r;
+}
+
+// The scene session's WebSocket: only with master.api, only as a WebSocket,
+// from a browser only from this server's own page, with the token where there
+// is one (as a header or in the query) and from this machine where there is none.
+TEST(OperatorApi, TheSceneSessionsWebSocketIsOpenedOnlyByWhoMay) {
+  const StatusTexts texts = published();
+  OperatorAccess with_token = kLoopback;
+  with_token.scene_sessions = true;
+  OperatorAccess no_secret = kNoSecret;
+  no_secret.scene_sessions = true;
+
+  Routed r = route(upgrade("application=page&token=" + kToken, "http://127.0.0.1:8080"), with_token, texts);
+  EXPECT_EQ(r.response.status, 101u);
+  EXPECT_EQ(r.scene_session.value_or("(none)"), "page");
+  http::Request bearer = upgrade("");
+  bearer.authorization = "Bearer " + kToken;
+  r = route(bearer, with_token, texts);
+  EXPECT_EQ(r.scene_session.value_or("(none)"), "websocket") << "a name by default";
+  r = route(upgrade("token=" + kToken + "x"), with_token, texts);
+  EXPECT_EQ(r.response.status, 401u);
+  EXPECT_FALSE(r.scene_session);
+  r = route(upgrade("application=page"), with_token, texts);
+  EXPECT_EQ(r.response.status, 401u) << "loopback too, where there is a token";
+  r = route(upgrade("token=" + kToken, "https://127.0.0.1:8080"), with_token, texts);
+  EXPECT_EQ(r.response.status, 101u) << "this server's page over https (a proxy in front)";
+  r = route(upgrade("token=" + kToken, "http://evil.example"), with_token, texts);
+  EXPECT_EQ(r.response.status, 403u) << "another site's page, with a token it somehow has";
+  EXPECT_FALSE(r.scene_session);
+
+  r = route(upgrade("application=script"), no_secret, texts);
+  EXPECT_EQ(r.response.status, 101u) << "no secret: this machine's scripts, as on master.api";
+  EXPECT_EQ(r.scene_session.value_or("(none)"), "script");
+  r = route(upgrade("", "http://evil.example"), no_secret, texts);
+  EXPECT_EQ(r.response.status, 403u) << "a page from anywhere, in a browser on this machine";
+  r = route(upgrade("", "", false), no_secret, texts);
+  EXPECT_EQ(r.response.status, 403u) << "another machine, with no token to give";
+  http::Request rebound = upgrade("");
+  rebound.host = "attacker.example:8080";
+  rebound.origin = "http://attacker.example:8080";
+  r = route(rebound, no_secret, texts);
+  EXPECT_EQ(r.response.status, 403u) << "a page whose name was rebound to this machine";
+
+  http::Request plain = upgrade("");
+  plain.websocket_upgrade = false;
+  r = route(plain, no_secret, texts);
+  EXPECT_EQ(r.response.status, 426u);
+  EXPECT_NE(r.response.body->find("WebSocket"), std::string::npos);
+  r = route(upgrade(""), kNoSecret, texts);
+  EXPECT_EQ(r.response.status, 404u) << "no master.api";
+  EXPECT_NE(r.response.body->find("master.api"), std::string::npos);
+  http::Request posted = upgrade("");
+  posted.method = http::Method::post;
+  EXPECT_EQ(route(posted, no_secret, texts).response.status, 405u);
+}
+
 }  // namespace
 }  // namespace optique::master

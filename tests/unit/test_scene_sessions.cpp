@@ -6,6 +6,7 @@
 
 #include "master/session/journal.h"
 #include "master/session/scene_sessions.h"
+#include "master/session/session_json.h"
 #include "net/envelope.h"
 
 namespace optique::master {
@@ -331,6 +332,85 @@ TEST_F(SceneSessionsTest, TheNumberOfSessionsIsBounded) {
   (void)sessions.closed(3, "refused");
   (void)sessions.closed(1, "gone");
   EXPECT_EQ(refusal_of(sessions.accepted(4, "d", true, kNonce)), "not refused");
+}
+
+// A WebSocket's application (opened by the operator's server, which checked
+// who may): no challenge or hello, the same requests, the same bound on
+// sessions; a message that is no request is answered, and the session goes on.
+TEST_F(SceneSessionsTest, AnApplicationOpenedByTheOperatorsServerNeedsNoHello) {
+  SceneSessionSettings settings;
+  settings.max_sessions = 2;
+  SceneSessions sessions(live_, settings);
+  const SessionActions opened = sessions.opened(1, "127.0.0.1:1 (WebSocket)", "page");
+  EXPECT_TRUE(of<session_action::Send>(opened).empty()) << "no challenge";
+  ASSERT_EQ(of<session_action::Log>(opened).size(), 1u);
+  EXPECT_EQ(of<session_action::Log>(opened)[0].text, "application 'page' connected from 127.0.0.1:1 (WebSocket)");
+  auto answer = of<session_action::Send>(sessions.request(1, create(5, "t1", "torus").session_request(), 12));
+  ASSERT_EQ(answer.size(), 1u);
+  EXPECT_EQ(answer[0].message.session_reply().id(), 5u);
+  EXPECT_EQ(answer[0].message.session_reply().applied().frame(), 12u);
+  EXPECT_EQ(live_.instances().size(), 1u);
+  answer = of<session_action::Send>(sessions.unreadable(1, "not a Request: x"));
+  ASSERT_EQ(answer.size(), 1u);
+  EXPECT_EQ(answer[0].message.session_reply().id(), 0u);
+  EXPECT_EQ(answer[0].message.session_reply().refused().field(), "request");
+  EXPECT_EQ(answer[0].message.session_reply().refused().reason(), "not a Request: x");
+
+  EXPECT_EQ(refusal_of(sessions.opened(2, "b", "bad name!")),
+            "name the application: 1 to 64 letters, digits, '-', '_' or '.'");
+  EXPECT_TRUE(sessions.request(2, create(6, "t2", "torus").session_request(), 12).empty()) << "refused: nothing";
+  EXPECT_TRUE(sessions.unreadable(2, "x").empty());
+  (void)sessions.closed(2, "refused");
+  EXPECT_EQ(refusal_of(sessions.accepted(3, "c", true, kNonce)), "not refused");
+  EXPECT_EQ(refusal_of(sessions.opened(4, "d", "late")), "the master holds 2 scene sessions, the most it may");
+  EXPECT_TRUE(sessions.request(3, create(7, "t3", "torus").session_request(), 12).empty()) << "no hello yet";
+  EXPECT_EQ(live_.instances().size(), 1u);
+}
+
+TEST(SessionJson, ARequestIsReadFromItsJsonAndAnythingElseIsNamed) {
+  auto read = request_from_json(
+      R"({"id": 7, "transaction": {"edits": [{"create": {"instance": "a", "asset": "torus",
+          "transform": {"position": [1, 2.5, -3], "scale": [2]}}}, {"visible": {"instance": "a"}}]}})");
+  ASSERT_TRUE(read.ok()) << read.error();
+  EXPECT_EQ(read.value().id(), 7u);
+  ASSERT_EQ(read.value().transaction().edits_size(), 2);
+  const auto& created = read.value().transaction().edits(0).create();
+  EXPECT_EQ(created.asset(), "torus");
+  EXPECT_EQ(created.transform().position(1), 2.5);
+  EXPECT_EQ(created.transform().scale_size(), 1);
+  EXPECT_TRUE(read.value().transaction().edits(1).has_visible());
+  read = request_from_json(R"({"id": "18446744073709551615", "readScene": {}})");
+  ASSERT_TRUE(read.ok()) << read.error() << " (64-bit numbers as strings, names in lowerCamelCase)";
+  EXPECT_EQ(read.value().id(), 18446744073709551615u);
+  EXPECT_TRUE(read.value().has_read_scene());
+
+  read = request_from_json(R"({"id": 1, "teleport": {}})");
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.error().find("teleport"), std::string::npos) << read.error();
+  read = request_from_json(R"({"id": 1, "transaction": {"edits": [{"create": {"instance": 5}}]}})");
+  ASSERT_FALSE(read.ok());
+  EXPECT_NE(read.error().find("instance"), std::string::npos) << read.error();
+  for (const char* bad : {"", "[", "{\"id\": -1}", "\xff\xfe", "{\"id\": 1} trailing"}) {
+    EXPECT_FALSE(request_from_json(bad).ok()) << bad;
+  }
+}
+
+TEST(SessionJson, WhatAnApplicationHearsIsOneObjectNamingItsKind) {
+  wire::Envelope applied;
+  applied.mutable_session_reply()->set_id(3);
+  applied.mutable_session_reply()->mutable_applied()->set_frame(40);
+  EXPECT_EQ(to_application_json(applied), R"({"reply":{"id":"3","applied":{"frame":"40"}}})");
+  wire::Envelope event;
+  event.mutable_session_event()->mutable_run()->set_frame(9);
+  EXPECT_EQ(to_application_json(event), R"({"event":{"run":{"state":"RUNNING","frame":"9","reason":""}}})")
+      << "every field given, even at its default";
+  EXPECT_EQ(to_application_json(net::refusal("full", true)), R"({"closing":{"reason":"full","retriable":true}})");
+  wire::Envelope goodbye;
+  goodbye.mutable_goodbye()->set_reason("the master is shutting down");
+  EXPECT_EQ(to_application_json(goodbye), R"({"closing":{"reason":"the master is shutting down","retriable":false}})");
+  wire::Envelope challenge;
+  challenge.mutable_challenge()->set_nonce("n");
+  EXPECT_EQ(to_application_json(challenge), "") << "nothing an application hears over JSON";
 }
 
 }  // namespace
