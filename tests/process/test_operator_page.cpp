@@ -16,6 +16,7 @@
 #include "headless_chromium.h"
 #include "http_client.h"
 #include "process.h"
+#include "websocket_client.h"
 
 namespace optique::testing {
 namespace {
@@ -32,12 +33,23 @@ struct StatusRun {
   std::unique_ptr<Process> master;
   int port = 0;
 
-  StatusRun(const std::string& config, const std::string& frames) {
-    master = std::make_unique<Process>(
-        std::vector<std::string>{kMaster, "--config", config, "--local", "--frames", frames, "--out", dir + "/out",
-                                 "--no-status", "--node-arg=--renderer=null", "--status-port", "0",
-                                 "--status-port-file", dir + "/status.port"},
-        dir + "/master.log");
+  StatusRun(const std::string& config, const std::string& frames, const std::vector<std::string>& more = {}) {
+    std::vector<std::string> argv{kMaster,
+                                  "--config",
+                                  config,
+                                  "--local",
+                                  "--frames",
+                                  frames,
+                                  "--out",
+                                  dir + "/out",
+                                  "--no-status",
+                                  "--node-arg=--renderer=null",
+                                  "--status-port",
+                                  "0",
+                                  "--status-port-file",
+                                  dir + "/status.port"};
+    argv.insert(argv.end(), more.begin(), more.end());
+    master = std::make_unique<Process>(argv, dir + "/master.log");
     if (wait_for_file(dir + "/status.port", 15s)) port = std::stoi(read_file(dir + "/status.port"));
   }
   [[nodiscard]] nlohmann::json status(const std::string& token = "") const {
@@ -62,6 +74,25 @@ struct StatusRun {
 int run_program(const std::vector<std::string>& argv, const std::string& log, std::chrono::seconds timeout = 60s) {
   Process process(argv, log);
   return process.wait(timeout).value_or(-1);
+}
+
+// The power wall with a shared secret in `dir`, written to `config_path`, its
+// status server on `status_listen`; its status token (empty: it failed).
+std::string wall_with_secret(const std::string& dir, const std::string& config_path, const std::string& status_listen) {
+  std::ofstream(dir + "/secret") << "correct horse battery staple\n";
+  EXPECT_EQ(chmod((dir + "/secret").c_str(), 0600), 0);
+  std::ifstream source(kConfigs + "/powerwall-2x2.json");
+  nlohmann::json config = nlohmann::json::parse(source);
+  config["master"]["secret_file"] = "secret";
+  config["master"]["status"] = {{"listen", status_listen}};
+  std::ofstream(config_path) << config.dump(2);
+  if (run_program({kMaster, "--config", config_path, "--print-status-token"}, dir + "/token.txt") != 0) {
+    ADD_FAILURE() << read_file(dir + "/token.txt");
+    return "";
+  }
+  std::string token = read_file(dir + "/token.txt");
+  token.erase(token.find_last_not_of("\n") + 1);
+  return token;
 }
 
 TEST(OperatorPage, ChromiumSeesEveryNodeUpAndTheFramesAdvance) {
@@ -116,18 +147,8 @@ TEST(OperatorPage, ChromiumSeesEveryNodeUpAndTheFramesAdvance) {
 TEST(OperatorPage, TheTokenGuardsTheDataAndTheControls) {
   const ScratchDir dir_scratch("optique-status-token");
   const std::string dir = dir_scratch.string();
-  std::ofstream(dir + "/secret") << "correct horse battery staple\n";
-  ASSERT_EQ(chmod((dir + "/secret").c_str(), 0600), 0);
-  std::ifstream source(kConfigs + "/powerwall-2x2.json");
-  nlohmann::json config = nlohmann::json::parse(source);
-  config["master"]["secret_file"] = "secret";
-  config["master"]["status"] = {{"listen", "0.0.0.0"}};
   const std::string config_path = dir + "/wall.json";
-  std::ofstream(config_path) << config.dump(2);
-  ASSERT_EQ(run_program({kMaster, "--config", config_path, "--print-status-token"}, dir + "/token.txt"), 0)
-      << read_file(dir + "/token.txt");
-  std::string token = read_file(dir + "/token.txt");
-  token.erase(token.find_last_not_of("\n") + 1);
+  const std::string token = wall_with_secret(dir, config_path, "0.0.0.0");
   ASSERT_EQ(token.size(), 64u) << token;
   EXPECT_EQ(token.find("horse"), std::string::npos);
 
@@ -172,6 +193,90 @@ TEST(OperatorPage, TheTokenGuardsTheDataAndTheControls) {
   const std::string log = run.master->output();
   EXPECT_NE(log.find("paused by the operator"), std::string::npos);
   EXPECT_NE(log.find("resumed by the operator"), std::string::npos);
+}
+
+// The live scene on the page, opened with the token: it shows what another
+// application placed, and adds, moves, hides and removes instances itself; a
+// script on its own WebSocket reads back what the page did.
+TEST(OperatorPage, ThePageShowsAndEditsTheLiveScene) {
+  const ScratchDir dir_scratch("optique-status-live");
+  const std::string dir = dir_scratch.string();
+  const std::string config_path = dir + "/wall.json";
+  const std::string token = wall_with_secret(dir, config_path, "127.0.0.1");
+  ASSERT_EQ(token.size(), 64u);
+  StatusRun run(config_path, "100000", {"--api-port", "0"});
+  ASSERT_NE(run.port, 0) << run.master->output();
+  WebSocketClient refused(run.port, "/api/session?application=script");
+  EXPECT_EQ(refused.upgrade_status(), 401) << "with a secret, the token even on loopback";
+  WebSocketClient script(run.port, "/api/session?application=script&token=" + token);
+  ASSERT_TRUE(script.open()) << script.error() << run.master->output();
+  std::uint64_t next_id = 1;
+  const auto ask = [&](nlohmann::json request) {
+    request["id"] = next_id++;
+    EXPECT_TRUE(script.send(request.dump()));
+    const auto text = script.receive(10s);
+    return text ? nlohmann::json::parse(*text)["reply"] : nlohmann::json{{"error", script.error()}};
+  };
+  const auto instance = [&](const std::string& id) {
+    const nlohmann::json scene = ask({{"read_scene", nlohmann::json::object()}})["scene"];
+    for (const auto& i : scene["instances"]) {
+      if (i["instance"] == id) return i;
+    }
+    return nlohmann::json();
+  };
+  const nlohmann::json placed = ask(
+      {{"transaction",
+        {{"edits",
+          {{{"create",
+             {{"instance", "from-script"}, {"asset", "cubes"}, {"transform", {{"position", {0.25, 1.0, 0.0}}}}}}}}}}}});
+  ASSERT_TRUE(placed.contains("applied")) << placed;
+
+  HeadlessChromium chromium("http://127.0.0.1:" + std::to_string(run.port) + "/#token=" + token, run.dir);
+  ASSERT_TRUE(chromium.error().empty()) << chromium.error();
+  const auto page = [&](const std::string& expression) { return chromium.evaluate(expression).value_or("?"); };
+  const auto row = [&](const std::string& id, const std::string& field) {
+    return page("(document.querySelector('tr.instance[data-id=\"" + id + "\"]') || {dataset: {}}).dataset." + field +
+                " || 'none'");
+  };
+  ASSERT_TRUE(poll_until([&] { return row("from-script", "position") == "0.25 1 0"; }, 20s))
+      << "the page shows the script's instance: " << row("from-script", "position") << " "
+      << page("document.getElementById('live-note').textContent");
+
+  // Added on the page, at x = 0.5.
+  page(
+      "document.getElementById('add-id').value = 'from-page'; document.getElementById('add-x').value = '0.5';"
+      "document.getElementById('add').click(); 'clicked'");
+  ASSERT_TRUE(poll_until([&] { return !instance("from-page").is_null(); }, 10s))
+      << page("document.getElementById('live-note').textContent");
+  EXPECT_EQ(instance("from-page")["transform"]["position"], nlohmann::json({0.5, 1.0, 0.0}));
+  EXPECT_EQ(instance("from-page")["asset"], "cubes");
+  ASSERT_TRUE(poll_until([&] { return row("from-page", "position") == "0.5 1 0"; }, 5s));
+  EXPECT_NE(page("document.getElementById('live-note').textContent").find("every projector shows it from frame"),
+            std::string::npos);
+
+  // Selected, moved to x = -0.5, hidden, removed.
+  page("document.querySelector('tr.instance[data-id=\"from-page\"]').click(); 'selected'");
+  EXPECT_EQ(page("document.getElementById('selected').textContent"), "from-page");
+  page("document.getElementById('move-x').value = '-0.5'; document.getElementById('move').click(); 'moved'");
+  ASSERT_TRUE(poll_until([&] { return instance("from-page")["transform"]["position"][0] == -0.5; }, 10s));
+  page("document.getElementById('toggle').click(); 'hidden'");
+  ASSERT_TRUE(poll_until([&] { return instance("from-page")["hidden"] == true; }, 10s));
+  ASSERT_TRUE(poll_until([&] { return row("from-page", "hidden") == "true"; }, 5s));
+  EXPECT_TRUE(poll_until([&] { return page("document.getElementById('toggle').textContent") == "Show"; }, 5s));
+  const std::string shot = std::filesystem::absolute("operator-page-live.png").string();
+  ASSERT_TRUE(chromium.screenshot(shot)) << chromium.error();
+  std::cout << "screenshot: " << shot << "\n";
+  page("document.getElementById('remove').click(); 'removed'");
+  ASSERT_TRUE(poll_until([&] { return instance("from-page").is_null(); }, 10s));
+  EXPECT_TRUE(poll_until([&] { return row("from-page", "id") == "none"; }, 5s));
+  EXPECT_FALSE(instance("from-script").is_null()) << "the script's instance stays";
+  EXPECT_TRUE(run.master->wait_for_output("application 'operator-page' connected from 127.0.0.1:", 1s));
+
+  run.master->signal(SIGINT);
+  EXPECT_EQ(run.master->wait(20s).value_or(-1), 0) << run.master->output();
+  const ClusterRun result = read_cluster_run(run.dir + "/out");
+  ASSERT_TRUE(result.error.empty()) << result.error;
+  for (const auto& node : result.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
 }
 
 }  // namespace
