@@ -115,7 +115,7 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
       }
     }
     // Every edit made until now is in this frame; the next frame's budget of edits starts.
-    put_live(*settings_.live, state);
+    put_live(*settings_.live, frame, state);
     settings_.live->begin_frame();
   }
   bool tracked = false;

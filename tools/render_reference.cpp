@@ -27,7 +27,8 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
   scene::SceneState state = authority.state_at_frame(frame);
   if (options.replay != nullptr) {
     if (auto replayed = master::replay_into(*options.replay, scene.definition,
-                                            master::live_scene_limits(installation.master.api), frame, state);
+                                            master::live_scene_limits(installation.master.api),
+                                            installation.master.frame_rate, frame, state);
         !replayed) {
       return Error{"the replayed journal: " + replayed.error()};
     }

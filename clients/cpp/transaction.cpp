@@ -41,6 +41,15 @@ Transaction& Transaction::switch_light(std::uint32_t light, bool on) {
   return *this;
 }
 
+Transaction& Transaction::animate(const std::string& instance, std::optional<bool> playing,
+                                  std::optional<double> seek) {
+  auto& a = *message_.add_edits()->mutable_animation();
+  a.set_instance(instance);
+  if (playing) a.set_playing(*playing);
+  if (seek) a.set_seek(*seek);
+  return *this;
+}
+
 Transaction& Transaction::reparent(const std::string& instance, const std::string& parent) {
   auto& p = *message_.add_edits()->mutable_parent();
   p.set_instance(instance);

@@ -37,6 +37,10 @@ class Transaction {
   Transaction& navigate(const Placement& placement);
   // One of the scene's point lights, by its index, on or off.
   Transaction& switch_light(std::uint32_t light, bool on);
+  // The instance's own clock for its asset's animations: played or paused
+  // (nullopt: as it was), sought to `seek` seconds (nullopt: where it is).
+  Transaction& animate(const std::string& instance, std::optional<bool> playing,
+                       std::optional<double> seek = std::nullopt);
 
   [[nodiscard]] const session::Transaction& message() const { return message_; }
   [[nodiscard]] bool empty() const { return message_.edits_size() == 0; }

@@ -23,6 +23,11 @@ template <class Rep, class Period>
   return std::chrono::duration_cast<std::chrono::nanoseconds>(d).count();
 }
 
+// The simulation's frame period at `frame_rate` Hz, in whole nanoseconds:
+// frame k happens at simulation time k·period (the master's scene and the
+// live scene's animation clocks both count so).
+[[nodiscard]] constexpr Nanos frame_period(double frame_rate) { return static_cast<Nanos>(1e9 / frame_rate); }
+
 // CLOCK_MONOTONIC in nanoseconds.
 [[nodiscard]] Nanos monotonic_now();
 

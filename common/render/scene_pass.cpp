@@ -137,6 +137,7 @@ Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
 
   pass.materials_ = scene.materials;
   pass.instances_ = scene.instances;
+  for (const auto& object : scene.objects) pass.animations_.emplace(object.id, object.pose_at);
   pass.asset_id_ = scene.asset_id;
   pass.ambient_ = scene.ambient;
   pass.background_ = scene.background;
@@ -247,8 +248,29 @@ void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, cons
     }
     placement.base_colour = glm::vec3(instance.base_color);
     placement.emissive = glm::vec3(instance.emissive);
+    placement.animation = instance.animation;
+    for (int e = 0; e < (motion ? 2 : 0); ++e) {
+      const scene::SceneState* then = motion->ends[e].state;
+      const auto there = then ? then->instances.find(id) : state.instances.end();
+      placement.animation_at_end[e] =
+          then && there != then->instances.end() ? there->second.animation : std::nullopt;
+    }
     draw_placed(placement, state, view, terms, u, motion);
   }
+}
+
+std::optional<glm::dmat4> ScenePass::object_matrix(const scene::SceneState& state, std::uint32_t object,
+                                                    const std::optional<scene::AnimationTimes>& times,
+                                                    double fraction) const {
+  if (times) {
+    const auto animated = animations_.find(object);
+    if (animated == animations_.end()) return std::nullopt;
+    const scene::ObjectState poses{animated->second(times->now), animated->second(times->next)};
+    return scene::model_matrix(scene::interpolate(poses, fraction));
+  }
+  const auto found = state.objects.find(object);
+  if (found == state.objects.end()) return std::nullopt;
+  return scene::model_matrix(scene::interpolate(found->second, fraction));
 }
 
 void ScenePass::draw_placed(const Placement& placement, const scene::SceneState& state, const Viewpoint& view,
@@ -258,9 +280,9 @@ void ScenePass::draw_placed(const Placement& placement, const scene::SceneState&
     if ((placement.still_only && instance.object) || (placement.moving_only && !instance.object)) continue;
     glm::dmat4 model = instance.transform;
     if (instance.object) {
-      const auto found = state.objects.find(*instance.object);
-      if (found == state.objects.end()) continue;  // not in the state (yet): nothing to place
-      model = scene::model_matrix(scene::interpolate(found->second, view.fraction)) * instance.transform;
+      const auto on = object_matrix(state, *instance.object, placement.animation, view.fraction);
+      if (!on) continue;  // not in the state (yet): nothing to place
+      model = *on * instance.transform;
     }
     model = placement.world * model;
     // Products in double, then to float: keeps precision for large worlds.
@@ -278,9 +300,9 @@ void ScenePass::draw_placed(const Placement& placement, const scene::SceneState&
         glm::dmat4 then = instance.transform;
         bool there = placement.world_at_end[e].has_value();
         if (instance.object && there) {
-          const auto found = end.state->objects.find(*instance.object);
-          there = found != end.state->objects.end();
-          if (there) then = scene::model_matrix(scene::interpolate(found->second, end.fraction)) * instance.transform;
+          const auto on = object_matrix(*end.state, *instance.object, placement.animation_at_end[e], end.fraction);
+          there = on.has_value();
+          if (there) then = *on * instance.transform;
         }
         if (there) then = *placement.world_at_end[e] * then;
         const glm::mat4 clip(there ? end.view_projection * then : glm::dmat4(0.0));

@@ -8,6 +8,8 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
+#include <map>
 #include <optional>
 #include <set>
 #include <span>
@@ -88,12 +90,21 @@ class ScenePass {
     std::optional<glm::dmat4> world_at_end[2] = {glm::dmat4(1.0), glm::dmat4(1.0)};  // at the motion's ends
     glm::vec3 base_colour{1.0f};                                                     // factors on every material
     glm::vec3 emissive{1.0f};
+    // An instance's own animation times (none: the objects' poses in the state).
+    std::optional<scene::AnimationTimes> animation;
+    std::optional<scene::AnimationTimes> animation_at_end[2];
     bool still_only = false;   // only the instances on no animated object
     bool moving_only = false;  // only those on one
   };
 
   ScenePass() = default;
   void upload_shining_lights(const std::set<std::uint32_t>& off);
+  // Where animated object `object` puts what rides on it, `fraction` of a
+  // frame on: from `state`, or at `times` of the scene's animations (an
+  // instance's own clock). None: the object is not there.
+  [[nodiscard]] std::optional<glm::dmat4> object_matrix(const scene::SceneState& state, std::uint32_t object,
+                                                        const std::optional<scene::AnimationTimes>& times,
+                                                        double fraction) const;
   void draw_placed(const Placement& placement, const scene::SceneState& state, const Viewpoint& view,
                    const LightTerms& terms, const Uniforms& u, const Motion* motion);
 
@@ -118,6 +129,7 @@ class ScenePass {
   std::vector<MeshRange> meshes_;
   std::vector<scene::Material> materials_;
   std::vector<scene::Instance> instances_;
+  std::map<std::uint32_t, std::function<scene::Pose(double)>> animations_;  // the objects' poses at any time
   std::string asset_id_;  // the scene's: the live instances of it are drawn too
   glm::vec3 ambient_{0.0f};
   glm::vec3 background_{0.0f};

@@ -66,6 +66,11 @@ class StateHasher {
     add(static_cast<std::uint64_t>(i.visible ? 1 : 0));
     add(i.base_color);
     add(i.emissive);
+    add(static_cast<std::uint64_t>(i.animation ? 1 : 0));
+    if (i.animation) {
+      add(i.animation->now);
+      add(i.animation->next);
+    }
   }
   [[nodiscard]] std::uint64_t value() const {
     std::uint64_t v = hash_;
@@ -108,7 +113,9 @@ bool identical(const ObjectState& a, const ObjectState& b) {
 bool identical(const InstanceState& a, const InstanceState& b) {
   return a.asset == b.asset && a.parent == b.parent && identical(a.pose, b.pose) && a.visible == b.visible &&
          identical(glm::dvec3(a.base_color), glm::dvec3(b.base_color)) && same_bits(a.base_color.w, b.base_color.w) &&
-         identical(a.emissive, b.emissive);
+         identical(a.emissive, b.emissive) && a.animation.has_value() == b.animation.has_value() &&
+         (!a.animation ||
+          (same_bits(a.animation->now, b.animation->now) && same_bits(a.animation->next, b.animation->next)));
 }
 
 void to_wire(const glm::dvec3& v, wire::Vec3& out) {
@@ -149,6 +156,10 @@ void to_wire(const std::string& id, const InstanceState& i, wire::InstanceState&
   }
   if (i.emissive != glm::dvec3(1.0)) {
     for (int k = 0; k < 3; ++k) out.add_emissive(i.emissive[k]);
+  }
+  if (i.animation) {
+    out.mutable_animation()->set_now(i.animation->now);
+    out.mutable_animation()->set_next(i.animation->next);
   }
 }
 
@@ -265,6 +276,15 @@ Result<std::pair<std::string, InstanceState>> from_wire(const wire::InstanceStat
   }
   if (!i.base_color().empty()) out.base_color = {i.base_color(0), i.base_color(1), i.base_color(2), i.base_color(3)};
   if (!i.emissive().empty()) out.emissive = {i.emissive(0), i.emissive(1), i.emissive(2)};
+  if (i.has_animation()) {
+    for (double t : {i.animation().now(), i.animation().next()}) {
+      if (!std::isfinite(t) || t < 0.0 || t > kMaxAnimationSeconds) {
+        return Error{what.text() + ": its animation's time is outside [0, " + std::to_string(kMaxAnimationSeconds) +
+                     "] s"};
+      }
+    }
+    out.animation = AnimationTimes{i.animation().now(), i.animation().next()};
+  }
   return std::pair{i.id(), std::move(out)};
 }
 

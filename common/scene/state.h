@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -35,6 +36,19 @@ struct ObjectState {
   bool operator==(const ObjectState&) const = default;
 };
 
+// Where an instance's asset's animations are, in seconds into them, at the
+// frame time and at the next: the instance's own clock (an application's
+// SetAnimation) in place of the scene's time.
+struct AnimationTimes {
+  double now = 0.0;
+  double next = 0.0;
+
+  bool operator==(const AnimationTimes&) const = default;
+};
+// The most seconds into its animations an instance's clock may be (about 30
+// years: a clock that plays for the life of an installation stays below it).
+inline constexpr double kMaxAnimationSeconds = 1e9;
+
 // An instance of an asset an application placed (master/session/live_scene.h).
 struct InstanceState {
   std::string asset;
@@ -43,6 +57,7 @@ struct InstanceState {
   bool visible = true;
   glm::dvec4 base_color{1.0};  // multiplies the asset's base colour
   glm::dvec3 emissive{1.0};    // multiplies the asset's emissive colour
+  std::optional<AnimationTimes> animation;  // none: the scene's own time
 
   bool operator==(const InstanceState&) const = default;
 };

@@ -20,7 +20,8 @@ Result<void> Master::make_live_scene(RunSettings& run) {
   if (!settings.api && replay.empty()) return {};
 
   // For now the one asset is the installation's own scene, by name.
-  live_.emplace(LiveScene::of(options_.scene.definition, live_scene_limits(settings.api)));
+  live_.emplace(LiveScene::of(options_.scene.definition, live_scene_limits(settings.api),
+                              settings.frame_rate));
   const std::string& asset = options_.scene.definition.asset_id;
   run.live = &*live_;
 

@@ -7,7 +7,7 @@ SceneAuthority::SceneAuthority(std::vector<scene::AnimatedObject> objects, confi
     : objects_(std::move(objects)),
       viewer_(std::move(viewer)),
       switches_(std::move(switches)),
-      period_(static_cast<clock::Nanos>(1e9 / frame_rate)) {}
+      period_(clock::frame_period(frame_rate)) {}
 
 clock::Nanos SceneAuthority::simulation_time(std::uint64_t frame) const {
   return static_cast<clock::Nanos>(frame) * period_;

@@ -113,16 +113,19 @@ Result<std::size_t> restore_runs(LiveScene& live, const Journal& journal, std::s
   std::size_t applied = 0;
   for (std::size_t r = 0; r < runs; ++r) {
     const auto& transactions = journal.runs[r].transactions;
+    std::uint64_t last = 0;
     for (std::size_t i = 0; i < transactions.size(); ++i) {
       live.begin_frame();
-      if (auto refused = live.apply(transactions[i].transaction())) {
+      if (auto refused = live.apply(transactions[i].transaction(), transactions[i].frame())) {
         return Error{where(r, i, transactions[i]) + " was refused: " + refused_text(*refused) +
                      "; the journal was written for another installation"};
       }
+      last = transactions[i].frame();
       ++applied;
     }
+    // Each run counts its frames from 0.
+    live.begin_run(last);
   }
-  live.begin_frame();
   return applied;
 }
 
@@ -144,7 +147,7 @@ Result<JournalReplay> JournalReplay::start(const Journal& journal, LiveScene& li
 std::vector<std::string> JournalReplay::apply_due(LiveScene& live, std::uint64_t frame) {
   std::vector<std::string> problems;
   for (; next_ < transactions_.size() && transactions_[next_].frame() <= frame; ++next_) {
-    if (auto refused = live.apply(transactions_[next_].transaction())) {
+    if (auto refused = live.apply(transactions_[next_].transaction(), transactions_[next_].frame())) {
       problems.push_back("replaying the journal: transaction " + std::to_string(next_ + 1) + " (frame " +
                          std::to_string(transactions_[next_].frame()) + ") was refused: " + refused_text(*refused));
     }
@@ -153,13 +156,13 @@ std::vector<std::string> JournalReplay::apply_due(LiveScene& live, std::uint64_t
 }
 
 Result<void> replay_into(const Journal& journal, const scene::SceneDefinition& scene, LiveSceneLimits limits,
-                         std::uint64_t frame, scene::SceneState& state) {
-  LiveScene live = LiveScene::of(scene, limits);
+                         double frame_rate, std::uint64_t frame, scene::SceneState& state) {
+  LiveScene live = LiveScene::of(scene, limits, frame_rate);
   auto replay = JournalReplay::start(journal, live);
   if (!replay) return Error{replay.error()};
   const std::vector<std::string> problems = replay.value().apply_due(live, frame);
   if (!problems.empty()) return Error{problems.front()};
-  put_live(live, state);
+  put_live(live, frame, state);
   return {};
 }
 

@@ -89,8 +89,8 @@ class JournalReplay {
 // The live scene frame `frame` of a journal's last run shows when played
 // again (what the master's frame loop puts in that frame with --replay), put
 // into `state` (put_live): for render-reference --replay. `scene`: the
-// installation's.
+// installation's, at `frame_rate` Hz.
 [[nodiscard]] Result<void> replay_into(const Journal& journal, const scene::SceneDefinition& scene,
-                                       LiveSceneLimits limits, std::uint64_t frame, scene::SceneState& state);
+                                       LiveSceneLimits limits, double frame_rate, std::uint64_t frame, scene::SceneState& state);
 
 }  // namespace optique::master

@@ -5,6 +5,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "clock/clock.h"
 #include "util/id_text.h"
 #include "util/number_text.h"
 
@@ -16,6 +17,7 @@ using util::number_text;
 constexpr double kMaxPosition = 1e6;  // metres from the origin: a world larger than any room, short of float trouble
 constexpr double kMinScale = 1e-4;
 constexpr double kMaxScale = 1e4;
+constexpr double kMaxSeek = 1e6;  // seconds into an asset's animations: eleven days
 
 // What is wrong, at a field relative to the edit ("transform.scale[1]").
 struct Wrong {
@@ -89,7 +91,7 @@ void to_transform(const scene::Pose& pose, session::Transform& t) {
 // instance was before its first change, to put back if a later edit fails.
 class LiveScene::Edits {
  public:
-  explicit Edits(LiveScene& scene) : scene_(scene) {}
+  Edits(LiveScene& scene, std::uint64_t frame) : scene_(scene), frame_(frame) {}
 
   // Applies one edit; what is wrong is named from the edit ("create.asset").
   Check apply(const session::Edit& edit) {
@@ -114,6 +116,8 @@ class LiveScene::Edits {
         return named("navigation", navigation(edit.navigation()));
       case session::Edit::kLight:
         return named("light", light(edit.light()));
+      case session::Edit::kAnimation:
+        return named("animation", animation(edit.animation()));
       case session::Edit::EDIT_NOT_SET:
         break;
     }
@@ -270,6 +274,29 @@ class LiveScene::Edits {
     return std::nullopt;
   }
 
+  // The clock starts here from where the scene's time has the animations in
+  // this frame, or from where its own clock has them.
+  Check animation(const session::SetAnimation& a) {
+    return modify(a.instance(), [&](Instance& changed) -> Check {
+      if (!a.has_playing() && !a.has_seek()) return Wrong{"", "give playing, seek or both"};
+      const double period = scene_.frame_period_;
+      AnimationClock clock;
+      clock.anchor = frame_;
+      clock.position = changed.animation ? changed.animation->at(frame_, period) : static_cast<double>(frame_) * period;
+      clock.playing = changed.animation ? changed.animation->playing : true;
+      if (a.has_seek()) {
+        if (!std::isfinite(a.seek()) || a.seek() < 0.0 || a.seek() > kMaxSeek) {
+          return Wrong{"seek", "must be in [0, " + number_text(kMaxSeek) + "] seconds (got " + number_text(a.seek()) +
+                                   ")"};
+        }
+        clock.position = a.seek();
+      }
+      if (a.has_playing()) clock.playing = a.playing();
+      changed.animation = clock;
+      return std::nullopt;
+    });
+  }
+
   // The depth of `id`'s deepest descendant, below `parent`.
   Check subtree_depth_problem(const std::string& id, const std::string& parent) const {
     std::size_t above = 1;  // `id` itself
@@ -288,14 +315,29 @@ class LiveScene::Edits {
   }
 
   LiveScene& scene_;
+  std::uint64_t frame_;
   std::set<std::string> touched_;
   std::vector<std::pair<std::string, std::optional<Instance>>> before_;
   std::optional<NavigationSet> navigation_before_;
   std::optional<std::map<std::uint32_t, bool>> lights_before_;
 };
 
-LiveScene LiveScene::of(const scene::SceneDefinition& scene, LiveSceneLimits limits) {
-  LiveScene live(limits);
+double AnimationClock::at(std::uint64_t frame, double period) const {
+  if (!playing || frame <= anchor) return position;
+  return std::min(position + static_cast<double>(frame - anchor) * period, scene::kMaxAnimationSeconds);
+}
+
+void LiveScene::begin_run(std::uint64_t last) {
+  for (auto& [id, instance] : instances_) {
+    if (instance.animation) instance.animation = AnimationClock{instance.animation->playing,
+                                                                instance.animation->at(last, frame_period_), 0};
+  }
+  edits_this_frame_ = 0;
+}
+
+LiveScene LiveScene::of(const scene::SceneDefinition& scene, LiveSceneLimits limits, double frame_rate) {
+  // The scene's own clock's period, so that a clock set where the scene's time is starts there exactly.
+  LiveScene live(limits, static_cast<double>(clock::frame_period(frame_rate)) / clock::kNanosPerSecond);
   live.add_asset(scene.asset_id);
   live.set_light_count(scene.lights.size());
   return live;
@@ -320,7 +362,7 @@ void LiveScene::put(const std::string& id, std::optional<Instance> instance) {
   }
 }
 
-std::optional<Refusal> LiveScene::apply(const session::Transaction& transaction) {
+std::optional<Refusal> LiveScene::apply(const session::Transaction& transaction, std::uint64_t frame) {
   const auto count = static_cast<std::size_t>(transaction.edits_size());
   if (count > limits_.max_edits_per_frame - edits_this_frame_) {
     return Refusal{0, "edits",
@@ -328,7 +370,7 @@ std::optional<Refusal> LiveScene::apply(const session::Transaction& transaction)
                        std::to_string(limits_.max_edits_per_frame - edits_this_frame_) + " of this frame's " +
                        std::to_string(limits_.max_edits_per_frame) + " are left: send the rest in a later frame"};
   }
-  Edits edits(*this);
+  Edits edits(*this, frame);
   for (std::size_t i = 0; i < count; ++i) {
     if (auto wrong = edits.apply(transaction.edits(static_cast<int>(i)))) {
       edits.undo();
@@ -353,6 +395,10 @@ session::SceneContents scene_contents(const LiveScene& live, std::uint64_t frame
     to_transform(instance.pose, *view.mutable_transform());
     for (int i = 0; i < 4; ++i) view.add_base_color(instance.base_color[i]);
     for (int i = 0; i < 3; ++i) view.add_emissive(instance.emissive[i]);
+    if (instance.animation) {
+      view.mutable_animation()->set_playing(instance.animation->playing);
+      view.mutable_animation()->set_position(instance.animation->at(frame, live.frame_period()));
+    }
   }
   to_transform(live.navigation().pose, *contents.mutable_navigation());
   contents.set_light_count(static_cast<std::uint32_t>(live.light_count()));
@@ -373,7 +419,7 @@ LiveSceneLimits live_scene_limits(const std::optional<config::ApiServer>& api) {
   return limits;
 }
 
-void put_live(const LiveScene& live, scene::SceneState& state) {
+void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& state) {
   state.instances.clear();
   for (const auto& [id, instance] : live.instances()) {
     scene::InstanceState& placed = state.instances[id];
@@ -383,6 +429,10 @@ void put_live(const LiveScene& live, scene::SceneState& state) {
     placed.visible = instance.visible;
     placed.base_color = instance.base_color;
     placed.emissive = instance.emissive;
+    if (instance.animation) {
+      placed.animation = scene::AnimationTimes{instance.animation->at(frame, live.frame_period()),
+                                               instance.animation->at(frame + 1, live.frame_period())};
+    }
   }
   for (const auto& [light, on] : live.light_switches()) {
     if (on) {

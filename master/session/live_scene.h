@@ -27,6 +27,16 @@
 
 namespace optique::master {
 
+// An instance's own clock for its asset's animations (SetAnimation).
+struct AnimationClock {
+  bool playing = true;
+  double position = 0.0;    // seconds into the animations at frame `anchor`
+  std::uint64_t anchor = 0;  // the frame it was set for
+  // Where it is at `frame` (not before `anchor`), frames `period` seconds apart.
+  [[nodiscard]] double at(std::uint64_t frame, double period) const;
+  friend bool operator==(const AnimationClock&, const AnimationClock&) = default;
+};
+
 struct Instance {
   std::string asset;
   std::string parent;  // empty: the world
@@ -34,6 +44,7 @@ struct Instance {
   bool visible = true;
   glm::dvec4 base_color{1.0};  // multiplies the asset's base colour
   glm::dvec3 emissive{1.0};    // multiplies the asset's emissive colour
+  std::optional<AnimationClock> animation;  // none: the scene's time
   friend bool operator==(const Instance&, const Instance&) = default;
 };
 
@@ -63,18 +74,28 @@ struct NavigationSet {
 
 class LiveScene {
  public:
-  explicit LiveScene(LiveSceneLimits limits = {}) : limits_(limits) {}
-  // The live scene of an installation whose scene is `scene`: its one asset
-  // the scene itself (by its asset id), its point lights switchable.
-  [[nodiscard]] static LiveScene of(const scene::SceneDefinition& scene, LiveSceneLimits limits);
+  // `frame_period`: seconds from one frame's simulation time to the next
+  // (clock::frame_period), by which an instance's animation clock plays.
+  explicit LiveScene(LiveSceneLimits limits = {}, double frame_period = 1.0 / 60.0)
+      : limits_(limits), frame_period_(frame_period) {}
+  // The live scene of an installation whose scene is `scene`, at
+  // `frame_rate` Hz: its one asset the scene itself (by its asset id), its
+  // point lights switchable.
+  [[nodiscard]] static LiveScene of(const scene::SceneDefinition& scene, LiveSceneLimits limits, double frame_rate);
+  [[nodiscard]] double frame_period() const { return frame_period_; }
 
   // An asset the nodes can draw (loaded and shipped by the scene transfer).
   void add_asset(const std::string& id) { assets_.insert(id); }
   [[nodiscard]] bool has_asset(const std::string& id) const { return assets_.count(id) != 0; }
   [[nodiscard]] const std::set<std::string>& assets() const { return assets_; }
 
-  // Applies every edit, or none and says which and why.
-  [[nodiscard]] std::optional<Refusal> apply(const session::Transaction& transaction);
+  // Applies every edit, or none and says which and why; `frame` is the frame
+  // it is in (where an animation played, paused or sought starts from there).
+  [[nodiscard]] std::optional<Refusal> apply(const session::Transaction& transaction, std::uint64_t frame);
+  // A new run of the master begins, at frame 0, after the journal of the runs
+  // before was applied, the last of its transactions in frame `last`: each
+  // animation clock goes on from where it was then.
+  void begin_run(std::uint64_t last);
   // A new frame: the budget of edits starts again.
   void begin_frame() { edits_this_frame_ = 0; }
 
@@ -95,6 +116,7 @@ class LiveScene {
   void put(const std::string& id, std::optional<Instance> instance);
 
   LiveSceneLimits limits_;
+  double frame_period_;
   std::set<std::string> assets_;
   std::map<std::string, Instance> instances_;
   std::map<std::string, std::set<std::string>> children_;  // parent → its children; "" → the world's
@@ -112,11 +134,11 @@ void to_transform(const scene::Pose& pose, session::Transform& t);
 // `frame` will show it.
 [[nodiscard]] session::SceneContents scene_contents(const LiveScene& live, std::uint64_t frame);
 
-// The live scene into the state a frame shows (scene/state.h): the instances,
-// each at its pose, the same now and at the next frame time, as an edit
-// between them is not known yet; the lights applications switched, over the
-// config's switches; the navigation applications set (the flystick's, if any,
-// comes after: master/navigation.h).
-void put_live(const LiveScene& live, scene::SceneState& state);
+// The live scene into the state frame `frame` shows (scene/state.h): the
+// instances, each at its pose, the same now and at the next frame time, as an
+// edit between them is not known yet, and its animation clock's times; the
+// lights applications switched, over the config's switches; the navigation
+// applications set (the flystick's, if any, comes after: master/navigation.h).
+void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& state);
 
 }  // namespace optique::master

@@ -233,7 +233,7 @@ void SceneSessions::on_request(SessionId id, const session::Request& request, st
   wire::Envelope answer = reply(request.id());
   switch (request.request_case()) {
     case session::Request::kTransaction:
-      if (auto refusal = live_.apply(request.transaction())) {
+      if (auto refusal = live_.apply(request.transaction(), next_frame)) {
         auto& refused = *answer.mutable_session_reply()->mutable_refused();
         refused.set_edit(static_cast<std::uint32_t>(refusal->edit));
         refused.set_field(refusal->field);

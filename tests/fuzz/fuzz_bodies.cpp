@@ -303,7 +303,7 @@ std::string tracker(std::span<const std::uint8_t> input, Outcome& out) {
 constexpr std::size_t kFuzzLights = 4;
 
 // The live scene after any transactions: whole, and what the nodes accept.
-std::string check_live(const master::LiveScene& live, const master::LiveSceneLimits& limits,
+std::string check_live(const master::LiveScene& live, const master::LiveSceneLimits& limits, std::uint64_t frame,
                        scene::SceneState& previous) {
   OPTIQUE_FUZZ_REQUIRE(live.instances().size() <= limits.max_instances);
   std::size_t listed = 0;
@@ -321,7 +321,7 @@ std::string check_live(const master::LiveScene& live, const master::LiveSceneLim
   listed += live.children("").size();
   OPTIQUE_FUZZ_REQUIRE(listed == live.instances().size());
   scene::SceneState state;
-  master::put_live(live, state);
+  master::put_live(live, frame, state);
   // Only the scene's lights are switched; the navigation must pass the nodes'
   // checks, which apply_delta below makes.
   OPTIQUE_FUZZ_REQUIRE(live.light_switches().empty() || live.light_switches().rbegin()->first < kFuzzLights);
@@ -433,7 +433,7 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
     const bool request = message.has_session_request() && message.protocol_version() == net::kProtocolVersion;
     OPTIQUE_FUZZ_REQUIRE(replies == (request ? 1 : 0));
     OPTIQUE_FUZZ_REQUIRE(request || closed || message.has_heartbeat());
-    if (auto broken = check_live(live, limits, previous); !broken.empty()) return broken;
+    if (auto broken = check_live(live, limits, frame, previous); !broken.empty()) return broken;
     if (closed) break;
     // A frame event reaches the application only while it subscribes to frames.
     session::Event begun;

@@ -834,6 +834,11 @@ std::vector<Seed> session_seeds() {
                         "base_color": [1, 0.5, "NaN", 1]}}]}})"),
                      json(R"({"id": 5, "transaction": {"edits": [{"remove": {"instance": "a"}}, {"light":
                         {"light": 1, "on": false}}]}})"),
+                     json(R"({"id": 55, "transaction": {"edits": [{"create": {"instance": "b", "asset": "duck"}},
+                        {"animation": {"instance": "b", "playing": false, "seek": 2.5}}]}})"),
+                     kNextFrame, json(R"({"id": 56, "transaction": {"edits": [{"animation": {"instance": "b",
+                        "playing": true}}]}})"),
+                     json(R"({"id": 57, "transaction": {"edits": [{"animation": {"instance": "b", "seek": -1}}]}})"),
                      json(R"({"id": 6, "teleport": {}})"), json(R"({"id": -1})"), json("{"),
                      json(R"({"id": 7, "transaction": {"edits": [{"transform": {"instance": "a",
                         "transform": {"position": [1e400, 0, 0]}}}]}})")})});

@@ -108,8 +108,11 @@ class RandomEdits {
       parent_[id] = parent;
     } else if (kind == 7) {
       t.show(any(), random_() % 2 == 0);
-    } else if (kind == 8) {
+    } else if (kind == 8 && random_() % 2 == 0) {
       t.tint(any(), {uniform(0.0, 1.0), uniform(0.0, 1.0), uniform(0.0, 1.0), 1.0});
+    } else if (kind == 8) {  // its own animation clock: paused, played, sought
+      const bool seek = random_() % 2 == 0;
+      t.animate(any(), random_() % 2 == 0, seek ? std::optional<double>(uniform(0.0, 10.0)) : std::nullopt);
     } else {
       const std::string id = any();
       t.remove(id);

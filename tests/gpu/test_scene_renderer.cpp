@@ -339,6 +339,34 @@ TEST_F(SceneRendererTest, LiveInstancesOfTheSceneAreDrawnWhereTheirParentsPutThe
   EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.0f, kTolerance);
 }
 
+// An instance with its own animation clock draws its asset's animated objects
+// at its times, not where the scene's time has them in the state: the square
+// rides object 7, which an animation carries 1 m along x a second.
+TEST_F(SceneRendererTest, AnInstancesOwnAnimationTimesPlaceWhatRidesTheAnimation) {
+  scene::SceneDefinition square = emissive_square();
+  square.instances[0].object = 7u;
+  square.objects.push_back({7u, "slider", [](double t) {
+                              scene::Pose pose;
+                              pose.position.x = t;
+                              return pose;
+                            }});
+  auto renderer = SceneRenderer::create(square, kSize, kSize);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  const auto green = [&](const scene::SceneState& state, int x, int y) {
+    renderer.value()->draw(state, {0.0, kEye, view_of_unit_square()});
+    return renderer.value()->read_rendered().at(x, y, 1);
+  };
+  scene::SceneState state;
+  state.objects[7] = {};  // the scene's time: the slider at the origin
+  state.instances["copy"] = square_at(0.0, 0.5);
+  EXPECT_NEAR(green(state, kSize / 2, kNear), 0.5f, kTolerance) << "the copy where the state's slider puts it";
+  EXPECT_NEAR(green(state, kFar, kNear), 0.0f, kTolerance);
+  state.instances["copy"].animation = scene::AnimationTimes{0.5, 0.5};
+  EXPECT_NEAR(green(state, kFar, kNear), 0.5f, kTolerance) << "its own time: the slider 0.5 m on";
+  EXPECT_NEAR(green(state, kSize / 2, kNear), 0.0f, kTolerance);
+  EXPECT_NEAR(green(state, kSize / 2, kSize / 2), 0.5f, kTolerance) << "the installation's square stays";
+}
+
 // A DLP projector's fields draw what does not move once for every field: a
 // live instance is drawn in each field all the same.
 TEST_F(SceneRendererTest, LiveInstancesAreDrawnInEveryColourField) {

@@ -160,6 +160,22 @@ class OnAWall(unittest.TestCase):
             with wall.transaction() as t:
                 t.navigate(position=(0, 0, 0), scale=1).switch_light(0, True)
 
+    def test_an_instances_animation_is_paused_and_sought(self):
+        with self.connect() as wall:
+            asset = wall.scene.assets[0]
+            with wall.transaction() as t:
+                t.create("clip", asset).animate("clip", playing=False, seek=2.5)
+            view = [i for i in wall.read_scene().instances if i.instance == "clip"][0]
+            self.assertTrue(view.HasField("animation"))
+            self.assertFalse(view.animation.playing)
+            self.assertEqual(view.animation.position, 2.5)
+            with self.assertRaises(optique.Refused) as refused:
+                with wall.transaction() as t:
+                    t.animate("clip", seek=-1)
+            self.assertEqual(refused.exception.field, "edits[0].animation.seek")
+            with wall.transaction() as t:
+                t.remove("clip")
+
     def test_the_circle_example(self):
         run = subprocess.run([sys.executable, str(EXAMPLES / "circle.py"), "--port", str(self.master.port),
                               "--seconds", "1.5"], capture_output=True, text=True, timeout=60)

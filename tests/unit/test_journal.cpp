@@ -185,7 +185,7 @@ TEST(Journal, AReplayAppliesTheLastRunFrameByFrame) {
   LiveScene again = with_torus();
   auto second = JournalReplay::start(read.value(), again);
   ASSERT_TRUE(second.ok());
-  ASSERT_FALSE(again.apply(remove("t1")));
+  ASSERT_FALSE(again.apply(remove("t1"), 0));
   const auto problems = second.value().apply_due(again, 100);
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_EQ(problems[0],

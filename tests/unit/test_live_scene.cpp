@@ -31,13 +31,13 @@ LiveSceneLimits limits_with(std::size_t LiveSceneLimits::*limit, std::size_t val
 
 // The refusal of `text`, which must be refused.
 Refusal refused(LiveScene& scene, const std::string& text) {
-  const auto refusal = scene.apply(transaction(text));
+  const auto refusal = scene.apply(transaction(text), 0);
   EXPECT_TRUE(refusal.has_value()) << "accepted: " << text;
   return refusal.value_or(Refusal{});
 }
 
 void accept(LiveScene& scene, const std::string& text) {
-  const auto refusal = scene.apply(transaction(text));
+  const auto refusal = scene.apply(transaction(text), 0);
   ASSERT_FALSE(refusal) << refusal->field << ": " << refusal->reason;
 }
 
@@ -214,7 +214,7 @@ TEST(LiveScene, TheNavigationIsSetWholeAndUniformlyScaled) {
   EXPECT_EQ(scene.navigation().sets, 2u);
 
   scene::SceneState state;
-  put_live(scene, state);
+  put_live(scene, 0, state);
   EXPECT_EQ(state.navigation.now, scene.navigation().pose);
   EXPECT_EQ(state.navigation.next, scene.navigation().pose);
   const session::SceneContents contents = scene_contents(scene, 7);
@@ -236,7 +236,7 @@ TEST(LiveScene, LightsAreSwitchedOverTheConfigsSwitches) {
 
   scene::SceneState state;
   state.lights_off = {0, 2};  // the config's script switched 0 and 2 off
-  put_live(scene, state);
+  put_live(scene, 0, state);
   EXPECT_EQ(state.lights_off, (std::set<std::uint32_t>{0, 1})) << "1 switched off, 2 on; 0 as the script has it";
   const session::SceneContents contents = scene_contents(scene, 0);
   EXPECT_EQ(contents.light_count(), 3u);
@@ -250,10 +250,67 @@ TEST(LiveScene, OfAnInstallationsSceneHasItsAssetAndLights) {
   scene::SceneDefinition definition;
   definition.asset_id = "cubes";
   definition.lights.resize(2);
-  LiveScene scene = LiveScene::of(definition, {});
+  LiveScene scene = LiveScene::of(definition, {}, 60.0);
   EXPECT_TRUE(scene.has_asset("cubes"));
   accept(scene, R"(edits { light { light: 1 on: false } })");
-  EXPECT_FALSE(scene.apply(transaction(R"(edits { light { light: 2 on: false } })"))->reason.empty());
+  EXPECT_FALSE(scene.apply(transaction(R"(edits { light { light: 2 on: false } })"), 0)->reason.empty());
+}
+
+// An instance's own animation clock: from where the scene's time has its
+// asset's animations in the frame it is set for, paused, played and sought;
+// each frame's state carries its times, now and next; a refusal leaves it.
+TEST(LiveScene, AnInstancesAnimationsArePlayedPausedAndSought) {
+  LiveScene scene(LiveSceneLimits{}, 0.1);  // frames 0.1 s apart
+  scene.add_asset("torus");
+  const auto times = [&](std::uint64_t frame) {
+    scene::SceneState state;
+    put_live(scene, frame, state);
+    return state.instances.at("t").animation;
+  };
+  ASSERT_FALSE(scene.apply(transaction(R"(edits { create { instance: "t" asset: "torus" } })"), 5));
+  EXPECT_FALSE(times(10)) << "the scene's time until an application sets its clock";
+
+  // Paused in frame 10: where the scene's time is then, 1 s.
+  ASSERT_FALSE(scene.apply(transaction(R"(edits { animation { instance: "t" playing: false } })"), 10));
+  EXPECT_DOUBLE_EQ(times(10)->now, 1.0);
+  EXPECT_DOUBLE_EQ(times(25)->now, 1.0);
+  EXPECT_DOUBLE_EQ(times(25)->next, 1.0);
+  // Played again in frame 30, from 1 s on.
+  ASSERT_FALSE(scene.apply(transaction(R"(edits { animation { instance: "t" playing: true } })"), 30));
+  EXPECT_DOUBLE_EQ(times(30)->now, 1.0);
+  EXPECT_DOUBLE_EQ(times(40)->now, 2.0);
+  EXPECT_DOUBLE_EQ(times(40)->next, 2.1);
+  // Sought to 7 s in frame 40: it plays on from there.
+  ASSERT_FALSE(scene.apply(transaction(R"(edits { animation { instance: "t" seek: 7 } })"), 40));
+  EXPECT_DOUBLE_EQ(times(40)->now, 7.0);
+  EXPECT_DOUBLE_EQ(times(45)->now, 7.5);
+  // Sought and paused at once.
+  ASSERT_FALSE(scene.apply(transaction(R"(edits { animation { instance: "t" seek: 0.25 playing: false } })"), 50));
+  EXPECT_DOUBLE_EQ(times(90)->next, 0.25);
+  const session::SceneContents contents = scene_contents(scene, 90);
+  ASSERT_TRUE(contents.instances(0).has_animation());
+  EXPECT_FALSE(contents.instances(0).animation().playing());
+  EXPECT_EQ(contents.instances(0).animation().position(), 0.25);
+
+  for (const char* text : {R"(edits { animation { instance: "t" seek: -1 } })",
+                           R"(edits { animation { instance: "t" seek: nan } })",
+                           R"(edits { animation { instance: "t" seek: 2e6 } })"}) {
+    const Refusal wrong = refused(scene, text);
+    EXPECT_EQ(wrong.field, "edits[0].animation.seek") << text;
+    EXPECT_NE(wrong.reason.find("must be in [0, 1e+06] seconds"), std::string::npos) << wrong.reason;
+  }
+  EXPECT_EQ(refused(scene, R"(edits { animation { instance: "t" } })").reason, "give playing, seek or both");
+  EXPECT_EQ(refused(scene, R"(edits { animation { instance: "ghost" playing: true } })").reason,
+            "no instance 'ghost'");
+  refused(scene, R"(edits { animation { instance: "t" playing: true } } edits { remove { instance: "ghost" } })");
+  EXPECT_FALSE(scene.instances().at("t").animation->playing) << "a refused transaction changes no clock";
+
+  // A new run of the master (from its journal): the clocks go on from where
+  // they were at the last transaction, from frame 0.
+  ASSERT_FALSE(scene.apply(transaction(R"(edits { animation { instance: "t" playing: true } })"), 60));
+  scene.begin_run(80);
+  EXPECT_DOUBLE_EQ(times(0)->now, 0.25 + 2.0);
+  EXPECT_DOUBLE_EQ(times(10)->now, 0.25 + 3.0);
 }
 
 }  // namespace

@@ -497,6 +497,7 @@ SceneState with_instances() {
   s.instances["lamp"] = instance("lamp", "", 2.0);
   s.instances["lamp"].visible = false;
   s.instances["lamp"].emissive = {4.0, 3.0, 2.0};
+  s.instances["lamp"].animation = AnimationTimes{3.0, 3.0};  // paused at 3 s
   return s;
 }
 
@@ -531,7 +532,9 @@ TEST(SceneInstances, EachFieldChangesTheHash) {
   const std::vector<void (*)(InstanceState&)> changes{
       [](InstanceState& i) { i.asset = "teapot"; },       [](InstanceState& i) { i.parent = "lamp"; },
       [](InstanceState& i) { i.pose.next.scale.y *= 2; }, [](InstanceState& i) { i.visible = false; },
-      [](InstanceState& i) { i.base_color.a = 0.5; },     [](InstanceState& i) { i.emissive.b = 0.0; }};
+      [](InstanceState& i) { i.base_color.a = 0.5; },     [](InstanceState& i) { i.emissive.b = 0.0; },
+      [](InstanceState& i) { i.animation = AnimationTimes{0.0, 0.0}; },
+      [](InstanceState& i) { i.animation = AnimationTimes{0.0, 1.0 / 60.0}; }};
   for (std::size_t k = 0; k < changes.size(); ++k) {
     SceneState changed = base;
     changes[k](changed.instances["cup"]);
@@ -578,8 +581,10 @@ TEST(SceneHash, HasTheseValues) {
   state.instances["cup"].asset = "a-teacup-of-the-long-name";
   state.instances["cup"].pose.now.scale = {0.5, 0.5, 0.5};
   state.instances["cup"].emissive = {2.0, 0.0, 0.0};
+  state.instances["saucer"].asset = "a";
+  state.instances["saucer"].animation = AnimationTimes{2.0, 2.25};
   EXPECT_EQ(state_hash(SceneState{}), 0x9e4df0ed2b31c960u);
-  EXPECT_EQ(state_hash(state), 0xe74b45934fb0e1c8u);
+  EXPECT_EQ(state_hash(state), 0xc9b5facc0a617813u);
 }
 
 // What the parents make of the instances is checked as the delta would leave
@@ -626,6 +631,15 @@ TEST(SceneInstances, ADeltaThatBreaksTheParentsIsRefused) {
               changed(d, "cup", lost);
             }),
             "delta: instance cup (now) position has a non-finite coordinate");
+  for (double t : {-1.0, std::nan(""), 2e9}) {
+    EXPECT_EQ(refusal([&](auto& d) {
+                InstanceState animated = instance("cup", "table", 0.0);
+                animated.animation = AnimationTimes{0.0, t};
+                changed(d, "cup", animated);
+              }),
+              "delta: instance cup: its animation's time is outside [0, 1000000000.000000] s")
+        << t;
+  }
   // Moving the cup off the table, then removing the table, is fine in one delta.
   EXPECT_EQ(refusal([&](auto& d) {
               changed(d, "cup", instance("cup", "lamp", 0.0));

@@ -66,7 +66,7 @@ TEST_P(LiveEdits, AnEditBeforeAFrameBeginsIsInThatFrameOnEveryNode) {
   session::Transaction create;
   create.add_edits()->mutable_create()->set_instance("t1");
   create.mutable_edits(0)->mutable_create()->set_asset("torus");
-  ASSERT_FALSE(live.apply(create));
+  ASSERT_FALSE(live.apply(create, k));
   cluster.run_promptly(cluster.now() + 10 * kSecond);
   EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
   const report::RunReport report = cluster.master().report();

@@ -176,6 +176,17 @@ class Transaction:
         edit.light, edit.on = light, on
         return self
 
+    def animate(self, instance: str, playing=None, seek=None) -> "Transaction":
+        """The instance's own clock for its asset's animations: played (True) or
+        paused (False), and/or sought to `seek` seconds; what is None stays."""
+        edit = self.message.edits.add().animation
+        edit.instance = instance
+        if playing is not None:
+            edit.playing = bool(playing)
+        if seek is not None:
+            edit.seek = float(seek)
+        return self
+
     def __enter__(self) -> "Transaction":
         return self
 
