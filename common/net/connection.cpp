@@ -3,6 +3,8 @@
 #include <boost/asio/post.hpp>
 #include <boost/asio/write.hpp>
 
+#include <google/protobuf/arena.h>
+
 #include "net/envelope.h"
 #include "net/stamped_receive.h"
 
@@ -167,18 +169,23 @@ void Connection::handle_bytes(std::size_t count, clock::Nanos received) {
       opened = std::move(open).value();
       payload = opened;
     }
-    auto message = parse_envelope(payload);
-    if (!message) {
-      close("bad message: " + message.error());
+    if (!arena_block_) arena_block_ = std::make_unique<char[]>(kArenaBlockBytes);
+    google::protobuf::ArenaOptions options;
+    options.initial_block = arena_block_.get();
+    options.initial_block_size = kArenaBlockBytes;
+    google::protobuf::Arena arena(options);  // what it took beyond the block is freed with it
+    auto* message = google::protobuf::Arena::CreateMessage<wire::Envelope>(&arena);
+    if (auto parsed = parse_envelope_into(payload, *message); !parsed) {
+      close("bad message: " + parsed.error());
       return;
     }
-    if (message.value().sequence() != next_receive_sequence_) {
-      close("message out of sequence (got " + std::to_string(message.value().sequence()) + ", expected " +
+    if (message->sequence() != next_receive_sequence_) {
+      close("message out of sequence (got " + std::to_string(message->sequence()) + ", expected " +
             std::to_string(next_receive_sequence_) + ")");
       return;
     }
     ++next_receive_sequence_;
-    if (handlers_.on_message) handlers_.on_message(message.value(), received);
+    if (handlers_.on_message) handlers_.on_message(*message, received);
   }
 }
 

@@ -26,14 +26,19 @@ std::vector<std::uint8_t> with_header(std::span<const std::uint8_t> body, std::u
   return payload;
 }
 
-Result<wire::Envelope> parse_envelope(std::span<const std::uint8_t> payload) {
-  wire::Envelope envelope;
+Result<void> parse_envelope_into(std::span<const std::uint8_t> payload, wire::Envelope& envelope) {
   if (!envelope.ParseFromArray(payload.data(), static_cast<int>(payload.size()))) {
     return Error{"undecodable message (" + std::to_string(payload.size()) + " bytes are not an Envelope)"};
   }
   if (envelope.body_case() == wire::Envelope::BODY_NOT_SET) {
     return Error{"message without a body (unknown type, or a newer protocol)"};
   }
+  return {};
+}
+
+Result<wire::Envelope> parse_envelope(std::span<const std::uint8_t> payload) {
+  wire::Envelope envelope;
+  if (auto parsed = parse_envelope_into(payload, envelope); !parsed) return Error{parsed.error()};
   return envelope;
 }
 

@@ -33,6 +33,8 @@ void append_envelope(std::vector<std::uint8_t>& out, const wire::Envelope& envel
 // Parses one frame's payload. Fails on bytes that are not an Envelope or an
 // Envelope without a body; the protocol version is left for the handshake to judge.
 [[nodiscard]] Result<wire::Envelope> parse_envelope(std::span<const std::uint8_t> payload);
+// The same into `envelope` (one on an arena, say), which it clears first.
+[[nodiscard]] Result<void> parse_envelope_into(std::span<const std::uint8_t> payload, wire::Envelope& envelope);
 
 // "frame_begin", "hello", ...: for log lines.
 [[nodiscard]] const char* body_name(const wire::Envelope& envelope);

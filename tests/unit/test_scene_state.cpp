@@ -525,16 +525,29 @@ TEST(SceneInstances, TravelInSnapshotsDeltasAndTheHash) {
   EXPECT_EQ(applied, after);
   EXPECT_EQ(state_hash(applied), state_hash(after));
   EXPECT_EQ(make_delta(after, after).instances_changed_size(), 0);
+  // From a peer that lists them out of order: the same state.
+  wire::StateDelta reversed = delta;
+  std::reverse(reversed.mutable_instances_changed()->begin(), reversed.mutable_instances_changed()->end());
+  ASSERT_NE(reversed.instances_changed(0).id(), delta.instances_changed(0).id());
+  SceneState applied_reversed = before;
+  ASSERT_TRUE(apply_delta(applied_reversed, reversed));
+  EXPECT_EQ(applied_reversed, after);
 }
 
 TEST(SceneInstances, EachFieldChangesTheHash) {
   const SceneState base = with_instances();
-  const std::vector<void (*)(InstanceState&)> changes{
-      [](InstanceState& i) { i.asset = "teapot"; },       [](InstanceState& i) { i.parent = "lamp"; },
-      [](InstanceState& i) { i.pose.next.scale.y *= 2; }, [](InstanceState& i) { i.visible = false; },
-      [](InstanceState& i) { i.base_color.a = 0.5; },     [](InstanceState& i) { i.emissive.b = 0.0; },
-      [](InstanceState& i) { i.animation = AnimationTimes{0.0, 0.0}; },
-      [](InstanceState& i) { i.animation = AnimationTimes{0.0, 1.0 / 60.0}; }};
+  const std::vector<void (*)(InstanceState&)> changes{[](InstanceState& i) { i.asset = "teapot"; },
+                                                      [](InstanceState& i) { i.parent = "lamp"; },
+                                                      [](InstanceState& i) { i.pose.next.scale.y *= 2; },
+                                                      [](InstanceState& i) { i.visible = false; },
+                                                      [](InstanceState& i) { i.base_color.a = 0.5; },
+                                                      [](InstanceState& i) { i.emissive.b = 0.0; },
+                                                      [](InstanceState& i) {
+                                                        i.animation = AnimationTimes{0.0, 0.0};
+                                                      },
+                                                      [](InstanceState& i) {
+                                                        i.animation = AnimationTimes{0.0, 1.0 / 60.0};
+                                                      }};
   for (std::size_t k = 0; k < changes.size(); ++k) {
     SceneState changed = base;
     changes[k](changed.instances["cup"]);
@@ -640,6 +653,12 @@ TEST(SceneInstances, ADeltaThatBreaksTheParentsIsRefused) {
               "delta: instance cup: its animation's time is outside [0, 1000000000.000000] s")
         << t;
   }
+  EXPECT_EQ(refusal([&](auto& d) {
+              changed(d, "cup", instance("cup", "table", 0.0));
+              changed(d, "lamp", instance("lamp", "", 1.0));
+              changed(d, "cup", instance("cup", "", 0.0));
+            }),
+            "delta changes instance cup twice");
   // Moving the cup off the table, then removing the table, is fine in one delta.
   EXPECT_EQ(refusal([&](auto& d) {
               changed(d, "cup", instance("cup", "lamp", 0.0));
