@@ -286,8 +286,8 @@ class LiveScene::Edits {
       clock.playing = changed.animation ? changed.animation->playing : true;
       if (a.has_seek()) {
         if (!std::isfinite(a.seek()) || a.seek() < 0.0 || a.seek() > kMaxSeek) {
-          return Wrong{"seek", "must be in [0, " + number_text(kMaxSeek) + "] seconds (got " + number_text(a.seek()) +
-                                   ")"};
+          return Wrong{"seek",
+                       "must be in [0, " + number_text(kMaxSeek) + "] seconds (got " + number_text(a.seek()) + ")"};
         }
         clock.position = a.seek();
       }
@@ -329,8 +329,8 @@ double AnimationClock::at(std::uint64_t frame, double period) const {
 
 void LiveScene::begin_run(std::uint64_t last) {
   for (auto& [id, instance] : instances_) {
-    if (instance.animation) instance.animation = AnimationClock{instance.animation->playing,
-                                                                instance.animation->at(last, frame_period_), 0};
+    if (instance.animation)
+      instance.animation = AnimationClock{instance.animation->playing, instance.animation->at(last, frame_period_), 0};
   }
   edits_this_frame_ = 0;
 }
@@ -350,7 +350,12 @@ const std::set<std::string>& LiveScene::children(const std::string& parent) cons
 }
 
 void LiveScene::put(const std::string& id, std::optional<Instance> instance) {
-  if (const auto old = instances_.find(id); old != instances_.end()) {
+  const auto old = instances_.find(id);
+  if (instance && old != instances_.end() && old->second.parent == instance->parent) {
+    old->second = std::move(*instance);  // where it was, under the same parent: no index changes
+    return;
+  }
+  if (old != instances_.end()) {
     auto& siblings = children_[old->second.parent];
     siblings.erase(id);
     if (siblings.empty()) children_.erase(old->second.parent);
@@ -422,7 +427,9 @@ LiveSceneLimits live_scene_limits(const std::optional<config::ApiServer>& api) {
 void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& state) {
   state.instances.clear();
   for (const auto& [id, instance] : live.instances()) {
-    scene::InstanceState& placed = state.instances[id];
+    // In order: each goes at the end, found without a search.
+    scene::InstanceState& placed =
+        state.instances.emplace_hint(state.instances.end(), id, scene::InstanceState{})->second;
     placed.asset = instance.asset;
     placed.parent = instance.parent;
     placed.pose = {instance.pose, instance.pose};
