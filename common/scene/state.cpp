@@ -137,6 +137,9 @@ void to_wire(const Pose& p, wire::Pose& out) {
   to_wire(p.scale, *out.mutable_scale());
 }
 
+// An instance's pose packed: position, rotation (w first), scale.
+constexpr int kPackedPose = 10;
+
 void to_wire(std::uint32_t id, const ObjectState& o, wire::ObjectState& out) {
   out.set_id(id);
   to_wire(o.now, *out.mutable_now());
@@ -147,8 +150,16 @@ void to_wire(const std::string& id, const InstanceState& i, wire::InstanceState&
   out.set_id(id);
   out.set_asset(i.asset);
   out.set_parent(i.parent);
-  to_wire(i.pose.now, *out.mutable_now());
-  to_wire(i.pose.next, *out.mutable_next());
+  auto& pose = *out.mutable_pose();
+  const bool still = identical(i.pose.now, i.pose.next);
+  pose.Reserve(still ? kPackedPose : 2 * kPackedPose);
+  for (const Pose* p : {&i.pose.now, &i.pose.next}) {
+    for (double v : {p->position.x, p->position.y, p->position.z, p->rotation.w, p->rotation.x, p->rotation.y,
+                     p->rotation.z, p->scale.x, p->scale.y, p->scale.z}) {
+      pose.AddAlreadyReserved(v);
+    }
+    if (still) break;
+  }
   out.set_hidden(!i.visible);
   // The factors that change nothing are left out.
   if (i.base_color != glm::dvec4(1.0)) {
@@ -210,6 +221,25 @@ Result<glm::dquat> from_wire(const wire::Quat& q, const Where& what) {
   return rotation;
 }
 
+// A packed pose (kPackedPose numbers from `v`), checked as a Pose message is.
+Result<Pose> packed_from_wire(const double* v, const Where& what) {
+  Pose pose;
+  pose.position = {v[0], v[1], v[2]};
+  pose.rotation = glm::dquat(v[3], v[4], v[5], v[6]);
+  pose.scale = {v[7], v[8], v[9]};
+  for (const auto& [vector, part] : {std::pair{&pose.position, " position"}, std::pair{&pose.scale, " scale"}}) {
+    if (!std::isfinite(vector->x) || !std::isfinite(vector->y) || !std::isfinite(vector->z)) {
+      return Error{(what / part).text() + " has a non-finite coordinate"};
+    }
+  }
+  const glm::dquat& q = pose.rotation;
+  const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
+  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-6) {
+    return Error{(what / " rotation").text() + " is not a unit quaternion (norm " + std::to_string(norm) + ")"};
+  }
+  return pose;
+}
+
 Result<Pose> from_wire(const wire::Pose& p, const Where& what) {
   Pose pose;
   auto position = from_wire(p.position(), what / " position");
@@ -265,11 +295,19 @@ Result<std::pair<std::string, InstanceState>> from_wire(const wire::InstanceStat
   out.asset = i.asset();
   out.parent = i.parent();
   out.visible = !i.hidden();
-  auto now = from_wire(i.now(), what / " (now)");
+  if (i.pose_size() != kPackedPose && i.pose_size() != 2 * kPackedPose) {
+    return Error{what.text() + "'s pose has " + std::to_string(i.pose_size()) + " numbers, not " +
+                 std::to_string(kPackedPose) + " or " + std::to_string(2 * kPackedPose)};
+  }
+  auto now = packed_from_wire(i.pose().data(), what / " (now)");
   if (!now) return Error{now.error()};
-  auto next = from_wire(i.next(), what / " (next)");
-  if (!next) return Error{next.error()};
-  out.pose = {now.value(), next.value()};
+  if (i.pose_size() == kPackedPose) {
+    out.pose = {now.value(), now.value()};
+  } else {
+    auto next = packed_from_wire(i.pose().data() + kPackedPose, what / " (next)");
+    if (!next) return Error{next.error()};
+    out.pose = {now.value(), next.value()};
+  }
   if (auto ok = factors_from_wire(i.base_color(), 4, 1.0, what / " base colour"); !ok) return Error{ok.error()};
   if (auto ok = factors_from_wire(i.emissive(), 3, kMaxEmissiveFactor, what / " emissive"); !ok) {
     return Error{ok.error()};

@@ -341,6 +341,27 @@ std::vector<Seed> delta_seeds() {
   seeds.push_back({"empty", {}});
   seeds.push_back(delta_seed("snapshot_only", {}));
   {
+    // Live instances: a snapshot with a group, a move (the packed pose, once
+    // when still and twice when moving), a removal, and a pose of 9 numbers.
+    scene::SceneState placed;
+    placed.instances["table"].asset = "torus";
+    placed.instances["cup"].asset = "torus";
+    placed.instances["cup"].parent = "table";
+    placed.instances["cup"].animation = scene::AnimationTimes{1.0, 1.0};
+    scene::SceneState moved = placed;
+    moved.instances["table"].pose.now.position = {1.0, 0.0, 0.5};
+    moved.instances["table"].pose.next.position = {1.0, 0.0, 0.75};
+    moved.instances["cup"].pose = {{{0.0, 0.5, 0.0}, {0.0, 0.0, 1.0, 0.0}, {2.0, 2.0, 2.0}},
+                                   {{0.0, 0.5, 0.0}, {0.0, 0.0, 1.0, 0.0}, {2.0, 2.0, 2.0}}};
+    scene::SceneState gone = moved;
+    gone.instances.erase("cup");
+    wire::StateDelta short_pose = scene::make_delta(gone, moved);
+    short_pose.mutable_instances_changed(0)->mutable_pose()->RemoveLast();
+    seeds.push_back(delta_seed("instances_move_and_remove",
+                               {scene::make_delta(placed, moved), scene::make_delta(moved, gone), short_pose},
+                               scene::to_snapshot(placed)));
+  }
+  {
     wire::StateDelta d = change(object(1, 0.5, 1.0, -0.5));
     *d.add_changed() = object(9, 3.0, 0.0, 0.0);
     d.add_removed(5);

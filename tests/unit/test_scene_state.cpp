@@ -525,6 +525,20 @@ TEST(SceneInstances, TravelInSnapshotsDeltasAndTheHash) {
   EXPECT_EQ(applied, after);
   EXPECT_EQ(state_hash(applied), state_hash(after));
   EXPECT_EQ(make_delta(after, after).instances_changed_size(), 0);
+  // The pose packed: once for an instance that stands still over the frame,
+  // twice for one that moves.
+  SceneState still = after;
+  still.instances["cup"].pose.next = still.instances["cup"].pose.now;
+  SceneState moving = still;
+  moving.instances["cup"].pose.next.position.x += 0.25;
+  for (const auto& [from, to, numbers] : {std::tuple{&after, &still, 10}, std::tuple{&still, &moving, 20}}) {
+    const wire::StateDelta packed = make_delta(*from, *to);
+    ASSERT_EQ(packed.instances_changed_size(), 1);
+    EXPECT_EQ(packed.instances_changed(0).pose_size(), numbers);
+    SceneState applied_packed = *from;
+    ASSERT_TRUE(apply_delta(applied_packed, packed));
+    EXPECT_EQ(applied_packed, *to);
+  }
   // From a peer that lists them out of order: the same state.
   wire::StateDelta reversed = delta;
   std::reverse(reversed.mutable_instances_changed()->begin(), reversed.mutable_instances_changed()->end());
@@ -644,6 +658,16 @@ TEST(SceneInstances, ADeltaThatBreaksTheParentsIsRefused) {
               changed(d, "cup", lost);
             }),
             "delta: instance cup (now) position has a non-finite coordinate");
+  EXPECT_EQ(refusal([&](auto& d) {
+              changed(d, "cup", instance("cup", "table", 0.0));
+              d.mutable_instances_changed(0)->mutable_pose()->RemoveLast();
+            }),
+            "delta: instance cup's pose has 19 numbers, not 10 or 20");
+  EXPECT_EQ(refusal([&](auto& d) {
+              changed(d, "cup", instance("cup", "table", 0.0));
+              for (int k = 3; k < 7; ++k) d.mutable_instances_changed(0)->mutable_pose()->Set(k, 1.0);  // rotation
+            }),
+            "delta: instance cup (now) rotation is not a unit quaternion (norm 2.000000)");
   for (double t : {-1.0, std::nan(""), 2e9}) {
     EXPECT_EQ(refusal([&](auto& d) {
                 InstanceState animated = instance("cup", "table", 0.0);
