@@ -204,15 +204,14 @@ struct Where {
 };
 
 // Reading from the wire checks every number: NaN or Inf never reaches a matrix.
-Result<glm::dvec3> from_wire(const wire::Vec3& v, const Where& what) {
-  if (!std::isfinite(v.x()) || !std::isfinite(v.y()) || !std::isfinite(v.z())) {
+Result<glm::dvec3> checked(const glm::dvec3& v, const Where& what) {
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
     return Error{what.text() + " has a non-finite coordinate"};
   }
-  return glm::dvec3(v.x(), v.y(), v.z());
+  return v;
 }
 
-Result<glm::dquat> from_wire(const wire::Quat& q, const Where& what) {
-  const glm::dquat rotation(q.w(), q.x(), q.y(), q.z());
+Result<glm::dquat> checked(const glm::dquat& rotation, const Where& what) {
   const double norm =
       std::sqrt(rotation.w * rotation.w + rotation.x * rotation.x + rotation.y * rotation.y + rotation.z * rotation.z);
   if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-6) {
@@ -221,22 +220,20 @@ Result<glm::dquat> from_wire(const wire::Quat& q, const Where& what) {
   return rotation;
 }
 
+Result<glm::dvec3> from_wire(const wire::Vec3& v, const Where& what) {
+  return checked(glm::dvec3(v.x(), v.y(), v.z()), what);
+}
+
+Result<glm::dquat> from_wire(const wire::Quat& q, const Where& what) {
+  return checked(glm::dquat(q.w(), q.x(), q.y(), q.z()), what);
+}
+
 // A packed pose (kPackedPose numbers from `v`), checked as a Pose message is.
 Result<Pose> packed_from_wire(const double* v, const Where& what) {
-  Pose pose;
-  pose.position = {v[0], v[1], v[2]};
-  pose.rotation = glm::dquat(v[3], v[4], v[5], v[6]);
-  pose.scale = {v[7], v[8], v[9]};
-  for (const auto& [vector, part] : {std::pair{&pose.position, " position"}, std::pair{&pose.scale, " scale"}}) {
-    if (!std::isfinite(vector->x) || !std::isfinite(vector->y) || !std::isfinite(vector->z)) {
-      return Error{(what / part).text() + " has a non-finite coordinate"};
-    }
-  }
-  const glm::dquat& q = pose.rotation;
-  const double norm = std::sqrt(q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z);
-  if (!std::isfinite(norm) || std::abs(norm - 1.0) > 1e-6) {
-    return Error{(what / " rotation").text() + " is not a unit quaternion (norm " + std::to_string(norm) + ")"};
-  }
+  const Pose pose{{v[0], v[1], v[2]}, glm::dquat(v[3], v[4], v[5], v[6]), {v[7], v[8], v[9]}};
+  if (auto ok = checked(pose.position, what / " position"); !ok) return Error{ok.error()};
+  if (auto ok = checked(pose.rotation, what / " rotation"); !ok) return Error{ok.error()};
+  if (auto ok = checked(pose.scale, what / " scale"); !ok) return Error{ok.error()};
   return pose;
 }
 
@@ -513,9 +510,9 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
   auto old = before.instances.begin();
   for (const auto& [id, instance] : after.instances) {
     for (; old != before.instances.end() && old->first < id; ++old) delta.add_instances_removed(old->first);
-    const bool same = old != before.instances.end() && old->first == id && identical(old->second, instance);
-    if (!same) to_wire(id, instance, *delta.add_instances_changed());
-    if (old != before.instances.end() && old->first == id) ++old;
+    const bool was_there = old != before.instances.end() && old->first == id;
+    if (!was_there || !identical(old->second, instance)) to_wire(id, instance, *delta.add_instances_changed());
+    if (was_there) ++old;
   }
   for (; old != before.instances.end(); ++old) delta.add_instances_removed(old->first);
   return delta;

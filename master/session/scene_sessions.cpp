@@ -54,18 +54,20 @@ SessionActions SceneSessions::opened(SessionId id, const std::string& peer_text,
   return out;
 }
 
+bool SceneSessions::answerable(SessionId id) const {
+  const auto found = sessions_.find(id);
+  return found != sessions_.end() && !found->second.refused && !found->second.application.empty();
+}
+
 SessionActions SceneSessions::request(SessionId id, const session::Request& request, std::uint64_t next_frame) {
   SessionActions out;
-  const auto found = sessions_.find(id);
-  if (found == sessions_.end() || found->second.refused || found->second.application.empty()) return out;
-  on_request(id, request, next_frame, out);
+  if (answerable(id)) on_request(id, request, next_frame, out);
   return out;
 }
 
 SessionActions SceneSessions::unreadable(SessionId id, const std::string& reason) const {
   SessionActions out;
-  const auto found = sessions_.find(id);
-  if (found == sessions_.end() || found->second.refused || found->second.application.empty()) return out;
+  if (!answerable(id)) return out;
   wire::Envelope answer = reply(0);  // its id could not be read
   answer.mutable_session_reply()->mutable_refused()->set_field("request");
   answer.mutable_session_reply()->mutable_refused()->set_reason(reason);

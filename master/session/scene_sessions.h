@@ -125,6 +125,8 @@ class SceneSessions {
   };
 
   void on_hello(SessionId id, Session& session, const wire::Envelope& message, SessionActions& out);
+  // Whether `id` is a session past its hello (or opened) and not refused: one that may be answered.
+  [[nodiscard]] bool answerable(SessionId id) const;
   // Whether the master may hold one more session; refused if not.
   bool admit(SessionId id, Session& session, SessionActions& out);
   void connected(Session& session, const std::string& application, SessionActions& out);
