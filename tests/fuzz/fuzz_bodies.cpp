@@ -361,7 +361,7 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
       continue;
     }
     wire::Envelope message;
-    if (chunk.front() == '{') {
+    if (!chunk.empty() && chunk.front() == '{') {
       // JSON, as the operator's WebSocket takes it: a request, or one refusal
       // with id 0 that names why, and the session goes on.
       auto read =

@@ -844,7 +844,8 @@ std::vector<Seed> session_seeds() {
     seeds.push_back({"noise_then_a_node_message", join({noise(40, 7), request(1, {create("a", "torus")}),
                                                         serialize(ready), request(2, {create("b", "torus")})})});
   }
-  // As JSON, from the operator's WebSocket: well formed, and not.
+  // As JSON, from the operator's WebSocket: well formed, and not; and an empty
+  // chunk, which is neither JSON nor a frame, last (it once read past the input's end).
   const auto json = [](std::string_view text) { return Bytes(text.begin(), text.end()); };
   seeds.push_back(
       {"json", join({json(R"({"id": 1, "transaction": {"edits": [{"create": {"instance": "a", "asset": "torus",
@@ -862,7 +863,8 @@ std::vector<Seed> session_seeds() {
                      json(R"({"id": 57, "transaction": {"edits": [{"animation": {"instance": "b", "seek": -1}}]}})"),
                      json(R"({"id": 6, "teleport": {}})"), json(R"({"id": -1})"), json("{"),
                      json(R"({"id": 7, "transaction": {"edits": [{"transform": {"instance": "a",
-                        "transform": {"position": [1e400, 0, 0]}}}]}})")})});
+                        "transform": {"position": [1e400, 0, 0]}}}]}})"),
+                     Bytes{}})});
   return seeds;
 }
 
