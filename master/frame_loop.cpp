@@ -137,10 +137,16 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
   begin.set_frame_id(frame);
   begin.set_simulation_time_ns(authority_.simulation_time(frame));
   *begin.mutable_delta() = scene::make_delta(current_state_, state);
+  // A light added or removed is one more or fewer to share out, now: until
+  // then no node of a stacked group would draw it.
+  const bool lights_added =
+      begin.delta().point_lights_removed_size() > 0 ||
+      std::any_of(begin.delta().point_lights_set().begin(), begin.delta().point_lights_set().end(),
+                  [&](const wire::PointLightState& l) { return !current_state_.point_lights.contains(l.light()); });
   const bool lights_switched = begin.delta().lights_off_size() > 0 || begin.delta().lights_on_size() > 0;
   current_state_ = std::move(state);
   current_hash_ = scene::state_hash(current_state_);
-  if (lights_switched) log_light_switches(frame, begin.delta(), out);
+  if (lights_switched || lights_added) log_light_switches(frame, begin.delta(), out);
   begin.set_state_hash(current_hash_);
   begin.set_capture(captured);
   begin.set_present_time_ns(display);
@@ -151,7 +157,7 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
   // The scene moves: about once a second, see whether another split of the
   // automatic groups' lights would finish clearly sooner.
   const auto frames_per_second = static_cast<std::uint64_t>(std::max(1.0, config_.frame_rate));
-  if (lights_switched) {
+  if (lights_switched || lights_added) {
     rebalance_lights(true);
   } else if (frame % frames_per_second == 0) {
     rebalance_lights(false);
@@ -398,13 +404,16 @@ void MasterProtocol::log_light_switches(std::uint64_t frame, const wire::StateDe
     return config::format_light_list(std::vector<std::uint32_t>(lights.begin(), lights.end()));
   };
   std::string what;
-  if (delta.lights_off_size() > 0) what = "lights [" + list(delta.lights_off()) + "] go dark";
-  if (delta.lights_on_size() > 0) {
-    what += (what.empty() ? "" : ", ") + std::string("lights [") + list(delta.lights_on()) + "] come on";
-  }
+  const auto also = [&](const std::string& more) { what += (what.empty() ? "" : ", ") + more; };
+  if (delta.lights_off_size() > 0) also("lights [" + list(delta.lights_off()) + "] go dark");
+  if (delta.lights_on_size() > 0) also("lights [" + list(delta.lights_on()) + "] come on");
+  std::vector<std::uint32_t> set;
+  for (const wire::PointLightState& l : delta.point_lights_set()) set.push_back(l.light());
+  if (!set.empty()) also("lights [" + list(set) + "] added or changed");
+  if (delta.point_lights_removed_size() > 0) also("lights [" + list(delta.point_lights_removed()) + "] removed");
   out.push_back(
       Log{spdlog::level::info, fmt::format("frame {}: {} ({} of {} off)", frame, what, current_state_.lights_off.size(),
-                                           scene_.definition.lights.size())});
+                                           scene_.definition.lights.size() + current_state_.point_lights.size())});
 }
 
 }  // namespace optique::master

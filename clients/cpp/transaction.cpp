@@ -41,6 +41,21 @@ Transaction& Transaction::switch_light(std::uint32_t light, bool on) {
   return *this;
 }
 
+Transaction& Transaction::point_light(std::uint32_t light, std::optional<std::array<double, 3>> position,
+                                      std::optional<std::array<double, 3>> colour, std::optional<double> intensity) {
+  auto& l = *message_.add_edits()->mutable_point_light();
+  l.set_light(light);
+  if (position) l.mutable_position()->Add(position->begin(), position->end());
+  if (colour) l.mutable_colour()->Add(colour->begin(), colour->end());
+  if (intensity) l.set_intensity(*intensity);
+  return *this;
+}
+
+Transaction& Transaction::remove_point_light(std::uint32_t light) {
+  message_.add_edits()->mutable_remove_point_light()->set_light(light);
+  return *this;
+}
+
 Transaction& Transaction::animate(const std::string& instance, std::optional<bool> playing,
                                   std::optional<double> seek) {
   auto& a = *message_.add_edits()->mutable_animation();

@@ -37,6 +37,13 @@ class Transaction {
   Transaction& navigate(const Placement& placement);
   // One of the scene's point lights, by its index, on or off.
   Transaction& switch_light(std::uint32_t light, bool on);
+  // Adds a point light (index from the scene's light count on), or changes
+  // one added before: where it is (world metres; needed to add it), its
+  // linear colour, its intensity. What is left out keeps its value.
+  Transaction& point_light(std::uint32_t light, std::optional<std::array<double, 3>> position,
+                           std::optional<std::array<double, 3>> colour = std::nullopt,
+                           std::optional<double> intensity = std::nullopt);
+  Transaction& remove_point_light(std::uint32_t light);
   // The instance's own clock for its asset's animations: played or paused
   // (nullopt: as it was), sought to `seek` seconds (nullopt: where it is).
   Transaction& animate(const std::string& instance, std::optional<bool> playing,

@@ -1,6 +1,7 @@
 #include "protocol/welcome.h"
 
 #include "config/to_schema.h"
+#include "scene/state.h"
 
 namespace optique::protocol {
 namespace {
@@ -128,9 +129,10 @@ Result<LightShare> decode_light_share(const wire::LightShare& share, std::uint32
   out.ambient = share.ambient();
   for (int i = 0; i < share.lights_size(); ++i) {
     const std::uint32_t light = share.lights(i);
-    if (light >= light_count) {
+    // The scene's own lights, and those applications may add after them.
+    if (light >= std::uint64_t{light_count} + scene::kMaxAddedLights) {
       return Error{"light " + std::to_string(light) + " does not exist (the scene has " + std::to_string(light_count) +
-                   ")"};
+                   ", and at most " + std::to_string(scene::kMaxAddedLights) + " may be added)"};
     }
     if (i > 0 && light <= share.lights(i - 1)) {
       return Error{"lights must ascend, each once (" + std::to_string(light) + " after " +

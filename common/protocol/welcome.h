@@ -49,7 +49,9 @@ struct NodeJob {
 
 [[nodiscard]] wire::LightShare to_wire(const LightShare& share);
 [[nodiscard]] wire::SceneManifest to_wire(const scene::SceneManifest& manifest);
-// Fails when an index is not below `light_count`, or indices repeat or descend.
+// Fails when an index is not below `light_count` (the scene's lights) plus
+// scene::kMaxAddedLights (those applications may add), or indices repeat or
+// descend.
 [[nodiscard]] Result<LightShare> decode_light_share(const wire::LightShare& share, std::uint32_t light_count);
 
 }  // namespace optique::protocol

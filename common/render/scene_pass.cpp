@@ -131,9 +131,11 @@ Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
     pass.all_lights_.emplace_back(light.colour * light.intensity, 0.0f);
   }
   pass.light_buffer_ = glo::make_buffer();
-  glNamedBufferStorage(pass.light_buffer_.get(),
-                       static_cast<GLsizeiptr>(std::max<std::size_t>(1, pass.all_lights_.size()) * sizeof(glm::vec4)),
-                       nullptr, GL_DYNAMIC_STORAGE_BIT);
+  // Room for the lights applications may add too.
+  glNamedBufferStorage(
+      pass.light_buffer_.get(),
+      static_cast<GLsizeiptr>((pass.all_lights_.size() + 2 * scene::kMaxAddedLights) * sizeof(glm::vec4)), nullptr,
+      GL_DYNAMIC_STORAGE_BIT);
 
   pass.materials_ = scene.materials;
   pass.instances_ = scene.instances;
@@ -168,34 +170,42 @@ Result<void> ScenePass::prepare_motion_field() {
 }
 
 void ScenePass::set_lights(std::span<const std::uint32_t> lights) {
-  assert(std::all_of(lights.begin(), lights.end(),
-                     [&](std::uint32_t i) { return 2 * static_cast<std::size_t>(i) + 1 < all_lights_.size(); }));
-  chosen_lights_.assign(lights.begin(), lights.end());
-  upload_shining_lights({});
+  chosen_lights_ = std::vector<std::uint32_t>(lights.begin(), lights.end());
 }
 
-void ScenePass::set_all_lights() {
-  std::vector<std::uint32_t> all(all_lights_.size() / 2);
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<std::uint32_t>(i);
-  set_lights(all);
-}
+void ScenePass::set_all_lights() { chosen_lights_.reset(); }
 
-void ScenePass::upload_shining_lights(const std::set<std::uint32_t>& off) {
-  std::vector<std::uint32_t> shining;
-  for (std::uint32_t i : chosen_lights_) {
-    if (!off.contains(i)) shining.push_back(i);
-  }
-  if (shining == uploaded_lights_ && light_count_ == static_cast<int>(shining.size())) return;
+void ScenePass::upload_shining_lights(const scene::SceneState& state) {
+  const std::size_t own = all_lights_.size() / 2;
   std::vector<glm::vec4> data;
-  for (std::uint32_t i : shining) {
-    data.push_back(all_lights_[2 * i]);
-    data.push_back(all_lights_[2 * i + 1]);
+  const auto shine = [&](std::uint32_t i) {
+    if (state.lights_off.contains(i)) return;
+    if (i < own) {
+      data.push_back(all_lights_[2 * i]);
+      data.push_back(all_lights_[2 * i + 1]);
+      return;
+    }
+    // An added light; one a share names that the state has not is drawn by nobody.
+    const auto added = state.point_lights.find(i);
+    if (added == state.point_lights.end() || data.size() / 2 >= own + scene::kMaxAddedLights) return;
+    const scene::PointLightState& light = added->second;
+    data.emplace_back(glm::vec3(light.position), 1.0f);
+    data.emplace_back(glm::vec3(light.colour * light.intensity), 0.0f);
+  };
+  if (chosen_lights_) {
+    for (std::uint32_t i : *chosen_lights_) shine(i);
+  } else {
+    for (std::uint32_t i = 0; i < own; ++i) shine(i);
+    for (const auto& [i, light] : state.point_lights) {
+      if (i >= own) shine(i);
+    }
   }
+  if (data == uploaded_lights_) return;
   if (!data.empty()) {
     glNamedBufferSubData(light_buffer_.get(), 0, static_cast<GLsizeiptr>(data.size() * sizeof(glm::vec4)), data.data());
   }
-  light_count_ = static_cast<int>(shining.size());
-  uploaded_lights_ = std::move(shining);
+  light_count_ = static_cast<int>(data.size() / 2);
+  uploaded_lights_ = std::move(data);
 }
 
 bool ScenePass::anything_still() const {
@@ -204,7 +214,7 @@ bool ScenePass::anything_still() const {
 
 void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, const LightTerms& terms, int width,
                      int height, Objects which, const Motion* motion) {
-  upload_shining_lights(state.lights_off);
+  upload_shining_lights(state);
   const int keys = motion ? motion->key_frames : 0;
   const bool key_frames = keys > 0;
   assert(keys >= 0 && keys <= 2);
@@ -252,16 +262,15 @@ void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, cons
     for (int e = 0; e < (motion ? 2 : 0); ++e) {
       const scene::SceneState* then = motion->ends[e].state;
       const auto there = then ? then->instances.find(id) : state.instances.end();
-      placement.animation_at_end[e] =
-          then && there != then->instances.end() ? there->second.animation : std::nullopt;
+      placement.animation_at_end[e] = then && there != then->instances.end() ? there->second.animation : std::nullopt;
     }
     draw_placed(placement, state, view, terms, u, motion);
   }
 }
 
 std::optional<glm::dmat4> ScenePass::object_matrix(const scene::SceneState& state, std::uint32_t object,
-                                                    const std::optional<scene::AnimationTimes>& times,
-                                                    double fraction) const {
+                                                   const std::optional<scene::AnimationTimes>& times,
+                                                   double fraction) const {
   if (times) {
     const auto animated = animations_.find(object);
     if (animated == animations_.end()) return std::nullopt;

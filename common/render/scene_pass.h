@@ -59,8 +59,10 @@ class ScenePass {
   // Up-conversion's motion-field programs (from one key frame, from two); once.
   [[nodiscard]] Result<void> prepare_motion_field();
 
-  // Draws only these of the scene's point lights (indices), less those the
-  // drawn state has switched off. Asserts that each exists.
+  // Draws only these of the frame's point lights (indices: the scene's own,
+  // then those applications added, scene/light_coverage.h), less those the
+  // drawn state has switched off; an index the state has no light for is not
+  // drawn. Or every light of the state (the default).
   void set_lights(std::span<const std::uint32_t> lights);
   void set_all_lights();
 
@@ -98,7 +100,7 @@ class ScenePass {
   };
 
   ScenePass() = default;
-  void upload_shining_lights(const std::set<std::uint32_t>& off);
+  void upload_shining_lights(const scene::SceneState& state);
   // Where animated object `object` puts what rides on it, `fraction` of a
   // frame on: from `state`, or at `times` of the scene's animations (an
   // instance's own clock). None: the object is not there.
@@ -133,9 +135,9 @@ class ScenePass {
   std::string asset_id_;  // the scene's: the live instances of it are drawn too
   glm::vec3 ambient_{0.0f};
   glm::vec3 background_{0.0f};
-  std::vector<glm::vec4> all_lights_;           // position, radiance: two per light
-  std::vector<std::uint32_t> chosen_lights_;    // set_lights
-  std::vector<std::uint32_t> uploaded_lights_;  // those of them that shine, in the light buffer
+  std::vector<glm::vec4> all_lights_;  // the scene's own: position, radiance, two per light
+  std::optional<std::vector<std::uint32_t>> chosen_lights_;  // set_lights; none: every light
+  std::vector<glm::vec4> uploaded_lights_;  // what the light buffer holds: the lights that shine
   int light_count_ = 0;
 };
 

@@ -12,10 +12,24 @@
 
 namespace optique::scene {
 
+std::vector<std::optional<PointLight>> frame_lights(const SceneDefinition& scene, const SceneState& state) {
+  std::size_t count = scene.lights.size();
+  if (!state.point_lights.empty()) count = std::max(count, std::size_t{state.point_lights.rbegin()->first} + 1);
+  std::vector<std::optional<PointLight>> lights(count);
+  std::copy(scene.lights.begin(), scene.lights.end(), lights.begin());
+  for (const auto& [index, added] : state.point_lights) {
+    // The master adds none over the scene's own; a peer's that would is not drawn.
+    if (index < scene.lights.size()) continue;
+    lights[index] = PointLight{added.position, glm::vec3(added.colour), static_cast<float>(added.intensity)};
+  }
+  return lights;
+}
+
 std::vector<double> light_coverage(const SceneDefinition& scene, const SceneState& state, const CoverageGrid& grid) {
   assert(grid.nx > 0 && grid.ny > 0);
   assert(std::isfinite(grid.threshold) && grid.threshold >= 0.0);
-  std::vector<std::size_t> reached(scene.lights.size(), 0);
+  const std::vector<std::optional<PointLight>> lights = frame_lights(scene, state);
+  std::vector<std::size_t> reached(lights.size(), 0);
   // Frame 0 of the pair: the split is chosen for a frame, not for a sub-frame time.
   const RayCaster caster(scene, state, 0.0);
   for (int j = 0; j < grid.ny; ++j) {
@@ -28,8 +42,9 @@ std::vector<double> light_coverage(const SceneDefinition& scene, const SceneStat
       if (direction == glm::dvec3(0.0)) continue;
       const auto hit = caster.cast({grid.eye, direction});
       if (!hit) continue;
-      for (std::size_t k = 0; k < scene.lights.size(); ++k) {
-        const PointLight& light = scene.lights[k];
+      for (std::size_t k = 0; k < lights.size(); ++k) {
+        if (!lights[k]) continue;
+        const PointLight& light = *lights[k];
         const glm::dvec3 to_light = light.position - hit->point;
         // The same floor on r² as the shader, so a light on the surface is not infinite.
         const double r2 = std::max(glm::dot(to_light, to_light), 1e-8);

@@ -5,6 +5,7 @@
 // where the light does not reach, so a light's cost grows with the share of the
 // node's pixels it lights.
 
+#include <optional>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -29,7 +30,14 @@ struct CoverageGrid {
   double threshold = 1e-3;
 };
 
-// For each scene light, in [0, 1]: the share of the grid's sample rays whose first
+// The point lights a frame has, by index: the scene's own (0 to
+// scene.lights.size() - 1), then those applications added (state.point_lights);
+// an index between them that holds no light is empty. Switched-off lights are
+// here too (lights_off says which).
+[[nodiscard]] std::vector<std::optional<PointLight>> frame_lights(const SceneDefinition& scene,
+                                                                  const SceneState& state);
+
+// For each light of frame_lights (an empty index: 0), in [0, 1]: the share of the grid's sample rays whose first
 // hit (at the state's `now` poses) the light reaches with a noticeable
 // contribution: the surface faces it (n·l > 0, n the surface's normal on the
 // side the ray sees) and its irradiance intensity·max(colour)·(n·l)/r² is at

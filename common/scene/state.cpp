@@ -72,6 +72,11 @@ class StateHasher {
       add(i.animation->next);
     }
   }
+  void add(const PointLightState& light) {
+    add(light.position);
+    add(light.colour);
+    add(light.intensity);
+  }
   [[nodiscard]] std::uint64_t value() const {
     std::uint64_t v = hash_;
     v ^= v >> 33;
@@ -190,6 +195,10 @@ void to_wire(const SceneState& s, wire::ViewerState& out) {
     to_wire(s.navigation.now, *out.mutable_navigation_now());
     to_wire(s.navigation.next, *out.mutable_navigation_next());
   }
+}
+
+bool identical(const PointLightState& a, const PointLightState& b) {
+  return identical(a.position, b.position) && identical(a.colour, b.colour) && same_bits(a.intensity, b.intensity);
 }
 
 // Where a value read from the wire is ("instance a (now) position"), for an
@@ -323,6 +332,36 @@ Result<std::pair<std::string, InstanceState>> from_wire(const wire::InstanceStat
   return std::pair{i.id(), std::move(out)};
 }
 
+void to_wire(std::uint32_t index, const PointLightState& light, wire::PointLightState& out) {
+  out.set_light(index);
+  for (int k = 0; k < 3; ++k) {
+    out.add_position(light.position[k]);
+    out.add_colour(light.colour[k]);
+  }
+  out.set_intensity(light.intensity);
+}
+
+Result<std::pair<std::uint32_t, PointLightState>> from_wire(const wire::PointLightState& l) {
+  const std::string name = "point light " + std::to_string(l.light());
+  if (l.light() >= kMaxLightIndex) return Error{name + ": the index is " + std::to_string(kMaxLightIndex) + " or more"};
+  if (l.position_size() != 3)
+    return Error{name + ": its position has " + std::to_string(l.position_size()) + " numbers, not 3"};
+  if (l.colour_size() != 3)
+    return Error{name + ": its colour has " + std::to_string(l.colour_size()) + " numbers, not 3"};
+  PointLightState light{
+      {l.position(0), l.position(1), l.position(2)}, {l.colour(0), l.colour(1), l.colour(2)}, l.intensity()};
+  for (int k = 0; k < 3; ++k) {
+    if (!(std::abs(light.position[k]) <= kMaxLightDistance)) return Error{name + "'s position is not within ±1e6 m"};
+    if (!(light.colour[k] >= 0.0 && light.colour[k] <= kMaxLightColour)) {
+      return Error{name + "'s colour is outside [0, " + std::to_string(kMaxLightColour) + "]"};
+    }
+  }
+  if (!(light.intensity >= 0.0 && light.intensity <= kMaxLightIntensity)) {
+    return Error{name + "'s intensity is outside [0, " + std::to_string(kMaxLightIntensity) + "]"};
+  }
+  return std::pair{l.light(), light};
+}
+
 // Every instance a change names, and every one left without its parent by a
 // removal: its parent is there, and the chain above it ends at the world
 // within kMaxInstanceDepth (so without a cycle). `lookup` gives an instance as
@@ -441,6 +480,14 @@ std::uint64_t state_hash(const SceneState& state) {
     h.add(std::string_view(id));
     h.add(instance);
   }
+  // Only when there are any: a state without them hashes as it did before they were.
+  if (!state.point_lights.empty()) {
+    h.add(static_cast<std::uint64_t>(state.point_lights.size()));
+    for (const auto& [index, light] : state.point_lights) {
+      h.add(static_cast<std::uint64_t>(index));
+      h.add(light);
+    }
+  }
   return h.value();
 }
 
@@ -450,6 +497,7 @@ wire::Snapshot to_snapshot(const SceneState& state) {
   to_wire(state, *snapshot.mutable_viewer());
   snapshot.mutable_lights_off()->Add(state.lights_off.begin(), state.lights_off.end());
   for (const auto& [id, instance] : state.instances) to_wire(id, instance, *snapshot.add_instances());
+  for (const auto& [index, light] : state.point_lights) to_wire(index, light, *snapshot.add_point_lights());
   return snapshot;
 }
 
@@ -483,6 +531,16 @@ Result<SceneState> from_snapshot(const wire::Snapshot& snapshot) {
     return found == state.instances.end() ? nullptr : &found->second;
   };
   if (auto ok = check_parents(ids, lookup); !ok) return Error{"snapshot: " + ok.error()};
+  for (const auto& l : snapshot.point_lights()) {
+    auto light = from_wire(l);
+    if (!light) return Error{"snapshot: " + light.error()};
+    if (!state.point_lights.insert(light.value()).second) {
+      return Error{"snapshot lists point light " + std::to_string(l.light()) + " twice"};
+    }
+  }
+  if (state.point_lights.size() > kMaxAddedLights) {
+    return Error{"snapshot: more than " + std::to_string(kMaxAddedLights) + " point lights added"};
+  }
   return state;
 }
 
@@ -515,6 +573,15 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
     if (was_there) ++old;
   }
   for (; old != before.instances.end(); ++old) delta.add_instances_removed(old->first);
+  for (const auto& [index, light] : after.point_lights) {
+    const auto was = before.point_lights.find(index);
+    if (was == before.point_lights.end() || !identical(was->second, light)) {
+      to_wire(index, light, *delta.add_point_lights_set());
+    }
+  }
+  for (const auto& [index, light] : before.point_lights) {
+    if (!after.point_lights.contains(index)) delta.add_point_lights_removed(index);
+  }
   return delta;
 }
 
@@ -547,6 +614,29 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
     // Against the state before the delta, so one delta cannot switch a light off and on.
     if (!state.lights_off.contains(light) || lights_off.erase(light) == 0) {
       return Error{"delta switches on light " + std::to_string(light) + ", which is not off"};
+    }
+  }
+
+  // Copied only when the delta touches them: most frames do not.
+  std::optional<std::map<std::uint32_t, PointLightState>> point_lights;
+  if (delta.point_lights_set_size() > 0 || delta.point_lights_removed_size() > 0) {
+    point_lights = state.point_lights;
+    std::set<std::uint32_t> named;
+    for (const auto& l : delta.point_lights_set()) {
+      auto light = from_wire(l);
+      if (!light) return Error{"delta: " + light.error()};
+      if (!named.insert(l.light()).second)
+        return Error{"delta sets point light " + std::to_string(l.light()) + " twice"};
+      point_lights->insert_or_assign(light.value().first, light.value().second);
+    }
+    for (std::uint32_t index : delta.point_lights_removed()) {
+      if (!named.insert(index).second || point_lights->erase(index) == 0) {
+        return Error{"delta removes point light " + std::to_string(index) +
+                     ", which it cannot: it is not there, set too, or removed twice"};
+      }
+    }
+    if (point_lights->size() > kMaxAddedLights) {
+      return Error{"delta: more than " + std::to_string(kMaxAddedLights) + " point lights added"};
     }
   }
 
@@ -610,6 +700,7 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
   for (std::uint32_t id : delta.removed()) state.objects.erase(id);
   set_viewer(state, viewer);
   state.lights_off = std::move(lights_off);
+  if (point_lights) state.point_lights = std::move(*point_lights);
   return {};
 }
 

@@ -72,6 +72,26 @@ inline constexpr double kMaxEmissiveFactor = 1e3;
 // log, a file name and JSON as it is.
 [[nodiscard]] bool is_instance_id(std::string_view id);
 
+// A point light an application added (master.api's SetPointLight), in the
+// world as the scene's own lights are.
+struct PointLightState {
+  glm::dvec3 position{0.0};  // world metres
+  glm::dvec3 colour{1.0};    // linear
+  double intensity = 1.0;    // irradiance = colour·intensity / r²
+  bool operator==(const PointLightState&) const = default;
+};
+
+// What a node takes from the wire, and what the master's live scene allows:
+// at most kMaxAddedLights lights added, each index below kMaxLightIndex (the
+// scene's own lights come first: at most 2^16 of them), the colour's channels
+// in [0, kMaxLightColour], the intensity in [0, kMaxLightIntensity], the
+// position within ±kMaxLightDistance.
+inline constexpr std::size_t kMaxAddedLights = 64;
+inline constexpr std::uint32_t kMaxLightIndex = (1u << 16) + kMaxAddedLights;
+inline constexpr double kMaxLightColour = 1e3;
+inline constexpr double kMaxLightIntensity = 1e6;
+inline constexpr double kMaxLightDistance = 1e6;
+
 struct SceneState {
   std::map<std::uint32_t, ObjectState> objects;
   glm::dvec3 eye_now{0.0};  // the centre of the eyes
@@ -90,6 +110,9 @@ struct SceneState {
   std::set<std::uint32_t> lights_off;
   // By id: the live scene's instances, as the frame shows them.
   std::map<std::string, InstanceState> instances;
+  // By index (after the scene's own): the point lights applications added.
+  // lights_off switches them as it does the scene's.
+  std::map<std::uint32_t, PointLightState> point_lights;
 
   bool operator==(const SceneState&) const = default;
 };
@@ -117,7 +140,8 @@ inline constexpr double kMostNavigationScale = 1e4;
 // Applies `delta` to `state`, or leaves it untouched and says what is wrong
 // (non-finite numbers, removing an object that does not exist, switching off a
 // light that is off or on one that is on, an instance whose parent is missing,
-// is itself or under it, or deeper than kMaxInstanceDepth).
+// is itself or under it, or deeper than kMaxInstanceDepth; a point light out of
+// bounds, removed when it is not there, or more than kMaxAddedLights of them).
 [[nodiscard]] Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta);
 
 }  // namespace optique::scene

@@ -27,6 +27,12 @@ bool same_side(const scene::SceneState& key, const scene::SceneState& state, std
     if (why) *why = "lights switched";
     return false;
   }
+  // A light added, moved or removed shades every surface anew: no key frame
+  // drawn before shows it.
+  if (key.point_lights != state.point_lights) {
+    if (why) *why = "lights added or changed";
+    return false;
+  }
   if (glm::distance(key.eye_now, state.eye_now) > kCutEyeJump) {
     if (why) *why = "viewer jumped";
     return false;

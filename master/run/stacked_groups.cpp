@@ -178,15 +178,18 @@ LiveMembers live_members(const config::Installation& inst, const StackedGroup& g
 }
 
 // One share per member of the group: the live members' by cost, nothing for the
-// others; the lights that are off go to nobody.
+// others; the lights that are off, and the indices that hold none, go to nobody.
 std::vector<LightShare> shares_for(const StackedGroup& group, const LiveMembers& members,
-                                   const std::vector<double>& costs, const std::set<std::uint32_t>& lights_off) {
+                                   const std::vector<double>& costs, const scene::SceneDefinition& scene,
+                                   const scene::SceneState& state) {
   std::vector<LightShare> shares(group.members.size());
   if (members.places.empty()) return shares;
+  const auto lights = scene::frame_lights(scene, state);
+  assert(lights.size() == costs.size());
   std::vector<std::uint32_t> shining;
   std::vector<double> shining_costs;
   for (std::size_t light = 0; light < costs.size(); ++light) {
-    if (lights_off.contains(static_cast<std::uint32_t>(light))) continue;
+    if (!lights[light] || state.lights_off.contains(static_cast<std::uint32_t>(light))) continue;
     shining.push_back(static_cast<std::uint32_t>(light));
     shining_costs.push_back(costs[light]);
   }
@@ -204,8 +207,8 @@ std::vector<LightShare> shares_for(const StackedGroup& group, const LiveMembers&
 std::vector<LightShare> automatic_shares(const config::Installation& inst, const StackedGroup& group,
                                          const std::vector<bool>& live, const scene::SceneDefinition& scene,
                                          const scene::SceneState& state, const glm::dvec3& eye) {
-  return shares_for(group, live_members(inst, group, live), group_light_costs(inst, group, scene, state, eye),
-                    state.lights_off);
+  return shares_for(group, live_members(inst, group, live), group_light_costs(inst, group, scene, state, eye), scene,
+                    state);
 }
 
 LightPlan::LightPlan(const config::Installation& installation, const scene::SceneDefinition& scene)
@@ -220,12 +223,15 @@ bool LightPlan::rebalance(const std::vector<bool>& up, const scene::SceneState& 
   constexpr double kWorthwhileGain = 0.05;
   bool changed = false;
   for (const StackedGroup& group : groups_) {
-    if (!group.automatic) continue;
+    if (!group.automatic) {
+      changed = listed_with_added(group, state) || changed;
+      continue;
+    }
     std::vector<bool> live;
     for (std::size_t member : group.members) live.push_back(up[member]);
     const LiveMembers members = live_members(installation_, group, live);
     const std::vector<double> costs = group_light_costs(installation_, group, scene_, state, eye);
-    std::vector<LightShare> proposed = shares_for(group, members, costs, state.lights_off);
+    std::vector<LightShare> proposed = shares_for(group, members, costs, scene_, state);
     bool differs = false;
     for (std::size_t k = 0; k < group.members.size(); ++k) {
       const auto current = shares_.find(group.members[k]);
@@ -251,6 +257,28 @@ bool LightPlan::rebalance(const std::vector<bool>& up, const scene::SceneState& 
     }
     for (std::size_t k = 0; k < group.members.size(); ++k) shares_[group.members[k]] = std::move(proposed[k]);
     changed = true;
+  }
+  return changed;
+}
+
+// A group whose config lists its lights: the lights applications add are
+// drawn by the projector that carries the ambient light (one does: checked at
+// the start), beside its listed ones.
+bool LightPlan::listed_with_added(const StackedGroup& group, const scene::SceneState& state) {
+  bool changed = false;
+  for (std::size_t member : group.members) {
+    const config::Content& content = installation_.projectors[member].content;
+    LightShare share{content.lights, content.ambient};
+    if (content.ambient) {
+      for (const auto& [index, light] : state.point_lights) {
+        if (index >= scene_.lights.size()) share.lights.push_back(index);  // after the listed: ascending
+      }
+    }
+    LightShare& current = shares_[member];
+    if (current != share) {
+      current = std::move(share);
+      changed = true;
+    }
   }
   return changed;
 }

@@ -66,7 +66,8 @@ inline constexpr double kAmbientCost = 0.05;
                                                        const scene::SceneState& state, const glm::dvec3& eye);
 
 // Who draws which lights, for the whole installation, as the nodes come and go:
-// listed shares are fixed; an automatic group's lights go to the members that
+// listed shares are fixed, but for the lights applications add, which the
+// ambient carrier of the group draws; an automatic group's lights go to the members that
 // are up, by estimated cost, and are shared out again when a member comes or
 // goes, or when the scene has moved enough that another split would finish
 // clearly sooner.
@@ -85,6 +86,8 @@ class LightPlan {
   [[nodiscard]] const LightShare* share(std::size_t projector) const;
 
  private:
+  bool listed_with_added(const StackedGroup& group, const scene::SceneState& state);
+
   const config::Installation& installation_;
   const scene::SceneDefinition& scene_;
   std::vector<StackedGroup> groups_;

@@ -118,6 +118,10 @@ class LiveScene::Edits {
         return named("light", light(edit.light()));
       case session::Edit::kAnimation:
         return named("animation", animation(edit.animation()));
+      case session::Edit::kPointLight:
+        return named("point_light", point_light(edit.point_light()));
+      case session::Edit::kRemovePointLight:
+        return named("remove_point_light", remove_point_light(edit.remove_point_light()));
       case session::Edit::EDIT_NOT_SET:
         break;
     }
@@ -125,12 +129,13 @@ class LiveScene::Edits {
   }
 
   // Puts every changed instance back as it was, the last change first, and
-  // the navigation and the light switches.
+  // the navigation, the light switches and the lights added.
   void undo() {
     for (auto it = before_.rbegin(); it != before_.rend(); ++it) scene_.put(it->first, it->second);
     before_.clear();
     if (navigation_before_) scene_.navigation_ = *navigation_before_;
     if (lights_before_) scene_.light_switches_ = std::move(*lights_before_);
+    if (point_lights_before_) scene_.point_lights_ = std::move(*point_lights_before_);
   }
 
  private:
@@ -263,15 +268,72 @@ class LiveScene::Edits {
   }
 
   Check light(const session::SwitchLight& l) {
-    if (l.light() >= scene_.light_count_) {
-      return Wrong{"light", scene_.light_count_ == 0
-                                ? "the scene has no point lights"
-                                : "the scene's point lights are 0 to " + std::to_string(scene_.light_count_ - 1) +
-                                      " (got " + std::to_string(l.light()) + ")"};
+    if (l.light() >= scene_.light_count_ && !scene_.point_lights_.contains(l.light())) {
+      return Wrong{"light", (scene_.light_count_ == 0
+                                 ? std::string("the scene has no point lights")
+                                 : "the scene's point lights are 0 to " + std::to_string(scene_.light_count_ - 1)) +
+                                ", and no light " + std::to_string(l.light()) + " was added"};
     }
-    if (!lights_before_) lights_before_ = scene_.light_switches_;
-    scene_.light_switches_[l.light()] = l.on();
+    switch_light(l.light(), l.on());
     return std::nullopt;
+  }
+
+  // Adds a light after the scene's, or changes one added before.
+  Check point_light(const session::SetPointLight& l) {
+    const std::size_t first = scene_.light_count_;
+    const std::size_t most = scene_.limits_.max_point_lights;
+    if (l.light() < first || l.light() - first >= most) {
+      return Wrong{"light", "lights added take the indices " + std::to_string(first) + " to " +
+                                std::to_string(first + most - 1) + ", after the scene's own (got " +
+                                std::to_string(l.light()) + ")"};
+    }
+    const auto there = scene_.point_lights_.find(l.light());
+    if (there == scene_.point_lights_.end()) {
+      if (l.position().empty()) return Wrong{"position", "is needed to add a light"};
+      if (scene_.point_lights_.size() >= most) {
+        return Wrong{"light", "the scene has " + std::to_string(most) + " lights added, the most it may"};
+      }
+    }
+    scene::PointLightState light = there == scene_.point_lights_.end() ? scene::PointLightState{} : there->second;
+    if (!l.position().empty()) {
+      if (auto wrong = count_problem("position", l.position_size(), {3}, "[x, y, z]")) return wrong;
+      if (auto wrong = numbers_problem("position", l.position(), -kMaxPosition, kMaxPosition)) return wrong;
+      light.position = {l.position(0), l.position(1), l.position(2)};
+    }
+    if (!l.colour().empty()) {
+      if (auto wrong = count_problem("colour", l.colour_size(), {3}, "[r, g, b]")) return wrong;
+      if (auto wrong = numbers_problem("colour", l.colour(), 0.0, scene::kMaxLightColour)) return wrong;
+      light.colour = {l.colour(0), l.colour(1), l.colour(2)};
+    }
+    if (l.has_intensity()) {
+      if (!std::isfinite(l.intensity()) || l.intensity() < 0.0 || l.intensity() > scene::kMaxLightIntensity) {
+        return Wrong{"intensity", "must be in [0, " + number_text(scene::kMaxLightIntensity) + "] (got " +
+                                      number_text(l.intensity()) + ")"};
+      }
+      light.intensity = l.intensity();
+    }
+    if (!point_lights_before_) point_lights_before_ = scene_.point_lights_;
+    scene_.point_lights_[l.light()] = light;
+    return std::nullopt;
+  }
+
+  // A light added goes, and its switch with it.
+  Check remove_point_light(const session::RemovePointLight& r) {
+    if (!scene_.point_lights_.contains(r.light())) {
+      return Wrong{"light", "no light " + std::to_string(r.light()) + " was added"};
+    }
+    if (!point_lights_before_) point_lights_before_ = scene_.point_lights_;
+    scene_.point_lights_.erase(r.light());
+    if (scene_.light_switches_.contains(r.light())) {
+      if (!lights_before_) lights_before_ = scene_.light_switches_;
+      scene_.light_switches_.erase(r.light());
+    }
+    return std::nullopt;
+  }
+
+  void switch_light(std::uint32_t light, bool on) {
+    if (!lights_before_) lights_before_ = scene_.light_switches_;
+    scene_.light_switches_[light] = on;
   }
 
   // The clock starts here from where the scene's time has the animations in
@@ -320,6 +382,7 @@ class LiveScene::Edits {
   std::vector<std::pair<std::string, std::optional<Instance>>> before_;
   std::optional<NavigationSet> navigation_before_;
   std::optional<std::map<std::uint32_t, bool>> lights_before_;
+  std::optional<std::map<std::uint32_t, scene::PointLightState>> point_lights_before_;
 };
 
 double AnimationClock::at(std::uint64_t frame, double period) const {
@@ -412,6 +475,14 @@ session::SceneContents scene_contents(const LiveScene& live, std::uint64_t frame
     l.set_light(light);
     l.set_on(on);
   }
+  for (const auto& [index, light] : live.point_lights()) {
+    session::SetPointLight& l = *contents.add_point_lights();
+    l.set_light(index);
+    for (int i = 0; i < 3; ++i) l.add_position(light.position[i]);
+    for (int i = 0; i < 3; ++i) l.add_colour(light.colour[i]);
+    l.set_intensity(light.intensity);
+  }
+  contents.set_max_point_lights(static_cast<std::uint32_t>(live.max_point_lights()));
   return contents;
 }
 
@@ -449,6 +520,7 @@ void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& sta
     }
   }
   state.navigation = {live.navigation().pose, live.navigation().pose};
+  state.point_lights = live.point_lights();
 }
 
 }  // namespace optique::master

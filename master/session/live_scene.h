@@ -52,6 +52,7 @@ struct LiveSceneLimits {
   std::size_t max_instances = 100000;
   std::size_t max_edits_per_frame = 100000;          // over every transaction of a frame
   std::size_t max_depth = scene::kMaxInstanceDepth;  // instances above an instance, the world not counted
+  std::size_t max_point_lights = scene::kMaxAddedLights;  // lights added (SetPointLight), at most kMaxAddedLights
 };
 
 // The limits master.api sets (none: the defaults, as for a replay without it).
@@ -107,6 +108,9 @@ class LiveScene {
   [[nodiscard]] const NavigationSet& navigation() const { return navigation_; }
   // The lights applications switched: index → on.
   [[nodiscard]] const std::map<std::uint32_t, bool>& light_switches() const { return light_switches_; }
+  // The point lights applications added, by index (from light_count() on).
+  [[nodiscard]] const std::map<std::uint32_t, scene::PointLightState>& point_lights() const { return point_lights_; }
+  [[nodiscard]] std::size_t max_point_lights() const { return limits_.max_point_lights; }
   [[nodiscard]] const std::set<std::string>& children(const std::string& parent) const;
 
  private:
@@ -124,6 +128,7 @@ class LiveScene {
   std::size_t light_count_ = 0;
   NavigationSet navigation_;
   std::map<std::uint32_t, bool> light_switches_;
+  std::map<std::uint32_t, scene::PointLightState> point_lights_;
 };
 
 // A pose as the session writes it (InstanceView, SceneContents, HeadShown):
@@ -137,7 +142,8 @@ void to_transform(const scene::Pose& pose, session::Transform& t);
 // The live scene into the state frame `frame` shows (scene/state.h): the
 // instances, each at its pose, the same now and at the next frame time, as an
 // edit between them is not known yet, and its animation clock's times; the
-// lights applications switched, over the config's switches; the navigation
+// lights applications switched, over the config's switches, and the lights
+// they added; the navigation
 // applications set (the flystick's, if any, comes after: master/navigation.h).
 void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& state);
 

@@ -156,6 +156,11 @@ std::string check_state(const scene::SceneState& state) {
   }
   OPTIQUE_FUZZ_REQUIRE(finite(state.eye_now));
   OPTIQUE_FUZZ_REQUIRE(finite(state.eye_next));
+  OPTIQUE_FUZZ_REQUIRE(state.point_lights.size() <= scene::kMaxAddedLights);
+  for (const auto& [index, light] : state.point_lights) {
+    OPTIQUE_FUZZ_REQUIRE(index < scene::kMaxLightIndex);
+    OPTIQUE_FUZZ_REQUIRE(finite(light.position) && finite(light.colour) && std::isfinite(light.intensity));
+  }
 
   const std::uint64_t hash = scene::state_hash(state);
   OPTIQUE_FUZZ_REQUIRE(scene::state_hash(state) == hash);
@@ -190,6 +195,8 @@ std::string check_applied(const scene::SceneState& before, const scene::SceneSta
   }
   for (std::uint32_t light : delta.lights_off()) OPTIQUE_FUZZ_REQUIRE(after.lights_off.contains(light));
   for (std::uint32_t light : delta.lights_on()) OPTIQUE_FUZZ_REQUIRE(!after.lights_off.contains(light));
+  for (const auto& light : delta.point_lights_set()) OPTIQUE_FUZZ_REQUIRE(after.point_lights.contains(light.light()));
+  for (std::uint32_t light : delta.point_lights_removed()) OPTIQUE_FUZZ_REQUIRE(!after.point_lights.contains(light));
   if (!delta.has_viewer()) {
     OPTIQUE_FUZZ_REQUIRE(same_bits(after.eye_now, before.eye_now));
     OPTIQUE_FUZZ_REQUIRE(same_bits(after.eye_next, before.eye_next));
@@ -322,9 +329,16 @@ std::string check_live(const master::LiveScene& live, const master::LiveSceneLim
   OPTIQUE_FUZZ_REQUIRE(listed == live.instances().size());
   scene::SceneState state;
   master::put_live(live, frame, state);
-  // Only the scene's lights are switched; the navigation must pass the nodes'
-  // checks, which apply_delta below makes.
-  OPTIQUE_FUZZ_REQUIRE(live.light_switches().empty() || live.light_switches().rbegin()->first < kFuzzLights);
+  // Only the scene's lights and those added are switched, and lights are added
+  // only after the scene's; the navigation must pass the nodes' checks, which
+  // apply_delta below makes.
+  for (const auto& [light, on] : live.light_switches()) {
+    OPTIQUE_FUZZ_REQUIRE(light < kFuzzLights || live.point_lights().contains(light));
+  }
+  OPTIQUE_FUZZ_REQUIRE(live.point_lights().size() <= limits.max_point_lights);
+  for (const auto& [light, added] : live.point_lights()) {
+    OPTIQUE_FUZZ_REQUIRE(light >= kFuzzLights && light < kFuzzLights + limits.max_point_lights);
+  }
   if (auto broken = check_state(state); !broken.empty()) return broken;
   scene::SceneState node = previous;
   OPTIQUE_FUZZ_REQUIRE(scene::apply_delta(node, scene::make_delta(previous, state)).ok());

@@ -384,6 +384,24 @@ std::vector<Seed> delta_seeds() {
     half.mutable_viewer()->clear_navigation_next();
     seeds.push_back(delta_seed("navigation", {d, stretched, half}));
   }
+  {
+    // Point lights added, moved, switched and removed; and what a node refuses.
+    const auto point = [](std::uint32_t index, double x, double intensity) {
+      wire::StateDelta d;
+      auto& l = *d.add_point_lights_set();
+      l.set_light(index);
+      for (double v : {x, 1.5, 0.5}) l.add_position(v);
+      for (double v : {1.0, 0.5, 0.25}) l.add_colour(v);
+      l.set_intensity(intensity);
+      return d;
+    };
+    wire::StateDelta removed;
+    removed.add_point_lights_removed(21);
+    wire::StateDelta both = point(20, 0.0, 1.0);
+    both.add_point_lights_removed(20);
+    seeds.push_back(delta_seed("point_lights", {point(20, 0.0, 1.0), point(21, 1.0, 2.0), lights({21}, {}),
+                                                point(20, -1.0, 0.5), removed, point(22, 0.0, -1.0), both}));
+  }
   seeds.push_back(delta_seed("lights_off_then_on", {lights({3}, {}), lights({}, {2}), lights({}, {3, 7})}));
   seeds.push_back(delta_seed("light_off_twice", {lights({2}, {})}));
   seeds.push_back(delta_seed("light_on_not_off", {lights({}, {4})}));
@@ -597,7 +615,7 @@ std::vector<Seed> node_seeds() {
                            frame_and_swap(2, [](wire::FrameBegin& b) { b.set_skip(true); }), frame_and_swap(3)})});
   seeds.push_back(
       {"frame_light_out_of_range",
-       node_seed(welcome, {frame_and_swap(0, [](wire::FrameBegin& b) { b.mutable_lights()->add_lights(9); })})});
+       node_seed(welcome, {frame_and_swap(0, [](wire::FrameBegin& b) { b.mutable_lights()->add_lights(1000); })})});
   seeds.push_back(
       {"frame_nan_focus",
        node_seed(welcome, {frame_and_swap(0, [](wire::FrameBegin& b) { b.mutable_focus()->set_depth(kNaN); })})});
@@ -844,6 +862,28 @@ std::vector<Seed> session_seeds() {
     seeds.push_back({"noise_then_a_node_message", join({noise(40, 7), request(1, {create("a", "torus")}),
                                                         serialize(ready), request(2, {create("b", "torus")})})});
   }
+  {
+    const auto lamp = [](std::uint32_t light, std::vector<double> position) {
+      return [=](session::Edit& e) {
+        e.mutable_point_light()->set_light(light);
+        e.mutable_point_light()->mutable_position()->Add(position.begin(), position.end());
+      };
+    };
+    seeds.push_back(
+        {"point_lights",
+         join({request(1, {lamp(4, {0, 2, 1}), lamp(5, {1, 2, 1})}),
+               request(2, {[](session::Edit& e) {
+                             e.mutable_light()->set_light(5);
+                             e.mutable_light()->set_on(false);
+                           },
+                           lamp(4, {0, 2.5, 1})}),
+               kNextFrame, request(3, {[](session::Edit& e) { e.mutable_remove_point_light()->set_light(5); }}),
+               request(4, {lamp(2, {0, 0, 0})}), request(5, {lamp(70, {0, 0, 0})}),
+               request(6, {[](session::Edit& e) {
+                         e.mutable_point_light()->set_light(6);
+                         e.mutable_point_light()->set_intensity(-1);
+                       }})})});
+  }
   // As JSON, from the operator's WebSocket: well formed, and not; and an empty
   // chunk, which is neither JSON nor a frame, last (it once read past the input's end).
   const auto json = [](std::string_view text) { return Bytes(text.begin(), text.end()); };
@@ -860,6 +900,8 @@ std::vector<Seed> session_seeds() {
                         {"animation": {"instance": "b", "playing": false, "seek": 2.5}}]}})"),
                      kNextFrame, json(R"({"id": 56, "transaction": {"edits": [{"animation": {"instance": "b",
                         "playing": true}}]}})"),
+                     json(R"({"id": 58, "transaction": {"edits": [{"pointLight": {"light": 4, "position": [0, 2, 1],
+                        "colour": [1, 0.5, 0], "intensity": 3}}, {"light": {"light": 4, "on": false}}]}})"),
                      json(R"({"id": 57, "transaction": {"edits": [{"animation": {"instance": "b", "seek": -1}}]}})"),
                      json(R"({"id": 6, "teleport": {}})"), json(R"({"id": -1})"), json("{"),
                      json(R"({"id": 7, "transaction": {"edits": [{"transform": {"instance": "a",

@@ -39,10 +39,11 @@ constexpr std::uint64_t kCompared = 450;  // a captured frame well into the edit
 
 // Random edits that the master should accept every one of: the application
 // keeps its own copy of the tree (parents, so a removal takes the subtree and
-// no re-parenting makes a cycle or a chain over the limit).
+// no re-parenting makes a cycle or a chain over the limit), and of the point
+// lights it added (from index `first_light`, after the scene's own).
 class RandomEdits {
  public:
-  explicit RandomEdits(std::uint32_t seed) : random_(seed) {}
+  RandomEdits(std::uint32_t seed, std::uint32_t first_light) : random_(seed), first_light_(first_light) {}
 
   client::Transaction next() {
     client::Transaction t;
@@ -51,6 +52,7 @@ class RandomEdits {
     return t;
   }
   [[nodiscard]] std::size_t instances() const { return parent_.size(); }
+  [[nodiscard]] std::size_t lights() const { return lights_.size(); }
 
  private:
   double uniform(double low, double high) { return std::uniform_real_distribution<double>(low, high)(random_); }
@@ -106,6 +108,21 @@ class RandomEdits {
       if (!parent.empty() && (under(parent, id) || depth(parent) + height(id) > 12)) parent.clear();
       t.reparent(id, parent);
       parent_[id] = parent;
+    } else if (kind == 7 && random_() % 3 == 0) {  // a point light added, moved, switched or removed
+      // Two at most: each light costs llvmpipe every pixel of every frame.
+      const std::uint32_t light = first_light_ + static_cast<std::uint32_t>(random_() % 2);
+      if (lights_.count(light) == 0) {
+        t.point_light(light, {{uniform(-1.6, 1.6), uniform(0.0, 1.6), uniform(0.2, 1.0)}},
+                      {{uniform(0.0, 1.0), uniform(0.0, 1.0), uniform(0.0, 1.0)}}, uniform(0.1, 2.0));
+        lights_.insert(light);
+      } else if (random_() % 3 == 0) {
+        t.remove_point_light(light);
+        lights_.erase(light);
+      } else if (random_() % 2 == 0) {
+        t.switch_light(light, random_() % 2 == 0);
+      } else {
+        t.point_light(light, {{uniform(-1.6, 1.6), uniform(0.0, 1.6), uniform(0.2, 1.0)}});
+      }
     } else if (kind == 7) {
       t.show(any(), random_() % 2 == 0);
     } else if (kind == 8 && random_() % 2 == 0) {
@@ -128,6 +145,8 @@ class RandomEdits {
   }
 
   std::mt19937 random_;
+  std::uint32_t first_light_;
+  std::set<std::uint32_t> lights_;             // the point lights added
   std::map<std::string, std::string> parent_;  // every instance's parent ("" the world)
   int next_id_ = 0;
 };
@@ -161,7 +180,7 @@ TEST(LiveSceneOnGlNodes, RandomTransactionsStayCoherentAndTheJournalDrawsTheSame
   ASSERT_TRUE(app.subscribe(frames).ok());
 
   // Two transactions a frame, from the first frame on, until all are sent.
-  RandomEdits edits(31);
+  RandomEdits edits(31, app.scene().light_count());
   int sent = 0;
   int refused = 0;
   std::uint64_t last_frame = 0;
@@ -180,8 +199,8 @@ TEST(LiveSceneOnGlNodes, RandomTransactionsStayCoherentAndTheJournalDrawsTheSame
     }
   }
   app.close();
-  std::printf("%d transactions applied by frame %llu, %zu instances then\n", sent - refused,
-              static_cast<unsigned long long>(last_frame), edits.instances());
+  std::printf("%d transactions applied by frame %llu, %zu instances and %zu point lights added then\n", sent - refused,
+              static_cast<unsigned long long>(last_frame), edits.instances(), edits.lights());
   ASSERT_LT(last_frame, static_cast<std::uint64_t>(kFrames) - 10) << "the edits outlasted the run";
   ASSERT_EQ(master.wait(300s), 0) << master.output();
   const ClusterRun run = read_cluster_run(live_out);

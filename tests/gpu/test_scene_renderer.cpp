@@ -339,6 +339,49 @@ TEST_F(SceneRendererTest, LiveInstancesOfTheSceneAreDrawnWhereTheirParentsPutThe
   EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.0f, kTolerance);
 }
 
+// A point light an application added lights the scene as the scene's own
+// would: where the state puts it, as bright as it says, not when it is off,
+// not by a node whose share leaves it out, and never over one of the scene's
+// own lights (index 0 here: a state that names it is not drawn from).
+TEST_F(SceneRendererTest, APointLightAddedLightsTheSceneWhereTheStatePutsIt) {
+  scene::SceneDefinition scene;
+  scene.meshes.push_back(textured_quad());  // fills the view, facing the viewer
+  scene.materials.emplace_back(glm::vec3(1.0f), 0.0f, 1.0f, glm::vec3(0.0f));
+  scene.instances.push_back({0, 0, std::nullopt, glm::dmat4(1.0)});
+  scene.lights = {{{0.0, 0.0, 1.0}, glm::vec3(0.0f), 0.0f}};  // the scene's own: dark
+  scene.ambient = glm::vec3(0.0f);
+  auto renderer = SceneRenderer::create(scene, kSize, kSize);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  const auto green = [&](const scene::SceneState& state, int x, int y) {
+    renderer.value()->draw(state, {0.0, kEye, view_of_unit_square()});
+    return renderer.value()->read_rendered().at(x, y, 1);
+  };
+  const int centre = kSize / 2;
+  scene::SceneState state;
+  EXPECT_NEAR(green(state, centre, centre), 0.0f, kTolerance);
+  // 0.5 m in front of the upper right quarter: brightest there.
+  state.point_lights[1] = {{0.5, 0.5, 0.5}, {0.0, 1.0, 0.0}, 0.5};
+  const float lit = green(state, kFar, kNear);
+  EXPECT_GT(lit, 0.1f);
+  EXPECT_LT(green(state, kNear, kFar), 0.5f * lit) << "the far corner is lit less";
+  state.point_lights[1].intensity = 1.0;
+  EXPECT_NEAR(green(state, kFar, kNear), 2.0f * lit, 0.02f * lit) << "twice the intensity, twice the light";
+  state.point_lights[1].position = {-0.5, -0.5, 0.5};
+  EXPECT_GT(green(state, kNear, kFar), 1.5f * lit) << "moved to the lower left";
+  state.lights_off = {1};
+  EXPECT_NEAR(green(state, kNear, kFar), 0.0f, kTolerance) << "off";
+  state.lights_off.clear();
+  const std::vector<std::uint32_t> only_own{0};
+  renderer.value()->set_lights(only_own);
+  EXPECT_NEAR(green(state, kNear, kFar), 0.0f, kTolerance) << "a share without it";
+  const std::vector<std::uint32_t> with_it{0, 1};
+  renderer.value()->set_lights(with_it);
+  EXPECT_GT(green(state, kNear, kFar), 1.5f * lit);
+  scene::SceneState over_own;
+  over_own.point_lights[0] = {{0.0, 0.0, 0.5}, {1.0, 1.0, 1.0}, 1.0};
+  EXPECT_NEAR(green(over_own, centre, centre), 0.0f, kTolerance) << "the scene's own light 0 is dark";
+}
+
 // An instance with its own animation clock draws its asset's animated objects
 // at its times, not where the scene's time has them in the state: the square
 // rides object 7, which an animation carries 1 m along x a second.

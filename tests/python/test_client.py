@@ -160,6 +160,29 @@ class OnAWall(unittest.TestCase):
             with wall.transaction() as t:
                 t.navigate(position=(0, 0, 0), scale=1).switch_light(0, True)
 
+    def test_a_point_light_is_added_moved_and_removed(self):
+        with self.connect() as wall:
+            first = wall.scene.light_count
+            with wall.transaction() as t:
+                t.point_light(first, position=(0, 2, 1), colour=(1, 0.5, 0), intensity=3).switch_light(first, False)
+            added = wall.read_scene().point_lights
+            self.assertEqual([(l.light, list(l.position), list(l.colour), l.intensity) for l in added],
+                             [(first, [0.0, 2.0, 1.0], [1.0, 0.5, 0.0], 3.0)])
+            with wall.transaction() as t:
+                t.point_light(first, position=(1, 2, 1))
+            self.assertEqual(list(wall.read_scene().point_lights[0].position), [1.0, 2.0, 1.0])
+            with self.assertRaises(optique.Refused) as refused:
+                with wall.transaction() as t:
+                    t.point_light(first + 1, colour=(1, 1, 1))
+            self.assertEqual(refused.exception.field, "edits[0].point_light.position")
+            with self.assertRaises(ValueError):
+                t.point_light(first, position=(1, 2))
+            with wall.transaction() as t:
+                t.remove_point_light(first)
+            contents = wall.read_scene()
+            self.assertEqual(len(contents.point_lights), 0)
+            self.assertNotIn(first, [l.light for l in contents.lights], "its switch went with it")
+
     def test_an_instances_animation_is_paused_and_sought(self):
         with self.connect() as wall:
             asset = wall.scene.assets[0]

@@ -12,6 +12,7 @@
 
 #include "config/up_conversion.h"
 #include "protocol/welcome.h"
+#include "scene/state.h"
 
 namespace optique::protocol {
 namespace {
@@ -68,10 +69,14 @@ TEST(FrameMessage, WhatANodeCannotUseIsRefusedByName) {
   expect_refused(focus, 0, "focus depth");
 
   wire::FrameBegin lights = frame(4);
-  *lights.mutable_lights() = to_wire(LightShare{{4}, false});
-  expect_refused(lights, 4, "lights: light 4 does not exist");
+  // 4 of the scene's, and those applications may add: 4 + 64 is one too many.
+  *lights.mutable_lights() = to_wire(LightShare{{4 + scene::kMaxAddedLights}, false});
+  expect_refused(lights, 4, "lights: light 68 does not exist");
+  *lights.mutable_lights() = to_wire(LightShare{{3 + scene::kMaxAddedLights}, false});
+  EXPECT_TRUE(decode_frame_begin(lights, 4).ok());
 
-  for (const std::uint64_t ahead : {std::uint64_t{5}, std::uint64_t{4}, 5 + std::uint64_t(config::kMostFramesAhead) + 1}) {
+  for (const std::uint64_t ahead :
+       {std::uint64_t{5}, std::uint64_t{4}, 5 + std::uint64_t(config::kMostFramesAhead) + 1}) {
     wire::FrameBegin sent_ahead = frame(5);
     *sent_ahead.mutable_ahead() = scene::to_snapshot(scene::SceneState{});
     sent_ahead.set_ahead_frame(ahead);

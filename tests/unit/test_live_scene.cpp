@@ -225,11 +225,12 @@ TEST(LiveScene, TheNavigationIsSetWholeAndUniformlyScaled) {
 
 TEST(LiveScene, LightsAreSwitchedOverTheConfigsSwitches) {
   LiveScene scene = with_torus();
-  EXPECT_EQ(refused(scene, R"(edits { light { light: 0 on: false } })").reason, "the scene has no point lights");
+  EXPECT_EQ(refused(scene, R"(edits { light { light: 0 on: false } })").reason,
+            "the scene has no point lights, and no light 0 was added");
   scene.set_light_count(3);
   const Refusal beyond = refused(scene, R"(edits { light { light: 3 on: false } })");
   EXPECT_EQ(beyond.field, "edits[0].light.light");
-  EXPECT_EQ(beyond.reason, "the scene's point lights are 0 to 2 (got 3)");
+  EXPECT_EQ(beyond.reason, "the scene's point lights are 0 to 2, and no light 3 was added");
   refused(scene, R"(edits { light { light: 1 on: false } } edits { remove { instance: "none" } })");
   EXPECT_TRUE(scene.light_switches().empty()) << "a refused transaction switches nothing";
   accept(scene, R"(edits { light { light: 1 on: false } } edits { light { light: 2 on: true } })");
@@ -244,6 +245,76 @@ TEST(LiveScene, LightsAreSwitchedOverTheConfigsSwitches) {
   EXPECT_EQ(contents.lights(0).light(), 1u);
   EXPECT_FALSE(contents.lights(0).on());
   EXPECT_TRUE(contents.lights(1).on());
+}
+
+// Point lights added after the scene's own: placed, changed field by field,
+// switched, removed with their switch, bounded, and put into each frame's
+// state; a refused transaction leaves them as they were.
+TEST(LiveScene, PointLightsAreAddedChangedSwitchedAndRemoved) {
+  LiveSceneLimits limits;
+  limits.max_point_lights = 3;
+  LiveScene scene = with_torus(limits);
+  scene.set_light_count(2);
+  accept(scene, R"(edits { point_light { light: 2 position: [0, 2, -1] } })");
+  ASSERT_EQ(scene.point_lights().size(), 1u);
+  EXPECT_EQ(scene.point_lights().at(2), (scene::PointLightState{{0, 2, -1}, {1, 1, 1}, 1}));
+  accept(scene, R"(edits { point_light { light: 2 colour: [1, 0.5, 0] intensity: 3 } })");
+  EXPECT_EQ(scene.point_lights().at(2), (scene::PointLightState{{0, 2, -1}, {1, 0.5, 0}, 3}));
+  accept(scene, R"(edits { point_light { light: 4 position: [1, 1, 1] } } edits { light { light: 4 on: false } })");
+  scene::SceneState state;
+  put_live(scene, 0, state);
+  EXPECT_EQ(state.point_lights, scene.point_lights());
+  EXPECT_EQ(state.lights_off, (std::set<std::uint32_t>{4}));
+  const session::SceneContents contents = scene_contents(scene, 0);
+  ASSERT_EQ(contents.point_lights_size(), 2);
+  EXPECT_EQ(contents.point_lights(0).light(), 2u);
+  EXPECT_EQ(contents.point_lights(0).colour(1), 0.5);
+  EXPECT_EQ(contents.point_lights(0).intensity(), 3.0);
+  EXPECT_EQ(contents.max_point_lights(), 3u);
+
+  const auto why = [&](const std::string& text) {
+    const Refusal r = refused(scene, text);
+    return r.field + ": " + r.reason;
+  };
+  EXPECT_EQ(why(R"(edits { point_light { light: 1 position: [0, 0, 0] } })"),
+            "edits[0].point_light.light: lights added take the indices 2 to 4, after the scene's own (got 1)");
+  EXPECT_EQ(why(R"(edits { point_light { light: 5 position: [0, 0, 0] } })"),
+            "edits[0].point_light.light: lights added take the indices 2 to 4, after the scene's own (got 5)");
+  EXPECT_EQ(why(R"(edits { point_light { light: 3 colour: [1, 1, 1] } })"),
+            "edits[0].point_light.position: is needed to add a light");
+  EXPECT_EQ(why(R"(edits { point_light { light: 3 position: [0, 0] } })"),
+            "edits[0].point_light.position: must be [x, y, z] (got 2 numbers)");
+  EXPECT_EQ(why(R"(edits { point_light { light: 2 position: [0, nan, 0] } })"),
+            "edits[0].point_light.position[1]: must be in [-1e+06, 1e+06] (got nan)");
+  EXPECT_EQ(why(R"(edits { point_light { light: 2 colour: [0, 2000, 0] } })"),
+            "edits[0].point_light.colour[1]: must be in [0, 1000] (got 2000)");
+  EXPECT_EQ(why(R"(edits { point_light { light: 2 intensity: -1 } })"),
+            "edits[0].point_light.intensity: must be in [0, 1e+06] (got -1)");
+  EXPECT_EQ(why(R"(edits { remove_point_light { light: 3 } })"),
+            "edits[0].remove_point_light.light: no light 3 was added");
+  EXPECT_EQ(why(R"(edits { remove_point_light { light: 0 } })"),
+            "edits[0].remove_point_light.light: no light 0 was added");
+  // Refused whole: the light moved and removed first are as they were.
+  const auto lights = scene.point_lights();
+  const auto switches = scene.light_switches();
+  EXPECT_EQ(why(R"(edits { point_light { light: 2 position: [5, 5, 5] } } edits { remove_point_light { light: 4 } }
+                  edits { point_light { light: 3 position: [0, 0, 0] } } edits { point_light { light: 9 } })"),
+            "edits[3].point_light.light: lights added take the indices 2 to 4, after the scene's own (got 9)");
+  EXPECT_EQ(scene.point_lights(), lights);
+  EXPECT_EQ(scene.light_switches(), switches);
+
+  accept(scene, R"(edits { point_light { light: 3 position: [0, 0, 0] } })");
+  EXPECT_EQ(scene.point_lights().size(), 3u);
+  // Removed: its switch goes with it, and the index may be used again.
+  accept(scene, R"(edits { remove_point_light { light: 4 } })");
+  EXPECT_TRUE(scene.light_switches().empty());
+  scene::SceneState next;  // as the scene's authority makes each frame's
+  put_live(scene, 1, next);
+  EXPECT_EQ(next.point_lights.size(), 2u);
+  EXPECT_TRUE(next.lights_off.empty());
+  EXPECT_EQ(why(R"(edits { light { light: 4 on: true } })"),
+            "edits[0].light.light: the scene's point lights are 0 to 1, and no light 4 was added");
+  accept(scene, R"(edits { point_light { light: 4 position: [2, 2, 2] } })");
 }
 
 TEST(LiveScene, OfAnInstallationsSceneHasItsAssetAndLights) {
@@ -292,16 +363,15 @@ TEST(LiveScene, AnInstancesAnimationsArePlayedPausedAndSought) {
   EXPECT_FALSE(contents.instances(0).animation().playing());
   EXPECT_EQ(contents.instances(0).animation().position(), 0.25);
 
-  for (const char* text : {R"(edits { animation { instance: "t" seek: -1 } })",
-                           R"(edits { animation { instance: "t" seek: nan } })",
-                           R"(edits { animation { instance: "t" seek: 2e6 } })"}) {
+  for (const char* text :
+       {R"(edits { animation { instance: "t" seek: -1 } })", R"(edits { animation { instance: "t" seek: nan } })",
+        R"(edits { animation { instance: "t" seek: 2e6 } })"}) {
     const Refusal wrong = refused(scene, text);
     EXPECT_EQ(wrong.field, "edits[0].animation.seek") << text;
     EXPECT_NE(wrong.reason.find("must be in [0, 1e+06] seconds"), std::string::npos) << wrong.reason;
   }
   EXPECT_EQ(refused(scene, R"(edits { animation { instance: "t" } })").reason, "give playing, seek or both");
-  EXPECT_EQ(refused(scene, R"(edits { animation { instance: "ghost" playing: true } })").reason,
-            "no instance 'ghost'");
+  EXPECT_EQ(refused(scene, R"(edits { animation { instance: "ghost" playing: true } })").reason, "no instance 'ghost'");
   refused(scene, R"(edits { animation { instance: "t" playing: true } } edits { remove { instance: "ghost" } })");
   EXPECT_FALSE(scene.instances().at("t").animation->playing) << "a refused transaction changes no clock";
 

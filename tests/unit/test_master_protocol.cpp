@@ -16,6 +16,7 @@
 #include "config/load.h"
 #include "envelopes.h"
 #include "master/run/run_config.h"
+#include "master/session/live_scene.h"
 #include "net/envelope.h"
 #include "protocol/welcome.h"
 
@@ -928,6 +929,63 @@ TEST_F(MasterTest, AnAutomaticGroupsSharesFollowTheNodesThatAreUp) {
   a = master_->timer(Timer::next_frame, now_);
   for (PeerId p = 1; p <= 2; ++p) take(a, p);
   EXPECT_TRUE(every_light_once({1, 2})) << "its lights are shared out among the two left";
+}
+
+// A point light an application adds is shared out in the frame it lands in:
+// by cost in an automatic group, to the ambient carrier where the config lists
+// the lights; removed, it is nobody's again. Each node is told in its FrameBegin.
+TEST_F(MasterTest, ALightAddedIsSharedOutInTheFrameItLandsIn) {
+  for (const char* config : {"stacked-lighting-3-auto.json", "stacked-lighting-3.json"}) {
+    SCOPED_TRACE(config);
+    LiveScene live;
+    RunSettings settings;
+    settings.live = &live;
+    load(config, {}, settings);
+    live = LiveScene::of(run_.scene.definition, {}, 60.0);
+    std::map<PeerId, std::vector<std::uint32_t>> shares;
+    const auto take = [&](const Actions& actions) {
+      for (PeerId p = 1; p <= 3; ++p) {
+        const auto begin = sent_to(actions, p, wire::Envelope::kFrameBegin);
+        ASSERT_EQ(begin.size(), 1u);
+        if (begin.front().frame_begin().has_lights()) {
+          const auto& lights = begin.front().frame_begin().lights().lights();
+          shares[p].assign(lights.begin(), lights.end());
+        }
+      }
+    };
+    const auto drawn = [&] {
+      std::multiset<std::uint32_t> all;
+      for (const auto& [peer, lights] : shares) all.insert(lights.begin(), lights.end());
+      return all;
+    };
+    Actions a = join_all();
+    take(a);
+    ASSERT_EQ(drawn().size(), 20u);
+    const auto next = [&](std::uint64_t frame) {
+      const std::uint64_t hash = hash_of(a, 1);
+      for (PeerId p = 1; p <= 3; ++p) (void)ready(p, frame, hash);
+      all_shown(frame, {1, 2, 3});
+      now_ += 17 * kMs;
+      a = master_->timer(Timer::next_frame, now_);
+      take(a);
+    };
+    session::Transaction add;
+    auto& light = *add.add_edits()->mutable_point_light();
+    light.set_light(20);
+    for (double x : {0.0, 1.2, 0.5}) light.add_position(x);
+    ASSERT_FALSE(live.apply(add, 1));
+    next(0);
+    EXPECT_EQ(drawn().count(20), 1u) << "in frame 1, the one it landed in";
+    EXPECT_EQ(drawn().size(), 21u);
+    EXPECT_TRUE(logged(a, "lights [20] added or changed")) << config;
+    session::Transaction remove;
+    remove.add_edits()->mutable_remove_point_light()->set_light(20);
+    ASSERT_FALSE(live.apply(remove, 2));
+    next(1);
+    EXPECT_EQ(drawn().count(20), 0u);
+    EXPECT_EQ(drawn().size(), 20u);
+    master_.reset();  // before the live scene it keeps goes
+  }
 }
 
 // --- a node without a copy of the glTF scene asks for its files

@@ -460,10 +460,11 @@ TEST_F(NodeTest, BadFrameInputClosesTheConnection) {
   wire::Envelope e = envelope();
   auto& b = *e.mutable_frame_begin();
   b.set_frame_id(0);
-  b.mutable_lights()->add_lights(4);  // the welcome said the scene has 4 lights: 0-3
+  // The welcome said the scene has 4 lights (0-3): 64 more may be added (4-67).
+  b.mutable_lights()->add_lights(68);
   Actions a = node.message(e, now_);
   ASSERT_NE(first<Close>(a), nullptr);
-  EXPECT_NE(first<Close>(a)->reason.find("light 4 does not exist"), std::string::npos) << first<Close>(a)->reason;
+  EXPECT_NE(first<Close>(a)->reason.find("light 68 does not exist"), std::string::npos) << first<Close>(a)->reason;
   EXPECT_EQ(first<Render>(a), nullptr);
 
   NodeProtocol other(settings());

@@ -548,6 +548,114 @@ TEST(SceneInstances, TravelInSnapshotsDeltasAndTheHash) {
   EXPECT_EQ(applied_reversed, after);
 }
 
+// The point lights applications add: in snapshots and deltas, each field in
+// the hash, and a state without any hashing as it did before there were any
+// (the pinned values of SceneHash.HasTheseValues).
+TEST(ScenePointLights, TravelInSnapshotsDeltasAndTheHash) {
+  const SceneState before = with_instances();
+  SceneState after = before;
+  after.point_lights[3] = {{0.0, 2.0, -1.0}, {1.0, 0.5, 0.25}, 4.0};
+  after.point_lights[9] = {{1.0, 2.0, -1.0}, {1.0, 1.0, 1.0}, 1.0};
+  EXPECT_NE(state_hash(after), state_hash(before));
+  auto snapshot = from_snapshot(to_snapshot(after));
+  ASSERT_TRUE(snapshot) << snapshot.error();
+  EXPECT_EQ(snapshot.value(), after);
+
+  wire::StateDelta delta = make_delta(before, after);
+  EXPECT_EQ(delta.point_lights_set_size(), 2);
+  SceneState applied = before;
+  ASSERT_TRUE(apply_delta(applied, delta));
+  EXPECT_EQ(applied, after);
+  EXPECT_EQ(state_hash(applied), state_hash(after));
+
+  // One moved, one removed: only they travel.
+  SceneState later = after;
+  later.point_lights[3].position.y = 2.5;
+  later.point_lights.erase(9);
+  delta = make_delta(after, later);
+  ASSERT_EQ(delta.point_lights_set_size(), 1);
+  EXPECT_EQ(delta.point_lights_set(0).light(), 3u);
+  ASSERT_EQ(delta.point_lights_removed_size(), 1);
+  EXPECT_EQ(delta.point_lights_removed(0), 9u);
+  ASSERT_TRUE(apply_delta(applied, delta));
+  EXPECT_EQ(applied, later);
+  EXPECT_EQ(make_delta(later, later).point_lights_set_size(), 0);
+
+  const std::vector<void (*)(PointLightState&)> changes{[](PointLightState& l) { l.position.z += 1e-9; },
+                                                        [](PointLightState& l) { l.colour.g = 0.0; },
+                                                        [](PointLightState& l) { l.intensity = 2.0; }};
+  for (const auto& change : changes) {
+    SceneState changed = later;
+    change(changed.point_lights[3]);
+    EXPECT_NE(state_hash(changed), state_hash(later));
+    const wire::StateDelta one = make_delta(later, changed);
+    EXPECT_EQ(one.point_lights_set_size(), 1);
+  }
+  SceneState moved_index = later;
+  moved_index.point_lights[4] = moved_index.point_lights[3];
+  moved_index.point_lights.erase(3);
+  EXPECT_NE(state_hash(moved_index), state_hash(later));
+}
+
+TEST(ScenePointLights, WhatAPeerMayNotSendIsRefusedAndTheStateKept) {
+  SceneState state = with_instances();
+  state.point_lights[2] = {{0.0, 1.0, 0.0}, {1.0, 1.0, 1.0}, 1.0};
+  const SceneState kept = state;
+  const auto light = [](std::uint32_t index, std::vector<double> position, std::vector<double> colour,
+                        double intensity) {
+    wire::StateDelta d;
+    auto& l = *d.add_point_lights_set();
+    l.set_light(index);
+    l.mutable_position()->Add(position.begin(), position.end());
+    l.mutable_colour()->Add(colour.begin(), colour.end());
+    l.set_intensity(intensity);
+    return d;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::pair<std::string, wire::StateDelta>> bad{
+      {"a NaN position", light(5, {nan, 0, 0}, {1, 1, 1}, 1)},
+      {"a position too far", light(5, {2e6, 0, 0}, {1, 1, 1}, 1)},
+      {"two numbers for a position", light(5, {0, 0}, {1, 1, 1}, 1)},
+      {"a negative colour", light(5, {0, 0, 0}, {-1, 1, 1}, 1)},
+      {"an infinite intensity", light(5, {0, 0, 0}, {1, 1, 1}, std::numeric_limits<double>::infinity())},
+      {"an intensity too large", light(5, {0, 0, 0}, {1, 1, 1}, 2e6)},
+      {"an index too large", light(kMaxLightIndex, {0, 0, 0}, {1, 1, 1}, 1)},
+  };
+  wire::StateDelta twice = light(5, {0, 0, 0}, {1, 1, 1}, 1);
+  *twice.add_point_lights_set() = twice.point_lights_set(0);
+  bad.emplace_back("one light set twice", twice);
+  wire::StateDelta missing;
+  missing.add_point_lights_removed(7);
+  bad.emplace_back("a light removed that is not there", missing);
+  wire::StateDelta set_and_removed = light(2, {0, 0, 0}, {1, 1, 1}, 1);
+  set_and_removed.add_point_lights_removed(2);
+  bad.emplace_back("a light set and removed", set_and_removed);
+  wire::StateDelta too_many;
+  for (std::uint32_t i = 0; i < kMaxAddedLights; ++i)
+    *too_many.add_point_lights_set() = light(10 + i, {0, 0, 0}, {1, 1, 1}, 1).point_lights_set(0);
+  bad.emplace_back("more lights than a node takes", too_many);
+  for (const auto& [what, delta] : bad) {
+    const auto applied = apply_delta(state, delta);
+    EXPECT_FALSE(applied) << what;
+    if (!applied) {
+      EXPECT_NE(applied.error().find("point light"), std::string::npos) << what << ": " << applied.error();
+    }
+    EXPECT_EQ(state, kept) << what;
+    wire::Snapshot snapshot = to_snapshot(kept);
+    snapshot.mutable_point_lights()->MergeFrom(delta.point_lights_set());
+    // In a snapshot, each of them is refused too (a light set twice: there twice).
+    if (!delta.point_lights_set().empty()) {
+      EXPECT_FALSE(from_snapshot(snapshot)) << what;
+    }
+  }
+  // Just within: 64 lights, the largest index, the bounds themselves.
+  wire::StateDelta most;
+  for (std::uint32_t i = 0; i + 1 < kMaxAddedLights; ++i)
+    *most.add_point_lights_set() = light(10 + i, {1e6, 0, -1e6}, {0, 1e3, 0}, 1e6).point_lights_set(0);
+  EXPECT_TRUE(apply_delta(state, most));
+  EXPECT_EQ(state.point_lights.size(), kMaxAddedLights);
+}
+
 TEST(SceneInstances, EachFieldChangesTheHash) {
   const SceneState base = with_instances();
   const std::vector<void (*)(InstanceState&)> changes{[](InstanceState& i) { i.asset = "teapot"; },

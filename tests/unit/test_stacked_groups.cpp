@@ -193,5 +193,53 @@ TEST(LightPlan, LightsThatAreOffGoToNobodyAndComeBackWhenOn) {
   EXPECT_EQ(std::set<std::uint32_t>(all.begin(), all.end()).size(), 20u);
 }
 
+// The lights applications add: an automatic group shares them out with the
+// scene's (each once, none when off), a group whose config lists its lights
+// gives them to the projector that carries the ambient light; removed, they go.
+TEST(LightPlan, LightsAddedAreSharedOutLikeTheScenesOwn) {
+  auto scene = scene::builtin_scene("many-lights");
+  ASSERT_TRUE(scene);
+  const auto drawn = [](const LightPlan& plan) {
+    std::multiset<std::uint32_t> lights;
+    for (std::size_t i = 0; i < 3; ++i) lights.insert(plan.share(i)->lights.begin(), plan.share(i)->lights.end());
+    return lights;
+  };
+  const std::string autolights = R"({"role": "lights", "lights": "auto"})";
+  for (const bool automatic : {true, false}) {
+    SCOPED_TRACE(automatic ? "auto" : "listed");
+    const config::Installation installation =
+        automatic ? parsed(stacked(autolights, autolights, autolights)) : parsed(stacked(kA, kB, kC));
+    const SceneAuthority authority(scene.value().objects, installation.viewer, 60.0);
+    scene::SceneState state = authority.state_at_frame(0);
+    LightPlan plan(installation, scene.value());
+    plan.rebalance({true, true, true}, state, state.eye_now, true);
+    ASSERT_EQ(drawn(plan).size(), 20u);
+
+    // Two added in front of the screen, one of them off; index 21 is left empty.
+    state.point_lights[20] = {{0.0, 1.2, 0.5}, {1.0, 1.0, 1.0}, 2.0};
+    state.point_lights[22] = {{0.5, 1.0, 0.5}, {1.0, 1.0, 1.0}, 2.0};
+    state.lights_off = {22};
+    EXPECT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));
+    std::multiset<std::uint32_t> all = drawn(plan);
+    EXPECT_EQ(all.count(20), 1u);
+    EXPECT_EQ(all.count(21), 0u);
+    if (automatic) {
+      EXPECT_EQ(all.size(), 21u);
+      EXPECT_EQ(all.count(22), 0u) << "off: drawn by nobody";
+    } else {
+      // Listed: the ambient carrier 'a' draws both (the renderer skips one that is off).
+      EXPECT_EQ(plan.share(0)->lights, (std::vector<std::uint32_t>{0, 1, 2, 3, 4, 5, 6, 20, 22}));
+      EXPECT_EQ(plan.share(1)->lights.size(), 7u);
+    }
+    state.point_lights.erase(20);
+    state.point_lights.erase(22);
+    state.lights_off.clear();
+    EXPECT_TRUE(plan.rebalance({true, true, true}, state, state.eye_now, true));
+    all = drawn(plan);
+    EXPECT_EQ(all.size(), 20u);
+    EXPECT_EQ(all.count(20), 0u);
+  }
+}
+
 }  // namespace
 }  // namespace optique::master

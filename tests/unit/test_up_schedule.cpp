@@ -85,6 +85,19 @@ TEST(UpSchedule, ALightSwitchedOrTheViewerJumpingIsACut) {
   scene::SceneState near = state_at(2);
   near.eye_now.z += kCutEyeJump * 0.9;
   EXPECT_TRUE(jumps.plan(2, near).between);
+  // A light an application adds, moves or removes shades every surface anew.
+  UpSchedule lit(settings(4));
+  (void)lit.plan(0, state_at(0));
+  scene::SceneState added = state_at(1);
+  added.point_lights[4] = {{0.0, 1.0, 0.0}, {1.0, 1.0, 1.0}, 1.0};
+  EXPECT_EQ(lit.plan(1, added).why, "lights added or changed");
+  scene::SceneState same = state_at(2);
+  same.point_lights = added.point_lights;
+  EXPECT_TRUE(lit.plan(2, same).between);
+  scene::SceneState moved = state_at(3);
+  moved.point_lights = added.point_lights;
+  moved.point_lights[4].position.x = 0.5;
+  EXPECT_TRUE(lit.plan(3, moved).draw_key);
 }
 
 TEST(UpSchedule, FramesThatGoBackOrSkipStartOver) {

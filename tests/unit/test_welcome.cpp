@@ -13,6 +13,7 @@
 #include "config/load.h"
 #include "config/to_schema.h"
 #include "protocol/focus.h"
+#include "scene/state.h"
 
 namespace optique::protocol {
 namespace {
@@ -33,8 +34,9 @@ std::string bytes_of(const config::ProjectorJob& job) {
 }
 
 TEST(Welcome, EveryShippedProjectorsJobArrivesAsItWasCut) {
-  const scene::SceneManifest files{4096, {scene::describe_file("s.gltf", "{}", 4096),
-                                          scene::describe_file("maps/a.png", std::string(9000, 'x'), 4096)}};
+  const scene::SceneManifest files{
+      4096,
+      {scene::describe_file("s.gltf", "{}", 4096), scene::describe_file("maps/a.png", std::string(9000, 'x'), 4096)}};
   std::size_t checked = 0;
   for (const auto& entry : fs::directory_iterator(kConfigs)) {
     if (entry.path().extension() != ".json") continue;
@@ -114,10 +116,12 @@ TEST(Welcome, RefusesAProjectorThatWouldNotPassAsAConfig) {
 
 TEST(Welcome, RefusesAShareOfLightsTheSceneDoesNotHave) {
   config::Installation installation = load("stacked-lighting-3.json");
-  const LightShare beyond{{3, 20}, false};
+  const LightShare beyond{{3, 20 + scene::kMaxAddedLights}, false};  // 20 of its own, and 64 that may be added
   auto decoded = decode_welcome(encode_welcome(installation, 0, {}, 20, 16'666'666, &beyond), "lights-a");
   ASSERT_FALSE(decoded.ok());
-  EXPECT_NE(decoded.error().find("welcome: lights: light 20 does not exist (the scene has 20)"), std::string::npos)
+  EXPECT_NE(
+      decoded.error().find("welcome: lights: light 84 does not exist (the scene has 20, and at most 64 may be added)"),
+      std::string::npos)
       << decoded.error();
   const LightShare twice{{4, 4}, false};
   auto repeated = decode_welcome(encode_welcome(installation, 0, {}, 20, 16'666'666, &twice), "lights-a");

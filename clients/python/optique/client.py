@@ -176,6 +176,23 @@ class Transaction:
         edit.light, edit.on = light, on
         return self
 
+    def point_light(self, light: int, position=None, colour=None, intensity=None) -> "Transaction":
+        """Adds a point light (index from the scene's light count on), or
+        changes one added before: `position` (world metres, needed to add
+        it), linear `colour` (r, g, b), `intensity`; what is None stays."""
+        edit = self.message.edits.add().point_light
+        edit.light = light
+        edit.position.extend(_vector(position, "position", [3]))
+        edit.colour.extend(_vector(colour, "colour", [3]))
+        if intensity is not None:
+            edit.intensity = float(intensity)
+        return self
+
+    def remove_point_light(self, light: int) -> "Transaction":
+        """Removes a point light added with point_light (and its switch)."""
+        self.message.edits.add().remove_point_light.light = light
+        return self
+
     def animate(self, instance: str, playing=None, seek=None) -> "Transaction":
         """The instance's own clock for its asset's animations: played (True) or
         paused (False), and/or sought to `seek` seconds; what is None stays."""
