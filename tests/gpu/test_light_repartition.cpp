@@ -5,7 +5,8 @@
 // every shining light drawn exactly once — and the screen must show it: the
 // composite matches render-reference while lights are off, and after the kill the
 // two survivors' light alone matches it, where before the kill it lacked the
-// killed node's lights. Label `gpu`.
+// killed node's lights. And a light an application adds is shared out in the
+// frame it lands in, drawn once, and on the screen. Label `gpu`.
 
 #include <gtest/gtest.h>
 
@@ -15,6 +16,7 @@
 #include <set>
 #include <sstream>
 
+#include "clients/cpp/session.h"
 #include "config/light_list.h"
 #include "image/frame_files.h"
 #include "process.h"
@@ -189,6 +191,74 @@ TEST(LightRepartition, LightsSwitchedAndANodeKilledAreSharedOutAnewAndTheScreenS
   EXPECT_GE(after_kill.psnr_db, 45.0);
   EXPECT_LT(before_kill.psnr_db, after_kill.psnr_db - 10.0) << "the killed node's lights were missing before";
   EXPECT_GT(before_kill.pixels_off, 10 * std::max<std::size_t>(after_kill.pixels_off, 1));
+}
+
+// An application adds a light to the automatic group while it runs: the
+// master shares it out in the frame the reply names (every light, the new one
+// included, drawn once), and the composite of the three nodes matches the
+// reference drawn from the session's journal, which the reference without the
+// light does not.
+TEST(LightRepartition, ALightAnApplicationAddsIsSharedOutAndTheScreenShowsIt) {
+  const ScratchDir dir_scratch("optique-added-light");
+  const std::string dir = dir_scratch.string();
+  const std::string config = write_config_variant(
+      kConfig,
+      [](schema::Installation& installation) {
+        installation.mutable_master()->set_frame_rate(5.0);
+        installation.mutable_master()->set_frame_timeout_ms(5000);  // captures on a shared software rasterizer
+        installation.mutable_scene()->clear_light_switches();
+      },
+      dir + "/auto.json");
+  const std::string out = dir + "/out";
+  const std::string journal = dir + "/session.journal";
+  constexpr std::uint64_t kRun = 24;
+  Process master({kMaster, "--config", config, "--local", "--out", out, "--frames", std::to_string(kRun),
+                  "--capture-every", std::to_string(kCaptureEvery), "--no-status", "--api-port", "0", "--api-port-file",
+                  dir + "/api.port", "--record", journal},
+                 dir + "/master.log");
+  ASSERT_TRUE(wait_for_file(dir + "/api.port", 60s)) << master.output();
+  client::Options options;
+  options.port = static_cast<std::uint16_t>(std::stoi(read_file(dir + "/api.port")));
+  options.name = "lamp";
+  auto session = client::Session::connect(options);
+  ASSERT_TRUE(session.ok()) << session.error();
+  client::Session& app = *session.value();
+  ASSERT_EQ(app.scene().light_count(), 20u);
+  session::Subscribe frames;
+  frames.set_frames(true);
+  ASSERT_TRUE(app.subscribe(frames).ok());
+  for (std::uint64_t begun = 0; begun < 4;) {  // a few frames in, every node drawing
+    auto event = app.next_event(60s);
+    ASSERT_TRUE(event.ok() && event.value().has_value()) << master.output();
+    if (event.value()->has_frame_begun()) begun = event.value()->frame_begun().frame();
+  }
+  // Warm, in front of the middle of the screen: it lights what the 20 do not.
+  auto added = app.apply(client::Transaction().point_light(20, {{0.2, 1.0, 0.7}}, {{1.0, 0.7, 0.4}}, 0.6));
+  ASSERT_TRUE(added.ok() && added.value().applied()) << (added.ok() ? "refused" : added.error());
+  const std::uint64_t from = added.value().frame;
+  app.close();
+  ASSERT_EQ(master.wait(120s).value_or(-1), 0) << master.output();
+  ASSERT_LT(from, kRun - 2 * kCaptureEvery) << master.output();
+
+  const std::string log = master.output();
+  EXPECT_NE(log.find("frame " + std::to_string(from) + ": lights [20] added or changed"), std::string::npos) << log;
+  const ShareLog shares = parse_share_log(log);
+  EXPECT_EQ(drawn_at(shares, from - 1, kNodes).lights, range(0, 19)) << "before: the scene's 20";
+  const Drawn with = drawn_at(shares, from, kNodes);
+  EXPECT_EQ(with.lights, range(0, 20)) << "from frame " << from << ": the added one too, each once";
+  EXPECT_EQ(with.ambient_carriers, 1);
+
+  const std::uint64_t shown = (from + kCaptureEvery) / kCaptureEvery * kCaptureEvery;  // a captured frame after
+  const ScreenCheck lit{kMaster, config, out + "/nodes", dir + "/lit", "front", {"--replay", journal}};
+  const ScreenMatch match = compare_with_reference(lit, shown);
+  const ScreenCheck unlit{kMaster, config, out + "/nodes", dir + "/unlit", "front"};
+  const ScreenMatch without = compare_with_reference(unlit, shown);
+  std::cout << "frame " << shown << ", light 20 added in frame " << from << ": against the journal's reference "
+            << match.psnr_db << " dB, " << match.pixels_off << " px off by > 1 %; against the scene without it "
+            << without.psnr_db << " dB, " << without.pixels_off << " px off\n";
+  EXPECT_GE(match.psnr_db, 45.0);
+  EXPECT_LT(without.psnr_db, match.psnr_db - 10.0) << "the light shows on the screen";
+  EXPECT_GT(without.pixels_off, 10 * std::max<std::size_t>(match.pixels_off, 1));
 }
 
 }  // namespace

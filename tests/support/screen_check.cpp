@@ -39,9 +39,10 @@ ScreenMatch compare_with_reference(const ScreenCheck& check, std::uint64_t frame
                    check.captures_dir, "--out", check.out_dir},
                   log_dir + "/compose-" + k + ".log");
   EXPECT_EQ(compose.wait(60s).value_or(-1), 0) << compose.output();
-  Process reference(
-      {check.master_binary, "render-reference", "--config", check.config, "--frame", k, "--out", check.out_dir},
-      log_dir + "/reference-" + k + ".log");
+  std::vector<std::string> reference_argv{
+      check.master_binary, "render-reference", "--config", check.config, "--frame", k, "--out", check.out_dir};
+  reference_argv.insert(reference_argv.end(), check.reference_args.begin(), check.reference_args.end());
+  Process reference(reference_argv, log_dir + "/reference-" + k + ".log");
   EXPECT_EQ(reference.wait(60s).value_or(-1), 0) << reference.output();
 
   auto loaded = config::load_installation(check.config);

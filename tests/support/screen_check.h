@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "optique/config.pb.h"
 
@@ -25,6 +26,8 @@ struct ScreenCheck {
   std::string captures_dir;  // <projector-id>/frame-NNNNNN.png
   std::string out_dir;       // composites and the reference go here
   std::string screen;        // screen id
+  // More for render-reference: {"--replay", journal} for a live scene's frame.
+  std::vector<std::string> reference_args = {};
 };
 
 // Compares where the reference is at most 0.6 of full light in every channel
