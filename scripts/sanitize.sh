@@ -19,6 +19,9 @@
 #                     binaries they start (slower; the benches never run here)
 #   SANITIZE_JOBS     build and ctest parallelism (default: nproc)
 #   SANITIZE_EXCLUDE  ctest -E regex of tests not to run (default: none)
+#   SANITIZE_SKIP_BUILD  regex of test executables not to build at all (default:
+#                     none): those every test of which SANITIZE_EXCLUDE leaves out,
+#                     so that their compiling and linking is saved too
 #   SANITIZE_PRELOAD_MESA=0  do not keep Mesa's driver loaded (see below); expect
 #                     LSan reports from every process that drew with llvmpipe
 #
@@ -112,7 +115,9 @@ tests_labelled() {
 # The tests' add_dependencies pull in optique-master and optique-node where they run them.
 targets=()
 if [ "${SANITIZE_ALL:-0}" != 1 ]; then
-  mapfile -t targets < <(tests_labelled "$labels")
+  mapfile -t targets < <(tests_labelled "$labels" | { if [ -n "${SANITIZE_SKIP_BUILD:-}" ]; then
+    grep -Ev "$SANITIZE_SKIP_BUILD" || true
+  else cat; fi; })
   if [ ${#targets[@]} -eq 0 ]; then
     echo "sanitize: no test matches the labels '$labels'" >&2
     exit 1
