@@ -317,6 +317,35 @@ TEST(LiveScene, PointLightsAreAddedChangedSwitchedAndRemoved) {
   accept(scene, R"(edits { point_light { light: 4 position: [2, 2, 2] } })");
 }
 
+// put_live into a state that holds instances already: the state it leaves is
+// the one a fresh state gets, whether it held more instances, fewer, or others
+// with other fields.
+TEST(LiveScene, PutLiveIntoAStateThatHeldOtherInstancesGivesTheSameState) {
+  LiveScene scene = with_torus();
+  accept(scene, R"(edits { create { instance: "a" asset: "torus" transform { position: [1, 2, 3] } } }
+                   edits { create { instance: "b" asset: "torus" parent: "a" hidden: true } }
+                   edits { create { instance: "c" asset: "torus" } }
+                   edits { animation { instance: "c" playing: false seek: 2 } })");
+  scene::SceneState fresh;
+  put_live(scene, 5, fresh);
+  ASSERT_EQ(fresh.instances.size(), 3u);
+  for (std::size_t held : {0u, 1u, 3u, 7u}) {
+    scene::SceneState reused;
+    for (std::size_t i = 0; i < held; ++i) {
+      scene::InstanceState other;
+      other.asset = "a-much-longer-asset-name-than-torus";
+      other.parent = "someone-else";
+      other.visible = false;
+      other.base_color = {0.5, 0.5, 0.5, 0.5};
+      other.animation = scene::AnimationTimes{9.0, 9.5};
+      reused.instances["z" + std::to_string(i)] = other;
+    }
+    put_live(scene, 5, reused);
+    EXPECT_EQ(reused.instances, fresh.instances) << held << " held";
+    EXPECT_EQ(scene::state_hash(reused), scene::state_hash(fresh)) << held << " held";
+  }
+}
+
 TEST(LiveScene, OfAnInstallationsSceneHasItsAssetAndLights) {
   scene::SceneDefinition definition;
   definition.asset_id = "cubes";
