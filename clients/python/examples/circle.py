@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Places two copies of the installation's scene and moves one on a circle in
-front of the wall, once a frame, for a few seconds; the other turns red and
-back, and the scene's point lights go dark one at a time, a second each. Run it against a master with master.api on, e.g.:
+front of the wall, once a frame, for a few seconds, with a warm point light
+of its own riding above it; the other turns red and back, and the scene's
+point lights go dark one at a time, a second each. Run it against a master
+with master.api on, e.g.:
 
     optique-master --config configs/powerwall-2x2-api.json --local
     python3 circle.py --seconds 10
@@ -31,19 +33,23 @@ def main() -> None:
             for instance in wall.scene.instances:
                 if instance.instance in ("orbit", "beacon"):
                     t.remove(instance.instance)
+            for light in wall.scene.point_lights:
+                t.remove_point_light(light.light)
             t.create("orbit", asset, position=(args.radius, 0.0, 0.3), scale=0.25)
             t.create("beacon", asset, position=(0.0, 0.0, 0.3), scale=0.15)
         print(f"placed from frame {t.frame}")
         start = time.monotonic()
         frames = []
         lights = wall.scene.light_count
+        lamp = lights  # the first index after the scene's own lights
         dark = None  # the second whose light is off
         switches = 0
         while (now := time.monotonic() - start) < args.seconds:
             angle = now * 2.0 * math.pi / 4.0  # one turn every 4 s
             with wall.transaction() as t:
-                t.move("orbit", position=(args.radius * math.cos(angle), args.radius * math.sin(angle), 0.3),
-                       rotation=(math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0))
+                x, y = args.radius * math.cos(angle), args.radius * math.sin(angle)
+                t.move("orbit", position=(x, y, 0.3), rotation=(math.cos(angle / 2), 0.0, math.sin(angle / 2), 0.0))
+                t.point_light(lamp, position=(x, y + 0.3, 0.6), colour=(1.0, 0.7, 0.4), intensity=0.3)
                 red = 0.5 + 0.5 * math.sin(3.0 * now)
                 t.tint("beacon", base_color=(1.0, 1.0 - red, 1.0 - red, 1.0))
                 if lights and int(now) != dark:
@@ -54,9 +60,11 @@ def main() -> None:
                     switches += 1
             frames.append(t.frame)
             time.sleep(1.0 / 60.0)
-        if dark is not None:  # every light as the config has it again
+        if frames:  # every light as the config has it again
             with wall.transaction() as t:
-                t.switch_light(dark % lights, True)
+                if dark is not None:
+                    t.switch_light(dark % lights, True)
+                t.remove_point_light(lamp)
         print(f"moved it {len(frames)} times, frames {frames[0]} to {frames[-1]}; switched a light {switches} times")
 
 
