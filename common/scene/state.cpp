@@ -115,8 +115,9 @@ bool identical(const ObjectState& a, const ObjectState& b) {
   return identical(a.now, b.now) && identical(a.next, b.next);
 }
 
-bool identical(const InstanceState& a, const InstanceState& b) {
-  return a.asset == b.asset && a.parent == b.parent && identical(a.pose, b.pose) && a.visible == b.visible &&
+// Every field but the pose.
+bool identical_but_pose(const InstanceState& a, const InstanceState& b) {
+  return a.asset == b.asset && a.parent == b.parent && a.visible == b.visible &&
          identical(glm::dvec3(a.base_color), glm::dvec3(b.base_color)) && same_bits(a.base_color.w, b.base_color.w) &&
          identical(a.emissive, b.emissive) && a.animation.has_value() == b.animation.has_value() &&
          (!a.animation ||
@@ -151,20 +152,24 @@ void to_wire(std::uint32_t id, const ObjectState& o, wire::ObjectState& out) {
   to_wire(o.next, *out.mutable_next());
 }
 
-void to_wire(const std::string& id, const InstanceState& i, wire::InstanceState& out) {
-  out.set_id(id);
-  out.set_asset(i.asset);
-  out.set_parent(i.parent);
-  auto& pose = *out.mutable_pose();
-  const bool still = identical(i.pose.now, i.pose.next);
+// An instance's two poses packed: once when they are the same.
+void pose_to_wire(const ObjectState& poses, google::protobuf::RepeatedField<double>& pose) {
+  const bool still = identical(poses.now, poses.next);
   pose.Reserve(still ? kPackedPose : 2 * kPackedPose);
-  for (const Pose* p : {&i.pose.now, &i.pose.next}) {
+  for (const Pose* p : {&poses.now, &poses.next}) {
     for (double v : {p->position.x, p->position.y, p->position.z, p->rotation.w, p->rotation.x, p->rotation.y,
                      p->rotation.z, p->scale.x, p->scale.y, p->scale.z}) {
       pose.AddAlreadyReserved(v);
     }
     if (still) break;
   }
+}
+
+void to_wire(const std::string& id, const InstanceState& i, wire::InstanceState& out) {
+  out.set_id(id);
+  out.set_asset(i.asset);
+  out.set_parent(i.parent);
+  pose_to_wire(i.pose, *out.mutable_pose());
   out.set_hidden(!i.visible);
   // The factors that change nothing are left out.
   if (i.base_color != glm::dvec4(1.0)) {
@@ -290,6 +295,20 @@ Result<void> factors_from_wire(const google::protobuf::RepeatedField<double>& v,
   return {};
 }
 
+// An instance's packed poses: kPackedPose numbers, or twice that when the next differs.
+Result<ObjectState> poses_from_wire(const google::protobuf::RepeatedField<double>& v, const Where& what) {
+  if (v.size() != kPackedPose && v.size() != 2 * kPackedPose) {
+    return Error{what.text() + "'s pose has " + std::to_string(v.size()) + " numbers, not " +
+                 std::to_string(kPackedPose) + " or " + std::to_string(2 * kPackedPose)};
+  }
+  auto now = packed_from_wire(v.data(), what / " (now)");
+  if (!now) return Error{now.error()};
+  if (v.size() == kPackedPose) return ObjectState{now.value(), now.value()};
+  auto next = packed_from_wire(v.data() + kPackedPose, what / " (next)");
+  if (!next) return Error{next.error()};
+  return ObjectState{now.value(), next.value()};
+}
+
 Result<std::pair<std::string, InstanceState>> from_wire(const wire::InstanceState& i) {
   if (!is_instance_id(i.id())) return Error{"an instance's id is not one (1 to 64 of a-z A-Z 0-9 - _ .)"};
   const Where instance{"instance "};
@@ -301,19 +320,9 @@ Result<std::pair<std::string, InstanceState>> from_wire(const wire::InstanceStat
   out.asset = i.asset();
   out.parent = i.parent();
   out.visible = !i.hidden();
-  if (i.pose_size() != kPackedPose && i.pose_size() != 2 * kPackedPose) {
-    return Error{what.text() + "'s pose has " + std::to_string(i.pose_size()) + " numbers, not " +
-                 std::to_string(kPackedPose) + " or " + std::to_string(2 * kPackedPose)};
-  }
-  auto now = packed_from_wire(i.pose().data(), what / " (now)");
-  if (!now) return Error{now.error()};
-  if (i.pose_size() == kPackedPose) {
-    out.pose = {now.value(), now.value()};
-  } else {
-    auto next = packed_from_wire(i.pose().data() + kPackedPose, what / " (next)");
-    if (!next) return Error{next.error()};
-    out.pose = {now.value(), next.value()};
-  }
+  auto pose = poses_from_wire(i.pose(), what);
+  if (!pose) return Error{pose.error()};
+  out.pose = pose.value();
   if (auto ok = factors_from_wire(i.base_color(), 4, 1.0, what / " base colour"); !ok) return Error{ok.error()};
   if (auto ok = factors_from_wire(i.emissive(), 3, kMaxEmissiveFactor, what / " emissive"); !ok) {
     return Error{ok.error()};
@@ -385,6 +394,50 @@ Result<void> check_parents(const std::vector<Named>& named, const Lookup& lookup
     }
   }
   return {};
+}
+
+using Instances = std::map<std::string, InstanceState>;
+
+// The instances a delta moves, each found in the state with its new poses, or
+// what is wrong: an id that is not one, an instance not there, changed or
+// removed by the delta too, or moved twice, a pose that is not one. Nothing
+// is changed. The master names them in id order: each is looked for next to
+// the one before first (a frame that moves them all costs no search).
+template <class Changed>
+Result<std::vector<std::pair<Instances::iterator, ObjectState>>> moves_from_wire(const wire::StateDelta& delta,
+                                                                                 Instances& instances,
+                                                                                 const Changed& changed_instance,
+                                                                                 const std::set<std::string>& removed) {
+  std::vector<std::pair<Instances::iterator, ObjectState>> moves;
+  if (delta.instances_moved().empty()) return moves;
+  moves.reserve(static_cast<std::size_t>(delta.instances_moved_size()));
+  bool ascending = true;
+  auto at = instances.begin();
+  for (const wire::InstanceMove& m : delta.instances_moved()) {
+    const std::string& id = m.id();
+    if (!is_instance_id(id)) return Error{"delta moves an instance whose id is not one"};
+    ascending = ascending && (moves.empty() || moves.back().first->first < id);
+    if (at == instances.end() || at->first != id) {
+      const auto next = at == instances.end() ? at : std::next(at);
+      at = next != instances.end() && next->first == id ? next : instances.find(id);
+    }
+    if (at == instances.end() || removed.contains(id) || changed_instance(id) != nullptr) {
+      return Error{"delta moves instance " + id + ", which it cannot: it is not there, or changed or removed too"};
+    }
+    const Where instance{"instance "};
+    auto pose = poses_from_wire(m.pose(), instance / id);
+    if (!pose) return Error{"delta: " + pose.error()};
+    moves.emplace_back(at, pose.value());
+  }
+  if (!ascending) {  // a peer's own order: each once
+    std::vector<const std::string*> ids;
+    for (const auto& move : moves) ids.push_back(&move.first->first);
+    std::sort(ids.begin(), ids.end(), [](const auto* a, const auto* b) { return *a < *b; });
+    const auto twice =
+        std::adjacent_find(ids.begin(), ids.end(), [](const auto* a, const auto* b) { return *a == *b; });
+    if (twice != ids.end()) return Error{"delta moves instance " + **twice + " twice"};
+  }
+  return moves;
 }
 
 struct ViewerPair {
@@ -572,7 +625,13 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
   for (const auto& [id, instance] : after.instances) {
     for (; old != before.instances.end() && old->first < id; ++old) delta.add_instances_removed(old->first);
     const bool was_there = old != before.instances.end() && old->first == id;
-    if (!was_there || !identical(old->second, instance)) to_wire(id, instance, *delta.add_instances_changed());
+    if (!was_there || !identical_but_pose(old->second, instance)) {
+      to_wire(id, instance, *delta.add_instances_changed());
+    } else if (!identical(old->second.pose, instance.pose)) {
+      wire::InstanceMove& moved = *delta.add_instances_moved();
+      moved.set_id(id);
+      pose_to_wire(instance.pose, *moved.mutable_pose());
+    }
     if (was_there) ++old;
   }
   for (; old != before.instances.end(); ++old) delta.add_instances_removed(old->first);
@@ -693,6 +752,8 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
     }
     if (auto ok = check_parents(ids, lookup); !ok) return Error{"delta: " + ok.error()};
   }
+  auto moves = moves_from_wire(delta, state.instances, changed_instance, instances_removed);
+  if (!moves) return Error{moves.error()};
 
   for (auto& [id, object] : changed) state.objects.insert_or_assign(id, object);
   // In order, each hinted at the one after the last: next to it when they are neighbours.
@@ -700,6 +761,7 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
   for (auto& [id, instance] : instances_changed) {
     hint = std::next(state.instances.insert_or_assign(hint, id, std::move(instance)));
   }
+  for (auto& [at, pose] : moves.value()) at->second.pose = pose;
   for (const std::string& id : instances_removed) state.instances.erase(id);
   for (std::uint32_t id : delta.removed()) state.objects.erase(id);
   set_viewer(state, viewer);

@@ -196,6 +196,13 @@ std::string check_applied(const scene::SceneState& before, const scene::SceneSta
   for (std::uint32_t light : delta.lights_off()) OPTIQUE_FUZZ_REQUIRE(after.lights_off.contains(light));
   for (std::uint32_t light : delta.lights_on()) OPTIQUE_FUZZ_REQUIRE(!after.lights_off.contains(light));
   for (const auto& light : delta.point_lights_set()) OPTIQUE_FUZZ_REQUIRE(after.point_lights.contains(light.light()));
+  for (const auto& moved : delta.instances_moved()) {
+    // Only its pose: everything else as it was.
+    OPTIQUE_FUZZ_REQUIRE(before.instances.contains(moved.id()) && after.instances.contains(moved.id()));
+    scene::InstanceState was = before.instances.at(moved.id());
+    was.pose = after.instances.at(moved.id()).pose;
+    OPTIQUE_FUZZ_REQUIRE(was == after.instances.at(moved.id()));
+  }
   for (std::uint32_t light : delta.point_lights_removed()) OPTIQUE_FUZZ_REQUIRE(!after.point_lights.contains(light));
   if (!delta.has_viewer()) {
     OPTIQUE_FUZZ_REQUIRE(same_bits(after.eye_now, before.eye_now));

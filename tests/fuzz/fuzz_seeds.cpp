@@ -360,6 +360,20 @@ std::vector<Seed> delta_seeds() {
     seeds.push_back(delta_seed("instances_move_and_remove",
                                {scene::make_delta(placed, moved), scene::make_delta(moved, gone), short_pose},
                                scene::to_snapshot(placed)));
+    // Moves only (id and pose), the form a frame that moves things takes: in
+    // order, reversed, twice, and of an instance that is not there.
+    scene::SceneState shifted = placed;
+    for (auto& [id, instance] : shifted.instances) instance.pose.now.position.y += 0.5;
+    const wire::StateDelta moves = scene::make_delta(placed, shifted);
+    wire::StateDelta reversed = moves;
+    std::reverse(reversed.mutable_instances_moved()->begin(), reversed.mutable_instances_moved()->end());
+    wire::StateDelta twice = moves;
+    if (twice.instances_moved_size() > 0) *twice.add_instances_moved() = twice.instances_moved(0);
+    wire::StateDelta ghost = moves;
+    if (ghost.instances_moved_size() > 0) ghost.mutable_instances_moved(0)->set_id("ghost");
+    seeds.push_back(delta_seed("instances_moved_only",
+                               {moves, scene::make_delta(shifted, placed), reversed, twice, ghost},
+                               scene::to_snapshot(placed)));
   }
   {
     wire::StateDelta d = change(object(1, 0.5, 1.0, -0.5));

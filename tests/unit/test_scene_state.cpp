@@ -526,15 +526,17 @@ TEST(SceneInstances, TravelInSnapshotsDeltasAndTheHash) {
   EXPECT_EQ(state_hash(applied), state_hash(after));
   EXPECT_EQ(make_delta(after, after).instances_changed_size(), 0);
   // The pose packed: once for an instance that stands still over the frame,
-  // twice for one that moves.
+  // twice for one that moves; an instance that only moved travels as a move.
   SceneState still = after;
   still.instances["cup"].pose.next = still.instances["cup"].pose.now;
   SceneState moving = still;
   moving.instances["cup"].pose.next.position.x += 0.25;
   for (const auto& [from, to, numbers] : {std::tuple{&after, &still, 10}, std::tuple{&still, &moving, 20}}) {
     const wire::StateDelta packed = make_delta(*from, *to);
-    ASSERT_EQ(packed.instances_changed_size(), 1);
-    EXPECT_EQ(packed.instances_changed(0).pose_size(), numbers);
+    EXPECT_EQ(packed.instances_changed_size(), 0);
+    ASSERT_EQ(packed.instances_moved_size(), 1);
+    EXPECT_EQ(packed.instances_moved(0).id(), "cup");
+    EXPECT_EQ(packed.instances_moved(0).pose_size(), numbers);
     SceneState applied_packed = *from;
     ASSERT_TRUE(apply_delta(applied_packed, packed));
     EXPECT_EQ(applied_packed, *to);
@@ -674,7 +676,77 @@ TEST(SceneInstances, EachFieldChangesTheHash) {
     SceneState changed = base;
     changes[k](changed.instances["cup"]);
     EXPECT_NE(state_hash(changed), state_hash(base)) << "change " << k;
-    EXPECT_EQ(make_delta(base, changed).instances_changed_size(), 1) << "change " << k;
+    const wire::StateDelta delta = make_delta(base, changed);
+    EXPECT_EQ(delta.instances_changed_size() + delta.instances_moved_size(), 1) << "change " << k;
+    EXPECT_EQ(delta.instances_moved_size(), k == 2 ? 1 : 0) << "change " << k << ": only the pose is a move";
+    SceneState applied = base;
+    ASSERT_TRUE(apply_delta(applied, delta)) << "change " << k;
+    EXPECT_EQ(applied, changed) << "change " << k;
+  }
+}
+
+// Instances that only moved travel as moves (id and pose): applied in place,
+// in the master's order or a peer's; what a peer may not send is refused and
+// leaves the state as it was.
+TEST(SceneInstances, MovesAreAppliedInPlaceAndWhatCannotBeMovedIsRefused) {
+  SceneState before = with_instances();
+  for (int i = 0; i < 50; ++i) before.instances["m" + std::to_string(100 + i)] = instance("torus", "", i * 0.1);
+  SceneState after = before;
+  for (auto& [id, instance] : after.instances) {
+    if (id[0] == 'm' && (id.back() - '0') % 3 != 0) instance.pose.now.position.y += 1.0;  // every third stays
+  }
+  after.instances["m149"].pose.next.position.z = 2.0;
+  const wire::StateDelta delta = make_delta(before, after);
+  EXPECT_EQ(delta.instances_changed_size(), 0);
+  EXPECT_GT(delta.instances_moved_size(), 30);
+  SceneState applied = before;
+  ASSERT_TRUE(apply_delta(applied, delta));
+  EXPECT_EQ(applied, after);
+  EXPECT_EQ(state_hash(applied), state_hash(after));
+  wire::StateDelta reversed = delta;
+  std::reverse(reversed.mutable_instances_moved()->begin(), reversed.mutable_instances_moved()->end());
+  SceneState applied_reversed = before;
+  ASSERT_TRUE(apply_delta(applied_reversed, reversed));
+  EXPECT_EQ(applied_reversed, after);
+
+  const auto move = [&](const std::string& id) {
+    wire::StateDelta d;
+    auto& m = *d.add_instances_moved();
+    m.set_id(id);
+    *m.mutable_pose() = delta.instances_moved(0).pose();
+    return d;
+  };
+  std::vector<std::pair<std::string, wire::StateDelta>> bad{{"not there", move("ghost")}, {"not an id", move("a b")}};
+  wire::StateDelta twice = move("m101");
+  *twice.add_instances_moved() = twice.instances_moved(0);
+  bad.emplace_back("moved twice", twice);
+  wire::StateDelta twice_apart = move("m101");
+  *twice_apart.add_instances_moved() = move("m102").instances_moved(0);
+  *twice_apart.add_instances_moved() = twice_apart.instances_moved(0);
+  bad.emplace_back("moved twice, not next to each other", twice_apart);
+  wire::StateDelta removed = move("m101");
+  removed.add_instances_removed("m101");
+  bad.emplace_back("moved and removed", removed);
+  SceneState hidden = before;
+  hidden.instances["cup"].visible = false;
+  wire::StateDelta changed = make_delta(before, hidden);
+  ASSERT_EQ(changed.instances_changed_size(), 1);
+  *changed.add_instances_moved() = move("cup").instances_moved(0);
+  bad.emplace_back("moved and changed", changed);
+  wire::StateDelta short_pose = move("m101");
+  short_pose.mutable_instances_moved(0)->mutable_pose()->RemoveLast();
+  bad.emplace_back("a pose of 9 numbers", short_pose);
+  wire::StateDelta nan_pose = move("m101");
+  nan_pose.mutable_instances_moved(0)->set_pose(0, std::numeric_limits<double>::quiet_NaN());
+  bad.emplace_back("a NaN position", nan_pose);
+  wire::StateDelta unit = move("m101");
+  unit.mutable_instances_moved(0)->set_pose(3, 2.0);
+  bad.emplace_back("a rotation of length 2", unit);
+  for (const auto& [what, d] : bad) {
+    SceneState state = before;
+    const auto outcome = apply_delta(state, d);
+    EXPECT_FALSE(outcome) << what;
+    EXPECT_EQ(state, before) << what;
   }
 }
 
