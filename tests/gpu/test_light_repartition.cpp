@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <functional>
 #include <map>
 #include <regex>
 #include <set>
@@ -102,24 +103,33 @@ std::multiset<std::uint32_t> range(std::uint32_t first, std::uint32_t last) {
   return lights;
 }
 
+// The group's config at 5 Hz, with a frame timeout for captures on a shared
+// software rasterizer, its scene's light switches as `switches` sets them;
+// written to `path`.
+std::string slow_config(const std::string& path, const std::function<void(schema::Scene&)>& switches) {
+  return write_config_variant(
+      kConfig,
+      [&](schema::Installation& installation) {
+        installation.mutable_master()->set_frame_rate(5.0);
+        installation.mutable_master()->set_frame_timeout_ms(5000);
+        switches(*installation.mutable_scene());
+      },
+      path);
+}
+
 TEST(LightRepartition, LightsSwitchedAndANodeKilledAreSharedOutAnewAndTheScreenShowsIt) {
   const ScratchDir dir_scratch("optique-repartition");
   const std::string dir = dir_scratch.string();
-  const std::string config = write_config_variant(
-      kConfig,
-      [](schema::Installation& installation) {
-        installation.mutable_master()->set_frame_rate(5.0);
-        installation.mutable_master()->set_frame_timeout_ms(5000);  // captures on a shared software rasterizer
-        auto& switches = *installation.mutable_scene()->mutable_light_switches();
-        switches.Clear();
-        auto* off = switches.Add();
-        off->set_time(2.0);
-        off->set_off("10-19");
-        auto* on = switches.Add();
-        on->set_time(4.0);
-        on->set_on("10-19");
-      },
-      dir + "/auto.json");
+  const std::string config = slow_config(dir + "/auto.json", [](schema::Scene& scene) {
+    auto& switches = *scene.mutable_light_switches();
+    switches.Clear();
+    auto* off = switches.Add();
+    off->set_time(2.0);
+    off->set_off("10-19");
+    auto* on = switches.Add();
+    on->set_time(4.0);
+    on->set_on("10-19");
+  });
   const std::string out = dir + "/out";
   Process master(
       {kMaster, "--config", config, "--listen", "127.0.0.1", "--port", "0", "--port-file", dir + "/port", "--out", out,
@@ -201,14 +211,8 @@ TEST(LightRepartition, LightsSwitchedAndANodeKilledAreSharedOutAnewAndTheScreenS
 TEST(LightRepartition, ALightAnApplicationAddsIsSharedOutAndTheScreenShowsIt) {
   const ScratchDir dir_scratch("optique-added-light");
   const std::string dir = dir_scratch.string();
-  const std::string config = write_config_variant(
-      kConfig,
-      [](schema::Installation& installation) {
-        installation.mutable_master()->set_frame_rate(5.0);
-        installation.mutable_master()->set_frame_timeout_ms(5000);  // captures on a shared software rasterizer
-        installation.mutable_scene()->clear_light_switches();
-      },
-      dir + "/auto.json");
+  const std::string config =
+      slow_config(dir + "/auto.json", [](schema::Scene& scene) { scene.clear_light_switches(); });
   const std::string out = dir + "/out";
   const std::string journal = dir + "/session.journal";
   constexpr std::uint64_t kRun = 24;
