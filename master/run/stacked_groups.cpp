@@ -212,9 +212,11 @@ std::vector<LightShare> automatic_shares(const config::Installation& inst, const
 }
 
 LightPlan::LightPlan(const config::Installation& installation, const scene::SceneDefinition& scene)
-    : installation_(installation), scene_(scene), groups_(lighting_groups(installation)) {
-  shares_ = listed_shares(installation, scene.lights.size());
-}
+    : installation_(installation),
+      scene_(scene),
+      groups_(lighting_groups(installation)),
+      listed_(listed_shares(installation, scene.lights.size())),
+      shares_(listed_) {}
 
 bool LightPlan::rebalance(const std::vector<bool>& up, const scene::SceneState& state, const glm::dvec3& eye,
                           bool force) {
@@ -267,9 +269,8 @@ bool LightPlan::rebalance(const std::vector<bool>& up, const scene::SceneState& 
 bool LightPlan::listed_with_added(const StackedGroup& group, const scene::SceneState& state) {
   bool changed = false;
   for (std::size_t member : group.members) {
-    const config::Content& content = installation_.projectors[member].content;
-    LightShare share{content.lights, content.ambient};
-    if (content.ambient) {
+    LightShare share = listed_.at(member);
+    if (share.ambient) {
       for (const auto& [index, light] : state.point_lights) {
         if (index >= scene_.lights.size()) share.lights.push_back(index);  // after the listed: ascending
       }

@@ -91,6 +91,7 @@ class LightPlan {
   const config::Installation& installation_;
   const scene::SceneDefinition& scene_;
   std::vector<StackedGroup> groups_;
+  std::map<std::size_t, LightShare> listed_;  // the shares the config lists (listed_shares)
   std::map<std::size_t, LightShare> shares_;
 };
 

@@ -274,7 +274,7 @@ class LiveScene::Edits {
                                  : "the scene's point lights are 0 to " + std::to_string(scene_.light_count_ - 1)) +
                                 ", and no light " + std::to_string(l.light()) + " was added"};
     }
-    switch_light(l.light(), l.on());
+    switches()[l.light()] = l.on();
     return std::nullopt;
   }
 
@@ -312,8 +312,7 @@ class LiveScene::Edits {
       }
       light.intensity = l.intensity();
     }
-    if (!point_lights_before_) point_lights_before_ = scene_.point_lights_;
-    scene_.point_lights_[l.light()] = light;
+    added_lights()[l.light()] = light;
     return std::nullopt;
   }
 
@@ -322,18 +321,20 @@ class LiveScene::Edits {
     if (!scene_.point_lights_.contains(r.light())) {
       return Wrong{"light", "no light " + std::to_string(r.light()) + " was added"};
     }
-    if (!point_lights_before_) point_lights_before_ = scene_.point_lights_;
-    scene_.point_lights_.erase(r.light());
-    if (scene_.light_switches_.contains(r.light())) {
-      if (!lights_before_) lights_before_ = scene_.light_switches_;
-      scene_.light_switches_.erase(r.light());
-    }
+    added_lights().erase(r.light());
+    if (scene_.light_switches_.contains(r.light())) switches().erase(r.light());
     return std::nullopt;
   }
 
-  void switch_light(std::uint32_t light, bool on) {
+  // The light switches and the lights added, to change: kept as they were
+  // first, for undo().
+  std::map<std::uint32_t, bool>& switches() {
     if (!lights_before_) lights_before_ = scene_.light_switches_;
-    scene_.light_switches_[light] = on;
+    return scene_.light_switches_;
+  }
+  std::map<std::uint32_t, scene::PointLightState>& added_lights() {
+    if (!point_lights_before_) point_lights_before_ = scene_.point_lights_;
+    return scene_.point_lights_;
   }
 
   // The clock starts here from where the scene's time has the animations in

@@ -276,24 +276,22 @@ TEST(LiveScene, PointLightsAreAddedChangedSwitchedAndRemoved) {
     const Refusal r = refused(scene, text);
     return r.field + ": " + r.reason;
   };
-  EXPECT_EQ(why(R"(edits { point_light { light: 1 position: [0, 0, 0] } })"),
-            "edits[0].point_light.light: lights added take the indices 2 to 4, after the scene's own (got 1)");
-  EXPECT_EQ(why(R"(edits { point_light { light: 5 position: [0, 0, 0] } })"),
-            "edits[0].point_light.light: lights added take the indices 2 to 4, after the scene's own (got 5)");
-  EXPECT_EQ(why(R"(edits { point_light { light: 3 colour: [1, 1, 1] } })"),
-            "edits[0].point_light.position: is needed to add a light");
-  EXPECT_EQ(why(R"(edits { point_light { light: 3 position: [0, 0] } })"),
-            "edits[0].point_light.position: must be [x, y, z] (got 2 numbers)");
-  EXPECT_EQ(why(R"(edits { point_light { light: 2 position: [0, nan, 0] } })"),
-            "edits[0].point_light.position[1]: must be in [-1e+06, 1e+06] (got nan)");
-  EXPECT_EQ(why(R"(edits { point_light { light: 2 colour: [0, 2000, 0] } })"),
-            "edits[0].point_light.colour[1]: must be in [0, 1000] (got 2000)");
-  EXPECT_EQ(why(R"(edits { point_light { light: 2 intensity: -1 } })"),
-            "edits[0].point_light.intensity: must be in [0, 1e+06] (got -1)");
-  EXPECT_EQ(why(R"(edits { remove_point_light { light: 3 } })"),
-            "edits[0].remove_point_light.light: no light 3 was added");
-  EXPECT_EQ(why(R"(edits { remove_point_light { light: 0 } })"),
-            "edits[0].remove_point_light.light: no light 0 was added");
+  // Each edit, and the field and reason it is refused with.
+  const std::vector<std::pair<std::string, std::string>> refusals{
+      {R"(point_light { light: 1 position: [0, 0, 0] })",
+       "point_light.light: lights added take the indices 2 to 4, after the scene's own (got 1)"},
+      {R"(point_light { light: 5 position: [0, 0, 0] })",
+       "point_light.light: lights added take the indices 2 to 4, after the scene's own (got 5)"},
+      {R"(point_light { light: 3 colour: [1, 1, 1] })", "point_light.position: is needed to add a light"},
+      {R"(point_light { light: 3 position: [0, 0] })", "point_light.position: must be [x, y, z] (got 2 numbers)"},
+      {R"(point_light { light: 2 position: [0, nan, 0] })",
+       "point_light.position[1]: must be in [-1e+06, 1e+06] (got nan)"},
+      {R"(point_light { light: 2 colour: [0, 2000, 0] })", "point_light.colour[1]: must be in [0, 1000] (got 2000)"},
+      {R"(point_light { light: 2 intensity: -1 })", "point_light.intensity: must be in [0, 1e+06] (got -1)"},
+      {R"(remove_point_light { light: 3 })", "remove_point_light.light: no light 3 was added"},
+      {R"(remove_point_light { light: 0 })", "remove_point_light.light: no light 0 was added"},
+  };
+  for (const auto& [edit, says] : refusals) EXPECT_EQ(why("edits { " + edit + " }"), "edits[0]." + says);
   // Refused whole: the light moved and removed first are as they were.
   const auto lights = scene.point_lights();
   const auto switches = scene.light_switches();
