@@ -111,8 +111,21 @@ struct AppEvent {
   session::Event event;
 };
 
+// An asset an application loaded is ready on every node in the frames: from
+// frame `frame` on, instances of it may be created (the live scene takes it).
+struct AssetUsable {
+  std::string asset;
+  std::uint64_t frame = 0;
+};
+// An asset could not be readied on a node: it is not offered any longer.
+struct AssetFailed {
+  std::string asset;
+  std::string reason;
+};
+
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, SetLiveness, SetMaxPayload, Protect, Arm, Disarm,
-                            StopAccepting, SignalLocalNodes, HeadShown, FrameRows, Finish, Log, AppEvent>;
+                            StopAccepting, SignalLocalNodes, HeadShown, FrameRows, Finish, Log, AppEvent, AssetUsable,
+                            AssetFailed>;
 using Actions = std::vector<Action>;
 
 }  // namespace optique::master

@@ -155,11 +155,15 @@ Actions MasterProtocol::message(PeerId peer, const wire::Envelope& message, cloc
     case wire::Envelope::kHeartbeat:
       break;
     case wire::Envelope::kSceneRequest:
-      if (session.phase != Phase::configuring) {
-        out.push_back(Close{peer, "asked for the scene's files after setting up"});
+      scene_server_.request(peer, slot_id(*session.slot), session.scene, message.scene_request(),
+                            session.phase == Phase::configuring, now, out);
+      break;
+    case wire::Envelope::kAssetReady:
+      if (session.phase == Phase::configuring) {
+        out.push_back(Close{peer, "said an asset is ready before it was configured"});
         break;
       }
-      scene_server_.request(peer, slot_id(*session.slot), session.scene, message.scene_request(), now, out);
+      on_asset_ready(session, message.asset_ready(), out);
       break;
     case wire::Envelope::kSceneWait:
       if (session.phase != Phase::configuring) {
@@ -262,9 +266,13 @@ void MasterProtocol::on_hello(PeerId peer, Session& session, const wire::Envelop
       "node did not finish configuring within " + std::to_string(scene_server_.configure_timeout().count()) + " s"});
   const LightShare* share = light_plan_.share(*slot);
   wire::Envelope envelope;
-  *envelope.mutable_welcome() =
-      protocol::encode_welcome(installation_, *slot, scene_.manifest,
-                               static_cast<std::uint32_t>(scene_.definition.lights.size()), frame_period_, share);
+  // Every asset applications loaded: the node readies them before it says it
+  // is configured.
+  const std::vector<protocol::AssetOffer> assets = asset_offers();
+  for (const protocol::AssetOffer& asset : assets) session.assets_ready.insert(asset.asset);
+  *envelope.mutable_welcome() = protocol::encode_welcome(installation_, *slot, scene_.manifest,
+                                                         static_cast<std::uint32_t>(scene_.definition.lights.size()),
+                                                         frame_period_, share, assets);
   // Its first frame repeats the share, so the log tells from which frame each node
   // draws what (and a share changed while it set itself up still reaches it).
   if (share != nullptr) target.sent_share.reset();
@@ -355,6 +363,7 @@ Actions MasterProtocol::closed(PeerId peer, const std::string& reason, clock::Na
     }
     present_owed(slot, now, out);  // nor waited for to show the last one (after its lights moved)
     begin_if_held_frame_may(now, out);
+    check_assets(out);  // an asset it had not readied yet waits for it no longer
   }
   finish_if_all_gone(out);
   return out;

@@ -47,6 +47,7 @@
 #include "net/session_seal.h"
 #include "optique/report.pb.h"
 #include "optique/wire.pb.h"
+#include "protocol/welcome.h"
 #include "scene_load/load_scene.h"
 #include "tracking/head_tracker.h"
 
@@ -107,6 +108,13 @@ class MasterProtocol {
   // the scene waits too. Resume: frames go on from where they stopped. Stop:
   // as a first interrupt, the run finishes in order.
   [[nodiscard]] Actions operator_command(OperatorCommand command, const std::string& from, clock::Nanos now);
+  // An asset an application loaded (checked and hashed off the io thread),
+  // named `id`: offered to every node that has said hello (and in every
+  // welcome from now on); AssetUsable once every node in the frames has
+  // readied it (at once when none is), AssetFailed when one cannot. A built-in
+  // asset (no files) or an id offered before is a contract violation.
+  [[nodiscard]] Actions add_asset(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset,
+                                  clock::Nanos now);
 
   // For the status line and tests: the frame to begin next, the nodes up of the
   // projectors, whether frames are running.
@@ -141,7 +149,8 @@ class MasterProtocol {
     // newest and is waited for again.
     std::optional<std::uint64_t> drawing;
     RenderPace pace;
-    bool said_slow = false;  // logged once that it draws slower than the period
+    bool said_slow = false;              // logged once that it draws slower than the period
+    std::set<std::string> assets_ready;  // readied (or in its welcome: ready once it is configured)
   };
   struct Slot {
     std::optional<PeerId> peer;
@@ -183,6 +192,12 @@ class MasterProtocol {
 
   // Shares automatic groups' lights among the nodes that are up (a node came or
   // went: `force`); the changes go out with the next FrameBegin.
+  // Assets applications loaded (live_assets.cpp).
+  void on_asset_ready(Session& session, const wire::AssetReady& ready, Actions& out);
+  // Every asset not yet usable that every node in the frames has readied is now.
+  void check_assets(Actions& out);
+  [[nodiscard]] std::vector<protocol::AssetOffer> asset_offers() const;
+
   void rebalance_lights(bool force);
   void log_light_switches(std::uint64_t frame, const wire::StateDelta& delta, Actions& out) const;
   // Events for the scene session's subscribers (AppEvent), raised only with a live scene.
@@ -204,6 +219,12 @@ class MasterProtocol {
   RunRecorder& recorder_;
 
   std::map<PeerId, Session> sessions_;
+  struct LiveAsset {
+    protocol::AssetOffer offer;
+    std::shared_ptr<const scene::LoadedScene> scene;
+    bool usable = false;
+  };
+  std::vector<LiveAsset> assets_;  // in the order they were loaded
   std::vector<Slot> slots_;
   SceneAuthority authority_;
   SceneServer scene_server_;

@@ -9,6 +9,8 @@
 
 #include <chrono>
 #include <cstdint>
+#include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -34,6 +36,7 @@ inline constexpr std::uint64_t kMostSceneRepeats = 4;
 // SceneServed: clang does not take a nested struct's default member
 // initializers in the enclosing one's std::optional of it.
 struct SceneSending {
+  std::string sha256;  // which scene (the installation's, or an asset)
   clock::Nanos started = 0;
   std::uint64_t bytes_asked = 0;  // all chunks sent, repeats included
   std::uint64_t bytes_new = 0;    // each chunk once
@@ -54,18 +57,32 @@ class SceneServer {
   // Keeps a reference: `scene` must outlive it.
   explicit SceneServer(const scene::LoadedScene& scene);
 
+  // Serves an asset an application loaded too (by its content_sha256), from
+  // now on; a node asks for its chunks while it sets up or while frames go on.
+  void add(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset);
+  void remove(const std::string& sha256) { assets_.erase(sha256); }
+
   // How long a node may take to set up, from its welcome or its last word
   // about the scene (kConfigureTimeout and a second per 64 MiB of files).
   [[nodiscard]] std::chrono::seconds configure_timeout() const;
-  // `node`: its projector's id, for the log.
+  // `node`: its projector's id, for the log. `setting_up`: the node has not
+  // yet joined the frames (each request gives it more time to set up); a
+  // node in the frames may ask only for an asset's files.
   void request(PeerId peer, const std::string& node, SceneServed& served, const wire::SceneRequest& request,
-               clock::Nanos now, Actions& out) const;
+               bool setting_up, clock::Nanos now, Actions& out) const;
   void wait(PeerId peer, const std::string& node, SceneServed& served, const wire::SceneWait& wait, clock::Nanos now,
             Actions& out) const;
 
  private:
   static constexpr int kRepeatsLogged = 10;
+  struct Asset {
+    std::string id;
+    std::shared_ptr<const scene::LoadedScene> scene;
+  };
+  // The scene or asset with these files, and how the log names it; null: none.
+  [[nodiscard]] std::pair<const scene::LoadedScene*, std::string> find(const std::string& sha256) const;
   const scene::LoadedScene& scene_;
+  std::map<std::string, Asset> assets_;  // by content_sha256
 };
 
 }  // namespace optique::master

@@ -1,6 +1,7 @@
 #include "node/node.h"
 
 #include <boost/asio/connect.hpp>
+#include <boost/asio/post.hpp>
 
 #include <csignal>
 #include <cstring>
@@ -125,116 +126,127 @@ void Node::complete(std::variant<Answer, Due> event, clock::Nanos at) {
 }
 
 void Node::carry_out(Action& action) {
-  std::visit(
-      util::Overloaded{
-          [&](Send& a) {
-            if (!connection_ || !connection_->is_open()) return;
-            // A ping's t1 is when it leaves, as the master's pong t3 is: the
-            // legs are measured alike.
-            if (a.message.has_ping()) a.message.mutable_ping()->set_t1(options_.protocol.clock.now());
-            connection_->send(a.message);
-          },
-          [&](Close& a) {
-            if (!connection_ || !connection_->is_open()) return;
-            if (a.after_sending) {
-              connection_->close_after_sending(a.reason);
-            } else {
-              connection_->close(a.reason);
-            }
-          },
-          [&](SetDeadline& a) {
-            if (connection_) connection_->set_deadline(a.after, a.reason);
-          },
-          [&](CancelDeadline&) {
-            if (connection_) connection_->cancel_deadline();
-          },
-          [&](Protect& a) {
-            if (connection_) connection_->protect(a.send, a.receive, true);
-          },
-          [&](SetLiveness& a) {
-            if (connection_) connection_->set_liveness_timeout(a.timeout, a.reason);
-          },
-          [&](Configure& a) {
-            Result<void> result = renderer_.configure(a.job);
-            complete(Configured{std::move(result), renderer_.description(), renderer_.warm_up()}, clock::monotonic_now());
-          },
-          [&](Render& a) {
-            const clock::Nanos started = clock::monotonic_now();
-            const Rendered how = renderer_.render(a.frame);
-            const clock::Nanos done = clock::monotonic_now();
-            complete(FrameRendered{a.frame.frame_id, done - started, how}, done);
-          },
-          [&](Skip& a) { renderer_.skip(a.frame); },
-          [&](PresentAt& a) { wait_for_present(a.deadline); },
-          [&](Present& a) {
-            renderer_.present(a.image);
-            const clock::Nanos shown = clock::monotonic_now();
-            // Nodes sharing a machine present at the same instant: let the others
-            // on this core show theirs before this one does its bookkeeping.
-            std::this_thread::yield();
-            complete(ImagePresented{}, shown);
-          },
-          [&](ShowBlack&) { renderer_.show_black(); },
-          [&](PingIn& a) {
-            ping_timer_.expires_after(a.after);
-            ping_timer_.async_wait([this](const boost::system::error_code& error) {
-              if (!error) carry_out(protocol_.due(Due::ping, clock::monotonic_now()));
-            });
-          },
-          [&](CancelPings&) { ping_timer_.cancel(); },
-          [&](Reconnect& a) {
-            retry_timer_.expires_after(a.after);
-            retry_timer_.async_wait([this](const boost::system::error_code& error) {
-              if (!error) connect();
-            });
-          },
-          [&](Stop& a) {
-            exit_code_ = a.exit_code;
-            retry_timer_.cancel();
-            ping_timer_.cancel();
-            scene_timer_.cancel();
-            connect_timer_.cancel();
-            present_timer_.cancel();
-            signals_.cancel();
-            resolver_.cancel();
-            if (connecting_) {
-              boost::system::error_code ignored;
-              connecting_->close(ignored);
-            }
-          },
-          [&](Log& a) { log_.log(a.level, "{}", a.text); },
-          [&](PrepareScene& a) {
-            if (auto found = scene_cache_.find(a.manifest, a.sha256)) {
-              complete(SceneFound{*found}, clock::monotonic_now());
-              return;
-            }
-            Result<SceneCache::Begun> begun = scene_cache_.begin(a.manifest, a.sha256, a.wait_for_others);
-            if (!begun) {
-              complete(SceneCopyStarted{Error{begun.error()}}, clock::monotonic_now());
-            } else if (const auto* elsewhere = std::get_if<SceneCache::FetchedElsewhere>(&begun.value())) {
-              complete(SceneFetchedElsewhere{elsewhere->bytes_there}, clock::monotonic_now());
-            } else {
-              complete(SceneCopyStarted{std::get<SceneCache::Present>(std::move(begun).value())},
-                       clock::monotonic_now());
-            }
-          },
-          [&](RecheckScene& a) {
-            scene_timer_.expires_after(a.after);
-            scene_timer_.async_wait([this](const boost::system::error_code& error) {
-              if (!error) carry_out(protocol_.due(Due::scene_recheck, clock::monotonic_now()));
-            });
-          },
-          [&](StoreSceneChunk& a) {
-            if (auto stored = scene_cache_.write(a.file, a.offset, a.data); !stored) {
-              complete(SceneStoreFailed{stored.error()}, clock::monotonic_now());
-            }
-          },
-          [&](FinishScene&) {
-            complete(SceneCopyFinished{scene_cache_.commit()}, clock::monotonic_now());
-          },
-          [&](AbandonScene&) { scene_cache_.abandon(); },
-      },
-      action);
+  std::visit(util::Overloaded{
+                 [&](Send& a) {
+                   if (!connection_ || !connection_->is_open()) return;
+                   // A ping's t1 is when it leaves, as the master's pong t3 is: the
+                   // legs are measured alike.
+                   if (a.message.has_ping()) a.message.mutable_ping()->set_t1(options_.protocol.clock.now());
+                   connection_->send(a.message);
+                 },
+                 [&](Close& a) {
+                   if (!connection_ || !connection_->is_open()) return;
+                   if (a.after_sending) {
+                     connection_->close_after_sending(a.reason);
+                   } else {
+                     connection_->close(a.reason);
+                   }
+                 },
+                 [&](SetDeadline& a) {
+                   if (connection_) connection_->set_deadline(a.after, a.reason);
+                 },
+                 [&](CancelDeadline&) {
+                   if (connection_) connection_->cancel_deadline();
+                 },
+                 [&](Protect& a) {
+                   if (connection_) connection_->protect(a.send, a.receive, true);
+                 },
+                 [&](SetLiveness& a) {
+                   if (connection_) connection_->set_liveness_timeout(a.timeout, a.reason);
+                 },
+                 [&](Configure& a) {
+                   Result<void> result = renderer_.configure(a.job);
+                   complete(Configured{std::move(result), renderer_.description(), renderer_.warm_up()},
+                            clock::monotonic_now());
+                 },
+                 [&](Render& a) {
+                   const clock::Nanos started = clock::monotonic_now();
+                   const Rendered how = renderer_.render(a.frame);
+                   const clock::Nanos done = clock::monotonic_now();
+                   complete(FrameRendered{a.frame.frame_id, done - started, how}, done);
+                 },
+                 [&](Skip& a) { renderer_.skip(a.frame); },
+                 [&](PresentAt& a) { wait_for_present(a.deadline); },
+                 [&](Present& a) {
+                   renderer_.present(a.image);
+                   const clock::Nanos shown = clock::monotonic_now();
+                   // Nodes sharing a machine present at the same instant: let the others
+                   // on this core show theirs before this one does its bookkeeping.
+                   std::this_thread::yield();
+                   complete(ImagePresented{}, shown);
+                 },
+                 [&](ShowBlack&) { renderer_.show_black(); },
+                 [&](PingIn& a) {
+                   ping_timer_.expires_after(a.after);
+                   ping_timer_.async_wait([this](const boost::system::error_code& error) {
+                     if (!error) carry_out(protocol_.due(Due::ping, clock::monotonic_now()));
+                   });
+                 },
+                 [&](CancelPings&) { ping_timer_.cancel(); },
+                 [&](Reconnect& a) {
+                   retry_timer_.expires_after(a.after);
+                   retry_timer_.async_wait([this](const boost::system::error_code& error) {
+                     if (!error) connect();
+                   });
+                 },
+                 [&](Stop& a) {
+                   exit_code_ = a.exit_code;
+                   retry_timer_.cancel();
+                   ping_timer_.cancel();
+                   scene_timer_.cancel();
+                   connect_timer_.cancel();
+                   present_timer_.cancel();
+                   signals_.cancel();
+                   resolver_.cancel();
+                   if (connecting_) {
+                     boost::system::error_code ignored;
+                     connecting_->close(ignored);
+                   }
+                 },
+                 [&](Log& a) { log_.log(a.level, "{}", a.text); },
+                 [&](PrepareScene& a) {
+                   if (auto found = scene_cache_.find(a.manifest, a.sha256)) {
+                     complete(SceneFound{*found}, clock::monotonic_now());
+                     return;
+                   }
+                   Result<SceneCache::Begun> begun = scene_cache_.begin(a.manifest, a.sha256, a.wait_for_others);
+                   if (!begun) {
+                     complete(SceneCopyStarted{Error{begun.error()}}, clock::monotonic_now());
+                   } else if (const auto* elsewhere = std::get_if<SceneCache::FetchedElsewhere>(&begun.value())) {
+                     complete(SceneFetchedElsewhere{elsewhere->bytes_there}, clock::monotonic_now());
+                   } else {
+                     complete(SceneCopyStarted{std::get<SceneCache::Present>(std::move(begun).value())},
+                              clock::monotonic_now());
+                   }
+                 },
+                 [&](RecheckScene& a) {
+                   scene_timer_.expires_after(a.after);
+                   scene_timer_.async_wait([this](const boost::system::error_code& error) {
+                     if (!error) carry_out(protocol_.due(Due::scene_recheck, clock::monotonic_now()));
+                   });
+                 },
+                 [&](StoreSceneChunk& a) {
+                   if (auto stored = scene_cache_.write(a.file, a.offset, a.data); !stored) {
+                     complete(SceneStoreFailed{stored.error()}, clock::monotonic_now());
+                   }
+                 },
+                 [&](FinishScene&) { complete(SceneCopyFinished{scene_cache_.commit()}, clock::monotonic_now()); },
+                 [&](AbandonScene&) { scene_cache_.abandon(); },
+                 // Read off this thread (the frames go on meanwhile), given to the GPU on it.
+                 [&](ReadyAsset& a) {
+                   const std::weak_ptr<bool> alive = alive_;
+                   asio::post(loader_, [this, alive, offer = std::move(a.asset)]() mutable {
+                     auto read = renderer_.read_asset(offer);
+                     asio::post(io_, [this, alive, offer = std::move(offer), read = std::move(read)] {
+                       if (alive.expired() || protocol_.stopped()) return;
+                       Result<void> added =
+                           read ? renderer_.add_asset(offer, *read.value()) : Result<void>{Error{read.error()}};
+                       carry_out(protocol_.answer(AssetLoaded{offer.asset, std::move(added)}, clock::monotonic_now()));
+                     });
+                   });
+                 },
+             },
+             action);
 }
 
 // The wait for a present deadline holds up nothing: pongs keep being stamped as

@@ -9,6 +9,7 @@
 #include <boost/asio/ip/tcp.hpp>
 #include <boost/asio/signal_set.hpp>
 #include <boost/asio/steady_timer.hpp>
+#include <boost/asio/thread_pool.hpp>
 
 #include <chrono>
 #include <deque>
@@ -79,6 +80,11 @@ class Node {
   };
   std::deque<Completion> completions_;
   int depth_ = 0;  // carry_out calls running (a Close calls back into it)
+  // What the loader's thread posts back finds the node gone once it is.
+  std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  // Reads assets offered while frames go on (Renderer::read_asset), one at a
+  // time; joined first when the node goes.
+  asio::thread_pool loader_{1};
 };
 
 }  // namespace optique::node

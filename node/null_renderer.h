@@ -10,6 +10,13 @@ class NullRenderer final : public Renderer {
  public:
   [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
   [[nodiscard]] std::string description() const override { return "null renderer (draws nothing)"; }
+  [[nodiscard]] Result<std::shared_ptr<const scene::SceneDefinition>> read_asset(
+      const protocol::AssetOffer&) const override {
+    return std::make_shared<const scene::SceneDefinition>();
+  }
+  [[nodiscard]] Result<void> add_asset(const protocol::AssetOffer&, const scene::SceneDefinition&) override {
+    return {};
+  }
   Rendered render(const FrameInput& frame) override;
   void present(int image) override;
   void show_black() override {}

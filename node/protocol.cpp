@@ -85,6 +85,10 @@ Actions NodeProtocol::closed(const std::string& reason, clock::Nanos now) {
   const bool was_joined = phase_ == Phase::joined;
   fetch_.reset();  // its copy is kept: the fetch goes on from it after the reconnect
   waiting_.reset();
+  // The next welcome names every asset again.
+  target_.reset();
+  offers_.clear();
+  readying_.reset();
   phase_ = Phase::disconnected;
   pending_.reset();
   held_.clear();
@@ -117,6 +121,12 @@ Actions NodeProtocol::interrupted(const std::string& signal_name) {
 
 // ---------------------------------------------------------------- messages
 
+// An asset's chunks come while frames go on, to a fetch of one.
+bool NodeProtocol::accepts(const wire::Envelope& message) const {
+  if (message.body_case() == wire::Envelope::kSceneChunk && phase_ == Phase::joined) return fetch_.has_value();
+  return accepts(phase_, message.body_case());
+}
+
 // Which messages each phase takes; a Challenge, a Refuse and a Goodbye are taken
 // in every phase, before the version is checked (message()).
 bool NodeProtocol::accepts(Phase phase, wire::Envelope::BodyCase kind) {
@@ -125,6 +135,9 @@ bool NodeProtocol::accepts(Phase phase, wire::Envelope::BodyCase kind) {
       return phase == Phase::awaiting_welcome;
     case wire::Envelope::kSceneChunk:
       return phase == Phase::fetching_scene;
+    case wire::Envelope::kAssetOffer:
+      return phase == Phase::preparing_scene || phase == Phase::fetching_scene || phase == Phase::configuring ||
+             phase == Phase::awaiting_state || phase == Phase::joined;
     case wire::Envelope::kHeartbeat:
       return phase == Phase::preparing_scene || phase == Phase::fetching_scene || phase == Phase::joined;
     case wire::Envelope::kResync:
@@ -166,7 +179,7 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
          out);
     return out;
   }
-  if (!accepts(phase_, message.body_case())) {
+  if (!accepts(message)) {
     out.push_back(Close{std::string("unexpected ") + net::body_name(message) +
                         (phase_ == Phase::joined ? " from the master" : " before the welcome")});
     return out;
@@ -177,6 +190,9 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
       break;
     case wire::Envelope::kSceneChunk:
       on_scene_chunk(message.scene_chunk(), out);
+      break;
+    case wire::Envelope::kAssetOffer:
+      on_asset_offer(message.asset_offer(), out);
       break;
     case wire::Envelope::kResync:
     case wire::Envelope::kFrameBegin:
@@ -213,6 +229,7 @@ Actions NodeProtocol::answer(Answer answer, clock::Nanos now) {
                  [&](const SceneCopyFinished& a) { on_scene_copy_finished(a, now, out); },
                  [&](const FrameRendered& a) { on_rendered(a, out); },
                  [&](const ImagePresented&) { on_presented(now, out); },
+                 [&](const AssetLoaded& a) { on_asset_loaded(a, out); },
              },
              answer);
   return out;
@@ -287,22 +304,8 @@ void NodeProtocol::on_welcome(const wire::Welcome& welcome, Actions& out) {
     return;
   }
   job_ = std::move(job).value();
-  if (!settings_.needs_scene_files || job_->scene_files.files.empty()) {
-    configure(out);
-    return;
-  }
-  const std::uint64_t bytes = job_->scene_files.total_bytes();
-  if (bytes > settings_.most_scene_bytes) {
-    stop(kExitRefused,
-         fmt::format("the master's scene {} is {:.1f} MiB, more than the {:.1f} MiB this node takes "
-                     "(--max-scene-mb)",
-                     job_->job.installation.scene.gltf, static_cast<double>(bytes) / (1 << 20),
-                     static_cast<double>(settings_.most_scene_bytes) / (1 << 20)),
-         out);
-    return;
-  }
-  phase_ = Phase::preparing_scene;
-  out.push_back(PrepareScene{job_->scene_files, job_->scene_sha256});
+  target_.reset();
+  prepare_next(out);
 }
 
 void NodeProtocol::configure(Actions& out) {
@@ -377,6 +380,7 @@ void NodeProtocol::on_resync(const wire::Resync& resync, clock::Nanos now, Actio
   // A quick burst of pings to get a clock offset before the first swap.
   pings_in_burst_ = kPingBurst;
   send_ping(now, out);
+  ready_next(out);  // assets offered while this node set up
 }
 
 void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos now, Actions& out) {

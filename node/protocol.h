@@ -165,10 +165,15 @@ struct FinishScene {};
 // whose connection went, or whose node stops, is kept: it goes on after the
 // reconnect, or in the next node to fetch the scene.
 struct AbandonScene {};
+// An asset offered while frames go on is here (its files at `asset.path`):
+// give it to the renderer (Renderer::add_asset); answer AssetLoaded.
+struct ReadyAsset {
+  protocol::AssetOffer asset;
+};
 
 using Action = std::variant<Send, Close, SetDeadline, CancelDeadline, Protect, SetLiveness, Configure, Render, Skip,
                             PresentAt, Present, ShowBlack, PingIn, CancelPings, Reconnect, Stop, Log, PrepareScene,
-                            RecheckScene, StoreSceneChunk, FinishScene, AbandonScene>;
+                            RecheckScene, StoreSceneChunk, FinishScene, AbandonScene, ReadyAsset>;
 using Actions = std::vector<Action>;
 
 // --- answers: what the shell reports after carrying out an action that asks
@@ -211,9 +216,14 @@ struct FrameRendered {
 };
 // To Present: the image is shown (at the answer's time).
 struct ImagePresented {};
+// To ReadyAsset: the renderer has it, or why not.
+struct AssetLoaded {
+  std::string asset;
+  Result<void> result;
+};
 
 using Answer = std::variant<Configured, SceneFound, SceneFetchedElsewhere, SceneCopyStarted, SceneStoreFailed,
-                            SceneCopyFinished, FrameRendered, ImagePresented>;
+                            SceneCopyFinished, FrameRendered, ImagePresented, AssetLoaded>;
 
 // The shell's timers, armed by PingIn, PresentAt and RecheckScene.
 enum class Due { ping, present, scene_recheck };
@@ -281,6 +291,7 @@ class NodeProtocol {
   };
 
   [[nodiscard]] static bool accepts(Phase phase, wire::Envelope::BodyCase kind);
+  [[nodiscard]] bool accepts(const wire::Envelope& message) const;
   void on_configured(const Configured& answer, Actions& out);
   void on_scene_found(const SceneFound& answer, Actions& out);
   void on_scene_fetched_elsewhere(const SceneFetchedElsewhere& answer, clock::Nanos now, Actions& out);
@@ -288,6 +299,26 @@ class NodeProtocol {
   void on_scene_copy_started(const SceneCopyStarted& answer, clock::Nanos now, Actions& out);
   void on_scene_store_failed(const SceneStoreFailed& answer, Actions& out);
   void on_scene_copy_finished(const SceneCopyFinished& answer, clock::Nanos now, Actions& out);
+  // The files of the scene or of an asset are here (at `path`).
+  void fetched(const std::string& path, Actions& out);
+  // Setting up: fetches the next of the job's files not yet here (the scene's,
+  // then each asset's); when none is left, configures.
+  void prepare_next(Actions& out);
+  // Starts fetching `target`'s files: looks in the cache first.
+  struct FetchTarget;
+  void prepare(FetchTarget target, Actions& out);
+  // The step of a fetch the shell's answer is for: `stage`, and the phase that
+  // goes with it (the frames, for an asset offered while they go on).
+  [[nodiscard]] bool fetch_at(Phase stage) const;
+  void set_fetch_stage(Phase stage);
+  // Assets offered while frames go on (asset_readying.cpp).
+  void on_asset_offer(const wire::AssetOffer& offer, Actions& out);
+  // In the frames: readies the next asset offered, if none is being readied.
+  void ready_next(Actions& out);
+  void on_asset_loaded(const AssetLoaded& answer, Actions& out);
+  // Tells the master whether the asset being readied is ready, and goes on
+  // with the next.
+  void asset_done(const std::string& problem, Actions& out);
   void on_rendered(const FrameRendered& answer, Actions& out);
   void on_ping_due(clock::Nanos now, Actions& out);
   void on_present_due(clock::Nanos now, Actions& out);
@@ -328,7 +359,21 @@ class NodeProtocol {
   std::vector<std::uint8_t> nonce_;  // this connection's, for the session keys
   std::optional<protocol::NodeJob> job_;
   std::optional<protocol::SceneFetch> fetch_;  // the scene's files coming from the master
-  bool copy_unfinished_ = false;               // a copy started and not yet put in place
+  // What is being fetched: the scene's files or an asset's, while setting up
+  // or (an asset offered then) while frames go on.
+  struct FetchTarget {
+    std::string name;    // for the log: "the scene", "the asset 'duck'"
+    std::string detail;  // after the name, where it says what is fetched: " x.gltf"
+    scene::SceneManifest files;
+    std::string sha256;
+    std::string* path = nullptr;  // where the copy's path goes (in job_ or readying_)
+    bool in_frames = false;
+    Phase stage = Phase::preparing_scene;  // preparing_scene or fetching_scene
+  };
+  std::optional<FetchTarget> target_;
+  std::deque<protocol::AssetOffer> offers_;       // offered while frames go on, not yet readied
+  std::optional<protocol::AssetOffer> readying_;  // the one being readied
+  bool copy_unfinished_ = false;                  // a copy started and not yet put in place
   clock::Nanos fetch_started_ = 0;
   std::uint64_t fetch_had_bytes_ = 0;  // here already when the fetch (re)started
   int fetch_quarters_logged_ = 0;

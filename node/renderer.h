@@ -4,6 +4,7 @@
 // (node/gl) implement it.
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "protocol/focus.h"
 #include "protocol/light_share.h"
 #include "protocol/welcome.h"
+#include "scene/definition.h"
 #include "scene/state.h"
 #include "up/schedule.h"
 #include "util/result.h"
@@ -58,6 +60,17 @@ class Renderer {
   [[nodiscard]] virtual std::string description() const = 0;
   // How long configure()'s warm-up frame took.
   [[nodiscard]] virtual WarmUp warm_up() const { return {}; }
+  // An asset an application loaded, offered while frames go on, its files at
+  // `asset.path` (none for a renderer that needs no files), read in two
+  // steps: read_asset() on a thread of its own while frames go on (the files
+  // read and checked, images decoded; no GL), then add_asset() on the
+  // renderer's thread (to the GPU), after which its instances are drawn.
+  // Each fails, naming why, when the asset cannot be read or is not what the
+  // master offered. (The job's assets are readied by configure().)
+  [[nodiscard]] virtual Result<std::shared_ptr<const scene::SceneDefinition>> read_asset(
+      const protocol::AssetOffer& asset) const = 0;
+  [[nodiscard]] virtual Result<void> add_asset(const protocol::AssetOffer& asset,
+                                               const scene::SceneDefinition& read) = 0;
   // Draws the frame into the back buffer; returns when it is ready to show,
   // with how it was drawn.
   virtual Rendered render(const FrameInput& frame) = 0;

@@ -29,6 +29,8 @@ class ReferenceView {
   // The screen's light in `state`, `fraction` of a frame after its display time
   // (objects and eyes that far on), linear RGBA at the screen's raster.
   [[nodiscard]] Result<image::FloatImage> draw(const scene::SceneState& state, double fraction) const;
+  // An asset an application loaded: its live instances are drawn too.
+  [[nodiscard]] Result<void> add_asset(const scene::SceneDefinition& asset) { return renderer_->add_asset(asset); }
   // One sample per pixel, what the projectors' signal would encode: for PNGs.
   [[nodiscard]] image::ByteImage encoded() const { return renderer_->output().read_encoded(); }
 

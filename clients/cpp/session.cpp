@@ -181,10 +181,12 @@ Result<session::Reply> Session::ask(session::Request request) {
   }
 }
 
-Result<Outcome> Session::apply(const Transaction& transaction) {
-  session::Request request;
-  *request.mutable_transaction() = transaction.message();
+Result<Outcome> Session::outcome_of(session::Request request, std::chrono::milliseconds timeout) {
+  const bool transaction = request.has_transaction();
+  const std::chrono::milliseconds usual = timeout_;
+  timeout_ = std::max(timeout_, timeout);
   auto reply = ask(std::move(request));
+  timeout_ = usual;
   if (!reply) return Error{reply.error()};
   Outcome outcome;
   if (reply.value().has_refused()) {
@@ -192,9 +194,31 @@ Result<Outcome> Session::apply(const Transaction& transaction) {
   } else if (reply.value().has_applied()) {
     outcome.frame = reply.value().applied().frame();
   } else {
-    return Error{"the master answered a transaction with something else"};
+    return Error{std::string("the master answered ") + (transaction ? "a transaction" : "LoadAsset") +
+                 " with something else"};
   }
   return outcome;
+}
+
+Result<Outcome> Session::apply(const Transaction& transaction) {
+  session::Request request;
+  *request.mutable_transaction() = transaction.message();
+  return outcome_of(std::move(request), timeout_);
+}
+
+Result<Outcome> Session::load_asset(const std::string& asset, const std::string& path,
+                                    std::chrono::milliseconds timeout) {
+  session::Request request;
+  request.mutable_load_asset()->set_asset(asset);
+  request.mutable_load_asset()->set_path(path);
+  return outcome_of(std::move(request), timeout);
+}
+
+Result<Outcome> Session::upload_asset(const std::string& asset, std::string glb, std::chrono::milliseconds timeout) {
+  session::Request request;
+  request.mutable_load_asset()->set_asset(asset);
+  request.mutable_load_asset()->set_glb(std::move(glb));
+  return outcome_of(std::move(request), timeout);
 }
 
 Result<session::SceneContents> Session::read_scene() {

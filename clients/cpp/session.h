@@ -46,6 +46,16 @@ class Session {
   Session& operator=(const Session&) = delete;
 
   [[nodiscard]] Result<Outcome> apply(const Transaction& transaction);
+  // Loads a glTF asset that instances may then name: `path` a file inside the
+  // master's master.api.assets folder (relative to it), or `glb` the bytes of
+  // a binary glTF this application sends. The outcome's frame is the first
+  // from which every node can draw it (the reply waits until every node has
+  // it: the timeout is the options' or `timeout`, whichever is longer), or
+  // why not.
+  [[nodiscard]] Result<Outcome> load_asset(const std::string& asset, const std::string& path,
+                                           std::chrono::milliseconds timeout = std::chrono::seconds(60));
+  [[nodiscard]] Result<Outcome> upload_asset(const std::string& asset, std::string glb,
+                                             std::chrono::milliseconds timeout = std::chrono::seconds(60));
   [[nodiscard]] Result<session::SceneContents> read_scene();
   // From now on the master sends these kinds of events (all off at first);
   // read them with next_event. An application that stops reading them is
@@ -63,6 +73,7 @@ class Session {
   struct Link;  // the socket, the framing and the seal (session.cpp)
   explicit Session(std::unique_ptr<Link> link);
   [[nodiscard]] Result<session::Reply> ask(session::Request request);
+  [[nodiscard]] Result<Outcome> outcome_of(session::Request request, std::chrono::milliseconds timeout);
 
   std::unique_ptr<Link> link_;
   std::deque<session::Event> events_;  // those that came while a reply was awaited

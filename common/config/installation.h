@@ -164,6 +164,8 @@ struct ApiServer {
   std::uint32_t max_sessions = defaults::kApiMaxSessions;
   std::uint32_t max_edits_per_frame = defaults::kApiMaxEditsPerFrame;
   std::uint32_t max_instances = defaults::kApiMaxInstances;
+  // The folder LoadAsset's paths are in (absolute): the config's folder by default.
+  std::string assets;
 };
 
 struct MasterSettings {

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "config/address.h"
+#include "config/asset_path.h"
 #include "config/sections.h"
 #include "util/number_text.h"
 
@@ -49,7 +50,7 @@ std::optional<StatusServer> parse_status(const schema::MasterSettings& m, Checke
 }
 
 // Beyond loopback only with the secret, as the status server.
-std::optional<ApiServer> parse_api(const schema::MasterSettings& m, Checker& check) {
+std::optional<ApiServer> parse_api(const schema::MasterSettings& m, const std::string& config_dir, Checker& check) {
   if (!m.has_api()) return std::nullopt;
   const schema::ApiServer& a = m.api();
   check_listen(check, "master.api.listen", a.listen(), m, "applications must prove they hold the shared secret");
@@ -70,12 +71,13 @@ std::optional<ApiServer> parse_api(const schema::MasterSettings& m, Checker& che
   api.max_sessions = or_default(a.max_sessions(), defaults::kApiMaxSessions);
   api.max_edits_per_frame = or_default(a.max_edits_per_frame(), defaults::kApiMaxEditsPerFrame);
   api.max_instances = or_default(a.max_instances(), defaults::kApiMaxInstances);
+  api.assets = resolve_asset(a.assets().empty() ? "." : a.assets(), config_dir);
   return api;
 }
 
 }  // namespace
 
-MasterSettings parse_master(const schema::MasterSettings& m, Checker& check) {
+MasterSettings parse_master(const schema::MasterSettings& m, const std::string& config_dir, Checker& check) {
   using std::chrono::milliseconds;
   using util::number_text;
   MasterSettings master;
@@ -108,7 +110,7 @@ MasterSettings parse_master(const schema::MasterSettings& m, Checker& check) {
   }
   master.max_message_bytes = or_default(m.max_message_bytes(), defaults::kMaxMessageBytes);
   master.status = parse_status(m, check);
-  master.api = parse_api(m, check);
+  master.api = parse_api(m, config_dir, check);
   master.frame_timeout = milliseconds(or_default(m.frame_timeout_ms(), defaults::kFrameTimeoutMs));
   master.startup_timeout = milliseconds(or_default(m.startup_timeout_ms(), defaults::kStartupTimeoutMs));
   master.handshake_timeout = milliseconds(or_default(m.handshake_timeout_ms(), defaults::kHandshakeTimeoutMs));

@@ -15,7 +15,7 @@ Installation build(const schema::Installation& inst, const std::string& config_d
   out.screens = parse_screens(inst, check);
   out.projectors = parse_projectors(inst, out.screens, config_dir, check);
   out.viewer = parse_viewer(inst.viewer(), config_dir, check);
-  out.master = parse_master(inst.master(), check);
+  out.master = parse_master(inst.master(), config_dir, check);
   out.scene = parse_scene(inst.scene(), config_dir, scope, check);
   out.depth_of_field =
       parse_depth_of_field(inst, out.screens, out.viewer, scope, needs_depth_of_field(out.projectors), check);

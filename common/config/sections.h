@@ -36,7 +36,9 @@ namespace optique::config {
 
 [[nodiscard]] Viewer parse_viewer(const schema::Viewer& viewer, const std::string& config_dir, Checker& check);
 
-[[nodiscard]] MasterSettings parse_master(const schema::MasterSettings& master, Checker& check);
+// `config_dir` resolves master.api.assets.
+[[nodiscard]] MasterSettings parse_master(const schema::MasterSettings& master, const std::string& config_dir,
+                                          Checker& check);
 
 [[nodiscard]] SceneSource parse_scene(const schema::Scene& scene, const std::string& config_dir, Scope scope,
                                       Checker& check);

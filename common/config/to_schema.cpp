@@ -195,6 +195,7 @@ schema::MasterSettings to_schema(const MasterSettings& m) {
     api.set_max_sessions(m.api->max_sessions);
     api.set_max_edits_per_frame(m.api->max_edits_per_frame);
     api.set_max_instances(m.api->max_instances);
+    api.set_assets(m.api->assets);
   }
   return out;
 }

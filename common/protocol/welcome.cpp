@@ -43,7 +43,7 @@ constexpr std::uint32_t kLongestMs = 24 * 3600 * 1000;
 
 wire::Welcome encode_welcome(const config::Installation& installation, std::size_t projector,
                              const scene::SceneManifest& scene_files, std::uint32_t light_count,
-                             clock::Nanos frame_period, const LightShare* share) {
+                             clock::Nanos frame_period, const LightShare* share, std::span<const AssetOffer> assets) {
   const config::ProjectorJob job = config::job_for(installation, projector);
   const config::Installation& part = job.installation;
   wire::Welcome welcome;
@@ -59,6 +59,7 @@ wire::Welcome encode_welcome(const config::Installation& installation, std::size
     *welcome.mutable_scene_files() = to_wire(scene_files);
   }
   welcome.set_light_count(light_count);
+  for (const AssetOffer& asset : assets) *welcome.add_assets() = to_wire(asset);
   if (share != nullptr) *welcome.mutable_lights() = to_wire(*share);
   welcome.set_frame_period_ns(frame_period);
   welcome.set_heartbeat_ms(static_cast<std::uint32_t>(installation.master.heartbeat.count()));
@@ -92,6 +93,15 @@ Result<NodeJob> decode_welcome(const wire::Welcome& welcome, std::string_view pr
     node.scene_files = std::move(files).value();
     node.scene_sha256 = welcome.scene_sha256();
   }
+  if (static_cast<std::size_t>(welcome.assets_size()) > kMaxAssets) {
+    return Error{"welcome: assets: " + std::to_string(welcome.assets_size()) + " of them, at most " +
+                 std::to_string(kMaxAssets)};
+  }
+  for (int i = 0; i < welcome.assets_size(); ++i) {
+    auto asset = decode_asset_offer(welcome.assets(i));
+    if (!asset) return Error{"welcome: assets[" + std::to_string(i) + "]: " + asset.error()};
+    node.assets.push_back(std::move(asset).value());
+  }
   node.light_count = welcome.light_count();
   node.frame_period = welcome.frame_period_ns();
   node.heartbeat = std::chrono::milliseconds(welcome.heartbeat_ms());
@@ -102,6 +112,24 @@ Result<NodeJob> decode_welcome(const wire::Welcome& welcome, std::string_view pr
     node.lights = std::move(share).value();
   }
   return node;
+}
+
+wire::AssetOffer to_wire(const AssetOffer& offer) {
+  wire::AssetOffer out;
+  out.set_asset(offer.asset);
+  out.set_scene_sha256(offer.sha256);
+  *out.mutable_files() = to_wire(offer.files);
+  return out;
+}
+
+Result<AssetOffer> decode_asset_offer(const wire::AssetOffer& offer) {
+  if (!scene::is_instance_id(offer.asset())) {
+    return Error{"asset: not an id (1 to 64 letters, digits, '-', '_' or '.')"};
+  }
+  if (offer.files().files_size() == 0) return Error{"asset '" + offer.asset() + "': files: none"};
+  auto files = decode_scene_manifest(offer.files(), offer.scene_sha256());
+  if (!files) return Error{"asset '" + offer.asset() + "': files: " + files.error()};
+  return AssetOffer{offer.asset(), offer.scene_sha256(), std::move(files).value(), ""};
 }
 
 wire::LightShare to_wire(const LightShare& share) {

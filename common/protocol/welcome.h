@@ -9,8 +9,10 @@
 #include <chrono>
 #include <cstddef>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "clock/clock.h"
 #include "config/parse.h"
@@ -21,9 +23,22 @@
 
 namespace optique::protocol {
 
+// An asset an application loaded (the scene session's LoadAsset), as the
+// master offers it to nodes: its id, its files and their identity.
+struct AssetOffer {
+  std::string asset;
+  std::string sha256;          // the manifest's SHA-256
+  scene::SceneManifest files;  // checked, hashing to sha256
+  // Where this node reads it from: its copy of the master's files (set by the
+  // node once it has them).
+  std::string path;
+};
+// The most assets a master offers (in a welcome, or one at a time).
+inline constexpr std::size_t kMaxAssets = 256;
+
 struct NodeJob {
   config::ProjectorJob job;
-  std::string scene_sha256;         // the glTF's identity (its manifest's SHA-256); empty for built-in scenes
+  std::string scene_sha256;          // the glTF's identity (its manifest's SHA-256); empty for built-in scenes
   scene::SceneManifest scene_files;  // checked, and hashing to scene_sha256; none for built-in scenes
   // Where this node reads the glTF from: its copy of the master's files (set by
   // the node once it has them); empty: the installation's path.
@@ -33,19 +48,27 @@ struct NodeJob {
   std::chrono::milliseconds heartbeat{0};
   std::chrono::milliseconds liveness_timeout{0};
   std::optional<LightShare> lights;  // role lights: the share it starts with
+  std::vector<AssetOffer> assets;    // loaded by applications: readied before the node is configured
 };
 
 // The welcome for projector `projector` of `installation`, whose scene is made
 // of `scene_files` (none: a built-in scene).
 [[nodiscard]] wire::Welcome encode_welcome(const config::Installation& installation, std::size_t projector,
                                            const scene::SceneManifest& scene_files, std::uint32_t light_count,
-                                           clock::Nanos frame_period, const LightShare* share);
+                                           clock::Nanos frame_period, const LightShare* share,
+                                           std::span<const AssetOffer> assets = {});
 
 // The job a welcome gives the node `projector_id`; fails, naming what is wrong,
 // for a job that does not parse, a timing out of range, a share of the lights
 // that names lights the scene does not have, or a scene manifest that does not
 // pass scene::check_manifest or does not hash to the scene's identity.
 [[nodiscard]] Result<NodeJob> decode_welcome(const wire::Welcome& welcome, std::string_view projector_id);
+
+[[nodiscard]] wire::AssetOffer to_wire(const AssetOffer& offer);
+// Fails, naming what is wrong, for an id that is not one (scene::is_instance_id),
+// a manifest that does not pass scene::check_manifest or does not hash to
+// its SHA-256, or one with no files.
+[[nodiscard]] Result<AssetOffer> decode_asset_offer(const wire::AssetOffer& offer);
 
 [[nodiscard]] wire::LightShare to_wire(const LightShare& share);
 [[nodiscard]] wire::SceneManifest to_wire(const scene::SceneManifest& manifest);

@@ -78,33 +78,28 @@ Result<glo::Texture> upload_texture(const scene::Texture& texture) {
 
 }  // namespace
 
-Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
-  ScenePass pass;
-  auto program = scene_program(SceneOutput::colour, pass.colour_uniforms_);
-  if (!program) return Error{program.error()};
-  pass.colour_program_ = std::move(program).value();
-
-  // All meshes in one vertex and one index buffer.
+Result<ScenePass::Asset> ScenePass::upload(const scene::SceneDefinition& scene) {
+  Asset asset;
   std::vector<scene::Vertex> vertices;
   std::vector<std::uint32_t> indices;
   for (const auto& mesh : scene.meshes) {
-    pass.meshes_.push_back(
+    asset.meshes.push_back(
         {static_cast<GLsizei>(mesh.indices.size()), indices.size(), static_cast<GLint>(vertices.size())});
     vertices.insert(vertices.end(), mesh.vertices.begin(), mesh.vertices.end());
     indices.insert(indices.end(), mesh.indices.begin(), mesh.indices.end());
   }
-  pass.vertex_array_ = glo::make_vertex_array();
-  pass.vertex_buffer_ = glo::make_buffer();
-  pass.index_buffer_ = glo::make_buffer();
-  const GLuint array = pass.vertex_array_.get();
-  glNamedBufferStorage(pass.vertex_buffer_.get(),
+  asset.vertex_array = glo::make_vertex_array();
+  asset.vertex_buffer = glo::make_buffer();
+  asset.index_buffer = glo::make_buffer();
+  const GLuint array = asset.vertex_array.get();
+  glNamedBufferStorage(asset.vertex_buffer.get(),
                        static_cast<GLsizeiptr>(std::max<std::size_t>(1, vertices.size()) * sizeof(scene::Vertex)),
                        vertices.empty() ? nullptr : vertices.data(), 0);
-  glNamedBufferStorage(pass.index_buffer_.get(),
+  glNamedBufferStorage(asset.index_buffer.get(),
                        static_cast<GLsizeiptr>(std::max<std::size_t>(1, indices.size()) * sizeof(std::uint32_t)),
                        indices.empty() ? nullptr : indices.data(), 0);
-  glVertexArrayVertexBuffer(array, 0, pass.vertex_buffer_.get(), 0, sizeof(scene::Vertex));
-  glVertexArrayElementBuffer(array, pass.index_buffer_.get());
+  glVertexArrayVertexBuffer(array, 0, asset.vertex_buffer.get(), 0, sizeof(scene::Vertex));
+  glVertexArrayElementBuffer(array, asset.index_buffer.get());
   const auto attribute = [array](GLuint index, GLint size, std::size_t offset) {
     glEnableVertexArrayAttrib(array, index);
     glVertexArrayAttribFormat(array, index, size, GL_FLOAT, GL_FALSE, static_cast<GLuint>(offset));
@@ -117,7 +112,7 @@ Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
   for (const auto& texture : scene.textures) {
     auto uploaded = upload_texture(texture);
     if (!uploaded) return Error{uploaded.error()};
-    pass.textures_.push_back(std::move(uploaded).value());
+    asset.textures.push_back(std::move(uploaded).value());
   }
   for (const auto& material : scene.materials) {
     if (material.base_colour_texture && *material.base_colour_texture >= scene.textures.size()) {
@@ -125,6 +120,39 @@ Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
                    " is out of range (" + std::to_string(scene.textures.size()) + " textures)"};
     }
   }
+  for (const auto& instance : scene.instances) {
+    if (instance.mesh >= scene.meshes.size() || instance.material >= scene.materials.size()) {
+      return Error{"an instance names mesh " + std::to_string(instance.mesh) + " and material " +
+                   std::to_string(instance.material) + " (" + std::to_string(scene.meshes.size()) + " meshes, " +
+                   std::to_string(scene.materials.size()) + " materials)"};
+    }
+  }
+  asset.materials = scene.materials;
+  asset.instances = scene.instances;
+  for (const auto& object : scene.objects) asset.animations.emplace(object.id, object.pose_at);
+  asset.id = scene.asset_id;
+  return asset;
+}
+
+Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
+  ScenePass pass;
+  auto program = scene_program(SceneOutput::colour, pass.colour_uniforms_);
+  if (!program) return Error{program.error()};
+  pass.colour_program_ = std::move(program).value();
+  auto asset = upload(scene);
+  if (!asset) return Error{asset.error()};
+  asset.value().own_scene = true;
+  // A texture's first mipmaps cost a driver its setup (llvmpipe: about 200 ms):
+  // paid here, not by the first frames after an application loads a textured
+  // asset.
+  if (scene.textures.empty()) {
+    scene::Texture warm;
+    warm.name = "warm-up";
+    warm.width = warm.height = 4;
+    warm.rgba.assign(4 * 4 * 4, 255);
+    if (auto uploaded = upload_texture(warm); !uploaded) return Error{uploaded.error()};
+  }
+  pass.assets_.push_back(std::move(asset).value());
 
   for (const auto& light : scene.lights) {
     pass.all_lights_.emplace_back(glm::vec3(light.position), 1.0f);
@@ -136,15 +164,28 @@ Result<ScenePass> ScenePass::create(const scene::SceneDefinition& scene) {
       pass.light_buffer_.get(),
       static_cast<GLsizeiptr>((pass.all_lights_.size() + 2 * scene::kMaxAddedLights) * sizeof(glm::vec4)), nullptr,
       GL_DYNAMIC_STORAGE_BIT);
-
-  pass.materials_ = scene.materials;
-  pass.instances_ = scene.instances;
-  for (const auto& object : scene.objects) pass.animations_.emplace(object.id, object.pose_at);
-  pass.asset_id_ = scene.asset_id;
   pass.ambient_ = scene.ambient;
   pass.background_ = scene.background;
   pass.set_all_lights();
   return pass;
+}
+
+Result<void> ScenePass::add_asset(const scene::SceneDefinition& asset) {
+  assert(!asset.asset_id.empty());
+  auto uploaded = upload(asset);
+  if (!uploaded) return Error{"asset '" + asset.asset_id + "': " + uploaded.error()};
+  for (std::size_t i = 1; i < assets_.size(); ++i) {
+    if (assets_[i].id == asset.asset_id) {
+      assets_[i] = std::move(uploaded).value();
+      return {};
+    }
+  }
+  assets_.push_back(std::move(uploaded).value());
+  return {};
+}
+
+bool ScenePass::has_asset(const std::string& id) const {
+  return std::any_of(assets_.begin(), assets_.end(), [&](const Asset& a) { return a.id == id; });
 }
 
 Result<void> ScenePass::prepare_velocity() {
@@ -209,7 +250,8 @@ void ScenePass::upload_shining_lights(const scene::SceneState& state) {
 }
 
 bool ScenePass::anything_still() const {
-  return std::any_of(instances_.begin(), instances_.end(), [](const scene::Instance& i) { return !i.object; });
+  const auto& instances = assets_.front().instances;
+  return std::any_of(instances.begin(), instances.end(), [](const scene::Instance& i) { return !i.object; });
 }
 
 void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, const LightTerms& terms, int width,
@@ -223,7 +265,6 @@ void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, cons
   glUseProgram(key_frames ? key_frames_program_[field].get()
                : motion   ? velocity_program_.get()
                           : colour_program_.get());
-  glBindVertexArray(vertex_array_.get());
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, light_buffer_.get());
   const Uniforms& u = key_frames ? key_frames_uniforms_[field] : motion ? velocity_uniforms_ : colour_uniforms_;
   if (motion) glUniform2f(u.half_size, 0.5f * static_cast<float>(width), 0.5f * static_cast<float>(height));
@@ -238,17 +279,29 @@ void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, cons
   glUniform1i(u.light_count, light_count_);
   const glm::dmat4 view_projection = view.view_projection();
 
-  // The installation's scene where it is, then every visible instance of it
-  // an application placed (which moves between frames: never drawn as still).
+  // The installation's scene where it is, then every visible instance an
+  // application placed (which moves between frames: never drawn as still).
   Placement placement;
   placement.view_projection = view_projection;
   placement.moving_only = which == Objects::moving;
   placement.still_only = which == Objects::still;
-  draw_placed(placement, state, view, terms, u, motion);
-  if (which == Objects::still || asset_id_.empty()) return;
+  const Asset& own = assets_.front();
+  glBindVertexArray(own.vertex_array.get());
+  draw_placed(own, placement, state, view, terms, u, motion);
+  if (which == Objects::still || state.instances.empty()) return;
   placement.moving_only = false;
+  for (const Asset& asset : assets_) {
+    if (asset.id.empty()) continue;
+    glBindVertexArray(asset.vertex_array.get());
+    draw_instances(asset, placement, state, view, terms, u, motion);
+  }
+}
+
+void ScenePass::draw_instances(const Asset& asset, Placement placement, const scene::SceneState& state,
+                               const Viewpoint& view, const LightTerms& terms, const Uniforms& u,
+                               const Motion* motion) {
   for (const auto& [id, instance] : state.instances) {
-    if (instance.asset != asset_id_) continue;
+    if (instance.asset != asset.id) continue;
     const auto now = scene::instance_world(state, id, view.fraction);
     if (!now) continue;
     placement.world = *now;
@@ -264,17 +317,20 @@ void ScenePass::draw(const scene::SceneState& state, const Viewpoint& view, cons
       const auto there = then ? then->instances.find(id) : state.instances.end();
       placement.animation_at_end[e] = then && there != then->instances.end() ? there->second.animation : std::nullopt;
     }
-    draw_placed(placement, state, view, terms, u, motion);
+    draw_placed(asset, placement, state, view, terms, u, motion);
   }
 }
 
-std::optional<glm::dmat4> ScenePass::object_matrix(const scene::SceneState& state, std::uint32_t object,
-                                                   const std::optional<scene::AnimationTimes>& times,
-                                                   double fraction) const {
-  if (times) {
-    const auto animated = animations_.find(object);
-    if (animated == animations_.end()) return std::nullopt;
-    const scene::ObjectState poses{animated->second(times->now), animated->second(times->next)};
+std::optional<glm::dmat4> ScenePass::object_matrix(const Asset& asset, const scene::SceneState& state,
+                                                   std::uint32_t object,
+                                                   const std::optional<scene::AnimationTimes>& times, double fraction) {
+  // An asset an application loaded plays on its instance's clock; without
+  // one (never so from the master) it stands as at its start.
+  if (times || !asset.own_scene) {
+    const auto animated = asset.animations.find(object);
+    if (animated == asset.animations.end()) return std::nullopt;
+    const scene::AnimationTimes at = times.value_or(scene::AnimationTimes{});
+    const scene::ObjectState poses{animated->second(at.now), animated->second(at.next)};
     return scene::model_matrix(scene::interpolate(poses, fraction));
   }
   const auto found = state.objects.find(object);
@@ -282,14 +338,14 @@ std::optional<glm::dmat4> ScenePass::object_matrix(const scene::SceneState& stat
   return scene::model_matrix(scene::interpolate(found->second, fraction));
 }
 
-void ScenePass::draw_placed(const Placement& placement, const scene::SceneState& state, const Viewpoint& view,
-                            const LightTerms& terms, const Uniforms& u, const Motion* motion) {
+void ScenePass::draw_placed(const Asset& asset, const Placement& placement, const scene::SceneState& state,
+                            const Viewpoint& view, const LightTerms& terms, const Uniforms& u, const Motion* motion) {
   const int keys = motion ? motion->key_frames : 0;
-  for (const auto& instance : instances_) {
+  for (const auto& instance : asset.instances) {
     if ((placement.still_only && instance.object) || (placement.moving_only && !instance.object)) continue;
     glm::dmat4 model = instance.transform;
     if (instance.object) {
-      const auto on = object_matrix(state, *instance.object, placement.animation, view.fraction);
+      const auto on = object_matrix(asset, state, *instance.object, placement.animation, view.fraction);
       if (!on) continue;  // not in the state (yet): nothing to place
       model = *on * instance.transform;
     }
@@ -309,7 +365,8 @@ void ScenePass::draw_placed(const Placement& placement, const scene::SceneState&
         glm::dmat4 then = instance.transform;
         bool there = placement.world_at_end[e].has_value();
         if (instance.object && there) {
-          const auto on = object_matrix(*end.state, *instance.object, placement.animation_at_end[e], end.fraction);
+          const auto on =
+              object_matrix(asset, *end.state, *instance.object, placement.animation_at_end[e], end.fraction);
           there = on.has_value();
           if (there) then = *on * instance.transform;
         }
@@ -324,16 +381,16 @@ void ScenePass::draw_placed(const Placement& placement, const scene::SceneState&
     }
     glUniformMatrix4fv(u.model, 1, GL_FALSE, glm::value_ptr(model_f));
     glUniformMatrix3fv(u.normal_matrix, 1, GL_FALSE, glm::value_ptr(normal_matrix));
-    const scene::Material& m = materials_[instance.material];
+    const scene::Material& m = asset.materials[instance.material];
     const glm::vec3 base_colour = m.base_colour * placement.base_colour;
     glUniform3fv(u.base_colour, 1, glm::value_ptr(base_colour));
     glUniform1i(u.has_base_colour_texture, m.base_colour_texture ? 1 : 0);
-    if (m.base_colour_texture) glBindTextureUnit(1, textures_[*m.base_colour_texture].get());  // unit 0: encode
+    if (m.base_colour_texture) glBindTextureUnit(1, asset.textures[*m.base_colour_texture].get());  // unit 0: encode
     glUniform1f(u.metallic, m.metallic);
     glUniform1f(u.roughness, m.roughness);
     const glm::vec3 emissive = terms.emissive ? m.emissive * placement.emissive : glm::vec3(0.0f);
     glUniform3fv(u.emissive, 1, glm::value_ptr(emissive));
-    const MeshRange& mesh = meshes_[instance.mesh];
+    const MeshRange& mesh = asset.meshes[instance.mesh];
     glDrawElementsBaseVertex(GL_TRIANGLES, mesh.count, GL_UNSIGNED_INT,
                              reinterpret_cast<const void*>(mesh.first_index * sizeof(std::uint32_t)), mesh.base_vertex);
   }

@@ -54,6 +54,11 @@ class ScenePass {
   // Uploads the scene's static content and builds the colour program; fails
   // with the driver's message, or when a texture or material is malformed.
   [[nodiscard]] static Result<ScenePass> create(const scene::SceneDefinition& scene);
+  // Uploads an asset an application loaded (by its asset_id): the live
+  // instances of it are drawn from now on (its lights are not: the scene's
+  // are). Fails as create() does; an id added before is replaced.
+  [[nodiscard]] Result<void> add_asset(const scene::SceneDefinition& asset);
+  [[nodiscard]] bool has_asset(const std::string& id) const;
   // The gather's program (velocity beside colour); once.
   [[nodiscard]] Result<void> prepare_velocity();
   // Up-conversion's motion-field programs (from one key frame, from two); once.
@@ -99,22 +104,42 @@ class ScenePass {
     bool moving_only = false;  // only those on one
   };
 
-  ScenePass() = default;
-  void upload_shining_lights(const scene::SceneState& state);
-  // Where animated object `object` puts what rides on it, `fraction` of a
-  // frame on: from `state`, or at `times` of the scene's animations (an
-  // instance's own clock). None: the object is not there.
-  [[nodiscard]] std::optional<glm::dmat4> object_matrix(const scene::SceneState& state, std::uint32_t object,
-                                                        const std::optional<scene::AnimationTimes>& times,
-                                                        double fraction) const;
-  void draw_placed(const Placement& placement, const scene::SceneState& state, const Viewpoint& view,
-                   const LightTerms& terms, const Uniforms& u, const Motion* motion);
-
   struct MeshRange {
     GLsizei count = 0;
     std::size_t first_index = 0;
     GLint base_vertex = 0;
   };
+  // One asset's static content on the GPU: the installation's scene, or one
+  // an application loaded. All its meshes in one vertex and one index buffer.
+  struct Asset {
+    std::string id;  // the live instances of it are drawn
+    glo::VertexArray vertex_array;
+    glo::Buffer vertex_buffer;
+    glo::Buffer index_buffer;
+    std::vector<glo::Texture> textures;  // by index in its textures
+    std::vector<MeshRange> meshes;
+    std::vector<scene::Material> materials;
+    std::vector<scene::Instance> instances;
+    std::map<std::uint32_t, std::function<scene::Pose(double)>> animations;  // the objects' poses at any time
+    bool own_scene = false;  // the installation's: its objects' poses are in the state
+  };
+  [[nodiscard]] static Result<Asset> upload(const scene::SceneDefinition& scene);
+
+  ScenePass() = default;
+  void upload_shining_lights(const scene::SceneState& state);
+  // Where animated object `object` of `asset` puts what rides on it,
+  // `fraction` of a frame on: from `state` (the installation's scene), or at
+  // `times` of the asset's animations (an instance's own clock). None: the
+  // object is not there.
+  [[nodiscard]] static std::optional<glm::dmat4> object_matrix(const Asset& asset, const scene::SceneState& state,
+                                                               std::uint32_t object,
+                                                               const std::optional<scene::AnimationTimes>& times,
+                                                               double fraction);
+  void draw_placed(const Asset& asset, const Placement& placement, const scene::SceneState& state,
+                   const Viewpoint& view, const LightTerms& terms, const Uniforms& u, const Motion* motion);
+  // Every visible live instance of `asset` in `state`.
+  void draw_instances(const Asset& asset, Placement placement, const scene::SceneState& state, const Viewpoint& view,
+                      const LightTerms& terms, const Uniforms& u, const Motion* motion);
   glo::Program colour_program_;
   Uniforms colour_uniforms_{};
   glo::Program velocity_program_;  // prepare_velocity
@@ -123,21 +148,13 @@ class ScenePass {
   std::array<glo::Program, 2> key_frames_program_;
   std::array<Uniforms, 2> key_frames_uniforms_{};
 
-  glo::VertexArray vertex_array_;
-  glo::Buffer vertex_buffer_;
-  glo::Buffer index_buffer_;
+  std::vector<Asset> assets_;  // [0]: the installation's scene
   glo::Buffer light_buffer_;
-  std::vector<glo::Texture> textures_;  // by index in the scene's textures
-  std::vector<MeshRange> meshes_;
-  std::vector<scene::Material> materials_;
-  std::vector<scene::Instance> instances_;
-  std::map<std::uint32_t, std::function<scene::Pose(double)>> animations_;  // the objects' poses at any time
-  std::string asset_id_;  // the scene's: the live instances of it are drawn too
   glm::vec3 ambient_{0.0f};
   glm::vec3 background_{0.0f};
-  std::vector<glm::vec4> all_lights_;  // the scene's own: position, radiance, two per light
+  std::vector<glm::vec4> all_lights_;                        // the scene's own: position, radiance, two per light
   std::optional<std::vector<std::uint32_t>> chosen_lights_;  // set_lights; none: every light
-  std::vector<glm::vec4> uploaded_lights_;  // what the light buffer holds: the lights that shine
+  std::vector<glm::vec4> uploaded_lights_;                   // what the light buffer holds: the lights that shine
   int light_count_ = 0;
 };
 

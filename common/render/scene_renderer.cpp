@@ -48,6 +48,8 @@ void SceneRenderer::draw_black() {
 
 void SceneRenderer::set_lights(std::span<const std::uint32_t> lights) { parts_->scene.set_lights(lights); }
 
+Result<void> SceneRenderer::add_asset(const scene::SceneDefinition& asset) { return parts_->scene.add_asset(asset); }
+
 Result<void> SceneRenderer::prepare_gather() {
   if (gather_) return {};
   auto gather = GatherPasses::create(*parts_);

@@ -59,6 +59,11 @@ class SceneRenderer {
   // Black everywhere (the projector shows nothing), encoded like a drawn frame.
   void draw_black();
 
+  // An asset an application loaded (by its asset_id): its live instances are
+  // drawn from now on. Fails with the driver's message, or when its content
+  // is malformed.
+  [[nodiscard]] Result<void> add_asset(const scene::SceneDefinition& asset);
+
   // Draws only these of the scene's point lights (indices; all by default), less
   // those the drawn state has switched off. Asserts that each exists.
   void set_lights(std::span<const std::uint32_t> lights);

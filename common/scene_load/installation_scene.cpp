@@ -14,4 +14,18 @@ Result<scene::LoadedScene> load_scene(const Installation& installation, const sc
   return loaded;
 }
 
+Result<scene::LoadedScene> load_asset(const std::string& id, const std::string& path,
+                                      const scene::ImageDecoder& decode) {
+  auto gltf = scene::load_gltf_scene(path, decode);
+  if (!gltf) return Error{gltf.error()};
+  scene::LoadedScene loaded = std::move(gltf).value();
+  loaded.definition.asset_id = id;
+  if (!loaded.definition.lights.empty()) {
+    loaded.notes.push_back(path + ": its " + std::to_string(loaded.definition.lights.size()) +
+                           " light(s) are not drawn: an asset is lit by the installation's lights");
+    loaded.definition.lights.clear();
+  }
+  return loaded;
+}
+
 }  // namespace optique::config

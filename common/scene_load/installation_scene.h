@@ -17,4 +17,11 @@ namespace optique::config {
 [[nodiscard]] Result<scene::LoadedScene> load_scene(const Installation& installation, const scene::ImageDecoder& decode,
                                                     const std::string& gltf_path = {});
 
+// An asset an application loaded (the scene session's LoadAsset), named
+// `id`: the glTF file at `path`, loaded as a scene's is. It is drawn lit by
+// the installation's lights: its own lights (none are added) are dropped and
+// said so in its notes.
+[[nodiscard]] Result<scene::LoadedScene> load_asset(const std::string& id, const std::string& path,
+                                                    const scene::ImageDecoder& decode);
+
 }  // namespace optique::config

@@ -20,14 +20,9 @@ Result<LoadedScene> load_scene(const std::string& builtin, const std::string& pa
     loaded.source = "builtin " + builtin;
     return loaded;
   }
-  auto gltf = load_gltf(path, decode);
+  auto gltf = load_gltf_scene(path, decode);
   if (!gltf) return Error{gltf.error()};
-  loaded.definition = std::move(gltf.value().scene);
-  loaded.content_sha256 = gltf.value().content_sha256;
-  loaded.manifest = std::move(gltf.value().manifest);
-  loaded.files = std::move(gltf.value().files);
-  loaded.warnings = std::move(gltf.value().warnings);
-  loaded.source = path;
+  loaded = std::move(gltf).value();
   // Either way the log says how the scene is lit (an export without lights is
   // the usual case, not a fault).
   if (loaded.definition.lights.empty()) {
@@ -36,6 +31,19 @@ Result<LoadedScene> load_scene(const std::string& builtin, const std::string& pa
     loaded.notes.push_back(
         fmt::format("{}: lit by the file's {} point light(s)", path, loaded.definition.lights.size()));
   }
+  return loaded;
+}
+
+Result<LoadedScene> load_gltf_scene(const std::string& path, const ImageDecoder& decode) {
+  auto gltf = load_gltf(path, decode);
+  if (!gltf) return Error{gltf.error()};
+  LoadedScene loaded;
+  loaded.definition = std::move(gltf.value().scene);
+  loaded.content_sha256 = gltf.value().content_sha256;
+  loaded.manifest = std::move(gltf.value().manifest);
+  loaded.files = std::move(gltf.value().files);
+  loaded.warnings = std::move(gltf.value().warnings);
+  loaded.source = path;
   return loaded;
 }
 

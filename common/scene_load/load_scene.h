@@ -34,4 +34,7 @@ struct LoadedScene {
 [[nodiscard]] Result<LoadedScene> load_scene(const std::string& builtin, const std::string& gltf,
                                              const ImageDecoder& decode, const glm::dvec3& viewer);
 
+// The glTF file at `path` as it is (no lights added).
+[[nodiscard]] Result<LoadedScene> load_gltf_scene(const std::string& path, const ImageDecoder& decode);
+
 }  // namespace optique::scene

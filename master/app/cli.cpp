@@ -1,5 +1,7 @@
 #include "master/app/cli.h"
 
+#include "config/asset_path.h"
+
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -162,7 +164,11 @@ int run_cli(int argc, char** argv) {
     tracking->port = static_cast<std::uint16_t>(tracking_port);
   }
   if (api_port >= 0) {
-    if (!settings.api) settings.api.emplace();
+    if (!settings.api) {
+      // As the config would have it with an empty master.api: assets from its folder.
+      settings.api.emplace();
+      settings.api->assets = config::resolve_asset(".", options.config.directory);
+    }
     settings.api->port = static_cast<std::uint16_t>(api_port);
   }
   if (options.local) {

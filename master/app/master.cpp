@@ -111,6 +111,15 @@ Result<void> Master::start() {
   }
   if (auto made = make_live_scene(run); !made) return made;
   protocol_.emplace(installation, options_.scene, std::move(run), *recorder_);
+  // The journal's assets first: usable at once (no node is up yet), and in
+  // every welcome.
+  for (auto& [id, asset] : journal_assets_) carry_out(protocol_->add_asset(id, asset, clock::monotonic_now()));
+  journal_assets_.clear();
+  if (session_port_) {
+    session_port_->on_asset_loaded([this](const std::string& id, std::shared_ptr<const scene::LoadedScene> asset) {
+      if (!finished_) carry_out(protocol_->add_asset(id, std::move(asset), clock::monotonic_now()));
+    });
+  }
 
   // Listen.
   auto bound = listener_.listen(settings.listen, settings.port);
@@ -308,6 +317,13 @@ void Master::carry_out(Action& action) {
                  [&](Log& a) { log_.log(a.level, "{}", a.text); },
                  [&](AppEvent& a) {
                    if (session_port_) session_port_->publish(a.event);
+                 },
+                 // An asset from the journal is in the live scene already.
+                 [&](AssetUsable& a) {
+                   if (session_port_ && !live_->has_asset(a.asset)) session_port_->asset_usable(a.asset, a.frame);
+                 },
+                 [&](AssetFailed& a) {
+                   if (session_port_) session_port_->asset_unusable(a.asset, a.reason);
                  },
              },
              action);

@@ -88,6 +88,9 @@ class Master {
   // The live scene, with master.api or --replay: its journal restored or
   // replayed, its session port made (not yet listening).
   [[nodiscard]] Result<void> make_live_scene(RunSettings& run);
+  // Loads every asset of `journal` again, checks each is what was loaded then,
+  // and adds it to the live scene.
+  [[nodiscard]] Result<void> load_journal_assets(const Journal& journal);
   void publish_status();
   void finish(int exit_code);
   void write_outputs();
@@ -108,7 +111,10 @@ class Master {
   std::optional<RunRecorder> recorder_;
   std::optional<LiveScene> live_;                // outlives the session port and the protocol
   std::optional<JournalReplay> journal_replay_;  // --replay
-  std::optional<SessionPort> session_port_;      // master.api
+  // The assets of the journal (--record, --replay), loaded and checked before
+  // the protocol is made, for it to offer.
+  std::vector<std::pair<std::string, std::shared_ptr<const scene::LoadedScene>>> journal_assets_;
+  std::optional<SessionPort> session_port_;  // master.api
   std::optional<MasterProtocol> protocol_;
 
   TcpListener listener_;  // the nodes'

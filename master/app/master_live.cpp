@@ -1,9 +1,13 @@
 // The master's live scene: made with master.api or --replay; its journal
 // restored (--record) or replayed (--replay); its session port.
 
+#include <unistd.h>
+
 #include <chrono>
+#include <filesystem>
 
 #include "master/app/master.h"
+#include "scene_load/installation_scene.h"
 
 namespace optique::master {
 
@@ -20,14 +24,15 @@ Result<void> Master::make_live_scene(RunSettings& run) {
   if (!settings.api && replay.empty()) return {};
 
   // For now the one asset is the installation's own scene, by name.
-  live_.emplace(LiveScene::of(options_.scene.definition, live_scene_limits(settings.api),
-                              settings.frame_rate));
+  live_.emplace(LiveScene::of(options_.scene.definition, live_scene_limits(settings.api), settings.frame_rate));
   const std::string& asset = options_.scene.definition.asset_id;
   run.live = &*live_;
 
   if (!replay.empty()) {
     auto journal = read_journal_file(replay);
     if (!journal) return Error{"--replay: " + journal.error()};
+    if (auto assets = load_journal_assets(journal.value()); !assets)
+      return Error{"--replay " + replay + ": " + assets.error()};
     auto replaying = JournalReplay::start(journal.value(), *live_);
     if (!replaying) return Error{"--replay " + replay + ": " + replaying.error()};
     journal_replay_.emplace(std::move(replaying).value());
@@ -45,6 +50,7 @@ Result<void> Master::make_live_scene(RunSettings& run) {
       log_.warn("{}: cut away its torn last entry ({}): a write the last master's end cut short, never acknowledged",
                 record, journal.torn);
     }
+    if (auto assets = load_journal_assets(journal); !assets) return Error{"--record " + record + ": " + assets.error()};
     auto restored = restore(*live_, journal);
     if (!restored) return Error{"--record " + record + ": " + restored.error()};
     if (!journal.runs.empty()) {
@@ -61,9 +67,31 @@ Result<void> Master::make_live_scene(RunSettings& run) {
     journal_file.emplace(std::move(file).value());
   }
   if (settings.api) {
+    // Uploads beside the journal, so that a restart finds them; without one,
+    // for this run only.
+    const std::string uploads =
+        !record.empty()
+            ? record + ".assets"
+            : (std::filesystem::temp_directory_path() / ("optique-assets-" + std::to_string(getpid()))).string();
     session_port_.emplace(io_, *settings.api, *live_, std::move(journal_file), options_.run.secret,
-                          settings.max_message_bytes, log_);
+                          settings.max_message_bytes, uploads, log_);
   }
+  return {};
+}
+
+Result<void> Master::load_journal_assets(const Journal& journal) {
+  for (const session::JournalAsset& entry : journal.assets) {
+    const std::string& id = entry.asset();
+    auto loaded = config::load_asset(id, entry.path(), {});
+    if (!loaded) return Error{"asset '" + id + "': " + loaded.error()};
+    if (loaded.value().content_sha256 != entry.sha256()) {
+      return Error{"asset '" + id + "': " + entry.path() +
+                   " is not what was loaded then (its files have changed since): put the file back as it was"};
+    }
+    live_->add_asset(id, !loaded.value().definition.objects.empty());
+    journal_assets_.emplace_back(id, std::make_shared<const scene::LoadedScene>(std::move(loaded).value()));
+  }
+  if (!journal.assets.empty()) log_.info("loaded {} asset(s) the journal names", journal.assets.size());
   return {};
 }
 

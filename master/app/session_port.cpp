@@ -1,11 +1,62 @@
 #include "master/app/session_port.h"
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
 #include "master/session/session_json.h"
 #include "net/auth.h"
+#include "scene_load/installation_scene.h"
 #include "util/overloaded.h"
+#include "util/sha256.h"
 
 namespace optique::master {
 namespace {
+
+// An uploaded binary glTF kept in `folder` by its SHA-256 (written whole,
+// then renamed into place): the path.
+Result<std::string> keep_upload(const std::string& folder, const std::string& glb) {
+  const std::filesystem::path path = std::filesystem::path(folder) / (util::sha256_hex(glb) + ".glb");
+  if (std::filesystem::exists(path)) return path.string();
+  std::error_code error;
+  std::filesystem::create_directories(folder, error);
+  if (error) return Error{"cannot make " + folder + ": " + error.message()};
+  const std::filesystem::path partial = path.string() + ".partial";
+  {
+    std::ofstream out(partial, std::ios::binary | std::ios::trunc);
+    out.write(glb.data(), static_cast<std::streamsize>(glb.size()));
+    if (!out.flush()) return Error{"cannot write " + partial.string()};
+  }
+  std::filesystem::rename(partial, path, error);
+  if (error) return Error{"cannot write " + path.string() + ": " + error.message()};
+  return path.string();
+}
+
+// What the loader's thread makes of a LoadAsset: the asset, or why not.
+struct AssetRead {
+  std::shared_ptr<const scene::LoadedScene> asset;
+  std::string error;
+};
+
+AssetRead read_asset(const session_action::LoadAsset& load, const std::string& folder, const std::string& uploads) {
+  std::string path = load.path;
+  if (!load.path.empty()) {
+    // A link inside the folder must not lead out of it.
+    std::error_code error;
+    const std::filesystem::path inside = std::filesystem::weakly_canonical(folder, error);
+    const std::filesystem::path file = std::filesystem::weakly_canonical(load.path, error);
+    const auto [end, ignored] = std::mismatch(inside.begin(), inside.end(), file.begin(), file.end());
+    if (error || end != inside.end()) return {nullptr, "is not inside master.api.assets (" + folder + ")"};
+  } else {
+    auto kept = keep_upload(uploads, load.glb);
+    if (!kept) return {nullptr, kept.error()};
+    path = kept.value();
+  }
+  // The master draws nothing: the images are read by the nodes.
+  auto loaded = config::load_asset(load.asset, path, {});
+  if (!loaded) return {nullptr, loaded.error()};
+  return {std::make_shared<const scene::LoadedScene>(std::move(loaded).value()), ""};
+}
 
 // Before its hello an application has said nothing worth more.
 constexpr std::uint32_t kMaxApplicationHelloBytes = 4096;
@@ -21,15 +72,19 @@ constexpr std::size_t kMaxWebSocketQueuedBytes = 64u << 20;
 
 SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings, LiveScene& live,
                          std::optional<JournalFile> journal, std::optional<net::Secret> secret,
-                         std::uint32_t max_message_bytes, spdlog::logger& log)
+                         std::uint32_t max_message_bytes, std::string uploads, spdlog::logger& log)
     : io_(io),
       settings_(settings),
       max_message_bytes_(max_message_bytes),
       log_(log),
       journal_(std::move(journal)),
-      sessions_(live, SceneSessionSettings{settings.max_sessions, max_message_bytes, std::move(secret),
-                                           journal_.has_value()}),
-      listener_(io, log) {}
+      sessions_(live, SceneSessionSettings{.max_sessions = settings.max_sessions,
+                                           .max_message_bytes = max_message_bytes,
+                                           .secret = std::move(secret),
+                                           .journal = journal_.has_value(),
+                                           .assets_folder = settings.assets}),
+      listener_(io, log),
+      uploads_(std::move(uploads)) {}
 
 Result<std::uint16_t> SessionPort::start(std::function<std::uint64_t()> next_frame) {
   next_frame_ = std::move(next_frame);
@@ -129,6 +184,37 @@ std::optional<std::size_t> SessionPort::queued_bytes(SessionId session) const {
   return std::nullopt;
 }
 
+void SessionPort::load(session_action::LoadAsset load) {
+  const std::weak_ptr<bool> alive = alive_;
+  asio::post(loader_, [this, &io = io_, alive, folder = settings_.assets, uploads = uploads_, load = std::move(load)] {
+    AssetRead read = read_asset(load, folder, uploads);
+    asio::post(io, [this, alive, id = load.asset, from_file = !load.path.empty(), read = std::move(read)] {
+      if (alive.expired()) return;
+      if (!read.asset) {
+        carry_out(sessions_.asset_failed(id, from_file ? "load_asset.path" : "load_asset.glb", read.error));
+        return;
+      }
+      for (const std::string& warning : read.asset->warnings) log_.warn("asset '{}': {}", id, warning);
+      for (const std::string& note : read.asset->notes) log_.info("asset '{}': {}", id, note);
+      loaded_[id] = Loaded{read.asset->source, read.asset->content_sha256, !read.asset->definition.objects.empty()};
+      if (asset_loaded_) asset_loaded_(id, read.asset);
+    });
+  });
+}
+
+void SessionPort::asset_usable(const std::string& id, std::uint64_t frame) {
+  const auto found = loaded_.find(id);
+  if (found == loaded_.end()) return;
+  const Loaded loaded = found->second;
+  loaded_.erase(found);
+  carry_out(sessions_.asset_loaded(id, frame, loaded.animated, loaded.path, loaded.sha256));
+}
+
+void SessionPort::asset_unusable(const std::string& id, const std::string& reason) {
+  loaded_.erase(id);
+  carry_out(sessions_.asset_failed(id, "load_asset", reason));
+}
+
 void SessionPort::carry_out(SessionActions actions) {
   for (SessionAction& action : actions) {
     std::visit(util::Overloaded{
@@ -178,6 +264,7 @@ void SessionPort::carry_out(SessionActions actions) {
                      }
                    },
                    [&](session_action::Log& a) { log_.log(a.level, "{}", a.text); },
+                   [&](session_action::LoadAsset& a) { load(std::move(a)); },
                },
                action);
   }

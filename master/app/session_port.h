@@ -20,6 +20,7 @@
 #include "master/session/live_scene.h"
 #include "master/session/scene_sessions.h"
 #include "net/connection.h"
+#include "scene_load/load_scene.h"
 #include "util/result.h"
 
 namespace optique::master {
@@ -29,9 +30,21 @@ class SessionPort {
   // Applications edit `live` (which the frame loop reads: RunSettings::live;
   // it must outlive this); with `journal`, each transaction applied is
   // appended to it before the application hears so.
+  // An asset an application uploaded is kept in `uploads` (made when first
+  // needed), by its SHA-256: beside the journal, so that a restart finds it.
   SessionPort(asio::io_context& io, const config::ApiServer& settings, LiveScene& live,
               std::optional<JournalFile> journal, std::optional<net::Secret> secret, std::uint32_t max_message_bytes,
-              spdlog::logger& log);
+              std::string uploads, spdlog::logger& log);
+  // Where an asset an application loaded goes once it is read and checked
+  // (off this thread; the hook runs on it): the master offers it to the nodes,
+  // then says asset_usable() or asset_unusable().
+  using AssetLoaded = std::function<void(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset)>;
+  void on_asset_loaded(AssetLoaded hook) { asset_loaded_ = std::move(hook); }
+  // Every node in the frames has the asset from frame `frame` on: the live
+  // scene takes it, the journal records it, the application hears so.
+  void asset_usable(const std::string& id, std::uint64_t frame);
+  // A node cannot draw it: the application hears why.
+  void asset_unusable(const std::string& id, const std::string& reason);
   // Listens and accepts; `next_frame` says which frame the master begins next.
   // The port bound.
   [[nodiscard]] Result<std::uint16_t> start(std::function<std::uint64_t()> next_frame);
@@ -52,6 +65,8 @@ class SessionPort {
  private:
   void on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback);
   void carry_out(SessionActions actions);
+  // Reads and checks the asset on the loader's thread, then hands it on here.
+  void load(session_action::LoadAsset load);
   // How much waits to be sent to `session` (nullopt: it is gone).
   [[nodiscard]] std::optional<std::size_t> queued_bytes(SessionId session) const;
 
@@ -66,8 +81,18 @@ class SessionPort {
   std::map<SessionId, std::shared_ptr<net::Connection>> connections_;
   std::map<SessionId, std::shared_ptr<http::WebSocketPeer>> websockets_;
   SessionId next_id_ = 1;
+  const std::string uploads_;
+  AssetLoaded asset_loaded_;
+  struct Loaded {
+    std::string path;
+    std::string sha256;
+    bool animated = false;
+  };
+  std::map<std::string, Loaded> loaded_;  // offered to the nodes, not yet usable
   // What a WebSocket's thread posts here finds the port gone once it is.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
+  // Reads assets, one at a time; joined first when the port goes.
+  asio::thread_pool loader_{1};
 };
 
 }  // namespace optique::master

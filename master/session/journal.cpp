@@ -41,6 +41,17 @@ std::string journal_transaction(std::uint64_t frame, const std::string& applicat
   return framed(entry);
 }
 
+std::string journal_asset(std::uint64_t frame, const std::string& asset, const std::string& path,
+                          const std::string& sha256) {
+  session::JournalEntry entry;
+  auto& a = *entry.mutable_asset();
+  a.set_frame(frame);
+  a.set_asset(asset);
+  a.set_path(path);
+  a.set_sha256(sha256);
+  return framed(entry);
+}
+
 Result<Journal> read_journal(std::string_view bytes) {
   Journal journal;
   if (bytes.size() < kJournalMagic.size() && kJournalMagic.starts_with(bytes)) {
@@ -89,6 +100,11 @@ Result<Journal> read_journal(std::string_view bytes) {
         transactions.push_back(std::move(*entry.mutable_transaction()));
         break;
       }
+      case session::JournalEntry::kAsset:
+        if (journal.runs.empty()) return Error{entry_at + ": an asset before the journal's first start"};
+        if (!scene::is_instance_id(entry.asset().asset())) return Error{entry_at + ": an asset without an id"};
+        journal.assets.push_back(std::move(*entry.mutable_asset()));
+        break;
       case session::JournalEntry::ENTRY_NOT_SET:
         return Error{entry_at + ": an entry of a kind this master does not know"};
     }
@@ -156,8 +172,11 @@ std::vector<std::string> JournalReplay::apply_due(LiveScene& live, std::uint64_t
 }
 
 Result<void> replay_into(const Journal& journal, const scene::SceneDefinition& scene, LiveSceneLimits limits,
-                         double frame_rate, std::uint64_t frame, scene::SceneState& state) {
+                         double frame_rate, std::uint64_t frame, const std::set<std::string>& animated,
+                         scene::SceneState& state) {
   LiveScene live = LiveScene::of(scene, limits, frame_rate);
+  for (const session::JournalAsset& asset : journal.assets)
+    live.add_asset(asset.asset(), animated.contains(asset.asset()));
   auto replay = JournalReplay::start(journal, live);
   if (!replay) return Error{replay.error()};
   const std::vector<std::string> problems = replay.value().apply_due(live, frame);

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,6 +39,11 @@ inline constexpr std::uint32_t kMaxJournalEntryBytes = 1u << 30;
 [[nodiscard]] std::string journal_transaction(std::uint64_t frame, const std::string& application,
                                               const session::Transaction& transaction);
 
+// An asset loaded (LoadAsset), written before the application hears it may be
+// instantiated.
+[[nodiscard]] std::string journal_asset(std::uint64_t frame, const std::string& asset, const std::string& path,
+                                        const std::string& sha256);
+
 struct JournalRun {
   session::JournalStart start;
   std::vector<session::JournalTransaction> transactions;  // in the order they were accepted
@@ -45,6 +51,9 @@ struct JournalRun {
 
 struct Journal {
   std::vector<JournalRun> runs;
+  // Every asset applications loaded, in any run, in order: the master loads
+  // each again (and checks it is the same) before the transactions are applied.
+  std::vector<session::JournalAsset> assets;
   // The bytes of the magic and the whole entries (0: not even the magic); what
   // follows them (`torn` says what it is) was a write cut short by a crash,
   // never acknowledged.
@@ -62,9 +71,10 @@ struct Journal {
 [[nodiscard]] Result<Journal> read_journal_file(const std::string& path);
 
 // Applies every transaction of every run in order, each with a frame's budget
-// of edits of its own. Fails when one is refused (the installation is not the
-// one that wrote it: an asset gone, a smaller limit), naming it; `live` is
-// then as the transactions before it left it. The transactions applied.
+// of edits of its own (its assets added to `live` by the caller first). Fails
+// when one is refused (the installation is not the one that wrote it: an
+// asset gone, a smaller limit), naming it; `live` is then as the transactions
+// before it left it. The transactions applied.
 [[nodiscard]] Result<std::size_t> restore(LiveScene& live, const Journal& journal);
 
 // The last run of a journal played again: the runs before it restored at once,
@@ -89,8 +99,10 @@ class JournalReplay {
 // The live scene frame `frame` of a journal's last run shows when played
 // again (what the master's frame loop puts in that frame with --replay), put
 // into `state` (put_live): for render-reference --replay. `scene`: the
-// installation's, at `frame_rate` Hz.
+// installation's, at `frame_rate` Hz; `animated`: which of the journal's
+// assets have animations.
 [[nodiscard]] Result<void> replay_into(const Journal& journal, const scene::SceneDefinition& scene,
-                                       LiveSceneLimits limits, double frame_rate, std::uint64_t frame, scene::SceneState& state);
+                                       LiveSceneLimits limits, double frame_rate, std::uint64_t frame,
+                                       const std::set<std::string>& animated, scene::SceneState& state);
 
 }  // namespace optique::master

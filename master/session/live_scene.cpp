@@ -196,12 +196,16 @@ class LiveScene::Edits {
                    "the scene holds " + std::to_string(scene_.limits_.max_instances) + " instances, the most it may"};
     }
     if (auto wrong = id_problem("asset", c.asset())) return wrong;
+    if (scene_.is_loading(c.asset())) {
+      return Wrong{"asset", "'" + c.asset() + "' is still loading (its LoadAsset has not been answered)"};
+    }
     if (!scene_.has_asset(c.asset())) return Wrong{"asset", "no asset '" + c.asset() + "' is loaded"};
     if (auto wrong = parent_problem(c.instance(), c.parent())) return wrong;
     Instance instance;
     instance.asset = c.asset();
     instance.parent = c.parent();
     instance.visible = !c.hidden();
+    if (scene_.animated_.contains(c.asset())) instance.animation = AnimationClock{true, 0.0, frame_};
     if (auto wrong = read_transform(c.transform(), instance.pose)) return wrong;
     put(c.instance(), std::move(instance));
     return std::nullopt;

@@ -30,7 +30,7 @@ namespace optique::master {
 // An instance's own clock for its asset's animations (SetAnimation).
 struct AnimationClock {
   bool playing = true;
-  double position = 0.0;    // seconds into the animations at frame `anchor`
+  double position = 0.0;     // seconds into the animations at frame `anchor`
   std::uint64_t anchor = 0;  // the frame it was set for
   // Where it is at `frame` (not before `anchor`), frames `period` seconds apart.
   [[nodiscard]] double at(std::uint64_t frame, double period) const;
@@ -42,16 +42,16 @@ struct Instance {
   std::string parent;  // empty: the world
   scene::Pose pose;    // relative to the parent
   bool visible = true;
-  glm::dvec4 base_color{1.0};  // multiplies the asset's base colour
-  glm::dvec3 emissive{1.0};    // multiplies the asset's emissive colour
+  glm::dvec4 base_color{1.0};               // multiplies the asset's base colour
+  glm::dvec3 emissive{1.0};                 // multiplies the asset's emissive colour
   std::optional<AnimationClock> animation;  // none: the scene's time
   friend bool operator==(const Instance&, const Instance&) = default;
 };
 
 struct LiveSceneLimits {
   std::size_t max_instances = 100000;
-  std::size_t max_edits_per_frame = 100000;          // over every transaction of a frame
-  std::size_t max_depth = scene::kMaxInstanceDepth;  // instances above an instance, the world not counted
+  std::size_t max_edits_per_frame = 100000;               // over every transaction of a frame
+  std::size_t max_depth = scene::kMaxInstanceDepth;       // instances above an instance, the world not counted
   std::size_t max_point_lights = scene::kMaxAddedLights;  // lights added (SetPointLight), at most kMaxAddedLights
 };
 
@@ -86,9 +86,26 @@ class LiveScene {
   [[nodiscard]] double frame_period() const { return frame_period_; }
 
   // An asset the nodes can draw (loaded and shipped by the scene transfer).
-  void add_asset(const std::string& id) { assets_.insert(id); }
+  // `animated`: an asset an application loaded that has animations: each
+  // instance of it plays them on its own clock from the frame it is created
+  // in (the scene's own asset plays with the scene's time).
+  void add_asset(const std::string& id, bool animated = false) {
+    assets_.insert(id);
+    loading_.erase(id);
+    if (animated) animated_.insert(id);
+  }
   [[nodiscard]] bool has_asset(const std::string& id) const { return assets_.count(id) != 0; }
   [[nodiscard]] const std::set<std::string>& assets() const { return assets_; }
+  // An asset being loaded (LoadAsset) and not yet on every node: an instance
+  // of it is refused as "still loading", and its id is taken.
+  void set_loading(const std::string& id, bool loading) {
+    if (loading) {
+      loading_.insert(id);
+    } else {
+      loading_.erase(id);
+    }
+  }
+  [[nodiscard]] bool is_loading(const std::string& id) const { return loading_.count(id) != 0; }
 
   // Applies every edit, or none and says which and why; `frame` is the frame
   // it is in (where an animation played, paused or sought starts from there).
@@ -122,6 +139,8 @@ class LiveScene {
   LiveSceneLimits limits_;
   double frame_period_;
   std::set<std::string> assets_;
+  std::set<std::string> loading_;
+  std::set<std::string> animated_;  // of assets_
   std::map<std::string, Instance> instances_;
   std::map<std::string, std::set<std::string>> children_;  // parent → its children; "" → the world's
   std::size_t edits_this_frame_ = 0;

@@ -1,7 +1,9 @@
 #include "master/session/scene_sessions.h"
 
 #include <algorithm>
+#include <filesystem>
 
+#include "log/escape.h"
 #include "master/session/journal.h"
 #include "net/envelope.h"
 #include "net/hello_proof.h"
@@ -255,12 +257,102 @@ void SceneSessions::on_request(SessionId id, const session::Request& request, st
     case session::Request::kReadScene:
       *answer.mutable_session_reply()->mutable_scene() = scene_contents(live_, next_frame);
       break;
+    case session::Request::kLoadAsset: {
+      const session::LoadAsset& load = request.load_asset();
+      if (auto problem = load_problem(load)) {
+        answer.mutable_session_reply()->mutable_refused()->set_field(problem->first);
+        answer.mutable_session_reply()->mutable_refused()->set_reason(problem->second);
+        break;
+      }
+      live_.set_loading(load.asset(), true);
+      loading_[load.asset()] = Asking{id, request.id()};
+      const bool from_file = load.source_case() == session::LoadAsset::kPath;
+      out.push_back(Log{spdlog::level::info,
+                        "application '" + sessions_.at(id).application + "' loads asset '" + load.asset() + "' " +
+                            (from_file ? "from " + log::escape_for_log(load.path())
+                                       : "from " + std::to_string(load.glb().size()) + " bytes it sent")});
+      out.push_back(session_action::LoadAsset{
+          load.asset(),
+          from_file ? (std::filesystem::path(settings_.assets_folder) / load.path()).lexically_normal().string() : "",
+          from_file ? "" : load.glb()});
+      return;  // answered once it is loaded
+    }
     case session::Request::REQUEST_NOT_SET:
       answer.mutable_session_reply()->mutable_refused()->set_field("request");
       answer.mutable_session_reply()->mutable_refused()->set_reason("is empty or of a kind this master does not know");
       break;
   }
   out.push_back(Send{id, std::move(answer)});
+}
+
+std::optional<std::pair<std::string, std::string>> SceneSessions::load_problem(const session::LoadAsset& load) const {
+  const auto wrong = [](std::string field, std::string reason) {
+    return std::make_optional(std::make_pair(std::move(field), std::move(reason)));
+  };
+  if (!scene::is_instance_id(load.asset())) {
+    return wrong("load_asset.asset", "must be 1 to 64 letters, digits, '-', '_' or '.'");
+  }
+  if (live_.has_asset(load.asset()) || live_.is_loading(load.asset())) {
+    return wrong("load_asset.asset", "'" + load.asset() + "' is loaded already (an id names one asset for good)");
+  }
+  if (loading_.size() >= settings_.max_loading) {
+    return wrong("load_asset", std::to_string(settings_.max_loading) +
+                                   " assets are loading, the most at once: ask again once one is answered");
+  }
+  switch (load.source_case()) {
+    case session::LoadAsset::kPath: {
+      const std::filesystem::path path(load.path());
+      if (load.path().empty() || path.is_absolute()) {
+        return wrong("load_asset.path", "must be a file inside master.api.assets, relative to it");
+      }
+      for (const auto& part : path.lexically_normal()) {
+        if (part == "..") return wrong("load_asset.path", "must not leave master.api.assets ('..')");
+      }
+      return std::nullopt;
+    }
+    case session::LoadAsset::kGlb:
+      // A binary glTF begins with its magic, "glTF".
+      if (load.glb().size() < 12 || load.glb().compare(0, 4, "glTF") != 0) {
+        return wrong("load_asset.glb", "is not a binary glTF (.glb): it does not begin with \"glTF\"");
+      }
+      return std::nullopt;
+    case session::LoadAsset::SOURCE_NOT_SET:
+      break;
+  }
+  return wrong("load_asset", "give the asset's path (inside master.api.assets) or its glb bytes");
+}
+
+SessionActions SceneSessions::asset_loaded(const std::string& asset, std::uint64_t frame, bool animated,
+                                           const std::string& path, const std::string& sha256) {
+  SessionActions out;
+  live_.add_asset(asset, animated);
+  if (settings_.journal) out.push_back(session_action::Journal{journal_asset(frame, asset, path, sha256)});
+  const auto asking = loading_.find(asset);
+  if (asking == loading_.end()) return out;  // from the journal, at the start
+  if (answerable(asking->second.session)) {
+    wire::Envelope answer = reply(asking->second.request);
+    answer.mutable_session_reply()->mutable_applied()->set_frame(frame);
+    out.push_back(Send{asking->second.session, std::move(answer)});
+  }
+  loading_.erase(asking);
+  return out;
+}
+
+SessionActions SceneSessions::asset_failed(const std::string& asset, const std::string& field,
+                                           const std::string& reason) {
+  SessionActions out;
+  live_.set_loading(asset, false);
+  out.push_back(Log{spdlog::level::warn, "asset '" + asset + "' could not be loaded: " + reason});
+  const auto asking = loading_.find(asset);
+  if (asking == loading_.end()) return out;
+  if (answerable(asking->second.session)) {
+    wire::Envelope answer = reply(asking->second.request);
+    answer.mutable_session_reply()->mutable_refused()->set_field(field);
+    answer.mutable_session_reply()->mutable_refused()->set_reason(reason);
+    out.push_back(Send{asking->second.session, std::move(answer)});
+  }
+  loading_.erase(asking);
+  return out;
 }
 
 }  // namespace optique::master

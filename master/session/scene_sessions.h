@@ -58,10 +58,19 @@ struct Log {
   spdlog::level::level_enum level = spdlog::level::info;
   std::string text;
 };
+// Load asset `asset` (off the io thread): the glTF file at `path` (absolute,
+// inside master.api.assets by its words; the shell checks it resolves there),
+// or the binary glTF `glb`. Answer with asset_loaded() or asset_failed().
+struct LoadAsset {
+  std::string asset;
+  std::string path;
+  std::string glb;
+};
 }  // namespace session_action
 
-using SessionAction = std::variant<session_action::Send, session_action::Close, session_action::SetMaxPayload,
-                                   session_action::Protect, session_action::Journal, session_action::Log>;
+using SessionAction =
+    std::variant<session_action::Send, session_action::Close, session_action::SetMaxPayload, session_action::Protect,
+                 session_action::Journal, session_action::Log, session_action::LoadAsset>;
 using SessionActions = std::vector<SessionAction>;
 
 // The capability an application's Hello names.
@@ -82,6 +91,10 @@ struct SceneSessionSettings {
   // that drains a large reply within that time is not.
   std::size_t max_queued_bytes = 1u << 20;
   std::chrono::nanoseconds stalled_for = std::chrono::seconds(5);
+  // LoadAsset's paths are in this folder (absolute; master.api.assets).
+  std::string assets_folder;
+  // Assets loading at once (read, checked, sent to every node): more are refused.
+  std::size_t max_loading = 4;
 };
 
 class SceneSessions {
@@ -111,6 +124,16 @@ class SceneSessions {
   // How much waits to be sent to `session` at `now` (after an event was
   // queued for it): closes it when it has stopped reading.
   [[nodiscard]] SessionActions queued(SessionId session, std::size_t bytes, clock::Nanos now);
+  // The asset a LoadAsset asked for is on every node in the frames from
+  // `frame` on, read from `path` (absolute) with identity `sha256`: the live
+  // scene takes it (`animated`: it has animations), the journal records it,
+  // and the application that asked hears Applied.
+  [[nodiscard]] SessionActions asset_loaded(const std::string& asset, std::uint64_t frame, bool animated,
+                                            const std::string& path, const std::string& sha256);
+  // It could not be loaded: the application that asked hears why (`field`:
+  // "load_asset.path", "load_asset.glb"; the reason names the node when one failed).
+  [[nodiscard]] SessionActions asset_failed(const std::string& asset, const std::string& field,
+                                            const std::string& reason);
 
   [[nodiscard]] std::size_t open() const { return sessions_.size(); }
 
@@ -132,10 +155,18 @@ class SceneSessions {
   void connected(Session& session, const std::string& application, SessionActions& out);
   void refuse(SessionId id, Session& session, const std::string& reason, bool retriable, SessionActions& out);
   void on_request(SessionId id, const session::Request& request, std::uint64_t next_frame, SessionActions& out);
+  // Checks a LoadAsset; the field and reason it is refused for, if so.
+  [[nodiscard]] std::optional<std::pair<std::string, std::string>> load_problem(const session::LoadAsset& load) const;
 
   LiveScene& live_;
   SceneSessionSettings settings_;
   std::map<SessionId, Session> sessions_;
+  // Assets loading: who asked (the session may have gone since).
+  struct Asking {
+    SessionId session = 0;
+    std::uint64_t request = 0;
+  };
+  std::map<std::string, Asking> loading_;
 };
 
 }  // namespace optique::master

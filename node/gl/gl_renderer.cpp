@@ -1,8 +1,8 @@
 #include "node/gl/gl_renderer.h"
 
-#include "scene_load/installation_scene.h"
 #include "config/to_schema.h"
 #include "image/texture_decode.h"
+#include "scene_load/installation_scene.h"
 #include "scene_load/load_scene.h"
 
 namespace optique::node {
@@ -22,9 +22,18 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   const std::string key = config::to_schema(job.installation).SerializeAsString() + node.scene_sha256;
   ahead_.clear();  // sent ahead by the master before: a (re)join starts over
   last_frame_.reset();
+  const auto add_assets = [&]() -> Result<void> {
+    for (const protocol::AssetOffer& asset : node.assets) {
+      if (assets_.contains(asset.asset)) continue;
+      auto read = read_asset(asset);
+      if (!read) return Error{read.error()};
+      if (auto added = add_asset(asset, *read.value()); !added) return added;
+    }
+    return {};
+  };
   if (key == configured_for_ && pipeline_) {  // a rejoin: the same job, keep everything
     if (node.lights) pipeline_->set_share(*node.lights);
-    return {};
+    return add_assets();
   }
 
   // A glTF scene is read from this node's copy of the master's files.
@@ -53,6 +62,8 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
   auto pipeline = render::ProjectorPipeline::make(job, scene.definition);
   if (!pipeline) return Error{pipeline.error()};
   pipeline_ = std::move(pipeline).value();
+  assets_.clear();
+  if (auto added = add_assets(); !added) return added;
   if (node.lights) pipeline_->set_share(*node.lights);
   deep_signal_ = pipeline_->projector_model().settings().bits > 8;
   gathers_ = projector.color_fields.gathers();
@@ -80,6 +91,26 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
                 ? "two passes (" + std::to_string(view.render_width()) + "×" + std::to_string(view.render_height()) +
                       " px, then warped)"
                 : "single pass");
+  return {};
+}
+
+Result<std::shared_ptr<const scene::SceneDefinition>> GlRenderer::read_asset(const protocol::AssetOffer& asset) const {
+  auto loaded = config::load_asset(asset.asset, asset.path, image::decode_texture);
+  if (!loaded) return Error{"cannot load the asset '" + asset.asset + "': " + loaded.error()};
+  if (loaded.value().content_sha256 != asset.sha256) {
+    return Error{"the asset '" + asset.asset + "' here is not the master's (sha256 " +
+                 loaded.value().content_sha256.substr(0, 12) + "… here, " + asset.sha256.substr(0, 12) + "… offered)"};
+  }
+  for (const auto& warning : loaded.value().warnings) log_.warn("asset '{}': {}", asset.asset, warning);
+  return std::make_shared<const scene::SceneDefinition>(std::move(loaded.value().definition));
+}
+
+Result<void> GlRenderer::add_asset(const protocol::AssetOffer& asset, const scene::SceneDefinition& read) {
+  const clock::Nanos started = clock::monotonic_now();
+  if (auto added = pipeline_->renderer().add_asset(read); !added) return added;
+  assets_.insert(asset.asset);
+  log_.info("the asset '{}' is ready to draw ({} mesh(es), {} texture(s); uploaded in {:.1f} ms)", asset.asset,
+            read.meshes.size(), read.textures.size(), static_cast<double>(clock::monotonic_now() - started) / 1e6);
   return {};
 }
 

@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 
 #include <spdlog/logger.h>
@@ -26,6 +27,9 @@ class GlRenderer final : public Renderer {
   ~GlRenderer() override;
 
   [[nodiscard]] Result<void> configure(const protocol::NodeJob& job) override;
+  [[nodiscard]] Result<std::shared_ptr<const scene::SceneDefinition>> read_asset(
+      const protocol::AssetOffer& asset) const override;
+  [[nodiscard]] Result<void> add_asset(const protocol::AssetOffer& asset, const scene::SceneDefinition& read) override;
   [[nodiscard]] std::string description() const override;
   [[nodiscard]] WarmUp warm_up() const override { return warm_up_; }
   Rendered render(const FrameInput& frame) override;
@@ -36,7 +40,8 @@ class GlRenderer final : public Renderer {
  private:
   spdlog::logger& log_;
   std::string capture_folder_;
-  std::string configured_for_;  // the job, to skip rebuilding on a rejoin
+  std::string configured_for_;    // the job, to skip rebuilding on a rejoin
+  std::set<std::string> assets_;  // the ids of the assets the pipeline has
   std::unique_ptr<render::GlContext> context_;
   std::unique_ptr<render::ProjectorPipeline> pipeline_;
   std::optional<CaptureWriter> captures_;

@@ -249,6 +249,8 @@ void SimCluster::master_actions(master::Actions actions) {
                    [&](master::Finish& a) { finished_ = a.exit_code; },
                    [&](master::Log&) {},
                    [&](master::AppEvent& a) { app_events_.push_back(std::move(a.event)); },
+                   [&](master::AssetUsable& a) { asset_news_.push_back("usable " + a.asset); },
+                   [&](master::AssetFailed& a) { asset_news_.push_back("failed " + a.asset + ": " + a.reason); },
                },
                action);
   }
@@ -339,6 +341,9 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
             [&](node::StoreSceneChunk&) {},
             [&](node::FinishScene&) {},
             [&](node::AbandonScene&) {},
+            [&](node::ReadyAsset& a) {
+              node_actions(i, n.protocol.answer(node::AssetLoaded{a.asset.asset, {}}, now_));
+            },
         },
         action);
   }

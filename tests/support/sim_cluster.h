@@ -63,6 +63,8 @@ class SimCluster {
   [[nodiscard]] const std::map<std::uint64_t, std::set<std::string>>& instances_ahead(std::size_t node) const;
   // The events the master raised for applications (AppEvent), in order.
   [[nodiscard]] const std::vector<session::Event>& app_events() const { return app_events_; }
+  // What the master said of assets: "usable ID" or "failed ID: reason", in order.
+  [[nodiscard]] const std::vector<std::string>& asset_news() const { return asset_news_; }
   [[nodiscard]] const master::MasterProtocol& master() const { return *master_; }
   [[nodiscard]] const master::RunRecorder& recorder() const { return *recorder_; }
 
@@ -90,6 +92,7 @@ class SimCluster {
   clock::Nanos now_ = 1'000'000'000'000;
   std::vector<std::string> violations_;
   std::vector<session::Event> app_events_;
+  std::vector<std::string> asset_news_;
 };
 
 }  // namespace optique::testing

@@ -328,6 +328,36 @@ class Session:
             raise ConnectionClosed(f"the master answered a transaction with {reply.WhichOneof('reply')}")
         return reply.applied.frame
 
+    def load_asset(self, asset: str, path: Optional[str] = None, glb: Optional[bytes] = None,
+                   timeout: float = 60.0) -> int:
+        """Loads a glTF asset that instances may then name (``create(..., asset=...)``):
+        ``path`` a file inside the master's ``master.api.assets`` folder (relative to
+        it), or ``glb`` the bytes of a binary glTF this application sends (e.g.
+        ``open("duck.glb", "rb").read()``). Waits until every node can draw it and
+        returns the first frame from which they can, or raises ``Refused`` naming
+        why not (``field`` ``load_asset.path``, ``load_asset.glb`` ...). The reply
+        waits for every node: up to ``timeout`` seconds (or the session's, if longer)."""
+        if (path is None) == (glb is None):
+            raise ValueError("give the asset's path or its glb bytes, one of them")
+
+        def fill(request):
+            request.load_asset.asset = asset
+            if path is not None:
+                request.load_asset.path = path
+            else:
+                request.load_asset.glb = glb
+        previous = self._socket.gettimeout()
+        self._socket.settimeout(max(previous or 0.0, timeout))
+        try:
+            reply = self._ask(fill)
+        finally:
+            self._socket.settimeout(previous)
+        if reply.WhichOneof("reply") == "refused":
+            raise Refused(reply.refused.edit, reply.refused.field, reply.refused.reason)
+        if reply.WhichOneof("reply") != "applied":
+            raise ConnectionClosed(f"the master answered LoadAsset with {reply.WhichOneof('reply')}")
+        return reply.applied.frame
+
     def read_scene(self) -> session_pb2.SceneContents:
         """The live scene as it is: ``assets`` and ``instances`` (InstanceView), by id."""
         reply = self._ask(lambda r: r.read_scene.SetInParent())
