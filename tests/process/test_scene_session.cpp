@@ -38,6 +38,7 @@ const std::string kExample = std::string(OPTIQUE_BIN_DIR) + "/optique-example-ci
 const std::string kFlystickCave = std::string(OPTIQUE_SOURCE_DIR) + "/configs/cave-flystick.json";
 // The power wall; its scene session on an ephemeral port (--api-port 0).
 const std::string kWall = std::string(OPTIQUE_SOURCE_DIR) + "/configs/powerwall-2x2.json";
+const std::string kTorusGlb = std::string(OPTIQUE_SOURCE_DIR) + "/configs/assets/torus/torus.glb";
 
 // A master on that wall with null local nodes: `frames` frames, the rest of
 // its arguments `more`; its output in DIR/NAME, its api port in DIR/NAME.port.
@@ -159,31 +160,40 @@ TEST(SceneSession, AKilledMasterComesBackWithTheLiveSceneFromItsJournal) {
     ASSERT_EQ(outcome(*app, client::Transaction().create("c2", "cubes", at(-0.5))), "applied");
     ASSERT_EQ(outcome(*app, client::Transaction().create("c3", "teapot")), "no asset 'teapot' is loaded");
     ASSERT_EQ(outcome(*app, client::Transaction().remove("c1")), "applied");
+    // An uploaded model, kept beside the journal, and an instance of it.
+    auto loaded = app->upload_asset("duck", read_file(kTorusGlb));
+    ASSERT_TRUE(loaded.ok()) << loaded.error();
+    ASSERT_TRUE(loaded.value().applied()) << loaded.value().refused->reason() << first->output();
+    ASSERT_EQ(outcome(*app, client::Transaction().create("d1", "duck", at(0.2))), "applied");
     first->signal(SIGKILL);
     ASSERT_TRUE(first->wait(10s).has_value());
   }
 
   auto second = wall_master(dir, "second", "90", {"--record", journal});
   ASSERT_TRUE(second->wait_for_output(
-      "restored the live scene from " + journal + ": 3 transaction(s) of 1 run(s), 1 instance(s)", 15s))
+      "restored the live scene from " + journal + ": 4 transaction(s) of 1 run(s), 2 instance(s)", 15s))
       << second->output();
+  EXPECT_TRUE(second->wait_for_output("loaded 1 asset(s) the journal names", 1s)) << second->output();
   auto app = connect(api_port(dir, "second", *second));
   ASSERT_NE(app, nullptr) << second->output();
-  ASSERT_EQ(app->scene().instances_size(), 1);
+  ASSERT_EQ(app->scene().instances_size(), 2);
   EXPECT_EQ(app->scene().instances(0).instance(), "c2");
   EXPECT_EQ(app->scene().instances(0).transform().position(0), -0.5);
+  EXPECT_EQ(app->scene().instances(1).asset(), "duck");
+  ASSERT_EQ(app->scene().assets_size(), 2);
   ASSERT_EQ(outcome(*app, client::Transaction().create("c4", "cubes", at(0.0), "c2")), "applied");
   ASSERT_EQ(second->wait(60s), 0) << second->output();
   const ClusterRun run = read_cluster_run(dir.file("second"));
   ASSERT_EQ(run.error, "");
   for (const auto& node : run.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
-  EXPECT_EQ(run.report.instances(), 2u) << "c2 restored, c4 made";
+  EXPECT_EQ(run.report.instances(), 3u) << "c2 and d1 restored, c4 made";
 
   // Both runs are in the journal; a replay plays the second over the first.
   auto read = master::read_journal_file(journal);
   ASSERT_TRUE(read.ok()) << read.error();
   ASSERT_EQ(read.value().runs.size(), 2u);
-  EXPECT_EQ(read.value().runs[0].transactions.size(), 3u);
+  EXPECT_EQ(read.value().runs[0].transactions.size(), 4u);
+  ASSERT_EQ(read.value().assets.size(), 1u) << "loaded once: not again on the restart";
   EXPECT_EQ(read.value().runs[1].transactions.size(), 1u);
   Process replay({kMaster, "--config", kWall, "--local", "--frames", "90", "--out", dir.file("replay"), "--no-status",
                   "--node-arg=--renderer=null", "--replay", journal},
@@ -193,7 +203,7 @@ TEST(SceneSession, AKilledMasterComesBackWithTheLiveSceneFromItsJournal) {
       << replay.output();
   const ClusterRun replayed = read_cluster_run(dir.file("replay"));
   ASSERT_EQ(replayed.error, "");
-  EXPECT_EQ(replayed.report.instances(), 2u);
+  EXPECT_EQ(replayed.report.instances(), 3u);
   for (const auto& node : replayed.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
 }
 

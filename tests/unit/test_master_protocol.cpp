@@ -19,6 +19,7 @@
 #include "master/session/live_scene.h"
 #include "net/envelope.h"
 #include "protocol/welcome.h"
+#include "scene_load/installation_scene.h"
 
 namespace optique::master {
 namespace {
@@ -1112,6 +1113,90 @@ TEST_F(MasterTest, ABuiltInSceneHasNoFiles) {
   EXPECT_TRUE(welcome.front().welcome().scene_sha256().empty());
   const Actions a = master_->message(1, scene_request("", 0, 0), now_);
   EXPECT_NE(first<Close>(a), nullptr);
+}
+
+// --- assets an application loads while the frames go on
+
+std::shared_ptr<const scene::LoadedScene> torus_asset(const std::string& id) {
+  auto loaded = config::load_asset(id, std::string(OPTIQUE_SOURCE_DIR) + "/configs/assets/torus/torus.gltf", {});
+  EXPECT_TRUE(loaded) << (loaded ? "" : loaded.error());
+  return loaded ? std::make_shared<const scene::LoadedScene>(std::move(loaded).value()) : nullptr;
+}
+
+Actions asset_ready(MasterProtocol& master, PeerId peer, const std::string& asset, const std::string& problem,
+                    clock::Nanos now) {
+  wire::Envelope e = envelope();
+  e.mutable_asset_ready()->set_asset(asset);
+  e.mutable_asset_ready()->set_problem(problem);
+  return master.message(peer, e, now);
+}
+
+// Offered to every node; usable once every node in the frames has it, and not
+// before; a node that leaves waits for nothing. Its files are served to a
+// node in the frames (no deadline armed: its liveness bounds it), the scene's
+// are not.
+TEST_F(MasterTest, AnAssetIsUsableOnceEveryNodeInTheFramesHasReadiedIt) {
+  load("powerwall-2x2.json");
+  (void)join_all();
+  const auto torus = torus_asset("torus");
+  ASSERT_NE(torus, nullptr);
+  Actions a = master_->add_asset("torus", torus, now_);
+  for (PeerId peer = 1; peer <= 4; ++peer) {
+    const auto offers = sent_to(a, peer, wire::Envelope::kAssetOffer);
+    ASSERT_EQ(offers.size(), 1u) << peer;
+    EXPECT_EQ(offers.front().asset_offer().asset(), "torus");
+    EXPECT_EQ(offers.front().asset_offer().scene_sha256(), torus->content_sha256);
+  }
+  EXPECT_EQ(first<AssetUsable>(a), nullptr);
+
+  wire::Envelope request = envelope();
+  request.mutable_scene_request()->set_scene_sha256(torus->content_sha256);
+  a = master_->message(2, request, now_);
+  const auto chunks = sent_to(a, 2, wire::Envelope::kSceneChunk);
+  ASSERT_EQ(chunks.size(), 1u);
+  EXPECT_EQ(chunks.front().scene_chunk().data().size(), torus->manifest.chunk_length(0, 0));
+  EXPECT_EQ(first<SetDeadline>(a), nullptr);
+  EXPECT_TRUE(logged(a, "sending the asset 'torus' to 'bottom-right'"));
+
+  EXPECT_EQ(first<AssetUsable>(asset_ready(*master_, 1, "torus", "", now_)), nullptr);
+  EXPECT_EQ(first<AssetUsable>(asset_ready(*master_, 2, "torus", "", now_)), nullptr);
+  EXPECT_EQ(first<AssetUsable>(asset_ready(*master_, 3, "torus", "", now_)), nullptr);
+  a = master_->closed(4, "gone", now_);
+  ASSERT_NE(first<AssetUsable>(a), nullptr) << "the node that left waits for nothing";
+  EXPECT_EQ(first<AssetUsable>(a)->asset, "torus");
+  EXPECT_EQ(first<AssetUsable>(a)->frame, master_->progress().next_frame);
+
+  // Back, it gets the asset in its welcome, and counts as having it once
+  // configured: a second asset then waits for its word too.
+  a = hello(5, "top-right");
+  const auto welcome = sent_to(a, 5, wire::Envelope::kWelcome);
+  ASSERT_EQ(welcome.size(), 1u);
+  ASSERT_EQ(welcome.front().welcome().assets_size(), 1);
+  EXPECT_EQ(welcome.front().welcome().assets(0).asset(), "torus");
+  (void)configured(5);
+  a = master_->add_asset("torus2", torus_asset("torus2"), now_);
+  EXPECT_EQ(sent_to(a, 5, wire::Envelope::kAssetOffer).size(), 1u);
+  for (PeerId peer : {1, 2, 3}) EXPECT_EQ(first<AssetUsable>(asset_ready(*master_, peer, "torus2", "", now_)), nullptr);
+  EXPECT_NE(first<AssetUsable>(asset_ready(*master_, 5, "torus2", "", now_)), nullptr);
+}
+
+// A node that cannot draw the asset: it is not used, the application hears
+// which node and why, and later welcomes do not name it. A word about an
+// asset before the node is configured closes it.
+TEST_F(MasterTest, AnAssetANodeCannotDrawIsNotUsed) {
+  load("powerwall-2x2.json");
+  (void)join_all();
+  (void)master_->add_asset("torus", torus_asset("torus"), now_);
+  const Actions a = asset_ready(*master_, 3, "torus", "texture 0 is not a \x1b[31mPNG", now_);
+  ASSERT_NE(first<AssetFailed>(a), nullptr);
+  EXPECT_EQ(first<AssetFailed>(a)->asset, "torus");
+  EXPECT_EQ(first<AssetFailed>(a)->reason, "node 'top-left' cannot draw it: texture 0 is not a \\x1b[31mPNG");
+  EXPECT_EQ(first<AssetUsable>(asset_ready(*master_, 1, "torus", "", now_)), nullptr);
+  (void)master_->closed(4, "gone", now_);
+  const auto welcome = sent_to(hello(9, "top-right"), 9, wire::Envelope::kWelcome);
+  ASSERT_EQ(welcome.size(), 1u);
+  EXPECT_EQ(welcome.front().welcome().assets_size(), 0);
+  EXPECT_NE(first<Close>(asset_ready(*master_, 9, "torus", "", now_)), nullptr) << "not configured yet";
 }
 
 }  // namespace

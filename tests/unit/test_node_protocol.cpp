@@ -980,5 +980,132 @@ TEST_F(NodeTest, ConfiguredSaysHowLongTheWarmUpFrameTook) {
   EXPECT_TRUE(logged(a, "warm-up frame 420.0 ms, 130.0 ms more when captured"));
 }
 
+// --- assets an application loads while the frames go on
+
+class AssetTest : public SceneFetchTest {
+ protected:
+  wire::Envelope offer(const std::string& id) {
+    wire::Envelope e = envelope();
+    *e.mutable_asset_offer() = protocol::to_wire(protocol::AssetOffer{id, scene_.sha256, scene_.files, ""});
+    return e;
+  }
+  static std::vector<std::string> readies(const Actions& a) {
+    std::vector<std::string> out;
+    for (const wire::Envelope& e : sent(a, wire::Envelope::kAssetReady)) {
+      out.push_back(e.asset_ready().asset() +
+                    (e.asset_ready().problem().empty() ? "" : ": " + e.asset_ready().problem()));
+    }
+    return out;
+  }
+};
+
+// Offered in the frames: its files fetched beside them (no other node's copy
+// waited for), given to the renderer, and the master told; the frames go on
+// throughout, and a second offer waits for the first.
+TEST_F(AssetTest, AnAssetOfferedInTheFramesIsFetchedReadiedAndAnswered) {
+  NodeProtocol node(settings());
+  join(node);
+  Actions a = node.message(offer("duck"), now_);
+  const PrepareScene* prepare = first<PrepareScene>(a);
+  ASSERT_NE(prepare, nullptr);
+  EXPECT_EQ(prepare->sha256, scene_.sha256);
+  EXPECT_FALSE(prepare->wait_for_others);
+  EXPECT_TRUE(node.joined());
+  a = node.message(offer("goose"), now_);
+  EXPECT_EQ(first<PrepareScene>(a), nullptr) << "one at a time";
+
+  a = node.answer(SceneCopyStarted{protocol::SceneFetch::Present{}}, now_);
+  EXPECT_EQ(sent(a, wire::Envelope::kSceneRequest).size(), 3u);
+  EXPECT_TRUE(logged(a, "fetching the asset 'duck' from the master"));
+  // A frame comes meanwhile, and is drawn.
+  a = begin(node, 0);
+  ASSERT_NE(first<Render>(a), nullptr);
+  (void)node.message(chunk(0, 0, scene_.gltf), now_);
+  (void)node.message(chunk(1, 0, scene_.bin.substr(0, 4096)), now_);
+  a = node.message(chunk(1, 1, scene_.bin.substr(4096)), now_);
+  ASSERT_NE(first<FinishScene>(a), nullptr);
+  a = node.answer(SceneCopyFinished{std::string("/cache/scenes/d/s.gltf")}, now_);
+  ASSERT_NE(first<ReadyAsset>(a), nullptr);
+  EXPECT_EQ(first<ReadyAsset>(a)->asset.asset, "duck");
+  EXPECT_EQ(first<ReadyAsset>(a)->asset.path, "/cache/scenes/d/s.gltf");
+  EXPECT_NE(first<CancelDeadline>(a), nullptr) << "the fetch's stall deadline goes with it";
+  EXPECT_TRUE(readies(a).empty()) << "not before the renderer has it";
+
+  a = node.answer(AssetLoaded{"duck", {}}, now_);
+  EXPECT_EQ(readies(a), std::vector<std::string>{"duck"});
+  ASSERT_NE(first<PrepareScene>(a), nullptr) << "then the next";
+  a = node.answer(SceneFound{"/cache/scenes/d/s.gltf"}, now_);
+  ASSERT_NE(first<ReadyAsset>(a), nullptr);
+  a = node.answer(AssetLoaded{"goose", Error{"texture 3 is not a PNG"}}, now_);
+  EXPECT_EQ(readies(a), std::vector<std::string>{"goose: texture 3 is not a PNG"});
+  EXPECT_TRUE(node.joined()) << "an asset that cannot be drawn costs the asset, not the node";
+}
+
+// Offered while the node sets up: readied once it is in the frames. A node
+// that draws nothing (the null renderer) needs no files: ready at once. An
+// offer of an id it has, or one the master cannot have meant, closes.
+TEST_F(AssetTest, OffersWaitForTheFramesNeedNoFilesWithoutARendererAndAreChecked) {
+  NodeSettings without = settings();
+  without.needs_scene_files = false;
+  NodeProtocol null_node(without);
+  (void)null_node.connected(now_);
+  wire::Envelope challenge = envelope();
+  challenge.mutable_challenge();
+  (void)null_node.message(challenge, now_);
+  wire::Envelope welcome = envelope();
+  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr);
+  ASSERT_NE(first<Configure>(null_node.message(welcome, now_)), nullptr);
+  EXPECT_TRUE(readies(null_node.message(offer("duck"), now_)).empty()) << "not in the frames yet";
+  (void)null_node.answer(Configured{{}, "null", {}}, now_);
+  wire::Envelope resync = envelope();
+  *resync.mutable_resync()->mutable_snapshot() = scene::to_snapshot(state_);
+  resync.mutable_resync()->set_state_hash(scene::state_hash(state_));
+  Actions a = null_node.message(resync, now_);
+  ASSERT_TRUE(null_node.joined());
+  EXPECT_EQ(readies(a), std::vector<std::string>{"duck"});
+  EXPECT_EQ(first<PrepareScene>(a), nullptr);
+  a = null_node.message(offer("duck"), now_);
+  ASSERT_NE(first<Close>(a), nullptr) << "offered twice";
+
+  NodeProtocol node(settings());
+  join(node);
+  wire::Envelope bad = offer("duck");
+  bad.mutable_asset_offer()->set_scene_sha256(std::string(64, '0'));
+  a = node.message(bad, now_);
+  ASSERT_NE(first<Close>(a), nullptr);
+  EXPECT_NE(first<Close>(a)->reason.find("does not hash to its SHA-256"), std::string::npos) << first<Close>(a)->reason;
+  wire::Envelope unnamed = offer("no such id!");
+  EXPECT_NE(first<Close>(node.message(unnamed, now_)), nullptr);
+}
+
+// A welcome that names assets: each is fetched after the scene, before the
+// renderer is configured, which gets their paths.
+TEST_F(AssetTest, AWelcomesAssetsAreFetchedBeforeTheNodeIsConfigured) {
+  NodeProtocol node(settings());
+  (void)node.connected(now_);
+  wire::Envelope challenge = envelope();
+  challenge.mutable_challenge();
+  (void)node.message(challenge, now_);
+  wire::Envelope welcome = envelope();
+  const std::vector<protocol::AssetOffer> assets{{"duck", scene_.sha256, scene_.files, ""}};
+  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr, assets);
+  Actions a = node.message(welcome, now_);
+  ASSERT_NE(first<PrepareScene>(a), nullptr);
+  EXPECT_TRUE(first<PrepareScene>(a)->wait_for_others) << "setting up, another node's copy is waited for";
+  EXPECT_EQ(first<Configure>(a), nullptr);
+  a = node.answer(SceneFound{"/cache/scenes/d/s.gltf"}, now_);
+  ASSERT_NE(first<Configure>(a), nullptr);
+  ASSERT_EQ(first<Configure>(a)->job.assets.size(), 1u);
+  EXPECT_EQ(first<Configure>(a)->job.assets[0].path, "/cache/scenes/d/s.gltf");
+  // A cache that cannot hold it stops the node, as for the scene.
+  NodeProtocol full(settings());
+  (void)full.connected(now_);
+  (void)full.message(challenge, now_);
+  (void)full.message(welcome, now_);
+  a = full.answer(SceneCopyStarted{Error{"no room"}}, now_);
+  ASSERT_NE(first<Stop>(a), nullptr);
+  EXPECT_TRUE(logged(a, "cannot keep the asset 'duck' here: no room"));
+}
+
 }  // namespace
 }  // namespace optique::node

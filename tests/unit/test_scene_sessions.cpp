@@ -413,5 +413,90 @@ TEST(SessionJson, WhatAnApplicationHearsIsOneObjectNamingItsKind) {
   EXPECT_EQ(to_application_json(challenge), "") << "nothing an application hears over JSON";
 }
 
+// LoadAsset: each source checked (a refusal names its field), then loaded by
+// the shell (LoadAsset action) and answered when the master says it is
+// usable, the journal told first; until then the id is taken and an instance
+// of it is refused as still loading.
+TEST_F(SceneSessionsTest, LoadAssetIsCheckedLoadedByTheShellAndAnsweredWhenUsable) {
+  SceneSessionSettings settings;
+  settings.journal = true;
+  settings.assets_folder = "/srv/models";
+  settings.max_loading = 2;
+  SceneSessions sessions(live_, settings);
+  (void)sessions.accepted(1, "127.0.0.1:5000", true, kNonce);
+  (void)sessions.message(1, hello("loader"), 0);
+  const auto load = [&](std::uint64_t id, const std::string& asset, const std::string* path, const std::string* glb) {
+    wire::Envelope e;
+    e.set_protocol_version(net::kProtocolVersion);
+    e.mutable_session_request()->set_id(id);
+    auto& l = *e.mutable_session_request()->mutable_load_asset();
+    l.set_asset(asset);
+    if (path) l.set_path(*path);
+    if (glb) l.set_glb(*glb);
+    return sessions.message(1, e, 7);
+  };
+  const auto refused = [](const SessionActions& a) {
+    const auto sends = of<session_action::Send>(a);
+    if (sends.size() != 1 || !sends[0].message.session_reply().has_refused()) return std::string("not refused");
+    return sends[0].message.session_reply().refused().field() + ": " +
+           sends[0].message.session_reply().refused().reason();
+  };
+  const std::string up = "../etc/passwd", absolute = "/etc/passwd", fine = "duck/duck.gltf", junk = "not a glb";
+  const std::string glb = std::string("glTF") + std::string(20, '\0');
+  EXPECT_EQ(refused(load(1, "a b", &fine, nullptr)),
+            "load_asset.asset: must be 1 to 64 letters, digits, '-', '_' or '.'");
+  EXPECT_EQ(refused(load(2, "torus", &fine, nullptr)),
+            "load_asset.asset: 'torus' is loaded already (an id names one asset for good)");
+  EXPECT_EQ(refused(load(3, "duck", &up, nullptr)), "load_asset.path: must not leave master.api.assets ('..')");
+  EXPECT_EQ(refused(load(4, "duck", &absolute, nullptr)),
+            "load_asset.path: must be a file inside master.api.assets, relative to it");
+  EXPECT_EQ(refused(load(5, "duck", nullptr, &junk)),
+            "load_asset.glb: is not a binary glTF (.glb): it does not begin with \"glTF\"");
+  EXPECT_EQ(refused(load(6, "duck", nullptr, nullptr)),
+            "load_asset: give the asset's path (inside master.api.assets) or its glb bytes");
+
+  auto a = load(7, "duck", &fine, nullptr);
+  EXPECT_TRUE(of<session_action::Send>(a).empty()) << "answered once loaded";
+  ASSERT_EQ(of<session_action::LoadAsset>(a).size(), 1u);
+  EXPECT_EQ(of<session_action::LoadAsset>(a)[0].path, "/srv/models/duck/duck.gltf");
+  a = load(8, "goose", nullptr, &glb);
+  ASSERT_EQ(of<session_action::LoadAsset>(a).size(), 1u);
+  EXPECT_EQ(of<session_action::LoadAsset>(a)[0].glb, glb);
+  EXPECT_EQ(refused(load(9, "swan", &fine, nullptr)),
+            "load_asset: 2 assets are loading, the most at once: ask again once one is answered");
+  EXPECT_EQ(refused(load(10, "duck", &fine, nullptr)),
+            "load_asset.asset: 'duck' is loaded already (an id names one asset for good)");
+  const auto still = sessions.message(1, create(11, "d1", "duck"), 7);
+  EXPECT_EQ(of<session_action::Send>(still)[0].message.session_reply().refused().reason(),
+            "'duck' is still loading (its LoadAsset has not been answered)");
+
+  a = sessions.asset_loaded("duck", 12, true, "/srv/models/duck/duck.gltf", "abc");
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_TRUE(std::holds_alternative<session_action::Journal>(a[0])) << "the journal before the reply";
+  auto journal = read_journal(std::string(kJournalMagic) + journal_start(0, "cubes") +
+                              std::get<session_action::Journal>(a[0]).entry);
+  ASSERT_TRUE(journal) << journal.error();
+  ASSERT_EQ(journal.value().assets.size(), 1u);
+  EXPECT_EQ(journal.value().assets[0].asset(), "duck");
+  EXPECT_EQ(journal.value().assets[0].path(), "/srv/models/duck/duck.gltf");
+  EXPECT_EQ(journal.value().assets[0].frame(), 12u);
+  const session::Reply done = std::get<session_action::Send>(a[1]).message.session_reply();
+  EXPECT_EQ(done.id(), 7u);
+  EXPECT_EQ(done.applied().frame(), 12u);
+  // Animated: each instance plays on its own clock from its frame.
+  const auto placed = sessions.message(1, create(12, "d1", "duck"), 13);
+  EXPECT_TRUE(of<session_action::Send>(placed)[0].message.session_reply().has_applied());
+  ASSERT_TRUE(live_.instances().at("d1").animation.has_value());
+  EXPECT_EQ(live_.instances().at("d1").animation->anchor, 13u);
+
+  a = sessions.asset_failed("goose", "load_asset", "node 'x' cannot draw it: no");
+  const auto failed = of<session_action::Send>(a);
+  ASSERT_EQ(failed.size(), 1u);
+  EXPECT_EQ(failed[0].message.session_reply().id(), 8u);
+  EXPECT_EQ(failed[0].message.session_reply().refused().reason(), "node 'x' cannot draw it: no");
+  EXPECT_FALSE(live_.is_loading("goose"));
+  EXPECT_FALSE(live_.has_asset("goose"));
+}
+
 }  // namespace
 }  // namespace optique::master
