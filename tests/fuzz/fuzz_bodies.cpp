@@ -4,6 +4,7 @@
 #include <bit>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "master/session/journal.h"
@@ -405,8 +406,18 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
     bool closed = false;
     int replies = 0;
     int journalled = 0;
+    std::optional<master::session_action::LoadAsset> loading;
     for (const master::SessionAction& action : actions) {
       closed = closed || std::holds_alternative<master::session_action::Close>(action);
+      if (const auto* load = std::get_if<master::session_action::LoadAsset>(&action)) {
+        // An asset to load: a valid id, now taken, from one source; answered later.
+        OPTIQUE_FUZZ_REQUIRE(message.session_request().has_load_asset() && !loading);
+        OPTIQUE_FUZZ_REQUIRE(scene::is_instance_id(load->asset) && live.is_loading(load->asset));
+        OPTIQUE_FUZZ_REQUIRE(load->path.empty() != load->glb.empty());
+        OPTIQUE_FUZZ_REQUIRE(load->path.find("..") == std::string::npos);
+        loading = *load;
+        continue;
+      }
       if (const auto* entry = std::get_if<master::session_action::Journal>(&action)) {
         // What is journalled reads back as the transaction, in this frame, before its reply.
         OPTIQUE_FUZZ_REQUIRE(replies == 0);
@@ -452,7 +463,20 @@ std::string session(std::span<const std::uint8_t> input, Outcome& out) {
       }
     }
     const bool request = message.has_session_request() && message.protocol_version() == net::kProtocolVersion;
-    OPTIQUE_FUZZ_REQUIRE(replies == (request ? 1 : 0));
+    OPTIQUE_FUZZ_REQUIRE(replies + (loading ? 1 : 0) == (request ? 1 : 0));
+    if (loading) {
+      // The shell loaded it, or not (as the chunk's last byte says): the
+      // application hears so, and only a usable asset is journalled, first.
+      const bool usable = (chunk.back() & 1) != 0;
+      const master::SessionActions answered =
+          usable ? sessions.asset_loaded(loading->asset, frame, false, "/fuzz/" + loading->asset + ".glb", "sha")
+                 : sessions.asset_failed(loading->asset, "load_asset", "fuzz");
+      const auto* sent = answered.empty() ? nullptr : std::get_if<master::session_action::Send>(&answered.back());
+      OPTIQUE_FUZZ_REQUIRE(sent != nullptr && sent->message.session_reply().id() == message.session_request().id());
+      OPTIQUE_FUZZ_REQUIRE(sent->message.session_reply().has_applied() == usable);
+      OPTIQUE_FUZZ_REQUIRE(!usable || std::holds_alternative<master::session_action::Journal>(answered.front()));
+      OPTIQUE_FUZZ_REQUIRE(live.has_asset(loading->asset) == usable && !live.is_loading(loading->asset));
+    }
     OPTIQUE_FUZZ_REQUIRE(request || closed || message.has_heartbeat());
     if (auto broken = check_live(live, limits, frame, previous); !broken.empty()) return broken;
     if (closed) break;

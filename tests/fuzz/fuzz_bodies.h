@@ -62,6 +62,7 @@ struct Outcome {
   int closes = 0;                      // run_node: messages that made it close or stop
   int configured = 0;                  // run_node: times the node set its renderer up
   int scene_chunks = 0;                // run_node: chunks of a scene's files it stored
+  int assets_readied = 0;              // run_node: assets offered in the frames it readied
   scene::SceneManifest scene_files{};  // run_node: the scene being fetched
   bool finished = false;               // run_protocol: the master's run ended
   int datagrams_parsed = 0;            // run_tracker: datagrams parse_dtrack took

@@ -119,6 +119,15 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
             [&](node::FinishScene&) {
               broken = carry_out(node, node.answer(node::SceneCopyFinished{std::string("fuzz.gltf")}, 0), light_count, outcome);
             },
+            // An asset offered in the frames: its files here, a checked offer, given to the renderer.
+            [&](node::ReadyAsset& a) {
+              if (a.asset.path.empty() || !scene::is_instance_id(a.asset.asset) || a.asset.files.files.empty()) {
+                broken = "an asset readied without its files or its id";
+              } else {
+                ++outcome.assets_readied;
+                broken = carry_out(node, node.answer(node::AssetLoaded{a.asset.asset, {}}, 0), light_count, outcome);
+              }
+            },
             [](auto&) {},
         },
         action);

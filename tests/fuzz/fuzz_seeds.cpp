@@ -664,6 +664,18 @@ std::vector<Seed> node_seeds() {
                      node_seed(with_files, {chunk(0, 0, gltf), chunk(1, 0, spoilt), chunk(1, 1, bin.substr(4096)),
                                             chunk(1, 0, bin.substr(0, 4096)), frame_and_swap(0), frame_and_swap(1)})});
     seeds.push_back({"scene_chunk_not_asked_for", node_seed(with_files, {chunk(1, 7, "x"), frame_and_swap(0)})});
+    // The same files as an asset an application loaded, offered in the
+    // frames and fetched beside them; then an offer that is not one.
+    const auto offer = [&](const std::string& id, const std::string& sha256) {
+      wire::Envelope e = envelope(sequence++);
+      *e.mutable_asset_offer() = protocol::to_wire(protocol::AssetOffer{id, sha256, files, ""});
+      return serialize(e);
+    };
+    const std::string sha256 = scene::manifest_sha256(files);
+    seeds.push_back({"asset_offered_in_the_frames",
+                     node_seed(welcome, {frame_and_swap(0), offer("duck", sha256), chunk(0, 0, gltf), frame_and_swap(1),
+                                         chunk(1, 0, bin.substr(0, 4096)), chunk(1, 1, bin.substr(4096)),
+                                         frame_and_swap(2), offer("goose", std::string(64, 'f')), frame_and_swap(3)})});
   }
   return seeds;
 }
@@ -789,6 +801,17 @@ Bytes subscribe(std::uint64_t id, bool frames) {
   return serialize(e);
 }
 
+Bytes load_asset(std::uint64_t id, const std::string& asset, const std::string& path, const std::string& glb) {
+  wire::Envelope e;
+  e.set_protocol_version(net::kProtocolVersion);
+  e.mutable_session_request()->set_id(id);
+  auto& load = *e.mutable_session_request()->mutable_load_asset();
+  load.set_asset(asset);
+  if (!path.empty()) load.set_path(path);
+  if (!glb.empty()) load.set_glb(glb);
+  return serialize(e);
+}
+
 Bytes read_scene(std::uint64_t id) {
   wire::Envelope e;
   e.set_protocol_version(net::kProtocolVersion);
@@ -801,6 +824,14 @@ Bytes read_scene(std::uint64_t id) {
 
 std::vector<Seed> session_seeds() {
   std::vector<Seed> seeds;
+  // Assets loaded from a path and uploaded, each answered usable or not by
+  // the fuzz's shell; instances of them; and loads refused.
+  seeds.push_back({"load_assets", join({load_asset(1, "duck", "models/duck.gltf", ""), kNextFrame,
+                                        load_asset(2, "goose", "", "glTF" + std::string(20, '\2')), kNextFrame,
+                                        request(3, {create("d1", "duck"), create("g1", "goose", "d1")}),
+                                        load_asset(4, "a b", "x.gltf", ""), load_asset(5, "up", "../x.gltf", ""),
+                                        load_asset(6, "junk", "", "not a glb at all"), load_asset(7, "none", "", ""),
+                                        read_scene(8)})});
   seeds.push_back({"place_move_remove",
                    join({request(1, {create("table", "torus"), create("cup", "duck", "table", 0.5)}), kNextFrame,
                          request(2, {move("table", {1, 0, 0}, {0, 0, 1, 0}, {2}),

@@ -122,6 +122,7 @@ TEST(FuzzReplay, NodeCorpusHoldsInvariants) {
   int renders = 0;
   int closes = 0;
   int scene_chunks = 0;
+  int assets_readied = 0;
   for (const fs::path& file : corpus_files("node")) {
     const Outcome outcome = run_node(read_bytes(file));
     EXPECT_TRUE(outcome.broken.empty()) << file << ": " << outcome.broken;
@@ -129,10 +130,12 @@ TEST(FuzzReplay, NodeCorpusHoldsInvariants) {
     renders += outcome.renders;
     closes += outcome.closes;
     scene_chunks += outcome.scene_chunks;
+    assets_readied += outcome.assets_readied;
   }
   EXPECT_GE(inputs, 8);
   EXPECT_GE(renders, 4) << "some frames are drawn";
   EXPECT_GE(scene_chunks, 3) << "a scene's files are fetched";
+  EXPECT_GE(assets_readied, 1) << "an asset offered in the frames is readied";
   EXPECT_GE(closes, 5) << "and the bad ones refused";
 }
 
