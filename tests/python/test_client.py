@@ -199,17 +199,37 @@ class OnAWall(unittest.TestCase):
             with wall.transaction() as t:
                 t.remove("clip")
 
+    def test_an_asset_is_loaded_from_the_masters_folder_and_refused_with_its_field(self):
+        with self.connect() as wall:
+            frame = wall.load_asset("torus-file", path="assets/torus/torus.gltf")
+            self.assertIn("torus-file", wall.read_scene().assets)
+            with wall.transaction() as t:
+                t.create("ring", "torus-file", position=(0.0, 0.0, 0.3))
+            self.assertGreaterEqual(t.frame, frame)
+            with self.assertRaises(optique.Refused) as refused:
+                wall.load_asset("elsewhere", path="../../etc/passwd")
+            self.assertEqual(refused.exception.field, "load_asset.path")
+            with self.assertRaises(optique.Refused) as refused:
+                wall.load_asset("junk", glb=b"not a glb")
+            self.assertEqual(refused.exception.field, "load_asset.glb")
+            with self.assertRaises(ValueError):
+                wall.load_asset("both", path="a.gltf", glb=b"glTF")
+            with wall.transaction() as t:
+                t.remove("ring")
+
     def test_the_circle_example(self):
         run = subprocess.run([sys.executable, str(EXAMPLES / "circle.py"), "--port", str(self.master.port),
                               "--seconds", "1.5"], capture_output=True, text=True, timeout=60)
         self.assertEqual(run.returncode, 0, run.stdout + run.stderr)
         self.assertIn("placed from frame", run.stdout)
+        self.assertIn("loaded 'model-torus' from ", run.stdout)
         self.assertIn("switched a light 2 times", run.stdout)  # at 0 s and at 1 s
         with self.connect() as wall:
             contents = wall.read_scene()
             self.assertTrue(all(light.on for light in contents.lights), "every light on again at the end")
             names = {i.instance for i in contents.instances}
             self.assertEqual(names & {"orbit", "beacon"}, {"orbit", "beacon"})
+            self.assertEqual({i.asset for i in contents.instances if i.instance == "orbit"}, {"model-torus"})
             with wall.transaction() as t:
                 t.remove("orbit").remove("beacon")
 

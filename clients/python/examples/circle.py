@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
-"""Places two copies of the installation's scene and moves one on a circle in
-front of the wall, once a frame, for a few seconds, with a warm point light
-of its own riding above it; the other turns red and back, and the scene's
-point lights go dark one at a time, a second each. Run it against a master
-with master.api on, e.g.:
+"""Loads a model (the repository's torus, uploaded as a .glb) and moves it on
+a circle in front of the wall, once a frame, for a few seconds, with a warm
+point light of its own riding above it; a copy of the installation's scene
+turns red and back, and the scene's point lights go dark one at a time, a
+second each. Run it against a master with master.api on, e.g.:
 
     optique-master --config configs/powerwall-2x2-api.json --local
     python3 circle.py --seconds 10
@@ -12,6 +12,7 @@ with master.api on, e.g.:
 import argparse
 import math
 import time
+from pathlib import Path
 
 import optique
 
@@ -23,11 +24,21 @@ def main() -> None:
     parser.add_argument("--secret-file", help="the installation's shared secret, where the master needs it")
     parser.add_argument("--seconds", type=float, default=5.0)
     parser.add_argument("--radius", type=float, default=0.4, help="metres")
+    torus = Path(__file__).resolve().parents[3] / "configs" / "assets" / "torus" / "torus.glb"
+    parser.add_argument("--model", default=str(torus) if torus.is_file() else "",
+                        help="a binary glTF (.glb) to upload and move on the circle (empty: the installation's scene)")
     args = parser.parse_args()
 
     with optique.connect(args.host, args.port, name="circle", secret_file=args.secret_file) as wall:
         asset = wall.scene.assets[0]  # the installation's own scene
-        print(f"connected; {len(wall.scene.instances)} instance(s) already placed; placing '{asset}'")
+        model = asset
+        if args.model:
+            model = "model-" + "".join(c if c.isalnum() or c in "-_." else "-" for c in Path(args.model).stem)[:50]
+            if model not in wall.scene.assets:  # an asset id names one content for good
+                with open(args.model, "rb") as glb:
+                    frame = wall.load_asset(model, glb=glb.read())
+                print(f"loaded '{model}' from {args.model}: every node draws it from frame {frame}")
+        print(f"connected; {len(wall.scene.instances)} instance(s) already placed; placing '{model}' and '{asset}'")
         with wall.transaction() as t:
             # Replace what an earlier run of this example left (a master restarted from its journal keeps it).
             for instance in wall.scene.instances:
@@ -35,7 +46,7 @@ def main() -> None:
                     t.remove(instance.instance)
             for light in wall.scene.point_lights:
                 t.remove_point_light(light.light)
-            t.create("orbit", asset, position=(args.radius, 0.0, 0.3), scale=0.25)
+            t.create("orbit", model, position=(args.radius, 0.0, 0.3), scale=0.25)
             t.create("beacon", asset, position=(0.0, 0.0, 0.3), scale=0.15)
         print(f"placed from frame {t.frame}")
         start = time.monotonic()
