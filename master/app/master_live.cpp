@@ -69,10 +69,12 @@ Result<void> Master::make_live_scene(RunSettings& run) {
   if (settings.api) {
     // Uploads beside the journal, so that a restart finds them; without one,
     // for this run only.
-    const std::string uploads =
+    const SessionPort::Uploads uploads =
         !record.empty()
-            ? record + ".assets"
-            : (std::filesystem::temp_directory_path() / ("optique-assets-" + std::to_string(getpid()))).string();
+            ? SessionPort::Uploads{record + ".assets", false}
+            : SessionPort::Uploads{
+                  (std::filesystem::temp_directory_path() / ("optique-assets-" + std::to_string(getpid()))).string(),
+                  true};
     session_port_.emplace(io_, *settings.api, *live_, std::move(journal_file), options_.run.secret,
                           settings.max_message_bytes, uploads, log_);
   }

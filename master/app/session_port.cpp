@@ -72,7 +72,7 @@ constexpr std::size_t kMaxWebSocketQueuedBytes = 64u << 20;
 
 SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings, LiveScene& live,
                          std::optional<JournalFile> journal, std::optional<net::Secret> secret,
-                         std::uint32_t max_message_bytes, std::string uploads, spdlog::logger& log)
+                         std::uint32_t max_message_bytes, Uploads uploads, spdlog::logger& log)
     : io_(io),
       settings_(settings),
       max_message_bytes_(max_message_bytes),
@@ -85,6 +85,14 @@ SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings
                                            .assets_folder = settings.assets}),
       listener_(io, log),
       uploads_(std::move(uploads)) {}
+
+SessionPort::~SessionPort() {
+  loader_.join();  // no load writes there any more
+  if (uploads_.for_this_run_only) {
+    std::error_code ignored;
+    std::filesystem::remove_all(uploads_.folder, ignored);
+  }
+}
 
 Result<std::uint16_t> SessionPort::start(std::function<std::uint64_t()> next_frame) {
   next_frame_ = std::move(next_frame);
@@ -186,20 +194,21 @@ std::optional<std::size_t> SessionPort::queued_bytes(SessionId session) const {
 
 void SessionPort::load(session_action::LoadAsset load) {
   const std::weak_ptr<bool> alive = alive_;
-  asio::post(loader_, [this, &io = io_, alive, folder = settings_.assets, uploads = uploads_, load = std::move(load)] {
-    AssetRead read = read_asset(load, folder, uploads);
-    asio::post(io, [this, alive, id = load.asset, from_file = !load.path.empty(), read = std::move(read)] {
-      if (alive.expired()) return;
-      if (!read.asset) {
-        carry_out(sessions_.asset_failed(id, from_file ? "load_asset.path" : "load_asset.glb", read.error));
-        return;
-      }
-      for (const std::string& warning : read.asset->warnings) log_.warn("asset '{}': {}", id, warning);
-      for (const std::string& note : read.asset->notes) log_.info("asset '{}': {}", id, note);
-      loaded_[id] = Loaded{read.asset->source, read.asset->content_sha256, !read.asset->definition.objects.empty()};
-      if (asset_loaded_) asset_loaded_(id, read.asset);
-    });
-  });
+  asio::post(
+      loader_, [this, &io = io_, alive, folder = settings_.assets, uploads = uploads_.folder, load = std::move(load)] {
+        AssetRead read = read_asset(load, folder, uploads);
+        asio::post(io, [this, alive, id = load.asset, from_file = !load.path.empty(), read = std::move(read)] {
+          if (alive.expired()) return;
+          if (!read.asset) {
+            carry_out(sessions_.asset_failed(id, from_file ? "load_asset.path" : "load_asset.glb", read.error));
+            return;
+          }
+          for (const std::string& warning : read.asset->warnings) log_.warn("asset '{}': {}", id, warning);
+          for (const std::string& note : read.asset->notes) log_.info("asset '{}': {}", id, note);
+          loaded_[id] = Loaded{read.asset->source, read.asset->content_sha256, !read.asset->definition.objects.empty()};
+          if (asset_loaded_) asset_loaded_(id, read.asset);
+        });
+      });
 }
 
 void SessionPort::asset_usable(const std::string& id, std::uint64_t frame) {

@@ -31,10 +31,18 @@ class SessionPort {
   // it must outlive this); with `journal`, each transaction applied is
   // appended to it before the application hears so.
   // An asset an application uploaded is kept in `uploads` (made when first
-  // needed), by its SHA-256: beside the journal, so that a restart finds it.
+  // needed), by its SHA-256: beside the journal, so that a restart finds it;
+  // without a journal, a folder of this run's own, removed when the port goes.
+  struct Uploads {
+    std::string folder;
+    bool for_this_run_only = false;
+  };
   SessionPort(asio::io_context& io, const config::ApiServer& settings, LiveScene& live,
               std::optional<JournalFile> journal, std::optional<net::Secret> secret, std::uint32_t max_message_bytes,
-              std::string uploads, spdlog::logger& log);
+              Uploads uploads, spdlog::logger& log);
+  ~SessionPort();
+  SessionPort(const SessionPort&) = delete;
+  SessionPort& operator=(const SessionPort&) = delete;
   // Where an asset an application loaded goes once it is read and checked
   // (off this thread; the hook runs on it): the master offers it to the nodes,
   // then says asset_usable() or asset_unusable().
@@ -81,7 +89,7 @@ class SessionPort {
   std::map<SessionId, std::shared_ptr<net::Connection>> connections_;
   std::map<SessionId, std::shared_ptr<http::WebSocketPeer>> websockets_;
   SessionId next_id_ = 1;
-  const std::string uploads_;
+  const Uploads uploads_;
   AssetLoaded asset_loaded_;
   struct Loaded {
     std::string path;

@@ -339,6 +339,43 @@ TEST_F(SceneRendererTest, LiveInstancesOfTheSceneAreDrawnWhereTheirParentsPutThe
   EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.0f, kTolerance);
 }
 
+// An asset an application loaded: its instances are drawn from its own
+// meshes and materials once the renderer has it (before, none is), beside the
+// scene's, and with its parents among the scene's instances; loaded again
+// under the same id, the new content replaces the old.
+TEST_F(SceneRendererTest, InstancesOfALoadedAssetAreDrawnFromItsOwnContent) {
+  auto renderer = SceneRenderer::create(emissive_square(), kSize, kSize);
+  ASSERT_TRUE(renderer.ok()) << renderer.error();
+  const auto channel = [&](const scene::SceneState& state, int x, int y, int c) {
+    renderer.value()->draw(state, {0.0, kEye, view_of_unit_square()});
+    return renderer.value()->read_rendered().at(x, y, c);
+  };
+  scene::SceneDefinition red = emissive_square();
+  red.asset_id = "red";
+  red.materials[0].emissive = glm::vec3(0.75f, 0.0f, 0.0f);
+  scene::SceneState state;
+  state.instances["r"] = square_at(0.5, 0.5);
+  state.instances["r"].asset = "red";
+  EXPECT_NEAR(channel(state, kFar, kNear, 0), 0.0f, kTolerance) << "not loaded yet: not drawn";
+  ASSERT_TRUE(renderer.value()->add_asset(red).ok());
+  EXPECT_NEAR(channel(state, kFar, kNear, 0), 0.75f, kTolerance);
+  EXPECT_NEAR(channel(state, kFar, kNear, 1), 0.0f, kTolerance);
+  EXPECT_NEAR(channel(state, kSize / 2, kSize / 2, 1), 0.5f, kTolerance) << "the scene is still drawn";
+  // Under an instance of the scene moved to (0.5, 0): (0, 0.5) lands at (0.5, 0.5).
+  state.instances["group"] = square_at(0.5, 0.0);
+  state.instances["r"].pose = square_at(0.0, 0.5).pose;
+  state.instances["r"].parent = "group";
+  EXPECT_NEAR(channel(state, kFar, kNear, 0), 0.75f, kTolerance);
+  red.materials[0].emissive = glm::vec3(0.0f, 0.0f, 0.5f);
+  ASSERT_TRUE(renderer.value()->add_asset(red).ok());
+  EXPECT_NEAR(channel(state, kFar, kNear, 0), 0.0f, kTolerance);
+  EXPECT_NEAR(channel(state, kFar, kNear, 2), 0.5f, kTolerance);
+  scene::SceneDefinition broken = red;
+  broken.asset_id = "broken";
+  broken.instances[0].mesh = 7;
+  EXPECT_FALSE(renderer.value()->add_asset(broken).ok());
+}
+
 // A point light an application added lights the scene as the scene's own
 // would: where the state puts it, as bright as it says, not when it is off,
 // not by a node whose share leaves it out, and never over one of the scene's

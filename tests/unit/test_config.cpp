@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "config/asset_path.h"
+
 #include <algorithm>
 
 #include <cmath>
@@ -522,6 +524,11 @@ TEST(ParseInstallation, TheSceneSessionPort) {
   EXPECT_EQ(api.max_sessions, 16u);
   EXPECT_EQ(api.max_edits_per_frame, 100000u);
   EXPECT_EQ(api.max_instances, 100000u);
+  EXPECT_EQ(api.assets, resolve_asset(".", test_dir())) << "assets from the config's folder";
+  EXPECT_TRUE(std::filesystem::path(api.assets).is_absolute());
+  parsed = parse(with(R"("port": 7400)", R"("port": 7400, "api": {"assets": "models/../assets"})"));
+  ASSERT_TRUE(parsed.ok()) << parsed.error();
+  EXPECT_EQ(parsed.value().master.api->assets, resolve_asset("assets", test_dir()));
   parsed = parse(with(R"("port": 7400)", R"("port": 7400, "api": {"port": 0, "max_sessions": 2})"));
   ASSERT_TRUE(parsed.ok()) << parsed.error();
   EXPECT_EQ(parsed.value().master.api->port, 0u);
