@@ -80,6 +80,7 @@ void Node::connect() {
                     carry_out(protocol_.message(message, received));
                   },
                   [this](const std::string& reason) { carry_out(protocol_.closed(reason, clock::monotonic_now())); },
+                  {},  // a master's message over the size closes it
               });
               log_.debug("connected to the master at {}", connection_->peer());
               carry_out(protocol_.connected(clock::monotonic_now(), net::random_nonce()));

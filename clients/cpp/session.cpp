@@ -175,7 +175,11 @@ Result<session::Reply> Session::ask(session::Request request) {
     if (!got) return Error{got.error()};
     if (got.value().has_session_event()) {
       events_.push_back(std::move(*got.value().mutable_session_event()));
-    } else if (got.value().has_session_reply() && got.value().session_reply().id() == id) {
+    } else if (got.value().has_session_reply() &&
+               (got.value().session_reply().id() == id ||
+                (got.value().session_reply().id() == 0 && got.value().session_reply().has_refused()))) {
+      // Id 0: the master could not read the request (too large, or not one);
+      // one request is out at a time, so it is this one.
       return std::move(*got.value().mutable_session_reply());
     }
   }

@@ -19,6 +19,7 @@ Connection::Connection(asio::ip::tcp::socket socket, std::uint32_t max_payload_b
       liveness_timer_(socket_.get_executor()),
       deadline_timer_(socket_.get_executor()),
       reader_(max_payload_bytes),
+      reader_max_(max_payload_bytes),
       last_receive_(std::chrono::steady_clock::now()) {
   boost::system::error_code ec;
   socket_.set_option(asio::ip::tcp::no_delay(true), ec);
@@ -148,6 +149,13 @@ void Connection::handle_bytes(std::size_t count, clock::Nanos received) {
       close("bad frame: " + frame.error);
       return;
     }
+    if (frame.status == DecodeStatus::oversized) {
+      // Not read: the next message is the one after it in the seal's count and the sequence.
+      if (opener_) opener_->skip();
+      ++next_receive_sequence_;
+      if (handlers_.on_oversized) handlers_.on_oversized(frame.length, reader_max_);
+      continue;
+    }
     std::span<const std::uint8_t> payload = frame.payload;
     std::vector<std::uint8_t> opened;
     if (opener_) {
@@ -252,6 +260,7 @@ void Connection::cancel_deadline() {
 
 void Connection::set_max_payload_bytes(std::uint32_t max_payload_bytes) {
   reader_.set_max_payload_bytes(max_payload_bytes);
+  reader_max_ = max_payload_bytes;
 }
 
 void Connection::finish(const std::string& reason) {

@@ -35,6 +35,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
     std::function<void(wire::Envelope& message, clock::Nanos received)> on_message;
     // Called once, when the connection is gone for any reason.
     std::function<void(const std::string& reason)> on_closed;
+    // With skip_oversized(): a message over the maximum was passed over
+    // (`bytes` long); the connection goes on.
+    std::function<void(std::uint32_t bytes, std::uint32_t max_bytes)> on_oversized;
   };
 
   static std::shared_ptr<Connection> create(asio::ip::tcp::socket socket, std::uint32_t max_payload_bytes);
@@ -63,6 +66,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void cancel_deadline();
   // The largest frame accepted from now on (small before a peer has identified itself).
   void set_max_payload_bytes(std::uint32_t max_payload_bytes);
+  // A message over that size is passed over and told to on_oversized (the
+  // peer may be told and go on), instead of closing the connection.
+  void skip_oversized() { reader_.set_skip_oversized(true); }
   // From now on every message sent is sealed with `send` and every message
   // received must open with `receive` (net/session_seal.h); one that does not
   // closes the connection. `unsealed_refusal_first`: the first message may
@@ -95,6 +101,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   asio::steady_timer liveness_timer_;
   asio::steady_timer deadline_timer_;
   FrameReader reader_;
+  std::uint32_t reader_max_;  // its maximum, for on_oversized
   Handlers handlers_;
   std::string peer_;
   std::array<std::uint8_t, 64 * 1024> read_buffer_{};

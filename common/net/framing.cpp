@@ -16,6 +16,7 @@ DecodedFrame decode_frame(std::span<const std::uint8_t> bytes, std::uint32_t max
   }
   if (length > max_payload_bytes) {
     frame.status = DecodeStatus::bad;
+    frame.length = length;
     frame.error =
         "frame of " + std::to_string(length) + " bytes exceeds the maximum of " + std::to_string(max_payload_bytes);
     return frame;
@@ -59,8 +60,20 @@ DecodedFrame FrameReader::next() {
     bad.error = failure_;
     return bad;
   }
+  if (skipping_ > 0) {
+    const std::uint64_t dropped = std::min<std::uint64_t>(skipping_, buffer_.size() - read_pos_);
+    read_pos_ += static_cast<std::size_t>(dropped);
+    skipping_ -= dropped;
+    if (skipping_ > 0) return DecodedFrame{};
+  }
   const std::span<const std::uint8_t> pending(buffer_.data() + read_pos_, buffer_.size() - read_pos_);
   DecodedFrame frame = decode_frame(pending, max_payload_bytes_);
+  if (frame.status == DecodeStatus::bad && frame.length > 0 && skip_oversized_) {
+    read_pos_ += kFrameHeaderBytes;
+    skipping_ = frame.length;
+    frame.status = DecodeStatus::oversized;
+    return frame;
+  }
   if (frame.status == DecodeStatus::good) {
     read_pos_ += frame.consumed;
   } else if (frame.status == DecodeStatus::bad) {

@@ -70,6 +70,9 @@ class Opener {
   // for a tag, or it does not open (forged, changed, replayed, reordered, or a
   // frame missing before it). After a failure the session is over.
   [[nodiscard]] Result<std::vector<std::uint8_t>> open(std::span<const std::uint8_t> sealed);
+  // The next frame in order was not read (too large to take): the one after
+  // it opens with the count after its.
+  void skip() { ++count_; }
 
  private:
   CipherContextPtr context_;

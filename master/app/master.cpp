@@ -241,6 +241,7 @@ void Master::on_accepted(asio::ip::tcp::socket socket, const std::string& peer_t
         connections_.erase(id);
         carry_out(protocol_->closed(id, reason, clock::monotonic_now()));
       },
+      {},  // a node's message over the size closes it
   });
   carry_out(protocol_->accepted(id, peer_text, loopback, net::random_nonce(), clock::monotonic_now()));
 }

@@ -169,6 +169,12 @@ void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& p
         connections_.erase(id);
         carry_out(sessions_.closed(id, reason));
       },
+      [this, id](std::uint32_t bytes, std::uint32_t max_bytes) {
+        carry_out(sessions_.unreadable(
+            id, std::to_string(bytes) + " bytes, more than the " + std::to_string(max_bytes) +
+                    " this master takes (master.max_message_bytes): send less at once (a large model: put its file "
+                    "in master.api.assets and load it by path)"));
+      },
   });
   carry_out(sessions_.accepted(id, peer_text, loopback, net::random_nonce()));
 }
@@ -255,8 +261,10 @@ void SessionPort::carry_out(SessionActions actions) {
                      }
                    },
                    [&](session_action::SetMaxPayload& a) {
+                     // Past its hello: a message over the size is refused, and the session goes on.
                      if (auto found = connections_.find(a.session); found != connections_.end()) {
                        found->second->set_max_payload_bytes(a.bytes);
+                       found->second->skip_oversized();
                      }
                    },
                    [&](session_action::Protect& a) {

@@ -30,7 +30,7 @@ namespace optique::master {
 inline constexpr std::string_view kJournalMagic = "optique journal 1\n";
 
 // The largest entry a journal holds: a transaction is bounded by the session's
-// message limit (master.max_message_mb), far below this.
+// message limit (master.max_message_bytes), far below this.
 inline constexpr std::uint32_t kMaxJournalEntryBytes = 1u << 30;
 
 // An entry as it is appended after the magic: its length (4 bytes,

@@ -119,6 +119,43 @@ std::string frames(std::span<const std::uint8_t> input, Outcome& out) {
     OPTIQUE_FUZZ_REQUIRE(reader.buffered_bytes() == expected_left);
   }
 
+  // The same stream, cut the same way, through a reader that passes over
+  // oversized frames: every good frame and every oversized one's length, in
+  // order, as the stream decoded in place has them; nothing of a skipped
+  // payload is ever held.
+  std::vector<std::pair<std::uint32_t, Bytes>> skip_expected;  // (oversized length or 0, payload)
+  for (std::size_t pos = 0; pos < stream.size();) {
+    const net::DecodedFrame frame = net::decode_frame(stream.subspan(pos), kMaxPayloadBytes);
+    if (frame.status == net::DecodeStatus::good) {
+      skip_expected.emplace_back(0, Bytes(frame.payload.begin(), frame.payload.end()));
+      pos += frame.consumed;
+    } else if (frame.status == net::DecodeStatus::bad && frame.length > 0) {
+      skip_expected.emplace_back(frame.length, Bytes{});
+      pos += net::kFrameHeaderBytes + frame.length;
+    } else {
+      break;
+    }
+  }
+  net::FrameReader skipper(kMaxPayloadBytes);
+  skipper.set_skip_oversized(true);
+  std::vector<std::pair<std::uint32_t, Bytes>> skip_got;
+  rng_state = piece * 0x9E3779B9u + 0x7F4A7C15u;
+  for (std::size_t pos = 0; pos < stream.size();) {
+    std::size_t size = stream.size() - pos;
+    if (piece != 0) size = std::min<std::size_t>(size, 1 + next_random(rng_state) % piece);
+    skipper.append(stream.subspan(pos, size));
+    pos += size;
+    for (net::DecodedFrame frame = skipper.next();
+         frame.status == net::DecodeStatus::good || frame.status == net::DecodeStatus::oversized;
+         frame = skipper.next()) {
+      OPTIQUE_FUZZ_REQUIRE(frame.status == net::DecodeStatus::good || frame.length > kMaxPayloadBytes);
+      skip_got.emplace_back(frame.status == net::DecodeStatus::good ? 0 : frame.length,
+                            Bytes(frame.payload.begin(), frame.payload.end()));
+    }
+    OPTIQUE_FUZZ_REQUIRE(skipper.buffered_bytes() <= kMaxPayloadBytes + net::kFrameHeaderBytes + size);
+  }
+  OPTIQUE_FUZZ_REQUIRE(skip_got == skip_expected);
+
   out.good_frames += static_cast<int>(got.size());
   for (const Bytes& payload : got) {
     auto envelope = net::parse_envelope(payload);

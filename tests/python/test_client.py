@@ -296,6 +296,7 @@ class WithTheSharedSecret(unittest.TestCase):
             wrong.chmod(0o600)
             config = json.loads(WALL.read_text())
             config["master"]["secret_file"] = str(secret)
+            config["master"]["max_message_bytes"] = 65536
             (folder / "wall.json").write_text(json.dumps(config))
             master = Master(folder, config=folder / "wall.json")
             try:
@@ -303,6 +304,15 @@ class WithTheSharedSecret(unittest.TestCase):
                     with wall.transaction() as t:
                         t.create("c", "cubes", position=(0.0, 1.0, 0.0))
                     self.assertEqual([i.instance for i in wall.read_scene().instances], ["c"])
+                    # An upload over the master's message size is refused, and the
+                    # sealed session goes on in step (the seal's count skips it).
+                    with self.assertRaises(optique.Refused) as too_large:
+                        wall.load_asset("big", glb=b"glTF" + bytes(100_000))
+                    self.assertEqual(too_large.exception.field, "request")
+                    self.assertIn("more than the 65536 this master takes", too_large.exception.reason)
+                    with wall.transaction() as t:
+                        t.move("c", position=(0.5, 1.0, 0.0))
+                    self.assertEqual(wall.read_scene().instances[0].transform.position[0], 0.5)
                 with self.assertRaises(optique.SessionRefused) as without:
                     optique.connect(port=master.port, name="open")
                 self.assertIn("requires the installation's shared secret", without.exception.reason)

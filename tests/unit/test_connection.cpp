@@ -38,6 +38,7 @@ struct Loopback {
   std::shared_ptr<Connection> server;
   std::vector<Received> received;
   std::string closed_reason;
+  std::vector<std::uint32_t> oversized;  // the lengths of messages passed over
 
   Loopback() {
     tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
@@ -46,7 +47,8 @@ struct Loopback {
     server->start({[this](wire::Envelope& message, clock::Nanos at) {
                      received.push_back({message, at, clock::monotonic_now()});
                    },
-                   [this](const std::string& reason) { closed_reason = reason; }});
+                   [this](const std::string& reason) { closed_reason = reason; },
+                   [this](std::uint32_t bytes, std::uint32_t) { oversized.push_back(bytes); }});
   }
 
   // Frames `count` pings (t1 = 1, 2, …) with sequence numbers from `first`.
@@ -117,6 +119,45 @@ TEST(Connection, ABurstLargerThanTheReadBufferArrivesWholeAndInOrder) {
   EXPECT_TRUE(loop.closed_reason.empty()) << loop.closed_reason;
 }
 
+// A connection that skips oversized messages passes over one (its bytes
+// dropped as they come, in any pieces), says how long it was, and reads the
+// next in the sequence; without skipping, one closes it.
+TEST(Connection, AnOversizedMessageIsPassedOverWhenAskedAndClosesOtherwise) {
+  {
+    Loopback loop;
+    loop.server->set_max_payload_bytes(64 * 1024);
+    loop.server->skip_oversized();
+    std::vector<std::uint8_t> bytes = Loopback::pings(1, 1);
+    const std::vector<std::uint8_t> large = Loopback::pings(2, 1, 300 * 1024);
+    const std::vector<std::uint8_t> after = Loopback::pings(3, 2);
+    bytes.insert(bytes.end(), large.begin(), large.end());
+    bytes.insert(bytes.end(), after.begin(), after.end());
+    std::thread writer([&] {
+      // In pieces that split the header and the payload anywhere.
+      for (std::size_t at = 0; at < bytes.size(); at += 7001) {
+        asio::write(loop.client, asio::buffer(bytes.data() + at, std::min<std::size_t>(7001, bytes.size() - at)));
+      }
+    });
+    loop.run_until([&] { return loop.received.size() == 3 || !loop.closed_reason.empty(); });
+    writer.join();
+    ASSERT_EQ(loop.received.size(), 3u) << loop.closed_reason;
+    EXPECT_EQ(loop.received[0].message.ping().t1(), 1);
+    EXPECT_EQ(loop.received[1].message.ping().t1(), 3);
+    EXPECT_EQ(loop.received[2].message.ping().t1(), 4);
+    ASSERT_EQ(loop.oversized.size(), 1u);
+    EXPECT_GT(loop.oversized[0], 300u * 1024);
+    EXPECT_TRUE(loop.closed_reason.empty()) << loop.closed_reason;
+  }
+  {
+    Loopback loop;
+    loop.server->set_max_payload_bytes(64 * 1024);
+    asio::write(loop.client, asio::buffer(Loopback::pings(1, 1, 300 * 1024)));
+    loop.run_until([&] { return !loop.closed_reason.empty(); });
+    EXPECT_NE(loop.closed_reason.find("exceeds the maximum of 65536"), std::string::npos) << loop.closed_reason;
+    EXPECT_TRUE(loop.oversized.empty());
+  }
+}
+
 TEST(Connection, NoMessageReachesItsHandlerBeforeStartReturns) {
   asio::io_context io;
   tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
@@ -125,7 +166,7 @@ TEST(Connection, NoMessageReachesItsHandlerBeforeStartReturns) {
   asio::write(client, asio::buffer(Loopback::pings(1, 3)));
   auto server = Connection::create(acceptor.accept(), kDefaultMaxPayloadBytes);
   int handled = 0;
-  server->start({[&](wire::Envelope&, clock::Nanos) { ++handled; }, [](const std::string&) {}});
+  server->start({[&](wire::Envelope&, clock::Nanos) { ++handled; }, [](const std::string&) {}, {}});
   EXPECT_EQ(handled, 0);
   const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
   while (handled < 3 && std::chrono::steady_clock::now() < give_up) io.run_for(std::chrono::milliseconds(5));

@@ -311,7 +311,11 @@ class Session:
             reply = self._receive()
             if reply.WhichOneof("body") == "session_event":
                 self._events.append(reply.session_event)
-            elif reply.WhichOneof("body") == "session_reply" and reply.session_reply.id == self._request:
+            elif reply.WhichOneof("body") == "session_reply" and (
+                    reply.session_reply.id == self._request or
+                    (reply.session_reply.id == 0 and reply.session_reply.WhichOneof("reply") == "refused")):
+                # Id 0: the master could not read the request (too large, or not
+                # one); one request is out at a time, so it is this one.
                 return reply.session_reply
 
     def transaction(self) -> Transaction:
