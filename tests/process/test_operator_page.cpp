@@ -204,6 +204,7 @@ TEST(OperatorPage, ThePageShowsAndEditsTheLiveScene) {
   const std::string config_path = dir + "/wall.json";
   const std::string token = wall_with_secret(dir, config_path, "127.0.0.1");
   ASSERT_EQ(token.size(), 64u);
+  std::filesystem::copy_file(std::string(OPTIQUE_SOURCE_DIR) + "/configs/assets/torus/torus.glb", dir + "/torus.glb");
   StatusRun run(config_path, "100000", {"--api-port", "0"});
   ASSERT_NE(run.port, 0) << run.master->output();
   WebSocketClient refused(run.port, "/api/session?application=script");
@@ -268,6 +269,29 @@ TEST(OperatorPage, ThePageShowsAndEditsTheLiveScene) {
   std::cout << "screenshot: " << shot << "\n";
   page("document.getElementById('remove').click(); 'removed'");
   ASSERT_TRUE(poll_until([&] { return instance("from-page").is_null(); }, 10s));
+
+  // An asset loaded from the page: a glTF in the config's folder (the assets
+  // folder by default), then one chosen on this computer that is no glTF
+  // (refused, naming why). The page lists the loaded one for its next add.
+  page("document.getElementById('load-id').value = 'ring'; document.getElementById('load-path').value = 'torus.glb';"
+       "document.getElementById('load').click(); 'loading'");
+  const auto assets = [&] { return ask({{"read_scene", nlohmann::json::object()}})["scene"]["assets"]; };
+  ASSERT_TRUE(poll_until([&] { return assets().dump().find("\"ring\"") != std::string::npos; }, 20s))
+      << page("document.getElementById('live-note').textContent");
+  EXPECT_TRUE(poll_until(
+      [&] { return page("Array.from(document.getElementById('add-asset').options).map((o) => o.value).join()") ==
+                   "cubes,ring"; },
+      5s));
+  EXPECT_TRUE(poll_until(
+      [&] { return page("document.getElementById('live-note').textContent").starts_with("loaded: every projector"); },
+      5s));
+  page("const chosen = new DataTransfer(); chosen.items.add(new File(['glTF not really'], 'fake.glb'));"
+       "document.getElementById('load-file').files = chosen.files;"
+       "document.getElementById('load-id').value = 'fake'; document.getElementById('load').click(); 'loading'");
+  EXPECT_TRUE(poll_until(
+      [&] { return page("document.getElementById('live-note').textContent").starts_with("refused: load_asset.glb: "); },
+      10s))
+      << page("document.getElementById('live-note').textContent");
   EXPECT_TRUE(poll_until([&] { return row("from-page", "id") == "none"; }, 5s));
   EXPECT_FALSE(instance("from-script").is_null()) << "the script's instance stays";
   EXPECT_TRUE(run.master->wait_for_output("application 'operator-page' connected from 127.0.0.1:", 1s));
