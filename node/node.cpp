@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "net/auth.h"
+#include "util/background_thread.h"
 #include "util/overloaded.h"
 
 namespace optique::node {
@@ -32,7 +33,13 @@ Node::Node(asio::io_context& io, NodeOptions options, Renderer& renderer, spdlog
       connect_timer_(io),
       present_timer_(io),
       signals_(io, SIGINT, SIGTERM),
-      scene_cache_(options_.cache_dir, log) {}
+      scene_cache_(options_.cache_dir, log) {
+  asio::post(loader_, [&log] {
+    if (const std::string why = util::lower_this_threads_priority(); !why.empty()) {
+      log.debug("the asset loader's thread keeps its priority: {}", why);
+    }
+  });
+}
 
 void Node::start() {
   signals_.async_wait([this](const boost::system::error_code& error, int signal) {

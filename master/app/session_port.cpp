@@ -7,6 +7,7 @@
 #include "master/session/session_json.h"
 #include "net/auth.h"
 #include "scene_load/installation_scene.h"
+#include "util/background_thread.h"
 #include "util/overloaded.h"
 #include "util/sha256.h"
 
@@ -84,7 +85,13 @@ SessionPort::SessionPort(asio::io_context& io, const config::ApiServer& settings
                                            .journal = journal_.has_value(),
                                            .assets_folder = settings.assets}),
       listener_(io, log),
-      uploads_(std::move(uploads)) {}
+      uploads_(std::move(uploads)) {
+  asio::post(loader_, [&log] {
+    if (const std::string why = util::lower_this_threads_priority(); !why.empty()) {
+      log.debug("the asset loader's thread keeps its priority: {}", why);
+    }
+  });
+}
 
 SessionPort::~SessionPort() {
   loader_.join();  // no load writes there any more

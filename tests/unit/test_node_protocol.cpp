@@ -666,14 +666,19 @@ struct TwoFileScene {
 class SceneFetchTest : public NodeTest {
  protected:
   // Through the challenge to the welcome of a glTF scene.
-  Actions welcome_with_files(NodeProtocol& node) {
+  Actions welcome_with_files(NodeProtocol& node) { return welcomed(node, welcome_of(scene_.files)); }
+  // Through the challenge to `welcome`.
+  Actions welcomed(NodeProtocol& node, const wire::Envelope& welcome) {
     (void)node.connected(now_);
     wire::Envelope challenge = envelope();
     challenge.mutable_challenge();
     (void)node.message(challenge, now_);
-    wire::Envelope welcome = envelope();
-    *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, scene_.files, 4, kPeriod, nullptr);
     return node.message(welcome, now_);
+  }
+  wire::Envelope welcome_of(const scene::SceneManifest& files, std::span<const protocol::AssetOffer> assets = {}) {
+    wire::Envelope welcome = envelope();
+    *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, files, 4, kPeriod, nullptr, assets);
+    return welcome;
   }
   wire::Envelope chunk(std::uint32_t file, std::uint64_t index, std::string data) {
     wire::Envelope e = envelope();
@@ -895,23 +900,16 @@ TEST_F(SceneFetchTest, ANodeWithoutARendererOrTooSmallALimitFetchesNothing) {
 
 TEST_F(SceneFetchTest, AWelcomeWhoseManifestDoesNotHashToTheSceneIsRefused) {
   NodeProtocol node(settings());
-  (void)node.connected(now_);
-  wire::Envelope challenge = envelope();
-  challenge.mutable_challenge();
-  (void)node.message(challenge, now_);
-  wire::Envelope welcome = envelope();
-  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, scene_.files, 4, kPeriod, nullptr);
+  wire::Envelope welcome = welcome_of(scene_.files);
   welcome.mutable_welcome()->mutable_scene_files()->mutable_files(1)->set_size(4999);
-  Actions a = node.message(welcome, now_);
+  Actions a = welcomed(node, welcome);
   ASSERT_NE(first<Stop>(a), nullptr);
   EXPECT_TRUE(logged(a, "does not hash to its SHA-256")) << "the manifest is the scene's identity";
 
   NodeProtocol other(settings());
-  (void)other.connected(now_);
-  (void)other.message(challenge, now_);
-  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, scene_.files, 4, kPeriod, nullptr);
+  welcome = welcome_of(scene_.files);
   welcome.mutable_welcome()->mutable_scene_files()->mutable_files(1)->set_path("../../etc/s.bin");
-  a = other.message(welcome, now_);
+  a = welcomed(other, welcome);
   ASSERT_NE(first<Stop>(a), nullptr);
   EXPECT_TRUE(logged(a, "leaves the scene's folder"));
 }
@@ -1048,13 +1046,7 @@ TEST_F(AssetTest, OffersWaitForTheFramesNeedNoFilesWithoutARendererAndAreChecked
   NodeSettings without = settings();
   without.needs_scene_files = false;
   NodeProtocol null_node(without);
-  (void)null_node.connected(now_);
-  wire::Envelope challenge = envelope();
-  challenge.mutable_challenge();
-  (void)null_node.message(challenge, now_);
-  wire::Envelope welcome = envelope();
-  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr);
-  ASSERT_NE(first<Configure>(null_node.message(welcome, now_)), nullptr);
+  ASSERT_NE(first<Configure>(welcomed(null_node, welcome_of({}))), nullptr);
   EXPECT_TRUE(readies(null_node.message(offer("duck"), now_)).empty()) << "not in the frames yet";
   (void)null_node.answer(Configured{{}, "null", {}}, now_);
   wire::Envelope resync = envelope();
@@ -1082,14 +1074,9 @@ TEST_F(AssetTest, OffersWaitForTheFramesNeedNoFilesWithoutARendererAndAreChecked
 // renderer is configured, which gets their paths.
 TEST_F(AssetTest, AWelcomesAssetsAreFetchedBeforeTheNodeIsConfigured) {
   NodeProtocol node(settings());
-  (void)node.connected(now_);
-  wire::Envelope challenge = envelope();
-  challenge.mutable_challenge();
-  (void)node.message(challenge, now_);
-  wire::Envelope welcome = envelope();
   const std::vector<protocol::AssetOffer> assets{{"duck", scene_.sha256, scene_.files, ""}};
-  *welcome.mutable_welcome() = protocol::encode_welcome(wall_, 0, {}, 4, kPeriod, nullptr, assets);
-  Actions a = node.message(welcome, now_);
+  const wire::Envelope welcome = welcome_of({}, assets);
+  Actions a = welcomed(node, welcome);
   ASSERT_NE(first<PrepareScene>(a), nullptr);
   EXPECT_TRUE(first<PrepareScene>(a)->wait_for_others) << "setting up, another node's copy is waited for";
   EXPECT_EQ(first<Configure>(a), nullptr);
@@ -1099,9 +1086,7 @@ TEST_F(AssetTest, AWelcomesAssetsAreFetchedBeforeTheNodeIsConfigured) {
   EXPECT_EQ(first<Configure>(a)->job.assets[0].path, "/cache/scenes/d/s.gltf");
   // A cache that cannot hold it stops the node, as for the scene.
   NodeProtocol full(settings());
-  (void)full.connected(now_);
-  (void)full.message(challenge, now_);
-  (void)full.message(welcome, now_);
+  (void)welcomed(full, welcome);
   a = full.answer(SceneCopyStarted{Error{"no room"}}, now_);
   ASSERT_NE(first<Stop>(a), nullptr);
   EXPECT_TRUE(logged(a, "cannot keep the asset 'duck' here: no room"));
