@@ -21,6 +21,7 @@
 #include "local_capture.h"
 #include "process.h"
 #include "scratch.h"
+#include "wall_session.h"
 
 namespace optique::testing {
 namespace {
@@ -33,15 +34,6 @@ const std::string kTorusGlb = std::string(OPTIQUE_SOURCE_DIR) + "/configs/assets
 constexpr int kFrames = 360;
 constexpr int kCaptureEvery = 60;
 
-image::FloatImage stitched(const std::string& out, std::uint64_t frame) {
-  image::FloatImage wall(640, 360, 4);
-  image::paste(wall, capture(out, "top-left", frame), 0, 0);
-  image::paste(wall, capture(out, "top-right", frame), 320, 0);
-  image::paste(wall, capture(out, "bottom-left", frame), 0, 180);
-  image::paste(wall, capture(out, "bottom-right", frame), 320, 180);
-  return wall;
-}
-
 // "applied", or the refusal's field and reason.
 std::string outcome(const Result<client::Outcome>& done) {
   if (!done) return "error: " + done.error();
@@ -53,23 +45,12 @@ TEST(LiveAssetsOnGlNodes, AnUploadedModelIsDrawnByEveryNodeAndTheJournalDrawsIt)
   const std::string journal = dir.file("session.journal");
   const std::string live_out = dir.file("live");
   // A cache of its own for each run: no node has a copy of anything.
-  Process master({kMaster, "--config", kWall, "--local", "--frames", std::to_string(kFrames), "--capture-every",
-                  std::to_string(kCaptureEvery), "--out", live_out, "--no-status", "--api-port", "0", "--api-port-file",
-                  dir.file("api.port"), "--record", journal, "--node-arg=--cache-dir=" + dir.file("cache")},
-                 dir.file("live.log"));
-  ASSERT_TRUE(wait_for_file(dir.file("api.port"), 30s)) << master.output();
-  client::Options options;
-  options.port = static_cast<std::uint16_t>(std::stoi(read_file(dir.file("api.port"))));
-  options.name = "assets";
-  auto session = client::Session::connect(options);
-  ASSERT_TRUE(session.ok()) << session.error();
-  client::Session& app = *session.value();
-  // Once every node is in the frames: the assets are offered to them there.
-  session::Subscribe nodes;
-  nodes.set_frames(true);
-  ASSERT_TRUE(app.subscribe(nodes).ok());
-  auto first = app.next_event(60s);
-  ASSERT_TRUE(first.ok() && first.value().has_value()) << master.output();
+  auto running = recording_wall(dir, kFrames, kCaptureEvery, {"--node-arg=--cache-dir=" + dir.file("cache")});
+  Process& master = *running;
+  auto session = wall_session(dir.file("api.port"), "assets", master);
+  ASSERT_NE(session, nullptr);
+  client::Session& app = *session;
+  // Every node is in the frames: the assets are offered to them there.
 
   // Refused, each naming its field: bytes that are no .glb, a path out of
   // the assets folder, a file that is not there.
@@ -104,14 +85,8 @@ TEST(LiveAssetsOnGlNodes, AnUploadedModelIsDrawnByEveryNodeAndTheJournalDrawsIt)
   ASSERT_LT(compared, static_cast<std::uint64_t>(kFrames)) << "the loads took most of the run: " << master.output();
   app.close();
 
-  ASSERT_EQ(master.wait(300s), 0) << master.output();
-  const ClusterRun run = read_cluster_run(live_out);
-  ASSERT_EQ(run.error, "");
-  ASSERT_EQ(run.report.nodes_size(), 4);
-  for (const auto& node : run.report.nodes()) {
-    EXPECT_EQ(node.frames_presented(), static_cast<std::uint64_t>(kFrames)) << node.id();
-    EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
-  }
+  expect_whole_run(master, live_out, kFrames);
+  if (HasFatalFailure()) return;
   // The four nodes share one cache: one of them fetched each asset while
   // the frames went on, and every one readied it.
   int fetched = 0;
@@ -136,33 +111,20 @@ TEST(LiveAssetsOnGlNodes, AnUploadedModelIsDrawnByEveryNodeAndTheJournalDrawsIt)
   auto drawn = image::read_image(image::frame_path(dir.file("reference") + "/reference/front", compared, "png"));
   auto without = image::read_image(image::frame_path(dir.file("bare") + "/reference/front", compared, "png"));
   ASSERT_TRUE(drawn.ok() && without.ok());
-  const image::FloatImage tiles = stitched(live_out, compared);
-  auto with_it = image::compare(tiles, drawn.value());
+  const image::FloatImage tiles = stitched_wall(live_out, compared);
+  const double with_it = expect_near_reference(tiles, drawn.value(), 40.0, "optique-assets-gl-failure");
   auto not_it = image::compare(tiles, without.value());
-  ASSERT_TRUE(with_it.ok() && not_it.ok());
-  const auto worst = [](const image::Comparison& c) { return std::min({c.psnr_r, c.psnr_g, c.psnr_b}); };
+  ASSERT_TRUE(not_it.ok()) << not_it.error();
+  const double without_it = std::min({not_it.value().psnr_r, not_it.value().psnr_g, not_it.value().psnr_b});
   std::printf("frame %llu: stitched tiles vs the journal's reference %.1f dB, vs the wall without the torus %.1f dB\n",
-              static_cast<unsigned long long>(compared), worst(with_it.value()), worst(not_it.value()));
-  EXPECT_GE(worst(with_it.value()), 40.0);
-  EXPECT_LT(worst(not_it.value()), 30.0) << "the torus is not on the wall";
-  if (worst(with_it.value()) < 40.0) {
-    const ScratchDir kept_scratch("optique-assets-gl-failure");
-    (void)image::write_exr(kept_scratch.string() + "/stitched.exr", tiles);
-    (void)image::write_exr(kept_scratch.string() + "/reference.exr", drawn.value());
-    (void)image::write_exr(kept_scratch.string() + "/difference.exr", image::difference(tiles, drawn.value(), 10.0f));
-    ADD_FAILURE() << "images and the difference (×10) in " << kept_scratch.string();
-  }
+              static_cast<unsigned long long>(compared), with_it, without_it);
+  EXPECT_LT(without_it, 30.0) << "the torus is not on the wall";
 
   // Replayed with no application: the nodes get both assets in their
   // welcome, from a cache that has neither, and draw the same.
   const CapturedRun replayed = run_and_capture(kWall, static_cast<int>(compared) + 1, kCaptureEvery,
                                                {"--replay", journal, "--node-arg=--cache-dir=" + dir.file("cache2")});
-  for (const char* projector : {"top-left", "top-right", "bottom-left", "bottom-right"}) {
-    const std::string a = read_file(image::frame_path(live_out + "/nodes/" + projector, compared, "png"));
-    const std::string b = read_file(image::frame_path(replayed.out + "/nodes/" + projector, compared, "png"));
-    EXPECT_FALSE(a.empty());
-    EXPECT_TRUE(a == b) << projector << " frame " << compared << ": the replay's capture differs";
-  }
+  expect_same_captures(live_out, replayed.out, {compared});
 }
 
 }  // namespace

@@ -24,6 +24,7 @@
 #include "local_capture.h"
 #include "process.h"
 #include "scratch.h"
+#include "wall_session.h"
 
 namespace optique::testing {
 namespace {
@@ -151,33 +152,15 @@ class RandomEdits {
   int next_id_ = 0;
 };
 
-image::FloatImage stitched(const std::string& out, std::uint64_t frame) {
-  image::FloatImage wall(640, 360, 4);
-  image::paste(wall, capture(out, "top-left", frame), 0, 0);
-  image::paste(wall, capture(out, "top-right", frame), 320, 0);
-  image::paste(wall, capture(out, "bottom-left", frame), 0, 180);
-  image::paste(wall, capture(out, "bottom-right", frame), 320, 180);
-  return wall;
-}
-
 TEST(LiveSceneOnGlNodes, RandomTransactionsStayCoherentAndTheJournalDrawsTheSame) {
   ScratchDir dir("optique-live-gl");
   const std::string journal = dir.file("session.journal");
   const std::string live_out = dir.file("live");
-  Process master({kMaster, "--config", kWall, "--local", "--frames", std::to_string(kFrames), "--capture-every",
-                  std::to_string(kCaptureEvery), "--out", live_out, "--no-status", "--api-port", "0", "--api-port-file",
-                  dir.file("api.port"), "--record", journal},
-                 dir.file("live.log"));
-  ASSERT_TRUE(wait_for_file(dir.file("api.port"), 30s)) << master.output();
-  client::Options options;
-  options.port = static_cast<std::uint16_t>(std::stoi(read_file(dir.file("api.port"))));
-  options.name = "coherence";
-  auto session = client::Session::connect(options);
-  ASSERT_TRUE(session.ok()) << session.error();
-  client::Session& app = *session.value();
-  session::Subscribe frames;
-  frames.set_frames(true);
-  ASSERT_TRUE(app.subscribe(frames).ok());
+  auto running = recording_wall(dir, kFrames, kCaptureEvery);
+  Process& master = *running;
+  auto session = wall_session(dir.file("api.port"), "coherence", master);
+  ASSERT_NE(session, nullptr);
+  client::Session& app = *session;
 
   // Two transactions a frame, from the first frame on, until all are sent.
   RandomEdits edits(31, app.scene().light_count());
@@ -202,14 +185,8 @@ TEST(LiveSceneOnGlNodes, RandomTransactionsStayCoherentAndTheJournalDrawsTheSame
   std::printf("%d transactions applied by frame %llu, %zu instances and %zu point lights added then\n", sent - refused,
               static_cast<unsigned long long>(last_frame), edits.instances(), edits.lights());
   ASSERT_LT(last_frame, static_cast<std::uint64_t>(kFrames) - 10) << "the edits outlasted the run";
-  ASSERT_EQ(master.wait(300s), 0) << master.output();
-  const ClusterRun run = read_cluster_run(live_out);
-  ASSERT_EQ(run.error, "");
-  ASSERT_EQ(run.report.nodes_size(), 4);
-  for (const auto& node : run.report.nodes()) {
-    EXPECT_EQ(node.frames_presented(), static_cast<std::uint64_t>(kFrames)) << node.id();
-    EXPECT_EQ(node.hash_mismatches(), 0u) << node.id() << ": its state left the master's";
-  }
+  expect_whole_run(master, live_out, kFrames);
+  if (HasFatalFailure()) return;
 
   // The reference drawn from the journal against the stitched tiles.
   Process reference({kMaster, "render-reference", "--config", kWall, "--frame", std::to_string(kCompared), "--out",
@@ -218,33 +195,18 @@ TEST(LiveSceneOnGlNodes, RandomTransactionsStayCoherentAndTheJournalDrawsTheSame
   ASSERT_EQ(reference.wait(120s), 0) << reference.output();
   auto drawn = image::read_image(image::frame_path(dir.file("reference") + "/reference/front", kCompared, "png"));
   ASSERT_TRUE(drawn.ok()) << drawn.error();
-  const image::FloatImage tiles = stitched(live_out, kCompared);
-  auto comparison = image::compare(tiles, drawn.value());
-  ASSERT_TRUE(comparison.ok()) << comparison.error();
-  const auto& c = comparison.value();
-  std::printf("frame %llu, stitched tiles vs the journal's reference: PSNR R/G/B %.1f/%.1f/%.1f dB\n",
-              static_cast<unsigned long long>(kCompared), c.psnr_r, c.psnr_g, c.psnr_b);
-  if (std::min({c.psnr_r, c.psnr_g, c.psnr_b}) < 40.0) {
-    const ScratchDir kept_scratch("optique-live-gl-failure");
-    const std::string kept = kept_scratch.string();
-    (void)image::write_exr(kept + "/stitched.exr", tiles);
-    (void)image::write_exr(kept + "/reference.exr", drawn.value());
-    (void)image::write_exr(kept + "/difference.exr", image::difference(tiles, drawn.value(), 10.0f));
-    ADD_FAILURE() << "stitched vs reference under 40 dB; images and the difference (×10) in " << kept;
-  }
+  const image::FloatImage tiles = stitched_wall(live_out, kCompared);
+  const double worst = expect_near_reference(tiles, drawn.value(), 40.0, "optique-live-gl-failure");
+  std::printf("frame %llu, stitched tiles vs the journal's reference: PSNR %.1f dB (the worst channel)\n",
+              static_cast<unsigned long long>(kCompared), worst);
 
   // The journal replayed with no application: the same captures, byte for
   // byte, up to the frame compared with the reference.
   const CapturedRun replayed =
       run_and_capture(kWall, static_cast<int>(kCompared) + 1, kCaptureEvery, {"--replay", journal});
-  for (const char* projector : {"top-left", "top-right", "bottom-left", "bottom-right"}) {
-    for (std::uint64_t frame = 0; frame <= kCompared; frame += kCaptureEvery) {
-      const std::string a = read_file(image::frame_path(live_out + "/nodes/" + projector, frame, "png"));
-      const std::string b = read_file(image::frame_path(replayed.out + "/nodes/" + projector, frame, "png"));
-      EXPECT_FALSE(a.empty());
-      EXPECT_TRUE(a == b) << projector << " frame " << frame << ": the replay's capture differs";
-    }
-  }
+  std::vector<std::uint64_t> captured;
+  for (std::uint64_t frame = 0; frame <= kCompared; frame += kCaptureEvery) captured.push_back(frame);
+  expect_same_captures(live_out, replayed.out, captured);
 }
 
 }  // namespace

@@ -12,10 +12,8 @@ namespace optique::testing {
 
 using namespace std::chrono_literals;
 
-CapturedRun run_and_capture(const std::string& config, int frames, int capture_every,
-                            const std::vector<std::string>& extra) {
-  CapturedRun run{std::make_unique<ScratchDir>("optique-gl"), {}};
-  const std::string dir = run.folder->string();
+std::vector<std::string> capturing_master(const std::string& config, int frames, int capture_every,
+                                          const std::string& out, const std::vector<std::string>& extra) {
   std::vector<std::string> command{std::string(OPTIQUE_BIN_DIR) + "/optique-master",
                                    "--config",
                                    config,
@@ -25,10 +23,17 @@ CapturedRun run_and_capture(const std::string& config, int frames, int capture_e
                                    "--capture-every",
                                    std::to_string(capture_every),
                                    "--out",
-                                   dir + "/out",
+                                   out,
                                    "--no-status"};
   command.insert(command.end(), extra.begin(), extra.end());
-  Process master(command, dir + "/master.log");
+  return command;
+}
+
+CapturedRun run_and_capture(const std::string& config, int frames, int capture_every,
+                            const std::vector<std::string>& extra) {
+  CapturedRun run{std::make_unique<ScratchDir>("optique-gl"), {}};
+  const std::string dir = run.folder->string();
+  Process master(capturing_master(config, frames, capture_every, dir + "/out", extra), dir + "/master.log");
   const auto status = master.wait(120s);
   EXPECT_TRUE(status.has_value()) << "master still running:\n" << master.output();
   EXPECT_EQ(status.value_or(-1), 0) << master.output();

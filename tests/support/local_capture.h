@@ -21,6 +21,13 @@ struct CapturedRun {
   operator const std::string&() const { return out; }  // NOLINT: where an output folder is
 };
 
+// The command line of a master that runs `config` with local GL nodes for
+// `frames` frames, capturing every `capture_every`-th, writing into `out`,
+// `extra` arguments after.
+[[nodiscard]] std::vector<std::string> capturing_master(const std::string& config, int frames, int capture_every,
+                                                        const std::string& out,
+                                                        const std::vector<std::string>& extra = {});
+
 // Runs `config` for `frames` frames, capturing every `capture_every`-th, with
 // `extra` arguments for the master; expects it to succeed and returns its
 // output folder (in a fresh temporary folder).
