@@ -151,7 +151,8 @@ std::string summarize(const config::LoadedConfig& config) {
         << (m.api->port == 0 ? "an ephemeral port the master logs when it starts" : std::to_string(m.api->port))
         << (config::is_loopback_address(m.api->listen) ? "" : ", applications prove the shared secret") << "; at most "
         << m.api->max_sessions << " sessions, " << m.api->max_instances << " instances, " << m.api->max_edits_per_frame
-        << " edits a frame; an edit made before frame k begins is in frame k";
+        << " edits a frame; models loaded from " << m.api->assets
+        << "; an edit made before frame k begins is in frame k";
     // Key frames drawn ahead cannot know a later edit.
     for (const config::Projector& p : inst.projectors) {
       if (p.up_conversion.frames_ahead() > 0) {

@@ -51,6 +51,17 @@ TEST(CheckConfig, SaysThatAnUpConvertingDlpProjectorBuildsEveryField) {
   EXPECT_NE(said.find("; every colour field built from the key frames at its own moment"), std::string::npos) << said;
 }
 
+// With master.api, where applications' models are read from.
+TEST(CheckConfig, SaysWhereApplicationsLoadModelsFrom) {
+  config::LoadedConfig config = pinball();
+  config.installation.master.api = config::ApiServer{};
+  config.installation.master.api->assets = "/srv/wall/models";
+  const std::string said = summarize(config);
+  EXPECT_NE(said.find("edits a frame; models loaded from /srv/wall/models; an edit made before frame k"),
+            std::string::npos)
+      << said;
+}
+
 }  // namespace
 }  // namespace optique::tools
 
@@ -67,6 +78,17 @@ TEST(CheckConfig, AnEphemeralStatusPortIsNotGivenAsAnAddress) {
   EXPECT_NE(said.find("an ephemeral port the master logs when it starts"), std::string::npos) << said;
   config.installation.master.status->port = 7480;
   EXPECT_NE(summarize(config).find("http://127.0.0.1:7480/"), std::string::npos) << summarize(config);
+}
+
+// With master.api, where applications' models are read from.
+TEST(CheckConfig, SaysWhereApplicationsLoadModelsFrom) {
+  config::LoadedConfig config = pinball();
+  config.installation.master.api = config::ApiServer{};
+  config.installation.master.api->assets = "/srv/wall/models";
+  const std::string said = summarize(config);
+  EXPECT_NE(said.find("edits a frame; models loaded from /srv/wall/models; an edit made before frame k"),
+            std::string::npos)
+      << said;
 }
 
 }  // namespace
