@@ -51,17 +51,6 @@ TEST(CheckConfig, SaysThatAnUpConvertingDlpProjectorBuildsEveryField) {
   EXPECT_NE(said.find("; every colour field built from the key frames at its own moment"), std::string::npos) << said;
 }
 
-// With master.api, where applications' models are read from.
-TEST(CheckConfig, SaysWhereApplicationsLoadModelsFrom) {
-  config::LoadedConfig config = pinball();
-  config.installation.master.api = config::ApiServer{};
-  config.installation.master.api->assets = "/srv/wall/models";
-  const std::string said = summarize(config);
-  EXPECT_NE(said.find("edits a frame; models loaded from /srv/wall/models; an edit made before frame k"),
-            std::string::npos)
-      << said;
-}
-
 }  // namespace
 }  // namespace optique::tools
 
