@@ -589,6 +589,17 @@ std::vector<Seed> protocol_seeds() {
     }
     seeds.push_back({"one_node_starved", with_header(20, 0, steps)});
   }
+  {
+    // Assets loaded while the frames go on, one before and one after a link reset.
+    std::vector<std::uint8_t> steps = prompt_steps(80);
+    steps.push_back(247);
+    const auto more = prompt_steps(80);
+    steps.insert(steps.end(), more.begin(), more.end());
+    steps.push_back(246);  // reset node 2's link
+    steps.push_back(247);
+    steps.insert(steps.end(), more.begin(), more.end());
+    seeds.push_back({"assets_loaded", with_header(30, 0, steps)});
+  }
   seeds.push_back({"noise", noise(600, 7)});
   return seeds;
 }

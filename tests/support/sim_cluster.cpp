@@ -197,62 +197,72 @@ void SimCluster::master_actions(master::Actions actions) {
       const auto found = links_.find(peer);
       return found == links_.end() || !found->second->master_open ? nullptr : found->second;
     };
-    std::visit(util::Overloaded{
-                   [&](master::Send& a) {
-                     Link* link = peer_link(a.peer, "a send");
-                     if (link == nullptr) return;
-                     if (a.shared) a.message = *a.shared;  // the test's nodes each take their copy
-                     wire::Envelope& m = a.message;
-                     m.set_protocol_version(net::kProtocolVersion);
-                     if (m.has_pong()) m.mutable_pong()->set_t3(now_);
-                     if (m.has_frame_begin()) frame_hashes_[m.frame_begin().frame_id()] = m.frame_begin().state_hash();
-                     if (m.has_swap() && !link->readies.contains(m.swap().frame_id())) {
-                       violation("swap of frame " + std::to_string(m.swap().frame_id()) + " to peer " +
-                                 std::to_string(a.peer) + ", which did not say it was ready");
-                     }
-                     if (m.has_resync() && link->resyncs++ > 0) {
-                       nodes_[link->node]->repaired_frame = m.resync().next_frame_id();
-                     }
-                     link->to_node.push_back(std::move(m));
-                   },
-                   [&](master::Close& a) {
-                     Link* link = peer_link(a.peer, "a close");
-                     if (link == nullptr) return;
-                     close_link(*link, false, a.after_sending);
-                     links_.erase(a.peer);
-                     closed_peers_.insert(a.peer);
-                     master_actions(master_->closed(a.peer, a.reason, now_));
-                   },
-                   [&](master::SetDeadline& a) {
-                     if (Link* link = peer_link(a.peer, "a deadline")) {
-                       link->master_deadline = now_ + std::chrono::nanoseconds(a.after).count();
-                       link->master_deadline_reason = a.reason;
-                     }
-                   },
-                   [&](master::CancelDeadline& a) {
-                     if (Link* link = peer_link(a.peer, "a deadline")) link->master_deadline.reset();
-                   },
-                   [&](master::SetLiveness& a) {
-                     if (Link* link = peer_link(a.peer, "a liveness timeout")) {
-                       link->master_liveness = std::chrono::nanoseconds(a.timeout).count();
-                       link->master_heard = now_;
-                     }
-                   },
-                   [&](master::SetMaxPayload& a) { (void)peer_link(a.peer, "a payload limit"); },
-                   [&](master::Protect& a) { (void)peer_link(a.peer, "a session's keys"); },
-                   [&](master::Arm& a) { master_timers_[a.timer] = a.at; },
-                   [&](master::Disarm& a) { master_timers_.erase(a.timer); },
-                   [&](master::StopAccepting&) { accepting_ = false; },
-                   [&](master::SignalLocalNodes&) {},
-                   [&](master::HeadShown&) {},
-                   [&](master::FrameRows&) {},
-                   [&](master::Finish& a) { finished_ = a.exit_code; },
-                   [&](master::Log&) {},
-                   [&](master::AppEvent& a) { app_events_.push_back(std::move(a.event)); },
-                   [&](master::AssetUsable& a) { asset_news_.push_back("usable " + a.asset); },
-                   [&](master::AssetFailed& a) { asset_news_.push_back("failed " + a.asset + ": " + a.reason); },
-               },
-               action);
+    std::visit(
+        util::Overloaded{
+            [&](master::Send& a) {
+              Link* link = peer_link(a.peer, "a send");
+              if (link == nullptr) return;
+              if (a.shared) a.message = *a.shared;  // the test's nodes each take their copy
+              wire::Envelope& m = a.message;
+              m.set_protocol_version(net::kProtocolVersion);
+              if (m.has_pong()) m.mutable_pong()->set_t3(now_);
+              if (m.has_frame_begin()) frame_hashes_[m.frame_begin().frame_id()] = m.frame_begin().state_hash();
+              if (m.has_asset_offer() && !assets_offered_.emplace(a.peer, m.asset_offer().asset()).second) {
+                violation("asset '" + m.asset_offer().asset() + "' offered twice to peer " + std::to_string(a.peer));
+              }
+              if (m.has_swap() && !link->readies.contains(m.swap().frame_id())) {
+                violation("swap of frame " + std::to_string(m.swap().frame_id()) + " to peer " +
+                          std::to_string(a.peer) + ", which did not say it was ready");
+              }
+              if (m.has_resync() && link->resyncs++ > 0) {
+                nodes_[link->node]->repaired_frame = m.resync().next_frame_id();
+              }
+              link->to_node.push_back(std::move(m));
+            },
+            [&](master::Close& a) {
+              Link* link = peer_link(a.peer, "a close");
+              if (link == nullptr) return;
+              close_link(*link, false, a.after_sending);
+              links_.erase(a.peer);
+              closed_peers_.insert(a.peer);
+              master_actions(master_->closed(a.peer, a.reason, now_));
+            },
+            [&](master::SetDeadline& a) {
+              if (Link* link = peer_link(a.peer, "a deadline")) {
+                link->master_deadline = now_ + std::chrono::nanoseconds(a.after).count();
+                link->master_deadline_reason = a.reason;
+              }
+            },
+            [&](master::CancelDeadline& a) {
+              if (Link* link = peer_link(a.peer, "a deadline")) link->master_deadline.reset();
+            },
+            [&](master::SetLiveness& a) {
+              if (Link* link = peer_link(a.peer, "a liveness timeout")) {
+                link->master_liveness = std::chrono::nanoseconds(a.timeout).count();
+                link->master_heard = now_;
+              }
+            },
+            [&](master::SetMaxPayload& a) { (void)peer_link(a.peer, "a payload limit"); },
+            [&](master::Protect& a) { (void)peer_link(a.peer, "a session's keys"); },
+            [&](master::Arm& a) { master_timers_[a.timer] = a.at; },
+            [&](master::Disarm& a) { master_timers_.erase(a.timer); },
+            [&](master::StopAccepting&) { accepting_ = false; },
+            [&](master::SignalLocalNodes&) {},
+            [&](master::HeadShown&) {},
+            [&](master::FrameRows&) {},
+            [&](master::Finish& a) { finished_ = a.exit_code; },
+            [&](master::Log&) {},
+            [&](master::AppEvent& a) { app_events_.push_back(std::move(a.event)); },
+            [&](master::AssetUsable& a) {
+              if (std::count(asset_news_.begin(), asset_news_.end(), "usable " + a.asset) > 0 ||
+                  a.asset.rfind("asset-", 0) != 0) {
+                violation("asset '" + a.asset + "' made usable twice, or never added");
+              }
+              asset_news_.push_back("usable " + a.asset);
+            },
+            [&](master::AssetFailed& a) { asset_news_.push_back("failed " + a.asset + ": " + a.reason); },
+        },
+        action);
   }
 }
 
@@ -336,7 +346,14 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
               }
             },
             // Simulated clusters show built-in scenes: no files to fetch.
-            [&](node::PrepareScene&) { violation("node " + std::to_string(i) + " was sent a scene's files"); },
+            // An asset's files: a cache that holds them. The scene's: never (built in).
+            [&](node::PrepareScene& a) {
+              if (!asset_shas_.contains(a.sha256)) {
+                violation("node " + std::to_string(i) + " was sent a scene's files");
+                return;
+              }
+              node_actions(i, n.protocol.answer(node::SceneFound{"/sim/cache/" + a.sha256 + "/a.gltf"}, now_));
+            },
             [&](node::RecheckScene&) {},
             [&](node::StoreSceneChunk&) {},
             [&](node::FinishScene&) {},
@@ -445,6 +462,19 @@ void SimCluster::run_promptly(clock::Nanos until) {
   }
 }
 
+void SimCluster::add_asset() {
+  if (assets_added_ >= 8) return;
+  const std::string id = "asset-" + std::to_string(assets_added_++);
+  auto asset = std::make_shared<scene::LoadedScene>();
+  const std::string gltf = R"({"asset":{"version":"2.0"},"extras":")" + id + R"("})";
+  asset->manifest = scene::SceneManifest{scene::kSceneChunkBytes, {scene::describe_file("a.gltf", gltf)}};
+  asset->files = {std::make_shared<const std::string>(gltf)};
+  asset->content_sha256 = scene::manifest_sha256(asset->manifest);
+  asset->source = id + ".gltf";
+  asset_shas_.insert(asset->content_sha256);
+  master_actions(master_->add_asset(id, std::move(asset), now_));
+}
+
 void SimCluster::step(std::uint8_t choice) {
   const std::size_t node = (choice / 8u) % nodes_.size();
   switch (choice % 8u) {
@@ -470,6 +500,8 @@ void SimCluster::step(std::uint8_t choice) {
     default:
       if (choice == 255) {
         interrupt_master();
+      } else if (choice == 247) {
+        add_asset();
       } else {
         for (std::size_t i = 0; i < nodes_.size(); ++i) {
           if (deliver_to_node(i) || deliver_to_master(i)) break;

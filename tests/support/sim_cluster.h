@@ -42,6 +42,9 @@ class SimCluster {
   // Breaks node's link (a reset: both ends see it closed, queued messages lost).
   void reset_link(std::size_t node);
   void interrupt_master();
+  // An application loads an asset (up to eight, "asset-0" on): the master
+  // offers it to every node (which, drawing nothing, readies it at once).
+  void add_asset();
 
   // A prompt network: every message delivered as soon as it is sent, timers in
   // order, until the master has finished or `until` (virtual time) is reached.
@@ -93,6 +96,9 @@ class SimCluster {
   std::vector<std::string> violations_;
   std::vector<session::Event> app_events_;
   std::vector<std::string> asset_news_;
+  std::set<std::pair<master::PeerId, std::string>> assets_offered_;
+  int assets_added_ = 0;
+  std::set<std::string> asset_shas_;  // the assets' identities, whose files a node may ask for
 };
 
 }  // namespace optique::testing

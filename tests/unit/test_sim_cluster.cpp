@@ -196,6 +196,29 @@ TEST(SimCluster, ANodeWhoseLinkBreaksRejoinsAndShowsEveryFrameFromThereOn) {
   EXPECT_EQ(cluster.presented(0), frames(0, 60)) << "the others never stopped";
 }
 
+// Assets loaded while the frames go on: usable once every node has answered,
+// each offered once to each connection; a node that rejoins gets them in its
+// welcome (not offered again), and later ones are offered to it too. Every
+// frame is shown throughout.
+TEST(SimCluster, AssetsLoadedInTheFramesAreUsableOnceAndEveryFrameIsShown) {
+  const master::RunConfig run = load("powerwall-2x2.json");
+  SimCluster cluster(run, for_frames(60));
+  cluster.start();
+  cluster.run_promptly(cluster.now() + kSecond / 6);
+  cluster.add_asset();
+  EXPECT_EQ(cluster.asset_news(), std::vector<std::string>{}) << "not before the nodes answer";
+  cluster.run_promptly(cluster.now() + kSecond / 6);
+  EXPECT_EQ(cluster.asset_news(), std::vector<std::string>{"usable asset-0"});
+  cluster.reset_link(1);
+  cluster.run_promptly(cluster.now() + kSecond / 6);
+  cluster.add_asset();
+  cluster.run_promptly(cluster.now() + 10 * kSecond);
+  EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
+  ASSERT_TRUE(cluster.master_finished());
+  EXPECT_EQ(cluster.asset_news(), (std::vector<std::string>{"usable asset-0", "usable asset-1"}));
+  EXPECT_EQ(cluster.presented(0), frames(0, 60));
+}
+
 TEST(SimCluster, AnAutomaticGroupKeepsGoingWhenANodeIsLost) {
   const master::RunConfig run = load("stacked-lighting-3-auto.json");
   SimCluster cluster(run, for_frames(40));
