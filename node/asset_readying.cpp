@@ -24,7 +24,7 @@ void NodeProtocol::on_asset_offer(const wire::AssetOffer& offer, Actions& out) {
   const auto named = [&](const protocol::AssetOffer& a) { return a.asset == id; };
   if (std::any_of(job_->assets.begin(), job_->assets.end(), named) ||
       std::any_of(offers_.begin(), offers_.end(), named) || (readying_ && readying_->asset == id) ||
-      offers_.size() >= protocol::kMaxAssets) {
+      offers_.size() >= scene::kMaxAssets) {
     out.push_back(Close{"the master offered asset '" + id + "' twice, or more assets than it may"});
     return;
   }

@@ -93,9 +93,9 @@ Result<NodeJob> decode_welcome(const wire::Welcome& welcome, std::string_view pr
     node.scene_files = std::move(files).value();
     node.scene_sha256 = welcome.scene_sha256();
   }
-  if (static_cast<std::size_t>(welcome.assets_size()) > kMaxAssets) {
+  if (static_cast<std::size_t>(welcome.assets_size()) > scene::kMaxAssets) {
     return Error{"welcome: assets: " + std::to_string(welcome.assets_size()) + " of them, at most " +
-                 std::to_string(kMaxAssets)};
+                 std::to_string(scene::kMaxAssets)};
   }
   for (int i = 0; i < welcome.assets_size(); ++i) {
     auto asset = decode_asset_offer(welcome.assets(i));

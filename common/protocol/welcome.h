@@ -33,8 +33,6 @@ struct AssetOffer {
   // node once it has them).
   std::string path;
 };
-// The most assets a master offers (in a welcome, or one at a time).
-inline constexpr std::size_t kMaxAssets = 256;
 
 struct NodeJob {
   config::ProjectorJob job;

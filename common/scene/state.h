@@ -55,8 +55,8 @@ struct InstanceState {
   std::string parent;  // empty: the world; its pose is relative to the parent's
   ObjectState pose;
   bool visible = true;
-  glm::dvec4 base_color{1.0};  // multiplies the asset's base colour
-  glm::dvec3 emissive{1.0};    // multiplies the asset's emissive colour
+  glm::dvec4 base_color{1.0};               // multiplies the asset's base colour
+  glm::dvec3 emissive{1.0};                 // multiplies the asset's emissive colour
   std::optional<AnimationTimes> animation;  // none: the scene's own time
 
   bool operator==(const InstanceState&) const = default;
@@ -65,6 +65,9 @@ struct InstanceState {
 // The most instances a chain of parents holds (the world not counted): what a
 // node accepts from the wire, and what the master's live scene allows.
 inline constexpr std::size_t kMaxInstanceDepth = 64;
+// The most assets applications may load (LoadAsset) into one live scene: what
+// a node takes in its welcome.
+inline constexpr std::size_t kMaxAssets = 256;
 inline constexpr std::size_t kMaxInstanceIdLength = 64;
 inline constexpr double kMaxEmissiveFactor = 1e3;
 

@@ -295,6 +295,10 @@ std::optional<std::pair<std::string, std::string>> SceneSessions::load_problem(c
   if (live_.has_asset(load.asset()) || live_.is_loading(load.asset())) {
     return wrong("load_asset.asset", "'" + load.asset() + "' is loaded already (an id names one asset for good)");
   }
+  if (live_.assets().size() + loading_.size() >= scene::kMaxAssets + 1) {  // the installation's own scene is one
+    return wrong("load_asset", "the live scene holds " + std::to_string(scene::kMaxAssets) +
+                                   " assets an application loaded, the most it may");
+  }
   if (loading_.size() >= settings_.max_loading) {
     return wrong("load_asset", std::to_string(settings_.max_loading) +
                                    " assets are loading, the most at once: ask again once one is answered");

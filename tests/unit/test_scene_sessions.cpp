@@ -496,6 +496,11 @@ TEST_F(SceneSessionsTest, LoadAssetIsCheckedLoadedByTheShellAndAnsweredWhenUsabl
   EXPECT_EQ(failed[0].message.session_reply().refused().reason(), "node 'x' cannot draw it: no");
   EXPECT_FALSE(live_.is_loading("goose"));
   EXPECT_FALSE(live_.has_asset("goose"));
+
+  // At most kMaxAssets besides the installation's own (what a node's welcome takes).
+  for (std::size_t i = live_.assets().size(); i <= scene::kMaxAssets; ++i) live_.add_asset("a" + std::to_string(i));
+  EXPECT_EQ(refused(load(13, "one-more", &fine, nullptr)),
+            "load_asset: the live scene holds 256 assets an application loaded, the most it may");
 }
 
 }  // namespace
