@@ -22,12 +22,14 @@ void NodeProtocol::on_asset_offer(const wire::AssetOffer& offer, Actions& out) {
   }
   const std::string& id = asset.value().asset;
   const auto named = [&](const protocol::AssetOffer& a) { return a.asset == id; };
-  if (std::any_of(job_->assets.begin(), job_->assets.end(), named) ||
-      std::any_of(offers_.begin(), offers_.end(), named) || (readying_ && readying_->asset == id) ||
+  if (std::any_of(offers_.begin(), offers_.end(), named) || (readying_ && readying_->asset == id) ||
       offers_.size() >= scene::kMaxAssets) {
     out.push_back(Close{"the master offered asset '" + id + "' twice, or more assets than it may"});
     return;
   }
+  // One readied here before: it failed on another node and was loaded again
+  // (perhaps other content): readied again, in its place.
+  std::erase_if(job_->assets, named);
   offers_.push_back(std::move(asset).value());
   ready_next(out);
 }
