@@ -48,15 +48,16 @@ void SceneServer::request(PeerId peer, const std::string& id, SceneServed& serve
     return;
   }
   const std::uint64_t total = manifest.total_bytes();
-  if (!served.sending || served.sending->sha256 != scene->content_sha256) {
-    served.sending.emplace();
-    served.sending->sha256 = scene->content_sha256;
-    served.sending->started = now;
+  // Kept for each scene and asset the node asks for over its connection, so
+  // that asking for two by turns does not reset what it has asked for.
+  auto [at, first_request] = served.sending.try_emplace(scene->content_sha256);
+  if (first_request) {
+    at->second.started = now;
     out.push_back(
         Log{spdlog::level::info, fmt::format("sending {} to '{}', which has no copy: {} file(s), {:.1f} MiB", what, id,
                                              manifest.files.size(), static_cast<double>(total) / (1 << 20))});
   }
-  SceneSending& sending = *served.sending;
+  SceneSending& sending = at->second;
   const std::uint64_t offset = manifest.chunk_offset(request.chunk());
   const std::uint64_t length = manifest.chunk_length(request.file(), request.chunk());
   sending.bytes_asked += length;

@@ -32,11 +32,8 @@ inline constexpr std::uint64_t kSceneBytesPerExtraSecond = 64u << 20;
 // A node that asks for more than this many times the scene's bytes is broken.
 inline constexpr std::uint64_t kMostSceneRepeats = 4;
 
-// Sending one node the files (from its first request). Not nested in
-// SceneServed: clang does not take a nested struct's default member
-// initializers in the enclosing one's std::optional of it.
+// Sending one node the files of one scene or asset (from its first request).
 struct SceneSending {
-  std::string sha256;  // which scene (the installation's, or an asset)
   clock::Nanos started = 0;
   std::uint64_t bytes_asked = 0;  // all chunks sent, repeats included
   std::uint64_t bytes_new = 0;    // each chunk once
@@ -47,7 +44,7 @@ struct SceneSending {
 
 // What one node has been served: the bookkeeping a session keeps.
 struct SceneServed {
-  std::optional<SceneSending> sending;
+  std::map<std::string, SceneSending> sending;  // by the scene's or asset's SHA-256
   // Since when it waits for another node's copy of the scene (SceneWait).
   std::optional<clock::Nanos> waiting_since;
 };

@@ -1180,6 +1180,33 @@ TEST_F(MasterTest, AnAssetIsUsableOnceEveryNodeInTheFramesHasReadiedIt) {
   EXPECT_NE(first<AssetUsable>(asset_ready(*master_, 5, "torus2", "", now_)), nullptr);
 }
 
+// A node in the frames that asks for two assets' chunks by turns is held to
+// the bound on each (asked for kMostSceneRepeats times over): asking by turns
+// resets nothing.
+TEST_F(MasterTest, AskingForTwoAssetsByTurnsIsBoundedOnEach) {
+  load("powerwall-2x2.json");
+  (void)join_all();
+  auto embedded =
+      config::load_asset("embedded", std::string(OPTIQUE_SOURCE_DIR) + "/configs/assets/torus/torus-embedded.gltf", {});
+  ASSERT_TRUE(embedded) << embedded.error();
+  const std::shared_ptr<const scene::LoadedScene> assets[2] = {
+      torus_asset("torus"), std::make_shared<const scene::LoadedScene>(std::move(embedded).value())};
+  ASSERT_NE(assets[0]->content_sha256, assets[1]->content_sha256);
+  (void)master_->add_asset("torus", assets[0], now_);
+  (void)master_->add_asset("embedded", assets[1], now_);
+  bool closed = false;
+  for (int i = 0; i < 200 && !closed; ++i) {
+    wire::Envelope request = envelope();
+    request.mutable_scene_request()->set_scene_sha256(assets[i % 2]->content_sha256);
+    const Actions a = master_->message(1, request, now_);
+    if (const Close* close = first<Close>(a)) {
+      closed = true;
+      EXPECT_NE(close->reason.find("times over"), std::string::npos) << close->reason;
+    }
+  }
+  EXPECT_TRUE(closed);
+}
+
 // A node that cannot draw the asset: it is not used, the application hears
 // which node and why, and later welcomes do not name it. A word about an
 // asset before the node is configured closes it.
