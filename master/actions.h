@@ -112,10 +112,14 @@ struct AppEvent {
 };
 
 // An asset an application loaded is ready on every node in the frames: from
-// frame `frame` on, instances of it may be created (the live scene takes it).
+// frame `frame` on, instances of it may be created (the live scene takes it,
+// the journal records it: read from `path`, identity `sha256`).
 struct AssetUsable {
   std::string asset;
   std::uint64_t frame = 0;
+  std::string path;
+  std::string sha256;
+  bool animated = false;  // it has animations: each instance plays them on its own clock
 };
 // An asset could not be readied on a node: it is not offered any longer.
 struct AssetFailed {

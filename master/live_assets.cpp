@@ -14,9 +14,7 @@
 
 namespace optique::master {
 
-Actions MasterProtocol::add_asset(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset,
-                                  clock::Nanos now) {
-  (void)now;
+Actions MasterProtocol::add_asset(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset) {
   Actions out;
   assert(asset && !asset->manifest.files.empty());
   assert(std::none_of(assets_.begin(), assets_.end(), [&](const LiveAsset& a) { return a.offer.asset == id; }));
@@ -81,7 +79,8 @@ void MasterProtocol::check_assets(Actions& out) {
     out.push_back(Log{spdlog::level::info, fmt::format("asset '{}' is ready on {} node(s) in the frames: usable from "
                                                        "frame {}",
                                                        asset.offer.asset, nodes_up(), next_frame_)});
-    out.push_back(AssetUsable{asset.offer.asset, next_frame_});
+    out.push_back(AssetUsable{asset.offer.asset, next_frame_, asset.scene->source, asset.offer.sha256,
+                              !asset.scene->definition.objects.empty()});
   }
 }
 

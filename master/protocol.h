@@ -113,8 +113,7 @@ class MasterProtocol {
   // welcome from now on); AssetUsable once every node in the frames has
   // readied it (at once when none is), AssetFailed when one cannot. A built-in
   // asset (no files) or an id offered before is a contract violation.
-  [[nodiscard]] Actions add_asset(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset,
-                                  clock::Nanos now);
+  [[nodiscard]] Actions add_asset(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset);
 
   // For the status line and tests: the frame to begin next, the nodes up of the
   // projectors, whether frames are running.

@@ -113,11 +113,11 @@ Result<void> Master::start() {
   protocol_.emplace(installation, options_.scene, std::move(run), *recorder_);
   // The journal's assets first: usable at once (no node is up yet), and in
   // every welcome.
-  for (auto& [id, asset] : journal_assets_) carry_out(protocol_->add_asset(id, asset, clock::monotonic_now()));
+  for (auto& [id, asset] : journal_assets_) carry_out(protocol_->add_asset(id, asset));
   journal_assets_.clear();
   if (session_port_) {
     session_port_->on_asset_loaded([this](const std::string& id, std::shared_ptr<const scene::LoadedScene> asset) {
-      if (!finished_) carry_out(protocol_->add_asset(id, std::move(asset), clock::monotonic_now()));
+      if (!finished_) carry_out(protocol_->add_asset(id, std::move(asset)));
     });
   }
 
@@ -321,7 +321,7 @@ void Master::carry_out(Action& action) {
                  },
                  // An asset from the journal is in the live scene already.
                  [&](AssetUsable& a) {
-                   if (session_port_ && !live_->has_asset(a.asset)) session_port_->asset_usable(a.asset, a.frame);
+                   if (session_port_ && !live_->has_asset(a.asset)) session_port_->asset_usable(a);
                  },
                  [&](AssetFailed& a) {
                    if (session_port_) session_port_->asset_unusable(a.asset, a.reason);

@@ -207,33 +207,27 @@ std::optional<std::size_t> SessionPort::queued_bytes(SessionId session) const {
 
 void SessionPort::load(session_action::LoadAsset load) {
   const std::weak_ptr<bool> alive = alive_;
-  asio::post(
-      loader_, [this, &io = io_, alive, folder = settings_.assets, uploads = uploads_.folder, load = std::move(load)] {
-        AssetRead read = read_asset(load, folder, uploads);
-        asio::post(io, [this, alive, id = load.asset, from_file = !load.path.empty(), read = std::move(read)] {
-          if (alive.expired()) return;
-          if (!read.asset) {
-            carry_out(sessions_.asset_failed(id, from_file ? "load_asset.path" : "load_asset.glb", read.error));
-            return;
-          }
-          for (const std::string& warning : read.asset->warnings) log_.warn("asset '{}': {}", id, warning);
-          for (const std::string& note : read.asset->notes) log_.info("asset '{}': {}", id, note);
-          loaded_[id] = Loaded{read.asset->source, read.asset->content_sha256, !read.asset->definition.objects.empty()};
-          if (asset_loaded_) asset_loaded_(id, read.asset);
-        });
-      });
+  asio::post(loader_,
+             [this, &io = io_, alive, folder = settings_.assets, uploads = uploads_.folder, load = std::move(load)] {
+               AssetRead read = read_asset(load, folder, uploads);
+               asio::post(io, [this, alive, id = load.asset, from_file = !load.path.empty(), read = std::move(read)] {
+                 if (alive.expired()) return;
+                 if (!read.asset) {
+                   carry_out(sessions_.asset_failed(id, from_file ? "load_asset.path" : "load_asset.glb", read.error));
+                   return;
+                 }
+                 for (const std::string& warning : read.asset->warnings) log_.warn("asset '{}': {}", id, warning);
+                 for (const std::string& note : read.asset->notes) log_.info("asset '{}': {}", id, note);
+                 if (asset_loaded_) asset_loaded_(id, read.asset);
+               });
+             });
 }
 
-void SessionPort::asset_usable(const std::string& id, std::uint64_t frame) {
-  const auto found = loaded_.find(id);
-  if (found == loaded_.end()) return;
-  const Loaded loaded = found->second;
-  loaded_.erase(found);
-  carry_out(sessions_.asset_loaded(id, frame, loaded.animated, loaded.path, loaded.sha256));
+void SessionPort::asset_usable(const AssetUsable& usable) {
+  carry_out(sessions_.asset_loaded(usable.asset, usable.frame, usable.animated, usable.path, usable.sha256));
 }
 
 void SessionPort::asset_unusable(const std::string& id, const std::string& reason) {
-  loaded_.erase(id);
   carry_out(sessions_.asset_failed(id, "load_asset", reason));
 }
 

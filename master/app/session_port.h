@@ -15,6 +15,7 @@
 
 #include "config/installation.h"
 #include "http/websocket.h"
+#include "master/actions.h"
 #include "master/app/journal_file.h"
 #include "master/app/tcp_listener.h"
 #include "master/session/live_scene.h"
@@ -50,7 +51,7 @@ class SessionPort {
   void on_asset_loaded(AssetLoaded hook) { asset_loaded_ = std::move(hook); }
   // Every node in the frames has the asset from frame `frame` on: the live
   // scene takes it, the journal records it, the application hears so.
-  void asset_usable(const std::string& id, std::uint64_t frame);
+  void asset_usable(const AssetUsable& usable);
   // A node cannot draw it: the application hears why.
   void asset_unusable(const std::string& id, const std::string& reason);
   // Listens and accepts; `next_frame` says which frame the master begins next.
@@ -91,12 +92,6 @@ class SessionPort {
   SessionId next_id_ = 1;
   const Uploads uploads_;
   AssetLoaded asset_loaded_;
-  struct Loaded {
-    std::string path;
-    std::string sha256;
-    bool animated = false;
-  };
-  std::map<std::string, Loaded> loaded_;  // offered to the nodes, not yet usable
   // What a WebSocket's thread posts here finds the port gone once it is.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
   // Reads assets, one at a time; joined first when the port goes.

@@ -472,7 +472,7 @@ void SimCluster::add_asset() {
   asset->content_sha256 = scene::manifest_sha256(asset->manifest);
   asset->source = id + ".gltf";
   asset_shas_.insert(asset->content_sha256);
-  master_actions(master_->add_asset(id, std::move(asset), now_));
+  master_actions(master_->add_asset(id, std::move(asset)));
 }
 
 void SimCluster::step(std::uint8_t choice) {

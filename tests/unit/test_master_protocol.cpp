@@ -1140,7 +1140,7 @@ TEST_F(MasterTest, AnAssetIsUsableOnceEveryNodeInTheFramesHasReadiedIt) {
   (void)join_all();
   const auto torus = torus_asset("torus");
   ASSERT_NE(torus, nullptr);
-  Actions a = master_->add_asset("torus", torus, now_);
+  Actions a = master_->add_asset("torus", torus);
   for (PeerId peer = 1; peer <= 4; ++peer) {
     const auto offers = sent_to(a, peer, wire::Envelope::kAssetOffer);
     ASSERT_EQ(offers.size(), 1u) << peer;
@@ -1174,7 +1174,7 @@ TEST_F(MasterTest, AnAssetIsUsableOnceEveryNodeInTheFramesHasReadiedIt) {
   ASSERT_EQ(welcome.front().welcome().assets_size(), 1);
   EXPECT_EQ(welcome.front().welcome().assets(0).asset(), "torus");
   (void)configured(5);
-  a = master_->add_asset("torus2", torus_asset("torus2"), now_);
+  a = master_->add_asset("torus2", torus_asset("torus2"));
   EXPECT_EQ(sent_to(a, 5, wire::Envelope::kAssetOffer).size(), 1u);
   for (PeerId peer : {1, 2, 3}) EXPECT_EQ(first<AssetUsable>(asset_ready(*master_, peer, "torus2", "", now_)), nullptr);
   EXPECT_NE(first<AssetUsable>(asset_ready(*master_, 5, "torus2", "", now_)), nullptr);
@@ -1192,8 +1192,8 @@ TEST_F(MasterTest, AskingForTwoAssetsByTurnsIsBoundedOnEach) {
   const std::shared_ptr<const scene::LoadedScene> assets[2] = {
       torus_asset("torus"), std::make_shared<const scene::LoadedScene>(std::move(embedded).value())};
   ASSERT_NE(assets[0]->content_sha256, assets[1]->content_sha256);
-  (void)master_->add_asset("torus", assets[0], now_);
-  (void)master_->add_asset("embedded", assets[1], now_);
+  (void)master_->add_asset("torus", assets[0]);
+  (void)master_->add_asset("embedded", assets[1]);
   bool closed = false;
   for (int i = 0; i < 200 && !closed; ++i) {
     wire::Envelope request = envelope();
@@ -1213,7 +1213,7 @@ TEST_F(MasterTest, AskingForTwoAssetsByTurnsIsBoundedOnEach) {
 TEST_F(MasterTest, AnAssetANodeCannotDrawIsNotUsed) {
   load("powerwall-2x2.json");
   (void)join_all();
-  (void)master_->add_asset("torus", torus_asset("torus"), now_);
+  (void)master_->add_asset("torus", torus_asset("torus"));
   const Actions a = asset_ready(*master_, 3, "torus", "texture 0 is not a \x1b[31mPNG", now_);
   ASSERT_NE(first<AssetFailed>(a), nullptr);
   EXPECT_EQ(first<AssetFailed>(a)->asset, "torus");
