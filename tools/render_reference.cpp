@@ -34,12 +34,8 @@ Result<void> render_reference(const config::LoadedConfig& config, const scene::L
   if (options.replay != nullptr) {
     std::set<std::string> animated;
     for (const session::JournalAsset& entry : options.replay->assets) {
-      auto asset = config::load_asset(entry.asset(), entry.path(), image::decode_texture);
+      auto asset = config::load_asset(entry.asset(), entry.path(), image::decode_texture, entry.sha256());
       if (!asset) return Error{"the replayed journal's asset '" + entry.asset() + "': " + asset.error()};
-      if (asset.value().content_sha256 != entry.sha256()) {
-        return Error{"the replayed journal's asset '" + entry.asset() + "': " + entry.path() +
-                     " has changed since it was loaded"};
-      }
       if (!asset.value().definition.objects.empty()) animated.insert(entry.asset());
       assets.push_back(std::move(asset).value());
     }

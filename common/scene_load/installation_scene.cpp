@@ -14,11 +14,15 @@ Result<scene::LoadedScene> load_scene(const Installation& installation, const sc
   return loaded;
 }
 
-Result<scene::LoadedScene> load_asset(const std::string& id, const std::string& path,
-                                      const scene::ImageDecoder& decode) {
+Result<scene::LoadedScene> load_asset(const std::string& id, const std::string& path, const scene::ImageDecoder& decode,
+                                      const std::string& sha256) {
   auto gltf = scene::load_gltf_scene(path, decode);
   if (!gltf) return Error{gltf.error()};
   scene::LoadedScene loaded = std::move(gltf).value();
+  if (!sha256.empty() && loaded.content_sha256 != sha256) {
+    return Error{path + " is not the asset '" + id + "' it was loaded as: its files have changed (sha256 " +
+                 loaded.content_sha256.substr(0, 12) + "… here, " + sha256.substr(0, 12) + "… then)"};
+  }
   loaded.definition.asset_id = id;
   if (!loaded.definition.lights.empty()) {
     loaded.notes.push_back(path + ": its " + std::to_string(loaded.definition.lights.size()) +

@@ -20,8 +20,9 @@ namespace optique::config {
 // An asset an application loaded (the scene session's LoadAsset), named
 // `id`: the glTF file at `path`, loaded as a scene's is. It is drawn lit by
 // the installation's lights: its own lights (none are added) are dropped and
-// said so in its notes.
+// said so in its notes. With `sha256` (its identity when it was loaded: a
+// journal's, a master's offer), files that hash otherwise are refused.
 [[nodiscard]] Result<scene::LoadedScene> load_asset(const std::string& id, const std::string& path,
-                                                    const scene::ImageDecoder& decode);
+                                                    const scene::ImageDecoder& decode, const std::string& sha256 = {});
 
 }  // namespace optique::config

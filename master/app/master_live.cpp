@@ -84,12 +84,8 @@ Result<void> Master::make_live_scene(RunSettings& run) {
 Result<void> Master::load_journal_assets(const Journal& journal) {
   for (const session::JournalAsset& entry : journal.assets) {
     const std::string& id = entry.asset();
-    auto loaded = config::load_asset(id, entry.path(), {});
+    auto loaded = config::load_asset(id, entry.path(), {}, entry.sha256());
     if (!loaded) return Error{"asset '" + id + "': " + loaded.error()};
-    if (loaded.value().content_sha256 != entry.sha256()) {
-      return Error{"asset '" + id + "': " + entry.path() +
-                   " is not what was loaded then (its files have changed since): put the file back as it was"};
-    }
     live_->add_asset(id, !loaded.value().definition.objects.empty());
     journal_assets_.emplace_back(id, std::make_shared<const scene::LoadedScene>(std::move(loaded).value()));
   }

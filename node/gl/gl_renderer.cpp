@@ -95,12 +95,8 @@ Result<void> GlRenderer::configure(const protocol::NodeJob& node) {
 }
 
 Result<std::shared_ptr<const scene::SceneDefinition>> GlRenderer::read_asset(const protocol::AssetOffer& asset) const {
-  auto loaded = config::load_asset(asset.asset, asset.path, image::decode_texture);
+  auto loaded = config::load_asset(asset.asset, asset.path, image::decode_texture, asset.sha256);
   if (!loaded) return Error{"cannot load the asset '" + asset.asset + "': " + loaded.error()};
-  if (loaded.value().content_sha256 != asset.sha256) {
-    return Error{"the asset '" + asset.asset + "' here is not the master's (sha256 " +
-                 loaded.value().content_sha256.substr(0, 12) + "… here, " + asset.sha256.substr(0, 12) + "… offered)"};
-  }
   for (const auto& warning : loaded.value().warnings) log_.warn("asset '{}': {}", asset.asset, warning);
   return std::make_shared<const scene::SceneDefinition>(std::move(loaded.value().definition));
 }

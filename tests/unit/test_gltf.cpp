@@ -28,8 +28,9 @@
 #include <nlohmann/json.hpp>
 
 #include "image/texture_decode.h"
-#include "scene_load/gltf.h"
 #include "scene/manifest.h"
+#include "scene_load/gltf.h"
+#include "scene_load/installation_scene.h"
 #include "scratch.h"
 #include "util/sha256.h"
 
@@ -849,6 +850,22 @@ TEST(Gltf, NonFiniteWorldTransformsAreRefused) {
     doc["scenes"][0]["nodes"] = {6, 1, 2, 4, 5};
   });
   expect_error(path, {"red-box", "not finite"});
+}
+
+// An asset an application loads: named by its id, its lights dropped (the
+// installation's light it), and refused when its files are not those of the
+// identity it was loaded with (a journal's, a master's offer).
+TEST(Gltf, AnAssetIsNamedUnlitAndCheckedAgainstItsIdentity) {
+  const std::string torus = std::string(OPTIQUE_SOURCE_DIR) + "/configs/assets/torus/torus.glb";
+  auto loaded = config::load_asset("ring", torus, {});
+  ASSERT_TRUE(loaded) << loaded.error();
+  EXPECT_EQ(loaded.value().definition.asset_id, "ring");
+  EXPECT_TRUE(loaded.value().definition.lights.empty());
+  EXPECT_TRUE(config::load_asset("ring", torus, {}, loaded.value().content_sha256));
+  auto changed = config::load_asset("ring", torus, {}, std::string(64, 'a'));
+  ASSERT_FALSE(changed);
+  EXPECT_NE(changed.error().find("is not the asset 'ring' it was loaded as: its files have changed"), std::string::npos)
+      << changed.error();
 }
 
 }  // namespace
