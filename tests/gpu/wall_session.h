@@ -79,15 +79,15 @@ inline image::FloatImage stitched_wall(const std::string& out, std::uint64_t fra
 }
 
 // The master ends cleanly, every node of the wall having shown every one of
-// `frames` frames in the master's state.
-inline void expect_whole_run(Process& master, const std::string& out, int frames) {
+// `frames` frames (but at most `may_miss`) in the master's state.
+inline void expect_whole_run(Process& master, const std::string& out, int frames, int may_miss = 0) {
   using namespace std::chrono_literals;
   ASSERT_EQ(master.wait(300s), 0) << master.output();
   const ClusterRun run = read_cluster_run(out);
   ASSERT_EQ(run.error, "");
   ASSERT_EQ(run.report.nodes_size(), 4);
   for (const auto& node : run.report.nodes()) {
-    EXPECT_EQ(node.frames_presented(), static_cast<std::uint64_t>(frames)) << node.id();
+    EXPECT_GE(node.frames_presented(), static_cast<std::uint64_t>(frames - may_miss)) << node.id();
     EXPECT_EQ(node.hash_mismatches(), 0u) << node.id() << ": its state left the master's";
   }
 }
