@@ -117,6 +117,7 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
     // Every edit made until now is in this frame; the next frame's budget of edits starts.
     put_live(*settings_.live, frame, state);
     settings_.live->begin_frame();
+    (void)settings_.live->take_edited();  // all in this frame's delta, staged or not
   }
   bool tracked = false;
   if (head_) {
@@ -346,6 +347,7 @@ void MasterProtocol::swap(clock::Nanos now, Actions& out) {
     presents_owed_.push_back(slot);
   }
   presents_owed_frame_ = frame;
+  stage_edits(out);  // what came in the round
   // A node shows a frame no later than a period after its deadline (then it is stale).
   presents_grace_end_ = swap.present_deadline_ns() + frame_period_;
   recorder_.swapped(frame, sent, ready_for_swap_);

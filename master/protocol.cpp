@@ -311,13 +311,14 @@ void MasterProtocol::on_configured(PeerId peer, Session& session, const wire::Co
     start_frames(now, out);
 }
 
-// The state as of the last frame begun; the next FrameBegin's delta applies to it.
+// The state as of the last frame begun, with the edits staged since; the next
+// FrameBegin's delta applies to it.
 void MasterProtocol::send_resync(PeerId peer, Actions& out) const {
   wire::Envelope envelope;
   auto& resync = *envelope.mutable_resync();
   *resync.mutable_snapshot() = scene::to_snapshot(current_state_);
   resync.set_next_frame_id(next_frame_);
-  resync.set_state_hash(current_hash_);
+  resync.set_state_hash(scene::state_hash(current_state_));
   out.push_back(Send{peer, std::move(envelope)});
 }
 

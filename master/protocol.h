@@ -114,6 +114,9 @@ class MasterProtocol {
   // readied it (at once when none is), AssetFailed when one cannot. A built-in
   // asset (no files) or an id offered before is a contract violation.
   [[nodiscard]] Actions add_asset(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset);
+  // An application changed the live scene: the instances it changed go to
+  // every node now, or after the barrier round under way (master/staged_edits.cpp).
+  [[nodiscard]] Actions scene_edited();
 
   // For the status line and tests: the frame to begin next, the nodes up of the
   // projectors, whether frames are running.
@@ -123,6 +126,8 @@ class MasterProtocol {
     std::size_t projectors = 0;
     bool running = false;  // frames have started and the run is not draining
   };
+  // A barrier round is under way: from the FrameBegin to the Swap.
+  [[nodiscard]] bool in_round() const { return barrier_.active(); }
   [[nodiscard]] Progress progress() const {
     return {next_frame_, nodes_up(), slots_.size(), state_ == RunState::running};
   }
@@ -172,6 +177,7 @@ class MasterProtocol {
   void refuse(PeerId peer, Session& session, const std::string& node_id, const std::string& reason, bool retriable,
               Actions& out);
   void send_resync(PeerId peer, Actions& out) const;
+  void stage_edits(Actions& out);
 
   void start_frames(clock::Nanos now, Actions& out);
   void begin_frame(clock::Nanos now, Actions& out);
@@ -231,8 +237,10 @@ class MasterProtocol {
   std::optional<FocusSchedule> focus_;
   std::optional<ViewerHead> head_;  // viewer.tracking
   ViewerNavigation navigation_;     // flysticks, and what applications set
+  // The state of the last frame begun, with the edits staged since
+  // (stage_edits): what every node in the frames has.
   scene::SceneState current_state_;
-  std::uint64_t current_hash_ = 0;
+  std::uint64_t current_hash_ = 0;  // of the last frame begun, as it began
   Barrier barrier_;
   std::vector<std::size_t> ready_for_swap_;
   // The nodes told to show the last swapped frame that have not said they did.

@@ -38,7 +38,11 @@ void RunRecorder::frame_begun(std::uint64_t frame, clock::Nanos sent, const std:
   open_.push_back(std::move(record));
   if (first_begin_ == 0) first_begin_ = sent;
   last_begin_ = sent;
-  if (bytes > 0) frame_begin_bytes_.add(static_cast<double>(bytes));
+  if (bytes > 0) {
+    frame_begin_bytes_.add(static_cast<double>(bytes));
+    frame_state_bytes_.add(static_cast<double>(bytes + staged_bytes_));
+  }
+  staged_bytes_ = 0;
 }
 
 void RunRecorder::ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time,
@@ -210,6 +214,7 @@ report::RunReport RunRecorder::report() const {
       *node.mutable_clock()->mutable_true_error_us() = t.clock_true_error_us.summary();
   }
   if (frame_begin_bytes_.count() > 0) *r.mutable_frame_begin_bytes() = frame_begin_bytes_.summary();
+  if (frame_state_bytes_.count() > 0) *r.mutable_frame_state_bytes() = frame_state_bytes_.summary();
   auto& sync = *r.mutable_sync();
   *sync.mutable_barrier_round_us() = barrier_round_us_.summary();
   *sync.mutable_present_skew_us() = present_skew_us_.summary();

@@ -85,6 +85,9 @@ class RunRecorder {
   // each node's own: its share of the lights, a frame ahead).
   void frame_begun(std::uint64_t frame, clock::Nanos sent, const std::vector<std::size_t>& nodes,
                    std::size_t bytes = 0);
+  // A staged edit of `bytes` (master/staged_edits.cpp) for the next frame to
+  // begin: counted with its FrameBegin in the scene's bytes a frame.
+  void staged(std::size_t bytes) { staged_bytes_ += bytes; }
   // `drawn_as`: how a node that up-converts drew it (key frame, between…). A
   // render time beyond kLongestRender (or negative) is counted, not recorded.
   void ready(std::uint64_t frame, std::size_t node, clock::Nanos received, clock::Nanos render_time,
@@ -153,6 +156,8 @@ class RunRecorder {
   metrics::Reservoir barrier_round_us_;
   metrics::Reservoir present_skew_us_;
   metrics::Reservoir frame_begin_bytes_;
+  metrics::Reservoir frame_state_bytes_;  // the FrameBegin and the edits staged for its frame
+  std::size_t staged_bytes_ = 0;          // for the next frame to begin
   RunTotals run_;
   clock::Nanos first_begin_ = 0;
   clock::Nanos last_begin_ = 0;

@@ -143,6 +143,7 @@ bool NodeProtocol::accepts(Phase phase, wire::Envelope::BodyCase kind) {
     case wire::Envelope::kResync:
       return phase == Phase::awaiting_state || phase == Phase::joined;
     case wire::Envelope::kFrameBegin:
+    case wire::Envelope::kStagedEdit:
     case wire::Envelope::kSwap:
     case wire::Envelope::kPong:
       return phase == Phase::joined;
@@ -196,6 +197,7 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
       break;
     case wire::Envelope::kResync:
     case wire::Envelope::kFrameBegin:
+    case wire::Envelope::kStagedEdit:
     case wire::Envelope::kSwap:
       // A frame is waiting for its deadline: nothing may touch it (a new state,
       // the next frame drawn over it) before it is shown.
@@ -203,6 +205,8 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
         held_.push_back(message);
       } else if (message.has_resync()) {
         on_resync(message.resync(), now, out);
+      } else if (message.has_staged_edit()) {
+        on_staged_edit(message.staged_edit(), out);
       } else if (message.has_frame_begin()) {
         on_frame_begin(message.frame_begin(), now, out);
       } else {
@@ -355,11 +359,13 @@ void NodeProtocol::on_resync(const wire::Resync& resync, clock::Nanos now, Actio
     out.push_back(Close{"bad snapshot from the master: " + state.error()});
     return;
   }
-  if (scene::state_hash(state.value()) != resync.state_hash()) {
+  const scene::InstancesHash instances = scene::instances_hash(state.value());
+  if (scene::state_hash(state.value(), instances) != resync.state_hash()) {
     out.push_back(Close{"the master's snapshot does not match its hash"});
     return;
   }
   state_ = std::move(state).value();
+  instances_hash_ = instances;
   past_frames_.clear();
   next_frame_ = resync.next_frame_id();
   if (phase_ == Phase::joined) {
@@ -383,6 +389,19 @@ void NodeProtocol::on_resync(const wire::Resync& resync, clock::Nanos now, Actio
   ready_next(out);  // assets offered while this node set up
 }
 
+// The instances as the next frame will show them, staged between rounds: the
+// FrameBegin that follows carries only what changed since.
+void NodeProtocol::on_staged_edit(const wire::StagedEdit& staged, Actions& out) {
+  if (staged.frame_id() != next_frame_) {
+    log(out, spdlog::level::warn,
+        fmt::format("an edit staged for frame {} came while frame {} is next", staged.frame_id(), next_frame_));
+  }
+  if (auto applied = scene::apply_delta(state_, staged.delta(), instances_hash_); !applied) {
+    out.push_back(
+        Close{"cannot apply the edit staged for frame " + std::to_string(staged.frame_id()) + ": " + applied.error()});
+  }
+}
+
 void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos now, Actions& out) {
   last_begin_ = now;
   // A frame to skip has no round: no swap comes for it.
@@ -392,14 +411,14 @@ void NodeProtocol::on_frame_begin(const wire::FrameBegin& begin, clock::Nanos no
         "frame ids jumped from " + std::to_string(next_frame_) + " to " + std::to_string(begin.frame_id()));
   }
   next_frame_ = begin.frame_id() + 1;
-  if (auto applied = scene::apply_delta(state_, begin.delta()); !applied) {
+  if (auto applied = scene::apply_delta(state_, begin.delta(), instances_hash_); !applied) {
     out.push_back(Close{"cannot apply frame " + std::to_string(begin.frame_id()) + ": " + applied.error()});
     return;
   }
   if (settings_.faults.corrupt_state_at_frame != 0 && begin.frame_id() == settings_.faults.corrupt_state_at_frame) {
     state_.eye_now.x += 1e-3;
   }
-  last_hash_ = scene::state_hash(state_);
+  last_hash_ = scene::state_hash(state_, instances_hash_);
   if (last_hash_ != begin.state_hash()) {
     log(out, spdlog::level::warn,
         fmt::format("state hash {:016x} differs from the master's {:016x} at frame {}", last_hash_, begin.state_hash(),

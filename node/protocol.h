@@ -330,6 +330,7 @@ class NodeProtocol {
   void configure(Actions& out);
   void cache_failed(const std::string& error, Actions& out);
   void on_resync(const wire::Resync& resync, clock::Nanos now, Actions& out);
+  void on_staged_edit(const wire::StagedEdit& staged, Actions& out);
   void on_frame_begin(const wire::FrameBegin& begin, clock::Nanos now, Actions& out);
   void on_swap(const wire::FrameSwap& swap, clock::Nanos now, Actions& out);
   void on_pong(const wire::Pong& pong, clock::Nanos now, Actions& out);
@@ -386,6 +387,7 @@ class NodeProtocol {
   };
   std::optional<SceneWaiting> waiting_;
   scene::SceneState state_;
+  scene::InstancesHash instances_hash_;  // of state_'s instances, kept as deltas change them
   // The lag hook's memory: the last lag_frames + 1 frames as they came.
   struct PastFrame {
     protocol::FrameMessage frame;

@@ -97,9 +97,22 @@ void Connection::write_more() {
 // (Asio's async_wait re-arms epoll, which also reports bytes already there)
 // and one read, where Asio tried a read that found nothing before each wait.
 // A peek instead of async_wait costs one more read per message.
+void Connection::hold_reading(bool held) {
+  if (held == reading_held_) return;
+  reading_held_ = held;
+  if (held) return;
+  asio::post(socket_.get_executor(), [self = shared_from_this()] {
+    if (!self->open_ || self->reading_held_) return;
+    self->handle_bytes(0, clock::monotonic_now());  // what the reader holds already
+    if (self->open_ && !self->reading_held_ && !self->wait_armed_) self->read_available();
+  });
+}
+
 void Connection::wait_for_bytes() {
+  wait_armed_ = true;
   socket_.async_wait(asio::ip::tcp::socket::wait_read,
                      [self = shared_from_this()](const boost::system::error_code& ec) {
+                       self->wait_armed_ = false;
                        if (ec) {
                          if (ec != asio::error::operation_aborted) self->finish("read failed: " + ec.message());
                          return;
@@ -113,6 +126,7 @@ void Connection::read_available() {
   // after this many full reads the rest waits behind what else is queued.
   constexpr int kReadsPerTurn = 16;
   for (int reads = 0; open_ && reads < kReadsPerTurn; ++reads) {
+    if (reading_held_) return;  // hold_reading(false) reads on
     const StampedRead read = read_stamped(socket_.native_handle(), read_buffer_);
     switch (read.status) {
       case StampedRead::Status::data:
@@ -135,14 +149,16 @@ void Connection::read_available() {
         return;
     }
   }
-  if (open_) asio::post(socket_.get_executor(), [self = shared_from_this()] { self->read_available(); });
+  if (open_ && !reading_held_) {
+    asio::post(socket_.get_executor(), [self = shared_from_this()] { self->read_available(); });
+  }
 }
 
 void Connection::handle_bytes(std::size_t count, clock::Nanos received) {
   last_receive_ = std::chrono::steady_clock::now();
   if (closing_) return;  // draining: what the peer says no longer matters
   reader_.append({read_buffer_.data(), count});
-  while (open_ && !closing_) {
+  while (open_ && !closing_ && !reading_held_) {
     const DecodedFrame frame = reader_.next();
     if (frame.status == DecodeStatus::need_more) return;
     if (frame.status == DecodeStatus::bad) {

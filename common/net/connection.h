@@ -69,6 +69,10 @@ class Connection : public std::enable_shared_from_this<Connection> {
   // A message over that size is passed over and told to on_oversized (the
   // peer may be told and go on), instead of closing the connection.
   void skip_oversized() { reader_.set_skip_oversized(true); }
+  // Held, nothing more is read or handed on: bytes wait in the kernel and the
+  // reader. Let go, what waited is handed on and reading goes on. (The master
+  // holds the applications' sessions while a barrier round is under way.)
+  void hold_reading(bool held);
   // From now on every message sent is sealed with `send` and every message
   // received must open with `receive` (net/session_seal.h); one that does not
   // closes the connection. `unsealed_refusal_first`: the first message may
@@ -115,6 +119,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::optional<Sealer> sealer_;
   std::optional<Opener> opener_;
   bool unsealed_refusal_allowed_ = false;  // the next message may be a plain Refuse
+  bool reading_held_ = false;
+  bool wait_armed_ = false;  // an async_wait for bytes is outstanding
   std::uint64_t next_send_sequence_ = 1;
   std::uint64_t next_receive_sequence_ = 1;
   std::uint64_t deadline_generation_ = 0;

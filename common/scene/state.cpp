@@ -515,7 +515,22 @@ glm::dquat head_at(const SceneState& state, double fraction) {
                                                     : glm::slerp(state.head_now, state.head_next, fraction);
 }
 
-std::uint64_t state_hash(const SceneState& state) {
+std::uint64_t instance_hash(const std::string& id, const InstanceState& instance) {
+  StateHasher h;
+  h.add(std::string_view(id));
+  h.add(instance);
+  return h.value();
+}
+
+InstancesHash instances_hash(const SceneState& state) {
+  InstancesHash instances;
+  for (const auto& [id, instance] : state.instances) instances.sum += instance_hash(id, instance);
+  return instances;
+}
+
+std::uint64_t state_hash(const SceneState& state) { return state_hash(state, instances_hash(state)); }
+
+std::uint64_t state_hash(const SceneState& state, InstancesHash instances) {
   StateHasher h;
   h.add(static_cast<std::uint64_t>(state.objects.size()));
   for (const auto& [id, object] : state.objects) {
@@ -532,10 +547,7 @@ std::uint64_t state_hash(const SceneState& state) {
   h.add(static_cast<std::uint64_t>(state.lights_off.size()));
   for (std::uint32_t light : state.lights_off) h.add(static_cast<std::uint64_t>(light));
   h.add(static_cast<std::uint64_t>(state.instances.size()));
-  for (const auto& [id, instance] : state.instances) {
-    h.add(std::string_view(id));
-    h.add(instance);
-  }
+  if (!state.instances.empty()) h.add(instances.sum);
   // Only when there are any: a state without them hashes as it did before they were.
   if (!state.point_lights.empty()) {
     h.add(static_cast<std::uint64_t>(state.point_lights.size()));
@@ -600,6 +612,38 @@ Result<SceneState> from_snapshot(const wire::Snapshot& snapshot) {
   return state;
 }
 
+namespace {
+
+// An instance as `after` where it was `before` (none: it is new): changed,
+// moved (its pose alone changed), or nothing when it is the same.
+void add_instance_change(const std::string& id, const InstanceState* before, const InstanceState& after,
+                         wire::StateDelta& delta) {
+  if (before == nullptr || !identical_but_pose(*before, after)) {
+    to_wire(id, after, *delta.add_instances_changed());
+  } else if (!identical(before->pose, after.pose)) {
+    wire::InstanceMove& moved = *delta.add_instances_moved();
+    moved.set_id(id);
+    pose_to_wire(after.pose, *moved.mutable_pose());
+  }
+}
+
+}  // namespace
+
+wire::StateDelta make_instance_delta(const SceneState& before,
+                                     const std::map<std::string, std::optional<InstanceState>>& after) {
+  wire::StateDelta delta;
+  for (const auto& [id, instance] : after) {
+    const auto was = before.instances.find(id);
+    const InstanceState* old = was == before.instances.end() ? nullptr : &was->second;
+    if (instance) {
+      add_instance_change(id, old, *instance, delta);
+    } else if (old != nullptr) {
+      delta.add_instances_removed(id);
+    }
+  }
+  return delta;
+}
+
 wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
   wire::StateDelta delta;
   for (const auto& [id, object] : after.objects) {
@@ -625,13 +669,7 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
   for (const auto& [id, instance] : after.instances) {
     for (; old != before.instances.end() && old->first < id; ++old) delta.add_instances_removed(old->first);
     const bool was_there = old != before.instances.end() && old->first == id;
-    if (!was_there || !identical_but_pose(old->second, instance)) {
-      to_wire(id, instance, *delta.add_instances_changed());
-    } else if (!identical(old->second.pose, instance.pose)) {
-      wire::InstanceMove& moved = *delta.add_instances_moved();
-      moved.set_id(id);
-      pose_to_wire(instance.pose, *moved.mutable_pose());
-    }
+    add_instance_change(id, was_there ? &old->second : nullptr, instance, delta);
     if (was_there) ++old;
   }
   for (; old != before.instances.end(); ++old) delta.add_instances_removed(old->first);
@@ -647,7 +685,10 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
   return delta;
 }
 
-Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
+namespace {
+
+// apply_delta, keeping the instances' hash where `keep` says.
+Result<void> apply(SceneState& state, const wire::StateDelta& delta, InstancesHash& instances, bool keep) {
   // Check everything first so a bad delta leaves the state as it was.
   std::vector<std::pair<std::uint32_t, ObjectState>> changed;
   changed.reserve(static_cast<std::size_t>(delta.changed_size()));
@@ -756,18 +797,52 @@ Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
   if (!moves) return Error{moves.error()};
 
   for (auto& [id, object] : changed) state.objects.insert_or_assign(id, object);
+  // Each instance's hash out of the sum as it was, and in as it is.
+  const auto unhash = [&](const std::string& id, const InstanceState& instance) {
+    if (keep) instances.sum -= instance_hash(id, instance);
+  };
+  const auto rehash = [&](const std::string& id, const InstanceState& instance) {
+    if (keep) instances.sum += instance_hash(id, instance);
+  };
   // In order, each hinted at the one after the last: next to it when they are neighbours.
   auto hint = state.instances.begin();
   for (auto& [id, instance] : instances_changed) {
-    hint = std::next(state.instances.insert_or_assign(hint, id, std::move(instance)));
+    auto at = hint != state.instances.end() && hint->first == id ? hint : state.instances.find(id);
+    if (at != state.instances.end()) {
+      unhash(id, at->second);
+      at->second = std::move(instance);
+    } else {
+      at = state.instances.emplace_hint(hint, id, std::move(instance));
+    }
+    rehash(at->first, at->second);
+    hint = std::next(at);
   }
-  for (auto& [at, pose] : moves.value()) at->second.pose = pose;
-  for (const std::string& id : instances_removed) state.instances.erase(id);
+  for (auto& [at, pose] : moves.value()) {
+    unhash(at->first, at->second);
+    at->second.pose = pose;
+    rehash(at->first, at->second);
+  }
+  for (const std::string& id : instances_removed) {
+    const auto at = state.instances.find(id);
+    unhash(id, at->second);
+    state.instances.erase(at);
+  }
   for (std::uint32_t id : delta.removed()) state.objects.erase(id);
   set_viewer(state, viewer);
   state.lights_off = std::move(lights_off);
   if (point_lights) state.point_lights = std::move(*point_lights);
   return {};
+}
+
+}  // namespace
+
+Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta) {
+  InstancesHash unused;
+  return apply(state, delta, unused, false);
+}
+
+Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta, InstancesHash& instances) {
+  return apply(state, delta, instances, true);
 }
 
 }  // namespace optique::scene

@@ -131,8 +131,19 @@ inline constexpr double kMostNavigationScale = 1e4;
 
 // A 64-bit hash of a canonical encoding (ids in order, the bits of every
 // double, words of eight bytes the first lowest), so equal states hash equally
-// on every machine.
+// on every machine. The instances count in it as the sum (mod 2^64) of each
+// one's own hash: a delta that changes a few of thousands is followed by
+// hashing those few again (apply_delta with InstancesHash), not all of them.
 [[nodiscard]] std::uint64_t state_hash(const SceneState& state);
+
+struct InstancesHash {
+  std::uint64_t sum = 0;
+  bool operator==(const InstancesHash&) const = default;
+};
+[[nodiscard]] std::uint64_t instance_hash(const std::string& id, const InstanceState& instance);
+[[nodiscard]] InstancesHash instances_hash(const SceneState& state);
+// state_hash(state) with the instances' part known: O(what is not an instance).
+[[nodiscard]] std::uint64_t state_hash(const SceneState& state, InstancesHash instances);
 
 [[nodiscard]] wire::Snapshot to_snapshot(const SceneState& state);
 [[nodiscard]] Result<SceneState> from_snapshot(const wire::Snapshot& snapshot);
@@ -146,5 +157,15 @@ inline constexpr double kMostNavigationScale = 1e4;
 // is itself or under it, or deeper than kMaxInstanceDepth; a point light out of
 // bounds, removed when it is not there, or more than kMaxAddedLights of them).
 [[nodiscard]] Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta);
+// The same, keeping `instances` (instances_hash(state) before) true for the
+// state after; untouched when the delta is refused.
+[[nodiscard]] Result<void> apply_delta(SceneState& state, const wire::StateDelta& delta, InstancesHash& instances);
+
+// The instances `after` names, as a delta from `before`: each id with its
+// state then, or none where it is removed (where `before` has it). Every other
+// part of the state is left out: the master's staged edits (wire.proto's
+// StagedEdit).
+[[nodiscard]] wire::StateDelta make_instance_delta(const SceneState& before,
+                                                   const std::map<std::string, std::optional<InstanceState>>& after);
 
 }  // namespace optique::scene

@@ -119,6 +119,9 @@ Result<void> Master::start() {
     session_port_->on_asset_loaded([this](const std::string& id, std::shared_ptr<const scene::LoadedScene> asset) {
       if (!finished_) carry_out(protocol_->add_asset(id, std::move(asset)));
     });
+    session_port_->on_request_handled([this] {
+      if (!finished_) carry_out(protocol_->scene_edited());
+    });
   }
 
   // Listen.
@@ -254,7 +257,11 @@ net::Connection* Master::connection(PeerId peer) {
 // ---------------------------------------------------------------- actions
 
 void Master::carry_out(Actions actions) {
+  // Applications wait while a barrier round is under way (SessionPort::hold):
+  // from before its FrameBegin goes out to after its Swap has.
+  if (session_port_ && protocol_ && protocol_->in_round()) session_port_->hold(true);
   for (Action& action : actions) carry_out(action);
+  if (session_port_ && protocol_) session_port_->hold(protocol_->in_round());
 }
 
 void Master::carry_out(Action& action) {

@@ -150,8 +150,16 @@ std::shared_ptr<http::WebSocketEndpoint> SessionPort::websocket(const std::strin
   endpoint->received = [this, &io = io_, alive, id](std::string text) {
     asio::post(io, [this, alive, id, request = request_from_json(text)] {
       if (alive.expired() || *id == 0) return;
-      carry_out(request ? sessions_.request(*id, request.value(), next_frame_())
-                        : sessions_.unreadable(*id, request.error()));
+      auto handle = [this, id, request] {
+        if (!websockets_.contains(*id)) return;  // it closed while held
+        carry_out_request(request ? sessions_.request(*id, request.value(), next_frame_())
+                                  : sessions_.unreadable(*id, request.error()));
+      };
+      if (held_) {
+        requests_held_.push_back(std::move(handle));
+      } else {
+        handle();
+      }
     });
   };
   endpoint->closed = [this, &io = io_, alive, id](const std::string& reason) {
@@ -170,8 +178,11 @@ void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& p
   socket.set_option(asio::socket_base::send_buffer_size(kSendBufferBytes), ignored);
   auto connection = net::Connection::create(std::move(socket), kMaxApplicationHelloBytes);
   connections_[id] = connection;
+  connection->hold_reading(held_);
   connection->start({
-      [this, id](wire::Envelope& message, clock::Nanos) { carry_out(sessions_.message(id, message, next_frame_())); },
+      [this, id](wire::Envelope& message, clock::Nanos) {
+        carry_out_request(sessions_.message(id, message, next_frame_()));
+      },
       [this, id](const std::string& reason) {
         connections_.erase(id);
         carry_out(sessions_.closed(id, reason));
@@ -186,7 +197,24 @@ void SessionPort::on_accepted(asio::ip::tcp::socket socket, const std::string& p
   carry_out(sessions_.accepted(id, peer_text, loopback, net::random_nonce()));
 }
 
+void SessionPort::hold(bool held) {
+  if (held == held_) return;
+  held_ = held;
+  for (const auto& [id, connection] : connections_) connection->hold_reading(held);
+  if (held) return;
+  for (const session::Event& event : std::exchange(events_held_, {})) publish(event);
+  while (!held_ && !requests_held_.empty()) {
+    auto handle = std::move(requests_held_.front());
+    requests_held_.pop_front();
+    handle();
+  }
+}
+
 void SessionPort::publish(const session::Event& event) {
+  if (held_) {
+    events_held_.push_back(event);
+    return;
+  }
   const clock::Nanos now = clock::monotonic_now();
   for (SessionAction& action : sessions_.publish(event)) {
     const SessionId to = std::get<session_action::Send>(action).session;
@@ -229,6 +257,11 @@ void SessionPort::asset_usable(const AssetUsable& usable) {
 
 void SessionPort::asset_unusable(const std::string& id, const std::string& reason) {
   carry_out(sessions_.asset_failed(id, "load_asset", reason));
+}
+
+void SessionPort::carry_out_request(SessionActions actions) {
+  carry_out(std::move(actions));
+  if (request_handled_) request_handled_();
 }
 
 void SessionPort::carry_out(SessionActions actions) {

@@ -7,6 +7,7 @@
 #include <boost/asio.hpp>
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -49,6 +50,9 @@ class SessionPort {
   // then says asset_usable() or asset_unusable().
   using AssetLoaded = std::function<void(const std::string& id, std::shared_ptr<const scene::LoadedScene> asset)>;
   void on_asset_loaded(AssetLoaded hook) { asset_loaded_ = std::move(hook); }
+  // After each request an application sent (on this thread): the master
+  // stages what it changed in the live scene to the nodes.
+  void on_request_handled(std::function<void()> hook) { request_handled_ = std::move(hook); }
   // Every node in the frames has the asset from frame `frame` on: the live
   // scene takes it, the journal records it, the application hears so.
   void asset_usable(const AssetUsable& usable);
@@ -70,10 +74,18 @@ class SessionPort {
   void publish(const session::Event& event);
   // No more sessions; the open ones are told goodbye.
   void close(const std::string& reason);
+  // Held while a barrier round is under way: no request is read or handled
+  // and no event sent, so that neither the master's thread nor an application
+  // woken by an event competes with the nodes for the round (the round is what
+  // every frame waits for; an application is answered a few hundred
+  // microseconds later). Let go, what waited goes on, in order.
+  void hold(bool held);
 
  private:
   void on_accepted(asio::ip::tcp::socket socket, const std::string& peer_text, bool loopback);
   void carry_out(SessionActions actions);
+  // A request's actions, then the hook.
+  void carry_out_request(SessionActions actions);
   // Reads and checks the asset on the loader's thread, then hands it on here.
   void load(session_action::LoadAsset load);
   // How much waits to be sent to `session` (nullopt: it is gone).
@@ -92,6 +104,10 @@ class SessionPort {
   SessionId next_id_ = 1;
   const Uploads uploads_;
   AssetLoaded asset_loaded_;
+  std::function<void()> request_handled_;
+  bool held_ = false;
+  std::vector<session::Event> events_held_;
+  std::deque<std::function<void()>> requests_held_;  // from WebSockets
   // What a WebSocket's thread posts here finds the port gone once it is.
   std::shared_ptr<bool> alive_ = std::make_shared<bool>(true);
   // Reads assets, one at a time; joined first when the port goes.

@@ -418,6 +418,7 @@ const std::set<std::string>& LiveScene::children(const std::string& parent) cons
 }
 
 void LiveScene::put(const std::string& id, std::optional<Instance> instance) {
+  edited_.insert(id);
   const auto old = instances_.find(id);
   if (instance && old != instances_.end() && old->second.parent == instance->parent) {
     old->second = std::move(*instance);  // where it was, under the same parent: no index changes
@@ -500,22 +501,37 @@ LiveSceneLimits live_scene_limits(const std::optional<config::ApiServer>& api) {
   return limits;
 }
 
+namespace {
+
+void put_instance(const Instance& instance, std::uint64_t frame, double frame_period, scene::InstanceState& placed) {
+  placed.asset = instance.asset;
+  placed.parent = instance.parent;
+  placed.pose = {instance.pose, instance.pose};
+  placed.visible = instance.visible;
+  placed.base_color = instance.base_color;
+  placed.emissive = instance.emissive;
+  if (instance.animation) {
+    placed.animation = scene::AnimationTimes{instance.animation->at(frame, frame_period),
+                                             instance.animation->at(frame + 1, frame_period)};
+  }
+}
+
+}  // namespace
+
+std::optional<scene::InstanceState> instance_state(const LiveScene& live, const std::string& id, std::uint64_t frame) {
+  const auto found = live.instances().find(id);
+  if (found == live.instances().end()) return std::nullopt;
+  scene::InstanceState placed;
+  put_instance(found->second, frame, live.frame_period(), placed);
+  return placed;
+}
+
 void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& state) {
   state.instances.clear();
   for (const auto& [id, instance] : live.instances()) {
     // In order: each goes at the end, found without a search.
-    scene::InstanceState& placed =
-        state.instances.emplace_hint(state.instances.end(), id, scene::InstanceState{})->second;
-    placed.asset = instance.asset;
-    placed.parent = instance.parent;
-    placed.pose = {instance.pose, instance.pose};
-    placed.visible = instance.visible;
-    placed.base_color = instance.base_color;
-    placed.emissive = instance.emissive;
-    if (instance.animation) {
-      placed.animation = scene::AnimationTimes{instance.animation->at(frame, live.frame_period()),
-                                               instance.animation->at(frame + 1, live.frame_period())};
-    }
+    put_instance(instance, frame, live.frame_period(),
+                 state.instances.emplace_hint(state.instances.end(), id, scene::InstanceState{})->second);
   }
   for (const auto& [light, on] : live.light_switches()) {
     if (on) {

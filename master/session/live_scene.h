@@ -15,6 +15,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -116,6 +117,10 @@ class LiveScene {
   void begin_run(std::uint64_t last);
   // A new frame: the budget of edits starts again.
   void begin_frame() { edits_this_frame_ = 0; }
+  // The ids of the instances set or removed since the last call (a
+  // transaction refused may leave some that did not change): what the master
+  // stages to the nodes between rounds (wire.proto's StagedEdit).
+  [[nodiscard]] std::set<std::string> take_edited() { return std::exchange(edited_, {}); }
 
   // How many point lights the scene has (SwitchLight's bound).
   void set_light_count(std::size_t count) { light_count_ = count; }
@@ -144,6 +149,7 @@ class LiveScene {
   std::map<std::string, Instance> instances_;
   std::map<std::string, std::set<std::string>> children_;  // parent → its children; "" → the world's
   std::size_t edits_this_frame_ = 0;
+  std::set<std::string> edited_;
   std::size_t light_count_ = 0;
   NavigationSet navigation_;
   std::map<std::uint32_t, bool> light_switches_;
@@ -165,5 +171,8 @@ void to_transform(const scene::Pose& pose, session::Transform& t);
 // they added; the navigation
 // applications set (the flystick's, if any, comes after: master/navigation.h).
 void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& state);
+// One instance as put_live puts it; none when the live scene has no `id`.
+[[nodiscard]] std::optional<scene::InstanceState> instance_state(const LiveScene& live, const std::string& id,
+                                                                 std::uint64_t frame);
 
 }  // namespace optique::master

@@ -86,17 +86,21 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
               ++outcome.configured;
               broken = check_job(a.job);
               light_count = a.job.light_count;
-              if (broken.empty()) broken = carry_out(node, node.answer(node::Configured{{}, "fuzz", {}}, 0), light_count, outcome);
+              if (broken.empty())
+                broken = carry_out(node, node.answer(node::Configured{{}, "fuzz", {}}, 0), light_count, outcome);
             },
             [&](node::Render& a) {
               ++outcome.renders;
               broken = check_frame(a.frame, light_count);
               if (broken.empty()) {
-                broken = carry_out(node, node.answer(node::FrameRendered{a.frame.frame_id, 1000, {}}, 0), light_count, outcome);
+                broken = carry_out(node, node.answer(node::FrameRendered{a.frame.frame_id, 1000, {}}, 0), light_count,
+                                   outcome);
               }
             },
             [&](node::Skip& a) { broken = check_frame(a.frame, light_count); },
-            [&](node::PresentAt& a) { broken = carry_out(node, node.due(node::Due::present, a.deadline), light_count, outcome); },
+            [&](node::PresentAt& a) {
+              broken = carry_out(node, node.due(node::Due::present, a.deadline), light_count, outcome);
+            },
             [&](node::Present&) {
               ++outcome.frames_presented;
               broken = carry_out(node, node.answer(node::ImagePresented{}, 0), light_count, outcome);
@@ -106,8 +110,8 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
             // A scene's files: fetched into a cache that takes everything.
             [&](node::PrepareScene& a) {
               outcome.scene_files = a.manifest;
-              broken =
-                  carry_out(node, node.answer(node::SceneCopyStarted{protocol::SceneFetch::Present{}}, 0), light_count, outcome);
+              broken = carry_out(node, node.answer(node::SceneCopyStarted{protocol::SceneFetch::Present{}}, 0),
+                                 light_count, outcome);
             },
             [&](node::StoreSceneChunk& a) {
               if (a.file >= outcome.scene_files.files.size() ||
@@ -117,7 +121,8 @@ std::string carry_out(node::NodeProtocol& node, node::Actions actions, std::uint
               ++outcome.scene_chunks;
             },
             [&](node::FinishScene&) {
-              broken = carry_out(node, node.answer(node::SceneCopyFinished{std::string("fuzz.gltf")}, 0), light_count, outcome);
+              broken = carry_out(node, node.answer(node::SceneCopyFinished{std::string("fuzz.gltf")}, 0), light_count,
+                                 outcome);
             },
             // An asset offered in the frames: its files here, a checked offer, given to the renderer.
             [&](node::ReadyAsset& a) {
@@ -147,6 +152,10 @@ Outcome run_protocol(std::span<const std::uint8_t> input) {
   if (input.size() < 2) return outcome;
   master::RunSettings settings;
   settings.frames = 5 + input[0] % 40;
+  // An application's edits (SimCluster::edit), staged to the nodes between rounds.
+  master::LiveScene live;
+  live.add_asset("torus");
+  settings.live = &live;
   testing::SimCluster cluster(wall(), settings, input[1] % 16);
   cluster.start();
   for (std::uint8_t choice : input.subspan(2)) {

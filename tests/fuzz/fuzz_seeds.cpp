@@ -600,6 +600,17 @@ std::vector<Seed> protocol_seeds() {
     steps.insert(steps.end(), more.begin(), more.end());
     seeds.push_back({"assets_loaded", with_header(30, 0, steps)});
   }
+  {
+    // An application's edits at any moment (in a round or between), one node's link reset among them.
+    std::vector<std::uint8_t> steps;
+    for (int k = 0; k < 40; ++k) {
+      const auto some = prompt_steps(7 + k % 5);
+      steps.insert(steps.end(), some.begin(), some.end());
+      steps.push_back(k % 2 == 0 ? 239 : 231);
+      if (k == 20) steps.push_back(246);  // reset node 2's link
+    }
+    seeds.push_back({"edits_staged", with_header(30, 0, steps)});
+  }
   seeds.push_back({"noise", noise(600, 7)});
   return seeds;
 }

@@ -51,6 +51,8 @@ SimCluster::SimCluster(const master::RunConfig& run, master::RunSettings setting
   std::vector<std::string> ids;
   for (const config::Projector& p : installation.projectors) ids.push_back(p.id);
   recorder_ = std::make_unique<master::RunRecorder>(ids);
+  live_ = settings.live;
+  corrupt_frame_ = corrupt_frame;
   master_ = std::make_unique<master::MasterProtocol>(installation, run.scene, std::move(settings), *recorder_);
   for (std::size_t i = 0; i < ids.size(); ++i) {
     node::NodeSettings s;
@@ -341,7 +343,11 @@ void SimCluster::node_actions(std::size_t i, node::Actions actions) {
               n.reconnect_at.reset();
             },
             [&](node::Log& a) {
-              if (a.text.find("frame ids jumped") != std::string::npos) {
+              // A state that differs from the master's is a fault only where one was put in.
+              const bool wrong_state = a.text.find("differs from the master's") != std::string::npos;
+              if (a.text.find("frame ids jumped") != std::string::npos ||
+                  a.text.find("an edit staged for frame") != std::string::npos ||
+                  (wrong_state && corrupt_frame_ == 0)) {
                 violation("node " + std::to_string(i) + ": " + a.text);
               }
             },
@@ -475,6 +481,27 @@ void SimCluster::add_asset() {
   master_actions(master_->add_asset(id, std::move(asset)));
 }
 
+void SimCluster::edit() {
+  if (live_ == nullptr || live_->assets().empty()) return;
+  // Each edit moves an instance, the fourth of them new.
+  const std::string id = "e" + std::to_string(edits_ / 4);
+  session::Transaction transaction;
+  if (edits_ % 4 == 0) {
+    auto& create = *transaction.add_edits()->mutable_create();
+    create.set_instance(id);
+    create.set_asset(*live_->assets().begin());
+  } else {
+    auto& move = *transaction.add_edits()->mutable_transform();
+    move.set_instance(id);
+    for (double x : {0.01 * static_cast<double>(edits_), 1.0, -1.0}) move.mutable_transform()->add_position(x);
+  }
+  ++edits_;
+  if (live_->apply(transaction, master_->progress().next_frame)) return;
+  scene_edited();
+}
+
+void SimCluster::scene_edited() { master_actions(master_->scene_edited()); }
+
 void SimCluster::step(std::uint8_t choice) {
   const std::size_t node = (choice / 8u) % nodes_.size();
   switch (choice % 8u) {
@@ -502,6 +529,8 @@ void SimCluster::step(std::uint8_t choice) {
         interrupt_master();
       } else if (choice == 247) {
         add_asset();
+      } else if (choice == 239 || choice == 231) {
+        edit();
       } else {
         for (std::size_t i = 0; i < nodes_.size(); ++i) {
           if (deliver_to_node(i) || deliver_to_master(i)) break;

@@ -45,6 +45,12 @@ class SimCluster {
   // An application loads an asset (up to eight, "asset-0" on): the master
   // offers it to every node (which, drawing nothing, readies it at once).
   void add_asset();
+  // An application's transaction on the live scene (settings.live; none:
+  // nothing): an instance created, or moved; what it changed is staged to the
+  // nodes as the master's shell does (MasterProtocol::scene_edited).
+  void edit();
+  // The shell's call after an application's request (MasterProtocol::scene_edited).
+  void scene_edited();
 
   // A prompt network: every message delivered as soon as it is sent, timers in
   // order, until the master has finished or `until` (virtual time) is reached.
@@ -98,6 +104,9 @@ class SimCluster {
   std::vector<std::string> asset_news_;
   std::set<std::pair<master::PeerId, std::string>> assets_offered_;
   int assets_added_ = 0;
+  master::LiveScene* live_ = nullptr;
+  std::uint64_t corrupt_frame_ = 0;
+  std::uint64_t edits_ = 0;
   std::set<std::string> asset_shas_;  // the assets' identities, whose files a node may ask for
 };
 

@@ -39,6 +39,7 @@ struct Loopback {
   std::vector<Received> received;
   std::string closed_reason;
   std::vector<std::uint32_t> oversized;  // the lengths of messages passed over
+  std::function<void()> after_message;   // run by the handler after each
 
   Loopback() {
     tcp::acceptor acceptor(io, tcp::endpoint(asio::ip::make_address("127.0.0.1"), 0));
@@ -46,6 +47,7 @@ struct Loopback {
     server = Connection::create(acceptor.accept(), kDefaultMaxPayloadBytes);
     server->start({[this](wire::Envelope& message, clock::Nanos at) {
                      received.push_back({message, at, clock::monotonic_now()});
+                     if (after_message) after_message();
                    },
                    [this](const std::string& reason) { closed_reason = reason; },
                    [this](std::uint32_t bytes, std::uint32_t) { oversized.push_back(bytes); }});
@@ -70,7 +72,10 @@ struct Loopback {
 
   void run_until(const std::function<bool()>& done) {
     const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
-    while (!done() && std::chrono::steady_clock::now() < give_up) io.run_for(std::chrono::milliseconds(5));
+    while (!done() && std::chrono::steady_clock::now() < give_up) {
+      if (io.stopped()) io.restart();  // out of work a moment (a held connection waits for nothing)
+      io.run_for(std::chrono::milliseconds(5));
+    }
   }
 };
 
@@ -156,6 +161,41 @@ TEST(Connection, AnOversizedMessageIsPassedOverWhenAskedAndClosesOtherwise) {
     EXPECT_NE(loop.closed_reason.find("exceeds the maximum of 65536"), std::string::npos) << loop.closed_reason;
     EXPECT_TRUE(loop.oversized.empty());
   }
+}
+
+// A held connection hands on nothing, neither what its reader holds already
+// nor what comes meanwhile; let go, all of it comes, in order, and reading
+// goes on.
+TEST(Connection, AHeldConnectionHandsOnNothingUntilLetGo) {
+  Loopback loop;
+  // Held by its own handler after the first of three frames read at once.
+  loop.after_message = [&] {
+    if (loop.received.size() == 1) loop.server->hold_reading(true);
+  };
+  asio::write(loop.client, asio::buffer(Loopback::pings(1, 3)));
+  loop.run_until([&] { return !loop.received.empty(); });
+  asio::write(loop.client, asio::buffer(Loopback::pings(4, 2)));
+  const auto settle = std::chrono::steady_clock::now() + std::chrono::milliseconds(50);
+  loop.run_until([&] { return std::chrono::steady_clock::now() > settle; });
+  EXPECT_EQ(loop.received.size(), 1u) << "held";
+  loop.server->hold_reading(false);
+  loop.run_until([&] { return loop.received.size() == 5; });
+  ASSERT_EQ(loop.received.size(), 5u) << loop.closed_reason;
+  for (std::size_t i = 0; i < 5; ++i) EXPECT_EQ(loop.received[i].message.ping().t1(), static_cast<int>(i) + 1);
+  // Held while it waits for bytes, then let go twice over: each frame once.
+  loop.server->hold_reading(true);
+  asio::write(loop.client, asio::buffer(Loopback::pings(6, 1)));
+  const auto again = std::chrono::steady_clock::now() + std::chrono::milliseconds(50);
+  loop.run_until([&] { return std::chrono::steady_clock::now() > again; });
+  EXPECT_EQ(loop.received.size(), 5u) << "held";
+  loop.server->hold_reading(false);
+  loop.server->hold_reading(false);
+  loop.run_until([&] { return loop.received.size() == 6; });
+  asio::write(loop.client, asio::buffer(Loopback::pings(7, 1)));
+  loop.run_until([&] { return loop.received.size() == 7; });
+  ASSERT_EQ(loop.received.size(), 7u) << loop.closed_reason;
+  EXPECT_EQ(loop.received[6].message.ping().t1(), 7);
+  EXPECT_TRUE(loop.closed_reason.empty()) << loop.closed_reason;
 }
 
 TEST(Connection, NoMessageReachesItsHandlerBeforeStartReturns) {

@@ -989,6 +989,91 @@ TEST_F(MasterTest, ALightAddedIsSharedOutInTheFrameItLandsIn) {
   }
 }
 
+// What an application changes goes to the nodes between rounds (staged
+// edits), not in one: the FrameBegin after carries nothing of it, and a node
+// that applies what it was sent has the master's state. A node that joins
+// later gets the staged instances in its snapshot.
+TEST_F(MasterTest, EditsAreStagedToTheNodesBetweenRounds) {
+  LiveScene live;
+  RunSettings settings;
+  settings.live = &live;
+  load("powerwall-2x2.json", {}, settings);
+  live = LiveScene::of(run_.scene.definition, {}, 60.0);
+  (void)hello(1, "bottom-left");
+  Actions a = configured(1);
+  const auto snapshots = sent_to(a, 1, wire::Envelope::kResync);
+  ASSERT_EQ(snapshots.size(), 1u);
+  auto node = scene::from_snapshot(snapshots.front().resync().snapshot());
+  ASSERT_TRUE(node) << node.error();
+  (void)hello(2, "bottom-right");
+  (void)hello(3, "top-left");
+  (void)hello(4, "top-right");
+  for (PeerId p = 2; p <= 4; ++p) a = configured(p);
+  auto begun = sent_to(a, 1, wire::Envelope::kFrameBegin);
+  ASSERT_EQ(begun.size(), 1u);
+  ASSERT_TRUE(scene::apply_delta(node.value(), begun.front().frame_begin().delta()));
+  ASSERT_TRUE(master_->in_round());
+
+  const std::string asset = run_.scene.definition.asset_id;
+  session::Transaction create;
+  create.add_edits()->mutable_create()->set_instance("cup");
+  create.mutable_edits(0)->mutable_create()->set_asset(asset);
+  ASSERT_FALSE(live.apply(create, 1));
+  EXPECT_TRUE(sent_to(master_->scene_edited(), 1, wire::Envelope::kStagedEdit).empty()) << "not in a round";
+  const std::uint64_t hash = hash_of(a, 1);
+  for (PeerId p = 1; p <= 3; ++p) (void)ready(p, 0, hash);
+  a = ready(4, 0, hash);
+  ASSERT_FALSE(master_->in_round());
+  for (PeerId p = 1; p <= 4; ++p) {
+    const auto staged = sent_to(a, p, wire::Envelope::kStagedEdit);
+    ASSERT_EQ(staged.size(), 1u) << "after the swap: " << p;
+    EXPECT_EQ(staged.front().staged_edit().frame_id(), 1u);
+    ASSERT_EQ(staged.front().staged_edit().delta().instances_changed_size(), 1);
+    EXPECT_EQ(staged.front().staged_edit().delta().instances_changed(0).id(), "cup");
+    if (p == 1) {
+      ASSERT_TRUE(scene::apply_delta(node.value(), staged.front().staged_edit().delta()));
+    }
+  }
+  // Between rounds: at once.
+  session::Transaction move;
+  move.add_edits()->mutable_transform()->set_instance("cup");
+  for (double x : {0.5, 1.0, -1.0}) move.mutable_edits(0)->mutable_transform()->mutable_transform()->add_position(x);
+  ASSERT_FALSE(live.apply(move, 1));
+  a = master_->scene_edited();
+  auto staged = sent_to(a, 1, wire::Envelope::kStagedEdit);
+  ASSERT_EQ(staged.size(), 1u);
+  EXPECT_EQ(staged.front().staged_edit().delta().instances_moved_size(), 1);
+  ASSERT_TRUE(scene::apply_delta(node.value(), staged.front().staged_edit().delta()));
+  EXPECT_TRUE(master_->scene_edited().empty()) << "nothing new";
+
+  all_shown(0, {1, 2, 3, 4});
+  now_ += 17 * kMs;
+  a = master_->timer(Timer::next_frame, now_);
+  begun = sent_to(a, 1, wire::Envelope::kFrameBegin);
+  ASSERT_EQ(begun.size(), 1u);
+  const wire::StateDelta& delta = begun.front().frame_begin().delta();
+  EXPECT_EQ(delta.instances_changed_size() + delta.instances_moved_size() + delta.instances_removed_size(), 0);
+  ASSERT_TRUE(scene::apply_delta(node.value(), delta));
+  EXPECT_EQ(scene::state_hash(node.value()), begun.front().frame_begin().state_hash());
+  ASSERT_EQ(node.value().instances.count("cup"), 1u);
+  EXPECT_EQ(node.value().instances.at("cup").pose.now.position, glm::dvec3(0.5, 1.0, -1.0));
+
+  // Staged in this round's wake, then a node comes back: its snapshot has it.
+  session::Transaction hide;
+  hide.add_edits()->mutable_visible()->set_instance("cup");
+  ASSERT_FALSE(live.apply(hide, 2));
+  (void)master_->closed(4, "gone", now_);
+  for (PeerId p = 1; p <= 3; ++p) (void)ready(p, 1, begun.front().frame_begin().state_hash());
+  (void)hello(5, "top-right");
+  const auto back = sent_to(configured(5), 5, wire::Envelope::kResync);
+  ASSERT_EQ(back.size(), 1u);
+  auto rejoined = scene::from_snapshot(back.front().resync().snapshot());
+  ASSERT_TRUE(rejoined) << rejoined.error();
+  EXPECT_FALSE(rejoined.value().instances.at("cup").visible);
+  EXPECT_EQ(scene::state_hash(rejoined.value()), back.front().resync().state_hash());
+  master_.reset();  // before the live scene it keeps goes
+}
+
 // --- a node without a copy of the glTF scene asks for its files
 
 wire::Envelope scene_request(const std::string& sha256, std::uint32_t file, std::uint64_t chunk) {

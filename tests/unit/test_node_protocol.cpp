@@ -269,6 +269,52 @@ TEST_F(NodeTest, AFrameIsRenderedReportedAndShownAtItsDeadline) {
   EXPECT_TRUE(node.answer(ImagePresented{}, now_).empty()) << "shown once";
 }
 
+// An edit staged between rounds waits for the frame being shown, then goes
+// into the state the next FrameBegin applies to: its hash is the master's.
+// One that cannot be applied closes the connection, as a bad FrameBegin does.
+TEST_F(NodeTest, AnEditStagedBetweenRoundsIsInTheNextFrame) {
+  state_.instances["cup"].asset = "cubes";
+  NodeProtocol node(settings());
+  join(node, 5);
+  ASSERT_NE(first<Render>(begin(node, 5)), nullptr);
+  (void)node.answer(FrameRendered{5, kMs, {}}, now_);
+  ASSERT_NE(first<PresentAt>(swap(node, 5, now_ + 2 * kMs)), nullptr);
+
+  scene::SceneState next = state_;
+  next.instances["cup"].pose.now.position.x = 1.5;
+  next.instances["saucer"].asset = "cubes";
+  wire::Envelope staged = envelope();
+  staged.mutable_staged_edit()->set_frame_id(6);
+  *staged.mutable_staged_edit()->mutable_delta() =
+      scene::make_instance_delta(state_, {{"cup", next.instances.at("cup")}, {"saucer", next.instances.at("saucer")}});
+  Actions a = node.message(staged, now_);
+  EXPECT_TRUE(a.empty());
+  EXPECT_EQ(node.state(), state_) << "frame 5 is still to be shown";
+  now_ += 2 * kMs;
+  ASSERT_NE(first<Present>(node.due(Due::present, now_)), nullptr);
+  (void)node.answer(ImagePresented{}, now_);
+  EXPECT_EQ(node.state(), next) << "applied once frame 5 was shown";
+
+  state_ = next;
+  ASSERT_NE(first<Render>(begin(node, 6)), nullptr);  // an empty delta, the hash of the staged state
+  a = node.answer(FrameRendered{6, kMs, {}}, now_);
+  const auto ready = sent(a, wire::Envelope::kFrameReady);
+  ASSERT_EQ(ready.size(), 1u);
+  EXPECT_EQ(ready.front().frame_ready().state_hash(), scene::state_hash(next));
+
+  ASSERT_NE(first<PresentAt>(swap(node, 6, now_ + 2 * kMs)), nullptr);
+  now_ += 2 * kMs;
+  (void)node.due(Due::present, now_);
+  (void)node.answer(ImagePresented{}, now_);
+  wire::Envelope bad = envelope();
+  bad.mutable_staged_edit()->set_frame_id(7);
+  bad.mutable_staged_edit()->mutable_delta()->add_instances_removed("ghost");
+  a = node.message(bad, now_);
+  const Close* closed = first<Close>(a);
+  ASSERT_NE(closed, nullptr);
+  EXPECT_NE(closed->reason.find("cannot apply the edit staged for frame 7"), std::string::npos) << closed->reason;
+}
+
 // A 2×60 Hz stereo projector used as mono shows two images per frame: the second
 // half a frame after the first, the next frame held back until it is shown, and
 // only the first reported (the master's deadline and sync are for it).

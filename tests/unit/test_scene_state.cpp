@@ -6,6 +6,8 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -550,6 +552,65 @@ TEST(SceneInstances, TravelInSnapshotsDeltasAndTheHash) {
   EXPECT_EQ(applied_reversed, after);
 }
 
+// A node keeps the instances' part of the hash as deltas change them
+// (apply_delta with InstancesHash): after each delta it is what hashing every
+// instance again gives, and a refused delta leaves it as it was.
+TEST(SceneHash, TheInstancesKeptThroughDeltasHashAsTheWholeState) {
+  SceneState state = with_instances();
+  InstancesHash kept = instances_hash(state);
+  std::vector<SceneState> targets;
+  SceneState next = state;
+  next.instances["cup"].pose.now.position.x += 0.25;  // a move
+  targets.push_back(next);
+  next.instances["cup"].parent = "lamp";                 // a change
+  next.instances["stool"] = instance("stool", "", 3.0);  // a new one
+  targets.push_back(next);
+  next.instances.erase("table");  // a removal
+  next.instances["lamp"].pose.next.position.y += 1.0;
+  targets.push_back(next);
+  next.instances.clear();
+  targets.push_back(next);
+  for (const SceneState& target : targets) {
+    ASSERT_TRUE(apply_delta(state, make_delta(state, target), kept));
+    EXPECT_EQ(state, target);
+    EXPECT_EQ(kept, instances_hash(state));
+    EXPECT_EQ(state_hash(state, kept), state_hash(state));
+  }
+  wire::StateDelta refused;
+  refused.add_instances_removed("ghost");
+  const InstancesHash before = kept;
+  EXPECT_FALSE(apply_delta(state, refused, kept));
+  EXPECT_EQ(kept, before);
+}
+
+// The master's staged edits: the instances named, each as it is then, or
+// removed; nothing else of the state, and nothing for one that did not change.
+TEST(SceneInstances, AnInstanceDeltaCarriesTheNamedInstancesOnly) {
+  const SceneState before = with_instances();
+  std::map<std::string, std::optional<InstanceState>> after;
+  after["cup"] = before.instances.at("cup");
+  after["cup"]->pose.now.position.z -= 1.0;        // moved
+  after["lamp"] = before.instances.at("lamp");     // the same
+  after["stool"] = instance("stool", "cup", 1.0);  // new, on the moved cup
+  after["ghost"] = std::nullopt;                   // neither there nor here
+  const wire::StateDelta delta = make_instance_delta(before, after);
+  EXPECT_EQ(delta.instances_moved_size(), 1);
+  EXPECT_EQ(delta.instances_changed_size(), 1);
+  EXPECT_EQ(delta.instances_removed_size(), 0);
+  EXPECT_FALSE(delta.has_viewer());
+  EXPECT_EQ(delta.changed_size(), 0);
+  SceneState applied = before;
+  ASSERT_TRUE(apply_delta(applied, delta));
+  SceneState expected = before;
+  expected.instances["cup"] = *after["cup"];
+  expected.instances["stool"] = *after["stool"];
+  EXPECT_EQ(applied, expected);
+
+  const wire::StateDelta removal = make_instance_delta(expected, {{"stool", std::nullopt}});
+  ASSERT_EQ(removal.instances_removed_size(), 1);
+  EXPECT_EQ(removal.instances_removed(0), "stool");
+}
+
 // The point lights applications add: in snapshots and deltas, each field in
 // the hash, and a state without any hashing as it did before there were any
 // (the pinned values of SceneHash.HasTheseValues).
@@ -791,7 +852,9 @@ TEST(SceneHash, HasTheseValues) {
   state.instances["saucer"].asset = "a";
   state.instances["saucer"].animation = AnimationTimes{2.0, 2.25};
   EXPECT_EQ(state_hash(SceneState{}), 0x9e4df0ed2b31c960u);
-  EXPECT_EQ(state_hash(state), 0xc9b5facc0a617813u);
+  // The instances as the sum of each one's hash (so that a node follows a few
+  // moved of thousands without hashing them all again): from 0xc9b5facc0a617813.
+  EXPECT_EQ(state_hash(state), 0x977e1e590798ca65u);
 }
 
 // What the parents make of the instances is checked as the delta would leave

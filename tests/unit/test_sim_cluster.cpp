@@ -67,6 +67,17 @@ TEST_P(LiveEdits, AnEditBeforeAFrameBeginsIsInThatFrameOnEveryNode) {
   create.add_edits()->mutable_create()->set_instance("t1");
   create.mutable_edits(0)->mutable_create()->set_asset("torus");
   ASSERT_FALSE(live.apply(create, k));
+  cluster.scene_edited();  // staged to the nodes now, or after the round under way
+  // Moved on every frame from here: staged between rounds each time.
+  for (int moves = 0; moves < 10; ++moves) {
+    cluster.run_promptly(cluster.now() + kSecond / 60);
+    session::Transaction move;
+    move.add_edits()->mutable_transform()->set_instance("t1");
+    for (double x : {0.1 * moves, 1.0, -1.0})
+      move.mutable_edits(0)->mutable_transform()->mutable_transform()->add_position(x);
+    ASSERT_FALSE(live.apply(move, cluster.master().progress().next_frame));
+    cluster.scene_edited();
+  }
   cluster.run_promptly(cluster.now() + 10 * kSecond);
   EXPECT_EQ(cluster.violations(), std::vector<std::string>{});
   const report::RunReport report = cluster.master().report();
