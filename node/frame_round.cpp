@@ -93,6 +93,10 @@ void NodeProtocol::release_held(clock::Nanos now, Actions& out) {
   while (!held_.empty() && !pending_) {
     wire::Envelope next = std::move(held_.front());
     held_.pop_front();
+    if (next.has_staged_edit()) {  // its turn, whatever is held behind it
+      on_staged_edit(next.staged_edit(), out);
+      continue;
+    }
     Actions more = message(next, now);
     out.insert(out.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
   }

@@ -195,9 +195,17 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
     case wire::Envelope::kAssetOffer:
       on_asset_offer(message.asset_offer(), out);
       break;
+    case wire::Envelope::kStagedEdit:
+      // The state changes, nothing is drawn: a frame waiting for its deadline
+      // has its images already. Only what is held for it comes first.
+      if (held_.empty()) {
+        on_staged_edit(message.staged_edit(), out);
+      } else {
+        held_.push_back(message);
+      }
+      break;
     case wire::Envelope::kResync:
     case wire::Envelope::kFrameBegin:
-    case wire::Envelope::kStagedEdit:
     case wire::Envelope::kSwap:
       // A frame is waiting for its deadline: nothing may touch it (a new state,
       // the next frame drawn over it) before it is shown.
@@ -205,8 +213,6 @@ Actions NodeProtocol::message(const wire::Envelope& message, clock::Nanos now) {
         held_.push_back(message);
       } else if (message.has_resync()) {
         on_resync(message.resync(), now, out);
-      } else if (message.has_staged_edit()) {
-        on_staged_edit(message.staged_edit(), out);
       } else if (message.has_frame_begin()) {
         on_frame_begin(message.frame_begin(), now, out);
       } else {

@@ -269,8 +269,9 @@ TEST_F(NodeTest, AFrameIsRenderedReportedAndShownAtItsDeadline) {
   EXPECT_TRUE(node.answer(ImagePresented{}, now_).empty()) << "shown once";
 }
 
-// An edit staged between rounds waits for the frame being shown, then goes
-// into the state the next FrameBegin applies to: its hash is the master's.
+// An edit staged between rounds goes into the state the next FrameBegin
+// applies to at once (a frame waiting for its deadline has its images), or
+// after a FrameBegin held before it: its hash is the master's.
 // One that cannot be applied closes the connection, as a bad FrameBegin does.
 TEST_F(NodeTest, AnEditStagedBetweenRoundsIsInTheNextFrame) {
   state_.instances["cup"].asset = "cubes";
@@ -289,11 +290,10 @@ TEST_F(NodeTest, AnEditStagedBetweenRoundsIsInTheNextFrame) {
       scene::make_instance_delta(state_, {{"cup", next.instances.at("cup")}, {"saucer", next.instances.at("saucer")}});
   Actions a = node.message(staged, now_);
   EXPECT_TRUE(a.empty());
-  EXPECT_EQ(node.state(), state_) << "frame 5 is still to be shown";
+  EXPECT_EQ(node.state(), next) << "applied at once: frame 5's image is drawn already";
   now_ += 2 * kMs;
   ASSERT_NE(first<Present>(node.due(Due::present, now_)), nullptr);
   (void)node.answer(ImagePresented{}, now_);
-  EXPECT_EQ(node.state(), next) << "applied once frame 5 was shown";
 
   state_ = next;
   ASSERT_NE(first<Render>(begin(node, 6)), nullptr);  // an empty delta, the hash of the staged state
@@ -302,17 +302,31 @@ TEST_F(NodeTest, AnEditStagedBetweenRoundsIsInTheNextFrame) {
   ASSERT_EQ(ready.size(), 1u);
   EXPECT_EQ(ready.front().frame_ready().state_hash(), scene::state_hash(next));
 
+  // Behind a FrameBegin held for frame 6's deadline, it waits its turn.
   ASSERT_NE(first<PresentAt>(swap(node, 6, now_ + 2 * kMs)), nullptr);
+  EXPECT_EQ(first<Render>(begin(node, 7)), nullptr) << "held";
+  scene::SceneState later = next;
+  later.instances["saucer"].visible = false;
+  staged.mutable_staged_edit()->set_frame_id(8);
+  *staged.mutable_staged_edit()->mutable_delta() =
+      scene::make_instance_delta(next, {{"saucer", later.instances.at("saucer")}});
+  EXPECT_TRUE(node.message(staged, now_).empty());
+  EXPECT_EQ(node.state(), next) << "behind the held frame";
   now_ += 2 * kMs;
   (void)node.due(Due::present, now_);
-  (void)node.answer(ImagePresented{}, now_);
+  a = node.answer(ImagePresented{}, now_);
+  const Render* seventh = first<Render>(a);
+  ASSERT_NE(seventh, nullptr);
+  EXPECT_EQ(seventh->frame.frame_id, 7u);
+  EXPECT_EQ(node.state(), later) << "frame 7 began, then the edit staged for 8";
+  (void)node.answer(FrameRendered{7, kMs, {}}, now_);
   wire::Envelope bad = envelope();
-  bad.mutable_staged_edit()->set_frame_id(7);
+  bad.mutable_staged_edit()->set_frame_id(8);
   bad.mutable_staged_edit()->mutable_delta()->add_instances_removed("ghost");
   a = node.message(bad, now_);
   const Close* closed = first<Close>(a);
   ASSERT_NE(closed, nullptr);
-  EXPECT_NE(closed->reason.find("cannot apply the edit staged for frame 7"), std::string::npos) << closed->reason;
+  EXPECT_NE(closed->reason.find("cannot apply the edit staged for frame 8"), std::string::npos) << closed->reason;
 }
 
 // A 2×60 Hz stereo projector used as mono shows two images per frame: the second
