@@ -115,9 +115,8 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
       }
     }
     // Every edit made until now is in this frame; the next frame's budget of edits starts.
-    put_live(*settings_.live, frame, state);
+    put_live_lights(*settings_.live, state);  // the instances: below, as they changed
     settings_.live->begin_frame();
-    (void)settings_.live->take_edited();  // all in this frame's delta, staged or not
   }
   bool tracked = false;
   if (head_) {
@@ -137,7 +136,13 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
   auto& begin = *envelope.mutable_frame_begin();
   begin.set_frame_id(frame);
   begin.set_simulation_time_ns(authority_.simulation_time(frame));
-  *begin.mutable_delta() = scene::make_delta(current_state_, state);
+  *begin.mutable_delta() = scene::make_delta(current_state_, state, false);
+  if (settings_.live != nullptr) {
+    // The instances staged, with the edits since and the clocks that play.
+    std::set<std::string> changed = settings_.live->take_edited();
+    changed.insert(settings_.live->playing().begin(), settings_.live->playing().end());
+    begin.mutable_delta()->MergeFrom(take_live_instances(changed, frame));
+  }
   // A light added or removed is one more or fewer to share out, now: until
   // then no node of a stacked group would draw it.
   const bool lights_added =
@@ -145,8 +150,9 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
       std::any_of(begin.delta().point_lights_set().begin(), begin.delta().point_lights_set().end(),
                   [&](const wire::PointLightState& l) { return !current_state_.point_lights.contains(l.light()); });
   const bool lights_switched = begin.delta().lights_off_size() > 0 || begin.delta().lights_on_size() > 0;
+  state.instances = std::move(current_state_.instances);
   current_state_ = std::move(state);
-  current_hash_ = scene::state_hash(current_state_);
+  current_hash_ = scene::state_hash(current_state_, current_instances_hash_);
   if (lights_switched || lights_added) log_light_switches(frame, begin.delta(), out);
   begin.set_state_hash(current_hash_);
   begin.set_capture(captured);

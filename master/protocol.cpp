@@ -318,7 +318,7 @@ void MasterProtocol::send_resync(PeerId peer, Actions& out) const {
   auto& resync = *envelope.mutable_resync();
   *resync.mutable_snapshot() = scene::to_snapshot(current_state_);
   resync.set_next_frame_id(next_frame_);
-  resync.set_state_hash(scene::state_hash(current_state_));
+  resync.set_state_hash(scene::state_hash(current_state_, current_instances_hash_));
   out.push_back(Send{peer, std::move(envelope)});
 }
 

@@ -178,6 +178,9 @@ class MasterProtocol {
               Actions& out);
   void send_resync(PeerId peer, Actions& out) const;
   void stage_edits(Actions& out);
+  // The live scene's instances `ids`, as frame `frame` shows them, into
+  // current_state_ (and its instances' hash): what changed, as a delta.
+  [[nodiscard]] wire::StateDelta take_live_instances(const std::set<std::string>& ids, std::uint64_t frame);
 
   void start_frames(clock::Nanos now, Actions& out);
   void begin_frame(clock::Nanos now, Actions& out);
@@ -240,7 +243,8 @@ class MasterProtocol {
   // The state of the last frame begun, with the edits staged since
   // (stage_edits): what every node in the frames has.
   scene::SceneState current_state_;
-  std::uint64_t current_hash_ = 0;  // of the last frame begun, as it began
+  std::uint64_t current_hash_ = 0;               // of the last frame begun, as it began
+  scene::InstancesHash current_instances_hash_;  // of current_state_'s instances, kept as they change
   Barrier barrier_;
   std::vector<std::size_t> ready_for_swap_;
   // The nodes told to show the last swapped frame that have not said they did.

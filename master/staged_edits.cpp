@@ -4,10 +4,49 @@
 // the next FrameBegin carries only what changed after them. A thousand
 // instances moved a frame cost each node its decoding and checking; in the
 // round, every frame would wait for the slowest node's share of it.
+//
+// The master's own state follows the live scene the same way, instance by
+// instance: a frame takes the instances staged, with the edits since and the
+// animation clocks that play, and no frame copies or compares them all.
 
 #include "master/protocol.h"
 
 namespace optique::master {
+
+wire::StateDelta MasterProtocol::take_live_instances(const std::set<std::string>& ids, std::uint64_t frame) {
+  // As frame `frame` shows them, by id: walked beside the live scene's, not searched.
+  std::map<std::string, std::optional<scene::InstanceState>> after;
+  const auto& live = settings_.live->instances();
+  auto in_live = live.begin();
+  for (const std::string& id : ids) {
+    while (in_live != live.end() && in_live->first < id) ++in_live;
+    after.emplace_hint(
+        after.end(), id,
+        in_live != live.end() && in_live->first == id ? instance_state(*settings_.live, id, frame) : std::nullopt);
+  }
+  wire::StateDelta delta = scene::make_instance_delta(current_state_, after);
+  // Into the state, its hash kept: each instance's out as it was, in as it is.
+  auto& instances = current_state_.instances;
+  auto at = instances.begin();
+  for (auto& [id, instance] : after) {
+    while (at != instances.end() && at->first < id) ++at;
+    if (at != instances.end() && at->first == id) {
+      current_instances_hash_.sum -= scene::instance_hash(id, at->second);
+      if (!instance) {
+        at = instances.erase(at);
+        continue;
+      }
+      at->second = std::move(*instance);
+    } else if (instance) {
+      at = instances.emplace_hint(at, id, std::move(*instance));
+    } else {
+      continue;
+    }
+    current_instances_hash_.sum += scene::instance_hash(id, at->second);
+    ++at;
+  }
+  return delta;
+}
 
 Actions MasterProtocol::scene_edited() {
   Actions out;
@@ -20,25 +59,14 @@ void MasterProtocol::stage_edits(Actions& out) {
   if (settings_.live == nullptr || state_ != RunState::running) return;
   const std::set<std::string> edited = settings_.live->take_edited();
   if (edited.empty()) return;
-  // As the next frame will show them: begin_frame's state then holds the same.
-  std::map<std::string, std::optional<scene::InstanceState>> after;
-  for (const std::string& id : edited) after.emplace(id, instance_state(*settings_.live, id, next_frame_));
   auto envelope = std::make_shared<wire::Envelope>();
   auto& staged = *envelope->mutable_staged_edit();
   staged.set_frame_id(next_frame_);
-  *staged.mutable_delta() = scene::make_instance_delta(current_state_, after);
+  // As the next frame will show them: its FrameBegin then has nothing of them.
+  *staged.mutable_delta() = take_live_instances(edited, next_frame_);
   const wire::StateDelta& delta = staged.delta();
   if (delta.instances_changed_size() == 0 && delta.instances_moved_size() == 0 && delta.instances_removed_size() == 0) {
     return;  // a refused transaction's edits, undone
-  }
-  // What every node has from now on (a snapshot for a node that joins, the
-  // state the next FrameBegin's delta applies to).
-  for (auto& [id, instance] : after) {
-    if (instance) {
-      current_state_.instances.insert_or_assign(id, std::move(*instance));
-    } else {
-      current_state_.instances.erase(id);
-    }
   }
   for (const auto& [peer, session] : sessions_) {
     // Every node sent a snapshot (a resync); one still setting up gets one with these in it.

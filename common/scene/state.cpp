@@ -632,9 +632,11 @@ void add_instance_change(const std::string& id, const InstanceState* before, con
 wire::StateDelta make_instance_delta(const SceneState& before,
                                      const std::map<std::string, std::optional<InstanceState>>& after) {
   wire::StateDelta delta;
+  // Both by id: walked side by side.
+  auto was = before.instances.begin();
   for (const auto& [id, instance] : after) {
-    const auto was = before.instances.find(id);
-    const InstanceState* old = was == before.instances.end() ? nullptr : &was->second;
+    while (was != before.instances.end() && was->first < id) ++was;
+    const InstanceState* old = was != before.instances.end() && was->first == id ? &was->second : nullptr;
     if (instance) {
       add_instance_change(id, old, *instance, delta);
     } else if (old != nullptr) {
@@ -644,7 +646,7 @@ wire::StateDelta make_instance_delta(const SceneState& before,
   return delta;
 }
 
-wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
+wire::StateDelta make_delta(const SceneState& before, const SceneState& after, bool instances) {
   wire::StateDelta delta;
   for (const auto& [id, object] : after.objects) {
     const auto old = before.objects.find(id);
@@ -665,14 +667,16 @@ wire::StateDelta make_delta(const SceneState& before, const SceneState& after) {
     if (!after.lights_off.contains(light)) delta.add_lights_on(light);
   }
   // Both by id: walked side by side, not searched (thousands of instances).
+  static const Instances kNone;
+  const Instances& walked = instances ? after.instances : kNone;
   auto old = before.instances.begin();
-  for (const auto& [id, instance] : after.instances) {
+  for (const auto& [id, instance] : walked) {
     for (; old != before.instances.end() && old->first < id; ++old) delta.add_instances_removed(old->first);
     const bool was_there = old != before.instances.end() && old->first == id;
     add_instance_change(id, was_there ? &old->second : nullptr, instance, delta);
     if (was_there) ++old;
   }
-  for (; old != before.instances.end(); ++old) delta.add_instances_removed(old->first);
+  for (; instances && old != before.instances.end(); ++old) delta.add_instances_removed(old->first);
   for (const auto& [index, light] : after.point_lights) {
     const auto was = before.point_lights.find(index);
     if (was == before.point_lights.end() || !identical(was->second, light)) {

@@ -148,8 +148,9 @@ struct InstancesHash {
 [[nodiscard]] wire::Snapshot to_snapshot(const SceneState& state);
 [[nodiscard]] Result<SceneState> from_snapshot(const wire::Snapshot& snapshot);
 
-// What changed from `before` to `after`.
-[[nodiscard]] wire::StateDelta make_delta(const SceneState& before, const SceneState& after);
+// What changed from `before` to `after`; without `instances`, all but the
+// instances (the master follows them itself: make_instance_delta).
+[[nodiscard]] wire::StateDelta make_delta(const SceneState& before, const SceneState& after, bool instances = true);
 
 // Applies `delta` to `state`, or leaves it untouched and says what is wrong
 // (non-finite numbers, removing an object that does not exist, switching off a

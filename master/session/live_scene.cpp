@@ -397,8 +397,9 @@ double AnimationClock::at(std::uint64_t frame, double period) const {
 
 void LiveScene::begin_run(std::uint64_t last) {
   for (auto& [id, instance] : instances_) {
-    if (instance.animation)
-      instance.animation = AnimationClock{instance.animation->playing, instance.animation->at(last, frame_period_), 0};
+    if (!instance.animation) continue;
+    instance.animation = AnimationClock{instance.animation->playing, instance.animation->at(last, frame_period_), 0};
+    edited_.insert(id);
   }
   edits_this_frame_ = 0;
 }
@@ -419,6 +420,11 @@ const std::set<std::string>& LiveScene::children(const std::string& parent) cons
 
 void LiveScene::put(const std::string& id, std::optional<Instance> instance) {
   edited_.insert(id);
+  if (instance && instance->animation && instance->animation->playing) {
+    playing_.insert(id);
+  } else {
+    playing_.erase(id);
+  }
   const auto old = instances_.find(id);
   if (instance && old != instances_.end() && old->second.parent == instance->parent) {
     old->second = std::move(*instance);  // where it was, under the same parent: no index changes
@@ -533,6 +539,10 @@ void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& sta
     put_instance(instance, frame, live.frame_period(),
                  state.instances.emplace_hint(state.instances.end(), id, scene::InstanceState{})->second);
   }
+  put_live_lights(live, state);
+}
+
+void put_live_lights(const LiveScene& live, scene::SceneState& state) {
   for (const auto& [light, on] : live.light_switches()) {
     if (on) {
       state.lights_off.erase(light);

@@ -121,6 +121,8 @@ class LiveScene {
   // transaction refused may leave some that did not change): what the master
   // stages to the nodes between rounds (wire.proto's StagedEdit).
   [[nodiscard]] std::set<std::string> take_edited() { return std::exchange(edited_, {}); }
+  // The instances whose animation clock plays: their state changes every frame.
+  [[nodiscard]] const std::set<std::string>& playing() const { return playing_; }
 
   // How many point lights the scene has (SwitchLight's bound).
   void set_light_count(std::size_t count) { light_count_ = count; }
@@ -150,6 +152,7 @@ class LiveScene {
   std::map<std::string, std::set<std::string>> children_;  // parent → its children; "" → the world's
   std::size_t edits_this_frame_ = 0;
   std::set<std::string> edited_;
+  std::set<std::string> playing_;
   std::size_t light_count_ = 0;
   NavigationSet navigation_;
   std::map<std::uint32_t, bool> light_switches_;
@@ -171,6 +174,8 @@ void to_transform(const scene::Pose& pose, session::Transform& t);
 // they added; the navigation
 // applications set (the flystick's, if any, comes after: master/navigation.h).
 void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& state);
+// All put_live puts but the instances: the lights and the navigation.
+void put_live_lights(const LiveScene& live, scene::SceneState& state);
 // One instance as put_live puts it; none when the live scene has no `id`.
 [[nodiscard]] std::optional<scene::InstanceState> instance_state(const LiveScene& live, const std::string& id,
                                                                  std::uint64_t frame);

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "clients/cpp/session.h"
+#include "clock/clock.h"
 #include "cluster_run.h"
 #include "dtrack_sender.h"
 #include "head_walk.h"
@@ -119,12 +120,16 @@ TEST(SceneSession, AnApplicationPlacesAnInstanceAndEveryNodeShowsItFromTheFrameN
   kinds.set_run(true);
   ASSERT_TRUE(app->subscribe(kinds).ok());
   std::vector<std::uint64_t> begun;
+  std::map<std::uint64_t, std::int64_t> heard;  // frame → when FrameBegun came (this machine's monotonic clock)
   std::string stopping;
   while (stopping.empty()) {
     auto event = app->next_event(10s);
     ASSERT_TRUE(event.ok()) << event.error();
     ASSERT_TRUE(event.value().has_value()) << "an event within 10 s";
-    if (event.value()->has_frame_begun()) begun.push_back(event.value()->frame_begun().frame());
+    if (event.value()->has_frame_begun()) {
+      begun.push_back(event.value()->frame_begun().frame());
+      heard[begun.back()] = clock::monotonic_now();
+    }
     if (event.value()->has_run()) {
       EXPECT_EQ(event.value()->run().state(), session::RunChanged::STOPPING);
       stopping = event.value()->run().reason();
@@ -144,6 +149,16 @@ TEST(SceneSession, AnApplicationPlacesAnInstanceAndEveryNodeShowsItFromTheFrameN
   ASSERT_EQ(run.report.nodes_size(), 4);
   for (const auto& node : run.report.nodes()) EXPECT_EQ(node.hash_mismatches(), 0u) << node.id();
   EXPECT_EQ(run.report.instances(), 1u) << "the instance is in the last frame's state";
+  // No event while the nodes decide a frame: each FrameBegun came after its Swap went.
+  std::size_t swapped = 0, early = 0;
+  for (const FrameRow& row : run.rows) {
+    const auto at = heard.find(row.frame);
+    if (row.swap_sent == 0 || at == heard.end() || row.node != run.rows.front().node) continue;
+    ++swapped;
+    if (at->second < row.swap_sent) ++early;
+  }
+  EXPECT_GT(swapped, 10u);
+  EXPECT_EQ(early, 0u) << "of " << swapped << " frames, heard before the Swap";
 }
 
 // The master killed (-9) mid-session comes back, started again with the same

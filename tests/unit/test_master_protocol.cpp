@@ -1071,7 +1071,61 @@ TEST_F(MasterTest, EditsAreStagedToTheNodesBetweenRounds) {
   ASSERT_TRUE(rejoined) << rejoined.error();
   EXPECT_FALSE(rejoined.value().instances.at("cup").visible);
   EXPECT_EQ(scene::state_hash(rejoined.value()), back.front().resync().state_hash());
+  scene::SceneState whole;
+  put_live(live, master_->progress().next_frame, whole);
+  EXPECT_EQ(rejoined.value().instances, whole.instances) << "what put_live makes of the live scene";
   master_.reset();  // before the live scene it keeps goes
+}
+
+// An instance whose animation clock plays changes every frame without an
+// edit: each FrameBegin carries its times, and a node that applies them has
+// the master's hash; paused, it is in no FrameBegin.
+TEST_F(MasterTest, AnInstanceWhoseClockPlaysIsInEveryFrame) {
+  LiveScene live;
+  RunSettings settings;
+  settings.live = &live;
+  load("powerwall-2x2.json", {}, settings);
+  live = LiveScene::of(run_.scene.definition, {}, 60.0);
+  live.add_asset("walker", true);
+  session::Transaction create;
+  create.add_edits()->mutable_create()->set_instance("w");
+  create.mutable_edits(0)->mutable_create()->set_asset("walker");
+  ASSERT_FALSE(live.apply(create, 0));
+  (void)hello(1, "bottom-left");
+  Actions a = configured(1);
+  auto node = scene::from_snapshot(sent_to(a, 1, wire::Envelope::kResync).front().resync().snapshot());
+  ASSERT_TRUE(node) << node.error();
+  for (PeerId p = 2; p <= 4; ++p) (void)hello(p, run_.config.installation.projectors[p - 1].id);
+  for (PeerId p = 2; p <= 4; ++p) a = configured(p);
+  std::vector<double> times;
+  for (std::uint64_t frame = 0; frame < 4; ++frame) {
+    const auto begun = sent_to(a, 1, wire::Envelope::kFrameBegin);
+    ASSERT_EQ(begun.size(), 1u);
+    ASSERT_TRUE(scene::apply_delta(node.value(), begun.front().frame_begin().delta()));
+    EXPECT_EQ(scene::state_hash(node.value()), begun.front().frame_begin().state_hash()) << frame;
+    ASSERT_TRUE(node.value().instances.at("w").animation.has_value());
+    times.push_back(node.value().instances.at("w").animation->now);
+    if (frame == 1) {
+      session::Transaction pause;
+      pause.add_edits()->mutable_animation()->set_instance("w");
+      pause.mutable_edits(0)->mutable_animation()->set_playing(false);
+      ASSERT_FALSE(live.apply(pause, frame + 1));
+    }
+    for (PeerId p = 1; p <= 4; ++p) {
+      // The swap, and what was staged after it (the pause).
+      for (const auto& staged :
+           sent_to(ready(p, frame, begun.front().frame_begin().state_hash()), 1, wire::Envelope::kStagedEdit)) {
+        ASSERT_TRUE(scene::apply_delta(node.value(), staged.staged_edit().delta()));
+      }
+    }
+    all_shown(frame, {1, 2, 3, 4});
+    now_ += 17 * kMs;
+    a = master_->timer(Timer::next_frame, now_);
+  }
+  ASSERT_EQ(times.size(), 4u);
+  EXPECT_NEAR(times[1] - times[0], 1.0 / 60.0, 1e-3) << "it plays";
+  EXPECT_EQ(times[3], times[2]) << "paused";
+  master_.reset();
 }
 
 // --- a node without a copy of the glTF scene asks for its files
