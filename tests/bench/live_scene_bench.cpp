@@ -4,8 +4,10 @@
 // Throughput: the application moves 1, 100, 1,000 or 10,000 instances every
 // frame, each time a frame begins; beside it, in the same repeat, the same
 // cluster with no application. The barrier round, the achieved frame rate and
-// the bytes of the FrameBegin every node is sent, against a snapshot of the
-// whole state (run.json: frame_begin_bytes, snapshot_bytes).
+// the bytes of the scene every node is sent a frame (its FrameBegin and the
+// edits staged for it between rounds) and of the FrameBegin alone, against a
+// snapshot of the whole state (run.json: frame_state_bytes,
+// frame_begin_bytes, snapshot_bytes).
 //
 // Latency, edit to display: from the moment the application sends a
 // transaction to the display time of the frame its reply names (the first
@@ -74,6 +76,7 @@ struct Sample {
   double barrier_median = 0, barrier_p99 = 0;
   double frame_rate = 0;
   double begin_bytes_median = 0;
+  double state_bytes_median = 0;
   double snapshot_bytes = 0;
   double latency_median_ms = 0, latency_p99_ms = 0;  // to the display time
   double present_median_ms = 0, present_p99_ms = 0;  // to the last node's present
@@ -208,6 +211,7 @@ Sample run_once(const std::string& master_bin, const std::string& work, std::siz
   s.frame_rate = sync.achieved_frame_rate();
   s.missing = sync.frames_with_missing_node();
   s.begin_bytes_median = run.report.frame_begin_bytes().median();
+  s.state_bytes_median = run.report.frame_state_bytes().median();
   s.snapshot_bytes = static_cast<double>(run.report.snapshot_bytes());
   for (const auto& node : run.report.nodes()) s.mismatches += node.hash_mismatches();
   // A frame is on the screen when its last node presents it (frames every node presented only).
@@ -272,7 +276,8 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories(out);
   std::ofstream csv(out + "/live-scene.csv");
   csv << "case,send,moved,repeat,nodes,frames,rate_hz,barrier_median_us,barrier_p99_us,achieved_hz,"
-         "frame_begin_bytes_median,snapshot_bytes,latency_median_ms,latency_p99_ms,transactions,refused,"
+         "frame_begin_bytes_median,frame_state_bytes_median,snapshot_bytes,latency_median_ms,latency_p99_ms,"
+         "transactions,refused,"
          "frames_with_missing_node,hash_mismatches,present_latency_median_ms,present_latency_p99_ms\n";
   std::vector<std::vector<Sample>> samples(cases.size());
   for (std::size_t r = 0; r < repeats; ++r) {
@@ -282,9 +287,9 @@ int main(int argc, char** argv) {
       samples[i].push_back(s);
       csv << i << ',' << name_of(c.send) << ',' << c.moved << ',' << r << ',' << nodes << ',' << frames << ',' << rate
           << ',' << s.barrier_median << ',' << s.barrier_p99 << ',' << s.frame_rate << ',' << s.begin_bytes_median
-          << ',' << s.snapshot_bytes << ',' << s.latency_median_ms << ',' << s.latency_p99_ms << ',' << s.transactions
-          << ',' << s.refused << ',' << s.missing << ',' << s.mismatches << ',' << s.present_median_ms << ','
-          << s.present_p99_ms << '\n'
+          << ',' << s.state_bytes_median << ',' << s.snapshot_bytes << ',' << s.latency_median_ms << ','
+          << s.latency_p99_ms << ',' << s.transactions << ',' << s.refused << ',' << s.missing << ',' << s.mismatches
+          << ',' << s.present_median_ms << ',' << s.present_p99_ms << '\n'
           << std::flush;
       std::cerr << name_of(c.send) << " " << c.moved << " repeat " << r << ": barrier " << s.barrier_median << " µs, "
                 << s.frame_rate << " Hz, FrameBegin " << s.begin_bytes_median << " B (snapshot " << s.snapshot_bytes
@@ -310,8 +315,8 @@ int main(int argc, char** argv) {
   };
   std::ostringstream table;
   table << "| application | instances moved a frame | barrier round median µs | p99 µs | against none (median) | "
-           "achieved Hz | FrameBegin bytes (median) | snapshot bytes | hash mismatches |\n"
-        << "|---|---:|---:|---:|---:|---:|---:|---:|---:|\n";
+           "achieved Hz | scene bytes a frame (median) | of which FrameBegin | snapshot bytes | hash mismatches |\n"
+        << "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n";
   std::size_t all_mismatches = 0;
   for (std::size_t i = 0; i < cases.size(); ++i) {
     if (cases[i].send != Send::none && cases[i].send != Send::at_begin) continue;
@@ -321,8 +326,9 @@ int main(int argc, char** argv) {
     table << "| " << (cases[i].send == Send::none ? "none" : "moves every instance each frame") << " | "
           << cases[i].moved << " | " << cell(column(i, &Sample::barrier_median), 0) << " | "
           << cell(column(i, &Sample::barrier_p99), 0) << " | " << cell(against_none(i), 2) << " | "
-          << cell(column(i, &Sample::frame_rate), 1) << " | " << cell(column(i, &Sample::begin_bytes_median), 0)
-          << " | " << cell(column(i, &Sample::snapshot_bytes), 0) << " | " << mismatches << " |\n";
+          << cell(column(i, &Sample::frame_rate), 1) << " | " << cell(column(i, &Sample::state_bytes_median), 0)
+          << " | " << cell(column(i, &Sample::begin_bytes_median), 0) << " | "
+          << cell(column(i, &Sample::snapshot_bytes), 0) << " | " << mismatches << " |\n";
   }
   std::ostringstream latency;
   latency << "| sent | instances moved | to the display time: median ms | p99 ms | median / period | to the last "
@@ -350,9 +356,12 @@ int main(int argc, char** argv) {
      << " repeats, so that they share the machine. Cells: median over the repeats (min–max).\n\n"
      << "## Throughput: instances moved every frame\n\n"
      << "The application moves every instance in one transaction each time a frame begins. The barrier round "
-        "(FrameBegin sent → Swap sent) against the run without an application in the same repeat; the FrameBegin "
-        "every node is sent (the change since the frame before) against a snapshot of the whole state (what a node "
-        "that joins is sent). Hash mismatches: frames a node's state differed from the master's, all runs.\n\n"
+        "(FrameBegin sent → Swap sent) against the run without an application in the same repeat. The master "
+        "reads no request and sends no event while a round is under way, and sends the instances an application "
+        "moved to the nodes between rounds (staged edits), so that the FrameBegin carries only what changed after "
+        "them. The scene every node is sent a frame (its FrameBegin and the edits staged for it), and the "
+        "FrameBegin alone, against a snapshot of the whole state (what a node that joins is sent). Hash "
+        "mismatches: frames a node's state differed from the master's, all runs.\n\n"
      << table.str() << "\n"
      << "## Latency: from the send to the frame that shows it\n\n"
      << "The frame the reply names is the first every node shows the edit in. Two times of that frame: its display "
@@ -368,7 +377,7 @@ int main(int argc, char** argv) {
      << period_ms << " ms; the last column holds the present against the goal, a period and the run's barrier "
      << "round (≤ 1 meets it).\n\n"
      << latency.str() << "\n"
-     << "![barrier round and FrameBegin bytes against the instances moved a frame](live-scene.png)\n";
+     << "![barrier round and scene bytes a frame against the instances moved a frame](live-scene.png)\n";
   csv.close();
   (void)bench::draw_plot(out, "live-scene");  // says itself what failed; the tables are written
   if (all_mismatches != 0) {

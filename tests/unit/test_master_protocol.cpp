@@ -65,6 +65,14 @@ class MasterTest : public ::testing::Test {
     (void)master_->start(now_);
   }
 
+  // A master with a live scene (`live`, which must outlive it) of the config's scene.
+  void load_live(const std::string& name, LiveScene& live) {
+    RunSettings settings;
+    settings.live = &live;
+    load(name, {}, settings);
+    live = LiveScene::of(run_.scene.definition, {}, 60.0);
+  }
+
   // Connected and through the hello; returns what the hello brought.
   Actions hello(PeerId peer, const std::string& id) {
     (void)master_->accepted(peer, "127.0.0.1:" + std::to_string(40000 + peer), true, nonce_, now_);
@@ -939,10 +947,7 @@ TEST_F(MasterTest, ALightAddedIsSharedOutInTheFrameItLandsIn) {
   for (const char* config : {"stacked-lighting-3-auto.json", "stacked-lighting-3.json"}) {
     SCOPED_TRACE(config);
     LiveScene live;
-    RunSettings settings;
-    settings.live = &live;
-    load(config, {}, settings);
-    live = LiveScene::of(run_.scene.definition, {}, 60.0);
+    load_live(config, live);
     std::map<PeerId, std::vector<std::uint32_t>> shares;
     const auto take = [&](const Actions& actions) {
       for (PeerId p = 1; p <= 3; ++p) {
@@ -995,10 +1000,7 @@ TEST_F(MasterTest, ALightAddedIsSharedOutInTheFrameItLandsIn) {
 // later gets the staged instances in its snapshot.
 TEST_F(MasterTest, EditsAreStagedToTheNodesBetweenRounds) {
   LiveScene live;
-  RunSettings settings;
-  settings.live = &live;
-  load("powerwall-2x2.json", {}, settings);
-  live = LiveScene::of(run_.scene.definition, {}, 60.0);
+  load_live("powerwall-2x2.json", live);
   (void)hello(1, "bottom-left");
   Actions a = configured(1);
   const auto snapshots = sent_to(a, 1, wire::Envelope::kResync);
@@ -1082,10 +1084,7 @@ TEST_F(MasterTest, EditsAreStagedToTheNodesBetweenRounds) {
 // the master's hash; paused, it is in no FrameBegin.
 TEST_F(MasterTest, AnInstanceWhoseClockPlaysIsInEveryFrame) {
   LiveScene live;
-  RunSettings settings;
-  settings.live = &live;
-  load("powerwall-2x2.json", {}, settings);
-  live = LiveScene::of(run_.scene.definition, {}, 60.0);
+  load_live("powerwall-2x2.json", live);
   live.add_asset("walker", true);
   session::Transaction create;
   create.add_edits()->mutable_create()->set_instance("w");

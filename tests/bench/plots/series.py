@@ -293,9 +293,9 @@ def scene_transfer(rows):
 def live_scene(rows):
     """Block 0, per instance count moved each frame (the at-begin runs): the
     count, then (median, min, max over runs) of the barrier round median, the
-    FrameBegin bytes and the snapshot bytes. Block 1: the runs without an
-    application, at x = 0.5 (the plot's 'none')."""
-    columns = ("barrier_median_us", "frame_begin_bytes_median", "snapshot_bytes")
+    scene bytes a frame (FrameBegin and staged edits) and the snapshot bytes.
+    Block 1: the runs without an application, at x = 0.5 (the plot's 'none')."""
+    columns = ("barrier_median_us", "frame_state_bytes_median", "snapshot_bytes")
     by = defaultdict(list)
     for r in rows:
         if r["send"] in ("none", "at-begin"):
