@@ -283,12 +283,15 @@ std::string deltas(std::span<const std::uint8_t> input, Outcome& out) {
   }
   if (auto broken = check_state(state); !broken.empty()) return broken;
 
+  // The instances' hash as a node keeps it, delta by delta (apply_delta with InstancesHash).
+  scene::InstancesHash kept = scene::instances_hash(state);
   for (std::size_t i = 1; i < chunks.size(); ++i) {
     wire::StateDelta delta;
     if (!delta.ParseFromArray(chunks[i].data(), static_cast<int>(chunks[i].size()))) continue;
     const scene::SceneState before = state;
     const std::uint64_t before_hash = scene::state_hash(before);
-    auto applied = scene::apply_delta(state, delta);
+    auto applied = scene::apply_delta(state, delta, kept);
+    OPTIQUE_FUZZ_REQUIRE(kept == scene::instances_hash(state));
     if (!applied.ok()) {
       ++out.deltas_refused;
       OPTIQUE_FUZZ_REQUIRE(!applied.error().empty());
