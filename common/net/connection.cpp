@@ -92,11 +92,6 @@ void Connection::write_more() {
                     });
 }
 
-// Readiness from Asio, the bytes from recvmsg(): Asio's reads drop the kernel's
-// receive stamp. A message then costs what it cost with Asio's reads: one wait
-// (Asio's async_wait re-arms epoll, which also reports bytes already there)
-// and one read, where Asio tried a read that found nothing before each wait.
-// A peek instead of async_wait costs one more read per message.
 void Connection::hold_reading(bool held) {
   if (held == reading_held_) return;
   reading_held_ = held;
@@ -108,7 +103,13 @@ void Connection::hold_reading(bool held) {
   });
 }
 
+// Readiness from Asio, the bytes from recvmsg(): Asio's reads drop the kernel's
+// receive stamp. A message then costs what it cost with Asio's reads: one wait
+// (Asio's async_wait re-arms epoll, which also reports bytes already there)
+// and one read, where Asio tried a read that found nothing before each wait.
+// A peek instead of async_wait costs one more read per message.
 void Connection::wait_for_bytes() {
+  if (wait_armed_) return;  // one wait at a time (a hold let go can meet a read already posted)
   wait_armed_ = true;
   socket_.async_wait(asio::ip::tcp::socket::wait_read,
                      [self = shared_from_this()](const boost::system::error_code& ec) {
