@@ -9,6 +9,8 @@
 // instance: a frame takes the instances staged, with the edits since and the
 // animation clocks that play, and no frame copies or compares them all.
 
+#include <cassert>
+
 #include "master/protocol.h"
 
 namespace optique::master {
@@ -20,31 +22,15 @@ wire::StateDelta MasterProtocol::take_live_instances(const std::set<std::string>
   auto in_live = live.begin();
   for (const std::string& id : ids) {
     while (in_live != live.end() && in_live->first < id) ++in_live;
-    after.emplace_hint(
-        after.end(), id,
-        in_live != live.end() && in_live->first == id ? instance_state(*settings_.live, id, frame) : std::nullopt);
+    after.emplace_hint(after.end(), id,
+                       in_live != live.end() && in_live->first == id
+                           ? std::optional(instance_state(*settings_.live, in_live->second, frame))
+                           : std::nullopt);
   }
   wire::StateDelta delta = scene::make_instance_delta(current_state_, after);
-  // Into the state, its hash kept: each instance's out as it was, in as it is.
-  auto& instances = current_state_.instances;
-  auto at = instances.begin();
-  for (auto& [id, instance] : after) {
-    while (at != instances.end() && at->first < id) ++at;
-    if (at != instances.end() && at->first == id) {
-      current_instances_hash_.sum -= scene::instance_hash(id, at->second);
-      if (!instance) {
-        at = instances.erase(at);
-        continue;
-      }
-      at->second = std::move(*instance);
-    } else if (instance) {
-      at = instances.emplace_hint(at, id, std::move(*instance));
-    } else {
-      continue;
-    }
-    current_instances_hash_.sum += scene::instance_hash(id, at->second);
-    ++at;
-  }
+  // Into the state as every node takes it in (the same function), its instances' hash kept.
+  [[maybe_unused]] const auto applied = scene::apply_delta(current_state_, delta, current_instances_hash_);
+  assert(applied && "the master's delta from its own state applies to it");
   return delta;
 }
 

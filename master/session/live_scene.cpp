@@ -507,9 +507,8 @@ LiveSceneLimits live_scene_limits(const std::optional<config::ApiServer>& api) {
   return limits;
 }
 
-namespace {
-
-void put_instance(const Instance& instance, std::uint64_t frame, double frame_period, scene::InstanceState& placed) {
+scene::InstanceState instance_state(const LiveScene& live, const Instance& instance, std::uint64_t frame) {
+  scene::InstanceState placed;
   placed.asset = instance.asset;
   placed.parent = instance.parent;
   placed.pose = {instance.pose, instance.pose};
@@ -517,18 +516,9 @@ void put_instance(const Instance& instance, std::uint64_t frame, double frame_pe
   placed.base_color = instance.base_color;
   placed.emissive = instance.emissive;
   if (instance.animation) {
-    placed.animation = scene::AnimationTimes{instance.animation->at(frame, frame_period),
-                                             instance.animation->at(frame + 1, frame_period)};
+    placed.animation = scene::AnimationTimes{instance.animation->at(frame, live.frame_period()),
+                                             instance.animation->at(frame + 1, live.frame_period())};
   }
-}
-
-}  // namespace
-
-std::optional<scene::InstanceState> instance_state(const LiveScene& live, const std::string& id, std::uint64_t frame) {
-  const auto found = live.instances().find(id);
-  if (found == live.instances().end()) return std::nullopt;
-  scene::InstanceState placed;
-  put_instance(found->second, frame, live.frame_period(), placed);
   return placed;
 }
 
@@ -536,8 +526,7 @@ void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& sta
   state.instances.clear();
   for (const auto& [id, instance] : live.instances()) {
     // In order: each goes at the end, found without a search.
-    put_instance(instance, frame, live.frame_period(),
-                 state.instances.emplace_hint(state.instances.end(), id, scene::InstanceState{})->second);
+    state.instances.emplace_hint(state.instances.end(), id, instance_state(live, instance, frame));
   }
   put_live_lights(live, state);
 }

@@ -176,8 +176,7 @@ void to_transform(const scene::Pose& pose, session::Transform& t);
 void put_live(const LiveScene& live, std::uint64_t frame, scene::SceneState& state);
 // All put_live puts but the instances: the lights and the navigation.
 void put_live_lights(const LiveScene& live, scene::SceneState& state);
-// One instance as put_live puts it; none when the live scene has no `id`.
-[[nodiscard]] std::optional<scene::InstanceState> instance_state(const LiveScene& live, const std::string& id,
-                                                                 std::uint64_t frame);
+// One of the live scene's instances as put_live puts it.
+[[nodiscard]] scene::InstanceState instance_state(const LiveScene& live, const Instance& instance, std::uint64_t frame);
 
 }  // namespace optique::master
