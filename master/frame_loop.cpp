@@ -70,7 +70,7 @@ void MasterProtocol::begin_frame(clock::Nanos now, Actions& out) {
   std::vector<std::size_t> waited;
   for (std::size_t i = 0; i < slots_.size(); ++i) {
     if (!up(slots_[i])) continue;
-    if (!send_frame_begin(i, envelope, display, out)) continue;
+    if (!send_frame_begin(i, envelope, now, display, out)) continue;
     sent.push_back(i);
     if (session_of(i)->phase == Phase::in_barrier) waited.push_back(i);
   }
@@ -176,7 +176,7 @@ wire::Envelope MasterProtocol::next_frame_begin(std::uint64_t frame, clock::Nano
 // of the lights, the frame its key frame is drawn for ahead, or that it is to
 // skip this frame. False when it is behind (told to skip; not waited for).
 bool MasterProtocol::send_frame_begin(std::size_t slot, const std::shared_ptr<const wire::Envelope>& envelope,
-                                      clock::Nanos display, Actions& out) {
+                                      clock::Nanos now, clock::Nanos display, Actions& out) {
   const PeerId peer = *slots_[slot].peer;
   Session& session = sessions_.at(peer);
   const std::uint64_t frame = envelope->frame_begin().frame_id();
@@ -190,7 +190,10 @@ bool MasterProtocol::send_frame_begin(std::size_t slot, const std::shared_ptr<co
     session.phase = Phase::in_barrier;
   }
   if (session.phase == Phase::joined) session.phase = Phase::in_barrier;
-  if (!behind) session.drawing = frame;
+  if (!behind) {
+    session.drawing = frame;
+    session.drawing_since = now;
+  }
   const LightShare* share = light_plan_.share(slot);
   const bool new_share = share != nullptr && slots_[slot].sent_share != *share;
   const config::UpConversion& up_conversion = installation_.projectors[slot].up_conversion;
@@ -286,7 +289,7 @@ void MasterProtocol::on_ready(Session& session, const wire::FrameReady& ready, c
   const bool answers_drawing = session.drawing && ready.frame_id() >= *session.drawing;
   if (answers_drawing) {
     session.drawing.reset();
-    session.pace.add(ready.render_ns());
+    session.pace.add(ready.render_ns(), received - session.drawing_since);
     say_if_slow(session, out);
   }
   if (ready.frame_id() + 1 == next_frame_ && ready.state_hash() != current_hash_) {

@@ -152,6 +152,7 @@ class MasterProtocol {
     // barrier, it is told to skip frames until it answers, then draws the
     // newest and is waited for again.
     std::optional<std::uint64_t> drawing;
+    clock::Nanos drawing_since = 0;  // when the master sent it that frame
     RenderPace pace;
     bool said_slow = false;              // logged once that it draws slower than the period
     std::set<std::string> assets_ready;  // readied (or in its welcome: ready once it is configured)
@@ -187,7 +188,7 @@ class MasterProtocol {
   [[nodiscard]] wire::Envelope next_frame_begin(std::uint64_t frame, clock::Nanos display, bool captured,
                                                 clock::Nanos now, Actions& out);
   [[nodiscard]] bool send_frame_begin(std::size_t slot, const std::shared_ptr<const wire::Envelope>& envelope,
-                                      clock::Nanos display, Actions& out);
+                                      clock::Nanos now, clock::Nanos display, Actions& out);
   void wait_for(std::uint64_t frame, std::vector<std::size_t> waited, bool captured, clock::Nanos now, Actions& out);
   void on_barrier_timeout(clock::Nanos now, Actions& out);
   void swap(clock::Nanos now, Actions& out);

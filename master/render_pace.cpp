@@ -5,8 +5,9 @@
 
 namespace optique::master {
 
-void RenderPace::add(clock::Nanos render) {
+void RenderPace::add(clock::Nanos render, clock::Nanos round) {
   times_[count_ % kKept] = std::clamp<clock::Nanos>(render, 0, kLongestRender);
+  rounds_[count_ % kKept] = std::max(times_[count_ % kKept], std::clamp<clock::Nanos>(round, 0, kLongestRender));
   ++count_;
 }
 
@@ -26,7 +27,7 @@ std::optional<clock::Nanos> RenderPace::typical() const {
 clock::Nanos RenderPace::allowance(clock::Nanos frame_timeout, clock::Nanos longest, bool captured) const {
   const std::size_t kept = std::min(count_, kKept);
   const clock::Nanos slowest =
-      kept == 0 ? 0 : *std::max_element(times_.begin(), times_.begin() + static_cast<std::ptrdiff_t>(kept));
+      kept == 0 ? 0 : *std::max_element(rounds_.begin(), rounds_.begin() + static_cast<std::ptrdiff_t>(kept));
   return std::max(frame_timeout, std::min(2 * (slowest + (captured ? capture_ : 0)), longest));
 }
 

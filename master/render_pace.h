@@ -16,16 +16,20 @@ class RenderPace {
  public:
   static constexpr std::size_t kKept = 8;
 
-  // A frame (or the warm-up) took `render`, peer input: clamped to 0 …
-  // kLongestRender (run_recorder.h), as a report bounds it.
-  void add(clock::Nanos render);
+  // A frame (or the warm-up) took `render` by the node's word, peer input:
+  // clamped to 0 … kLongestRender (run_recorder.h), as a report bounds it.
+  // `round` is how long the master waited for it, from sending its FrameBegin
+  // to reading its answer: the draw, both trips, and on a busy machine the
+  // waits for a core on either side. The barrier waits for the longer.
+  void add(clock::Nanos render, clock::Nanos round);
+  void add(clock::Nanos render) { add(render, render); }
   // Reading a captured frame back takes `capture` more (the node measured it
   // on its warm-up frame), peer input: clamped as add() clamps.
   void set_capture(clock::Nanos capture);
   // The median of the times kept; none before the first.
   [[nodiscard]] std::optional<clock::Nanos> typical() const;
   // How long the barrier waits for this node: `frame_timeout`, or twice the
-  // slowest of the times kept when that is longer (a node that takes 300 ms a
+  // slowest of the rounds kept when that is longer (a node that takes 300 ms a
   // frame, or a key frame every fourth, is slow, not stalled; one that takes
   // 1 s after 300 ms each is stalled), but never more than `longest` (a node
   // reporting absurd times does not hold the others up for long). A
@@ -33,8 +37,9 @@ class RenderPace {
   [[nodiscard]] clock::Nanos allowance(clock::Nanos frame_timeout, clock::Nanos longest, bool captured = false) const;
 
  private:
-  std::array<clock::Nanos, kKept> times_{};
-  std::size_t count_ = 0;  // all added, of which the last kKept are kept
+  std::array<clock::Nanos, kKept> times_{};   // as the node drew them: what typical() says
+  std::array<clock::Nanos, kKept> rounds_{};  // as the master waited for them: what allowance() allows
+  std::size_t count_ = 0;                     // all added, of which the last kKept are kept
   clock::Nanos capture_ = 0;
 };
 

@@ -19,7 +19,14 @@ namespace {
 using namespace std::chrono_literals;
 
 const std::string kConfigs = std::string(OPTIQUE_SOURCE_DIR) + "/configs";
-constexpr int kFrames = 20;
+// A node that stalls past its allowance (the busy loops take its core for
+// longer than twice its usual round) misses one frame, sometimes two, and is
+// back. Measured here, cave-tracked, 20 runs of 60 frames: 55-60 shown by
+// every projector, median 59; with 20 frames a CI run once showed 17. Sixty
+// frames and 85 % leave room for three such stalls more than the worst seen;
+// a node lost and never taken back shows next to nothing.
+constexpr int kFrames = 60;
+constexpr double kShownByAll = 0.85;
 constexpr std::uint32_t kFrameTimeoutMs = 20;
 
 class UnderLoad : public ::testing::TestWithParam<std::string> {};
@@ -50,7 +57,7 @@ TEST_P(UnderLoad, NearlyEveryFrameIsShownByEveryProjector) {
   ASSERT_TRUE(run.error.empty()) << run.error;
   ASSERT_EQ(run.report.frames(), static_cast<std::uint64_t>(kFrames));
   const std::uint64_t shown_by_all = run.report.frames() - run.report.sync().frames_with_missing_node();
-  EXPECT_GE(static_cast<double>(shown_by_all), 0.9 * kFrames)
+  EXPECT_GE(static_cast<double>(shown_by_all), kShownByAll * kFrames)
       << shown_by_all << " of " << kFrames << " frames shown by every projector\n"
       << master.output();
 }

@@ -579,6 +579,45 @@ TEST_F(MasterTest, ACapturedFrameIsWaitedForAsLongAsItsReadBackTakesBesides) {
   EXPECT_EQ(pace.allowance(100 * kMs, 3000 * kMs, true), 200 * kMs);
 }
 
+// On a busy machine (or a slow network) a node's answer comes well after its
+// drawing is done: the barrier waits as long as the rounds took as the master
+// saw them, not only as the node says it drew, nor does it believe a node
+// that says it drew longer than it took.
+TEST_F(MasterTest, TheBarrierWaitsAsLongAsTheRoundsTookAsTheMasterSawThem) {
+  load("single-wall.json", [](config::Installation& i) { i.master.frame_timeout = std::chrono::milliseconds(20); });
+  const std::string id = run_.config.installation.projectors.front().id;
+  (void)hello(1, id);
+  wire::Envelope e = envelope();
+  e.mutable_configured()->set_renderer("test");
+  e.mutable_configured()->set_warm_up_ns(10 * kMs);
+  Actions a = master_->message(1, e, now_);
+  std::uint64_t hash = hash_of(a, 1);
+  for (std::uint64_t frame = 0; frame < 8; ++frame) {
+    now_ += 60 * kMs;  // drawn in 10 ms, read by the master 60 ms after it sent the FrameBegin
+    wire::Envelope r = envelope();
+    r.mutable_frame_ready()->set_frame_id(frame);
+    r.mutable_frame_ready()->set_state_hash(hash);
+    r.mutable_frame_ready()->set_render_ns(10 * kMs);
+    a = master_->message(1, r, now_);
+    ASSERT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "frame " << frame;
+    (void)shown(1, frame);
+    a = master_->timer(Timer::next_frame, now_);
+    hash = hash_of(a, 1);
+  }
+  const clock::Nanos* at = armed(a, Timer::barrier);
+  ASSERT_NE(at, nullptr);
+  EXPECT_EQ(*at - now_, 120 * kMs) << "twice the 60 ms rounds, not twice the 10 ms drawing";
+  RenderPace pace;
+  for (int i = 0; i < 8; ++i) pace.add(10 * kMs, 60 * kMs);
+  EXPECT_EQ(pace.allowance(20 * kMs, 3000 * kMs), 120 * kMs) << "twice the round, not twice the drawing";
+  EXPECT_EQ(pace.typical(), 10 * kMs) << "how long it draws is what it said";
+  pace.add(300 * kMs, 5 * kMs);
+  EXPECT_EQ(pace.allowance(20 * kMs, 3000 * kMs), 600 * kMs) << "a round is never shorter than its drawing";
+  pace.add(10 * kMs, -7);
+  pace.add(10 * kMs, std::numeric_limits<std::int64_t>::max());
+  EXPECT_EQ(pace.allowance(20 * kMs, 3000 * kMs), 3000 * kMs) << "bounded like a render time";
+}
+
 // Every node behind (one projector, stopped for a while): a frame would be
 // shown by nobody, so the next waits for the node to answer, and is drawn by it.
 TEST_F(MasterTest, WhenEveryNodeIsBehindTheNextFrameWaitsForOne) {
