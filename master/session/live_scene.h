@@ -142,6 +142,11 @@ class LiveScene {
 
   // Sets or (nullopt) removes an instance, keeping the children index true.
   void put(const std::string& id, std::optional<Instance> instance);
+  // Sets the instance at `at` to `instance`, under the same parent: put's
+  // work without its searches (a transaction that moves a thousand).
+  void replace(std::map<std::string, Instance>::iterator at, Instance instance);
+  // Notes an edit of `id`, playing or not after it: what put and replace share.
+  void note_edit(const std::string& id, bool was_playing, const Instance* now);
 
   LiveSceneLimits limits_;
   double frame_period_;
