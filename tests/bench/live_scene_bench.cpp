@@ -2,12 +2,12 @@
 // loopback, an application through the C++ client (clients/cpp).
 //
 // Throughput: the application moves 1, 100, 1,000 or 10,000 instances every
-// frame, each time a frame begins; beside it, in the same repeat, the same
-// cluster with no application. The barrier round, the achieved frame rate and
-// the bytes of the scene every node is sent a frame (its FrameBegin and the
-// edits staged for it between rounds) and of the FrameBegin alone, against a
-// snapshot of the whole state (run.json: frame_state_bytes,
-// frame_begin_bytes, snapshot_bytes).
+// frame, each time a frame begins; right before each, the same cluster with
+// no application, so that each is held against a run a minute apart at most
+// (this machine's barrier round drifted by half between runs minutes apart). The barrier round, the achieved frame rate
+// and the bytes of the scene every node is sent a frame (its FrameBegin and the edits staged for it between rounds) and
+// of the FrameBegin alone, against a snapshot of the whole state (run.json: frame_state_bytes, frame_begin_bytes,
+// snapshot_bytes).
 //
 // Latency, edit to display: from the moment the application sends a
 // transaction to the display time of the frame its reply names (the first
@@ -245,7 +245,7 @@ int main(int argc, char** argv) {
   std::size_t frames = 300;
   double rate = 60.0;
   std::size_t nodes = 8;
-  std::size_t repeats = 3;
+  std::size_t repeats = 5;
   double lead_us = 2000.0;
   std::vector<std::size_t> counts{1, 100, 1000, 10000};
   std::string master_bin = std::string(OPTIQUE_BIN_DIR) + "/optique-master";
@@ -280,21 +280,30 @@ int main(int argc, char** argv) {
          "transactions,refused,"
          "frames_with_missing_node,hash_mismatches,present_latency_median_ms,present_latency_p99_ms\n";
   std::vector<std::vector<Sample>> samples(cases.size());
+  // For each throughput run, the run without an application just before it.
+  std::vector<std::vector<Sample>> paired_none(cases.size());
   for (std::size_t r = 0; r < repeats; ++r) {
     for (std::size_t i = 0; i < cases.size(); ++i) {
-      const Case& c = cases[i];
-      const Sample s = run_once(master_bin, work, nodes, frames, rate, c, static_cast<std::int64_t>(lead_us * 1e3));
-      samples[i].push_back(s);
-      csv << i << ',' << name_of(c.send) << ',' << c.moved << ',' << r << ',' << nodes << ',' << frames << ',' << rate
-          << ',' << s.barrier_median << ',' << s.barrier_p99 << ',' << s.frame_rate << ',' << s.begin_bytes_median
-          << ',' << s.state_bytes_median << ',' << s.snapshot_bytes << ',' << s.latency_median_ms << ','
-          << s.latency_p99_ms << ',' << s.transactions << ',' << s.refused << ',' << s.missing << ',' << s.mismatches
-          << ',' << s.present_median_ms << ',' << s.present_p99_ms << '\n'
-          << std::flush;
-      std::cerr << name_of(c.send) << " " << c.moved << " repeat " << r << ": barrier " << s.barrier_median << " µs, "
-                << s.frame_rate << " Hz, FrameBegin " << s.begin_bytes_median << " B (snapshot " << s.snapshot_bytes
-                << " B), latency " << s.latency_median_ms << " ms (p99 " << s.latency_p99_ms << "), " << s.transactions
-                << " transactions, " << s.mismatches << " hash mismatches\n";
+      // The run without an application goes before each run it is held against, not once.
+      if (cases[i].send == Send::none) continue;
+      std::vector<std::size_t> runs{i};
+      if (cases[i].send == Send::at_begin) runs.insert(runs.begin(), 0);
+      for (const std::size_t run : runs) {
+        const Case& c = cases[run];
+        const Sample s = run_once(master_bin, work, nodes, frames, rate, c, static_cast<std::int64_t>(lead_us * 1e3));
+        samples[run].push_back(s);
+        if (run == 0) paired_none[i].push_back(s);
+        csv << i << ',' << name_of(c.send) << ',' << c.moved << ',' << r << ',' << nodes << ',' << frames << ',' << rate
+            << ',' << s.barrier_median << ',' << s.barrier_p99 << ',' << s.frame_rate << ',' << s.begin_bytes_median
+            << ',' << s.state_bytes_median << ',' << s.snapshot_bytes << ',' << s.latency_median_ms << ','
+            << s.latency_p99_ms << ',' << s.transactions << ',' << s.refused << ',' << s.missing << ',' << s.mismatches
+            << ',' << s.present_median_ms << ',' << s.present_p99_ms << '\n'
+            << std::flush;
+        std::cerr << name_of(c.send) << " " << c.moved << " repeat " << r << ": barrier " << s.barrier_median << " µs, "
+                  << s.frame_rate << " Hz, FrameBegin " << s.begin_bytes_median << " B (snapshot " << s.snapshot_bytes
+                  << " B), latency " << s.latency_median_ms << " ms (p99 " << s.latency_p99_ms << "), "
+                  << s.transactions << " transactions, " << s.mismatches << " hash mismatches\n";
+      }
     }
   }
 
@@ -306,11 +315,12 @@ int main(int argc, char** argv) {
     for (const Sample& s : samples[i]) values.push_back(s.*field);
     return spread(values);
   };
-  // The barrier round of each run against the run without an application in its repeat.
+  // The barrier round of each run against the run without an application just before it.
   const auto against_none = [&](std::size_t i) {
     std::vector<double> ratios;
+    if (i == 0) return spread({1.0});
     for (std::size_t r = 0; r < repeats; ++r)
-      ratios.push_back(samples[i][r].barrier_median / samples[0][r].barrier_median);
+      ratios.push_back(samples[i][r].barrier_median / paired_none[i][r].barrier_median);
     return spread(ratios);
   };
   std::ostringstream table;
@@ -353,10 +363,12 @@ int main(int argc, char** argv) {
      << "Generated by `optique-bench-live-scene` (tests/bench/live_scene_bench.cpp): a master and " << nodes
      << " null nodes (`--renderer=null`) on loopback, " << frames << " frames at " << rate
      << " Hz a run, and an application on the C++ client; every case once in each of " << repeats
-     << " repeats, so that they share the machine. Cells: median over the repeats (min–max).\n\n"
+     << " repeats, each throughput run right after a run without an application, so that they share the "
+        "machine. Cells: median over the repeats (min–max).\n\n"
      << "## Throughput: instances moved every frame\n\n"
      << "The application moves every instance in one transaction each time a frame begins. The barrier round "
-        "(FrameBegin sent → Swap sent) against the run without an application in the same repeat. The master "
+        "(FrameBegin sent → Swap sent) against the run without an application just before it (the none row: all of "
+        "those runs). The master "
         "reads no request and sends no event while a round is under way, and sends the instances an application "
         "moved to the nodes between rounds (staged edits), so that the FrameBegin carries only what changed after "
         "them. The scene every node is sent a frame (its FrameBegin and the edits staged for it), and the "
