@@ -24,6 +24,7 @@
 #include "config/up_conversion.h"
 #include "geometry/projection.h"
 #include "geometry/projector_geometry.h"
+#include "scene/placement.h"
 #include "scene/state.h"
 
 namespace optique::config {
@@ -197,9 +198,10 @@ struct LightSwitch {
 };
 
 struct SceneSource {
-  std::string builtin;                      // a procedural scene by name, or
-  std::string gltf;                         // a glTF file, absolute
-  std::vector<LightSwitch> light_switches;  // in time order
+  std::string builtin;                        // a procedural scene by name, or
+  std::string gltf;                           // a glTF file, absolute
+  std::vector<LightSwitch> light_switches;    // in time order
+  std::optional<scene::Placement> placement;  // of the glTF model; none: as the file has it
 };
 
 struct FocusPoint {

@@ -71,6 +71,73 @@ std::vector<LightSwitch> light_switches(const schema::Scene& scene, Checker& che
   return switches;
 }
 
+// How far a placed model may stand from the origin, and how much it may be
+// scaled: beyond either, float precision on the nodes is gone.
+constexpr double kMaxPlacedAt = 1e6;  // metres
+constexpr double kMinPlacedScale = 1e-6;
+constexpr double kMaxPlacedScale = 1e6;
+
+// A point within kMaxPlacedAt of the origin.
+std::optional<glm::dvec3> placed_point(const std::string& path, const google::protobuf::RepeatedField<double>& v,
+                                       Checker& check) {
+  const auto point = check.vec3(path, v);
+  if (point && glm::length(*point) > kMaxPlacedAt) {
+    check.fail(path, "is more than " + number_text(kMaxPlacedAt) + " m from the origin");
+    return std::nullopt;
+  }
+  return point;
+}
+
+std::optional<scene::Placement> placement(const schema::Placement& p, Checker& check) {
+  const std::string path = "scene.placement";
+  scene::Placement placed;
+  const std::size_t before = check.count();
+  if (!p.rotation().empty()) {
+    if (p.rotation_size() != 4) {
+      check.fail(path + ".rotation",
+                 "must be a quaternion [w, x, y, z] (got " + std::to_string(p.rotation_size()) + " numbers)");
+    } else {
+      bool finite = true;
+      for (int i = 0; i < 4; ++i)
+        finite = check.finite(path + ".rotation[" + std::to_string(i) + "]", p.rotation(i)) && finite;
+      const glm::dquat q(p.rotation(0), p.rotation(1), p.rotation(2), p.rotation(3));
+      if (finite && !(glm::length(q) > 1e-9)) check.fail(path + ".rotation", "has length 0: it is no rotation");
+      if (finite && glm::length(q) > 1e-9) placed.rotation = q / glm::length(q);
+    }
+  }
+  if (p.has_fit()) {
+    if (!p.position().empty() || p.scale() != 0.0) {
+      check.fail(path, "give position and scale, or fit, not both: fit sets them");
+    }
+    const auto centre = placed_point(path + ".fit.centre", p.fit().centre(), check);
+    const auto size = check.vec3(path + ".fit.size", p.fit().size());
+    if (size) {
+      for (int i = 0; i < 3; ++i) {
+        if (!((*size)[i] > 0.0 && (*size)[i] <= kMaxPlacedAt)) {
+          check.fail(path + ".fit.size[" + std::to_string(i) + "]",
+                     "must be in (0, " + number_text(kMaxPlacedAt) + "] metres (got " + number_text((*size)[i]) + ")");
+        }
+      }
+    }
+    if (centre && size) placed.fit = scene::Placement::Fit{*centre, *size};
+  } else {
+    if (!p.position().empty()) {
+      if (const auto position = placed_point(path + ".position", p.position(), check)) placed.position = *position;
+    }
+    if (p.scale() != 0.0) {
+      if (!(p.scale() >= kMinPlacedScale && p.scale() <= kMaxPlacedScale)) {
+        check.fail(path + ".scale", "must be in [" + number_text(kMinPlacedScale) + ", " +
+                                        number_text(kMaxPlacedScale) + "] (got " + number_text(p.scale()) +
+                                        "): a model is scaled alike on every axis");
+      } else {
+        placed.scale = p.scale();
+      }
+    }
+  }
+  if (check.count() != before) return std::nullopt;
+  return placed;
+}
+
 }  // namespace
 
 SceneSource parse_scene(const schema::Scene& s, const std::string& config_dir, Scope scope, Checker& check) {
@@ -87,6 +154,13 @@ SceneSource parse_scene(const schema::Scene& s, const std::string& config_dir, S
   }
   scene.builtin = s.builtin();
   scene.light_switches = light_switches(s, check);
+  if (s.has_placement()) {
+    if (builtin) {
+      check.fail("scene.placement", "places a glTF model; a built-in scene stands where it was made for");
+    } else {
+      scene.placement = placement(s.placement(), check);
+    }
+  }
   if (gltf) {
     scene.gltf = resolve_asset(s.gltf(), config_dir);
     // A job's scene is the master's, which the node fetches from it.

@@ -163,6 +163,20 @@ schema::Scene to_schema(const SceneSource& scene) {
     s.set_off(format_light_list(entry.off));
     s.set_on(format_light_list(entry.on));
   }
+  if (scene.placement) {
+    const scene::Placement& placed = *scene.placement;
+    auto& p = *out.mutable_placement();
+    for (double v : {placed.rotation.w, placed.rotation.x, placed.rotation.y, placed.rotation.z}) p.add_rotation(v);
+    if (placed.fit) {
+      for (int i = 0; i < 3; ++i) {
+        p.mutable_fit()->add_centre(placed.fit->centre[i]);
+        p.mutable_fit()->add_size(placed.fit->size[i]);
+      }
+    } else {
+      for (int i = 0; i < 3; ++i) p.add_position(placed.position[i]);
+      p.set_scale(placed.scale);
+    }
+  }
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "scene/placement.h"
 #include "util/finite.h"
 
 namespace optique::scene {
@@ -28,30 +29,6 @@ constexpr float kAmbient = 0.08f;
 // and far side), near enough to model its shape.
 constexpr double kDistance = 5.0;
 
-struct Bounds {
-  glm::dvec3 low{std::numeric_limits<double>::infinity()};
-  glm::dvec3 high{-std::numeric_limits<double>::infinity()};
-};
-
-// The world bounds of everything drawn, as it stands at t = 0.
-Bounds bounds_of(const SceneDefinition& scene) {
-  Bounds bounds;
-  for (const Instance& instance : scene.instances) {
-    glm::dmat4 transform = instance.transform;
-    if (instance.object) {
-      for (const AnimatedObject& object : scene.objects) {
-        if (object.id == *instance.object) transform = model_matrix(object.pose_at(0.0)) * transform;
-      }
-    }
-    for (const Vertex& vertex : scene.meshes[instance.mesh].vertices) {
-      const glm::dvec3 p(transform * glm::dvec4(glm::dvec3(vertex.position), 1.0));
-      bounds.low = glm::min(bounds.low, p);
-      bounds.high = glm::max(bounds.high, p);
-    }
-  }
-  return bounds;
-}
-
 PointLight light(const glm::dvec3& centre, const glm::dvec3& direction, double distance, double irradiance) {
   PointLight out;
   out.position = centre + distance * glm::normalize(direction);
@@ -62,12 +39,12 @@ PointLight light(const glm::dvec3& centre, const glm::dvec3& direction, double d
 }  // namespace
 
 std::string add_default_lights(SceneDefinition& scene, const glm::dvec3& viewer) {
-  const Bounds bounds = bounds_of(scene);
+  const std::optional<Box> bounds = world_bounds(scene);
   glm::dvec3 centre(0.0);
   double radius = 1.0;
-  if (util::finite(bounds.low) && util::finite(bounds.high)) {
-    centre = 0.5 * (bounds.low + bounds.high);
-    radius = std::max(0.5 * glm::length(bounds.high - bounds.low), 1e-3);
+  if (bounds && util::finite(bounds->low) && util::finite(bounds->high)) {
+    centre = bounds->centre();
+    radius = std::max(0.5 * glm::length(bounds->size()), 1e-3);
   }
   // The viewer's frame: forward to the scene, right, and up as near the world's
   // +y (glTF's up) as forward allows.

@@ -8,7 +8,7 @@ Result<scene::LoadedScene> load_scene(const Installation& installation, const sc
                                       const std::string& gltf_path) {
   const SceneSource& source = installation.scene;
   auto loaded = scene::load_scene(source.builtin, gltf_path.empty() ? source.gltf : gltf_path, decode,
-                                  installation.viewer.eye_at(0.0));
+                                  installation.viewer.eye_at(0.0), source.placement);
   // Named by the master's file, wherever this copy of it is.
   if (loaded) loaded.value().definition.asset_id = scene::scene_asset_id(source.builtin, source.gltf);
   return loaded;

@@ -13,6 +13,7 @@
 #include "scene/definition.h"
 #include "scene/image_decoder.h"
 #include "scene/manifest.h"
+#include "scene/placement.h"
 #include "util/result.h"
 
 namespace optique::scene {
@@ -28,11 +29,14 @@ struct LoadedScene {
 };
 
 // The built-in scene `builtin`, or else the glTF file at `gltf` (absolute, or
-// relative to the working folder); `decode` reads its images (empty: none are
+// relative to the working folder) placed by `placement` (scene/placement.h;
+// none: where the file has it); `decode` reads its images (empty: none are
 // read; see scene/image_decoder.h). A glTF without lights is lit by
-// scene/default_lights.h for a viewer at `viewer`.
+// scene/default_lights.h for a viewer at `viewer`. Its notes say how large it
+// is and where it stands, and whether the viewer stands in it.
 [[nodiscard]] Result<LoadedScene> load_scene(const std::string& builtin, const std::string& gltf,
-                                             const ImageDecoder& decode, const glm::dvec3& viewer);
+                                             const ImageDecoder& decode, const glm::dvec3& viewer,
+                                             const std::optional<Placement>& placement = std::nullopt);
 
 // The glTF file at `path` as it is (no lights added).
 [[nodiscard]] Result<LoadedScene> load_gltf_scene(const std::string& path, const ImageDecoder& decode);

@@ -423,6 +423,43 @@ TEST(ParseInstallation, GltfFilePresentRelativeToConfigDir) {
   EXPECT_TRUE(parsed.ok()) << parsed.error();
 }
 
+// A glTF model's placement: every bad field named at once, and what parses
+// is written back as it was read.
+TEST(ParseInstallation, APlacementIsCheckedFieldByFieldAndWrittenBack) {
+  const fs::path file = fs::path(test_dir()) / "optique-test-model.glb";
+  { std::ofstream(file) << "glTF"; }
+  const auto placed = [](const std::string& placement) {
+    return parse(with(R"("builtin": "cubes")", R"("gltf": "optique-test-model.glb", "placement": )" + placement));
+  };
+  const auto bad = placed(
+      R"({"position": [0, 1e7, 0], "rotation": [0, 0, 0, 0], "scale": -2, "fit": {"centre": [0, 1], "size": [1, 0, 2]}})");
+  expect_problem(bad, "scene.placement", {"position and scale, or fit, not both"});
+  expect_problem(bad, "scene.placement.rotation", {"length 0"});
+  expect_problem(bad, "scene.placement.fit.centre", {"[x, y, z]", "2 numbers"});
+  expect_problem(bad, "scene.placement.fit.size[1]", {"must be in (0,"});
+  const auto far = placed(R"({"position": [0, 1e7, 0], "scale": 1e-9})");
+  expect_problem(far, "scene.placement.position", {"from the origin"});
+  expect_problem(far, "scene.placement.scale", {"alike on every axis"});
+  expect_problem(parse(with(R"("builtin": "cubes")", R"("builtin": "cubes", "placement": {"scale": 2})")),
+                 "scene.placement", {"built-in scene"});
+
+  const auto fitted = placed(R"({"rotation": [2, 0, 0, 0], "fit": {"centre": [0, 1, -0.5], "size": [2, 1, 0.5]}})");
+  ASSERT_TRUE(fitted.ok()) << fitted.error();
+  ASSERT_TRUE(fitted.value().scene.placement && fitted.value().scene.placement->fit);
+  EXPECT_EQ(fitted.value().scene.placement->rotation, glm::dquat(1, 0, 0, 0)) << "normalized";
+  EXPECT_EQ(fitted.value().scene.placement->fit->size, glm::dvec3(2, 1, 0.5));
+  const auto at = placed(R"({"position": [1, 2, 3], "scale": 0.01})");
+  ASSERT_TRUE(at.ok()) << at.error();
+  EXPECT_EQ(at.value().scene.placement->position, glm::dvec3(1, 2, 3));
+  EXPECT_EQ(at.value().scene.placement->scale, 0.01);
+  for (const auto* parsed : {&fitted, &at}) {
+    const auto again = parse_installation(to_schema(parsed->value()), test_dir(), "again");
+    ASSERT_TRUE(again.ok()) << again.error();
+    EXPECT_EQ(to_schema(again.value()).SerializeAsString(), to_schema(parsed->value()).SerializeAsString());
+  }
+  fs::remove(file);
+}
+
 TEST(ParseInstallation, FrameRateTooHigh) {
   expect_problem(parse(with(R"("port": 7400)", R"("port": 7400, "frame_rate": 1500)")), "master.frame_rate",
                  {"must be in (0, 1000]", "1500"});

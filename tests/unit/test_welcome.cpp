@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -67,6 +69,26 @@ TEST(Welcome, EveryShippedProjectorsJobArrivesAsItWasCut) {
     }
   }
   EXPECT_GE(checked, 20u);
+}
+
+// A placed model is placed on the node too: the placement travels in the job.
+TEST(Welcome, AModelsPlacementArrivesWithTheJob) {
+  config::Installation installation = load("gltf-torus.json");
+  scene::Placement placement;
+  placement.rotation = glm::angleAxis(0.5, glm::dvec3(0.0, 1.0, 0.0));
+  placement.fit = scene::Placement::Fit{{0.0, 0.2, -0.4}, {1.5, 0.8, 0.5}};
+  installation.scene.placement = placement;
+  auto decoded = decode_welcome(encode_welcome(installation, 0, {}, 0, 16'666'666, nullptr),
+                                installation.projectors[0].id);
+  ASSERT_TRUE(decoded.ok()) << decoded.error();
+  ASSERT_TRUE(decoded.value().job.installation.scene.placement.has_value());
+  const scene::Placement& arrived = *decoded.value().job.installation.scene.placement;
+  EXPECT_EQ(arrived.fit->centre, placement.fit->centre);
+  EXPECT_EQ(arrived.fit->size, placement.fit->size);
+  EXPECT_NEAR(glm::length(glm::dvec4(arrived.rotation.w, arrived.rotation.x, arrived.rotation.y, arrived.rotation.z) -
+                          glm::dvec4(placement.rotation.w, placement.rotation.x, placement.rotation.y,
+                                     placement.rotation.z)),
+              0.0, 1e-15);
 }
 
 // A welcome for the first projector of the 2×2 wall, for the tests below to spoil.
