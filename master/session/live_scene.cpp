@@ -141,19 +141,22 @@ class LiveScene::Edits {
 
  private:
   void put(const std::string& id, std::optional<Instance> instance) {
-    if (touched_.insert(id).second) {
-      const auto now = scene_.instances_.find(id);
-      before_.emplace_back(id, now == scene_.instances_.end() ? std::nullopt : std::optional<Instance>(now->second));
-    }
+    const auto now = scene_.instances_.find(id);
+    remember(id, now == scene_.instances_.end() ? nullptr : &now->second);
     scene_.put(id, std::move(instance));
   }
 
+  // Keeps `id` as it is (`now`; none: not there) to put back, if this is the
+  // transaction's first change of it.
+  void remember(const std::string& id, const Instance* now) {
+    if (touched_.insert(id).second) before_.emplace_back(id, now == nullptr ? std::nullopt : std::optional(*now));
+  }
+
   // The instance `id` names (at `field`), or why there is none.
-  Check existing(const std::string& field, const std::string& id, const Instance*& instance) const {
+  Check existing(const std::string& field, const std::string& id, Instances::iterator& at) const {
     if (auto wrong = id_problem(field, id)) return wrong;
-    const auto found = scene_.instances_.find(id);
-    if (found == scene_.instances_.end()) return Wrong{field, "no instance '" + id + "'"};
-    instance = &found->second;
+    at = scene_.instances_.find(id);
+    if (at == scene_.instances_.end()) return Wrong{field, "no instance '" + id + "'"};
     return std::nullopt;
   }
 
@@ -161,9 +164,8 @@ class LiveScene::Edits {
   // instead, leaving it as it was).
   template <class Change>
   Check modify(const std::string& id, const Change& change) {
-    if (auto wrong = id_problem("instance", id)) return wrong;
-    const auto at = scene_.instances_.find(id);
-    if (at == scene_.instances_.end()) return Wrong{"instance", "no instance '" + id + "'"};
+    Instances::iterator at;
+    if (auto wrong = existing("instance", id, at)) return wrong;
     Instance changed = at->second;
     if (auto wrong = change(changed)) return wrong;
     if (changed.parent != at->second.parent) {
@@ -172,7 +174,7 @@ class LiveScene::Edits {
     }
     // Found once, kept as it was once: a transaction that moves a thousand
     // instances searched for each one five times.
-    if (touched_.insert(id).second) before_.emplace_back(id, at->second);
+    remember(id, &at->second);
     scene_.replace(at, std::move(changed));
     return std::nullopt;
   }
@@ -181,7 +183,7 @@ class LiveScene::Edits {
   // the chain above stays within the depth limit.
   Check parent_problem(const std::string& id, const std::string& parent) const {
     if (parent.empty()) return std::nullopt;
-    const Instance* above = nullptr;
+    Instances::iterator above;
     if (auto wrong = existing("parent", parent, above)) return wrong;
     std::size_t depth = 1;
     for (std::string at = parent; !at.empty(); at = scene_.instances_.at(at).parent, ++depth) {
@@ -242,7 +244,7 @@ class LiveScene::Edits {
   }
 
   Check remove(const session::RemoveInstance& r) {
-    const Instance* instance = nullptr;
+    Instances::iterator instance;
     if (auto wrong = existing("instance", r.instance(), instance)) return wrong;
     // The instances under it first, deepest first, then itself.
     std::vector<std::string> order{r.instance()};
@@ -442,7 +444,7 @@ void LiveScene::note_edit(const std::string& id, bool was_playing, const Instanc
   }
 }
 
-void LiveScene::replace(std::map<std::string, Instance>::iterator at, Instance instance) {
+void LiveScene::replace(Instances::iterator at, Instance instance) {
   assert(at->second.parent == instance.parent);
   note_edit(at->first, plays(&at->second), &instance);
   at->second = std::move(instance);
@@ -450,11 +452,11 @@ void LiveScene::replace(std::map<std::string, Instance>::iterator at, Instance i
 
 void LiveScene::put(const std::string& id, std::optional<Instance> instance) {
   const auto old = instances_.find(id);
-  note_edit(id, old != instances_.end() && plays(&old->second), instance ? &*instance : nullptr);
   if (instance && old != instances_.end() && old->second.parent == instance->parent) {
-    old->second = std::move(*instance);  // where it was, under the same parent: no index changes
+    replace(old, std::move(*instance));  // where it was, under the same parent: no index changes
     return;
   }
+  note_edit(id, old != instances_.end() && plays(&old->second), instance ? &*instance : nullptr);
   if (old != instances_.end()) {
     auto& siblings = children_[old->second.parent];
     siblings.erase(id);

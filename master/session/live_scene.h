@@ -128,7 +128,8 @@ class LiveScene {
   void set_light_count(std::size_t count) { light_count_ = count; }
   [[nodiscard]] std::size_t light_count() const { return light_count_; }
 
-  [[nodiscard]] const std::map<std::string, Instance>& instances() const { return instances_; }
+  using Instances = std::map<std::string, Instance>;
+  [[nodiscard]] const Instances& instances() const { return instances_; }
   [[nodiscard]] const NavigationSet& navigation() const { return navigation_; }
   // The lights applications switched: index → on.
   [[nodiscard]] const std::map<std::uint32_t, bool>& light_switches() const { return light_switches_; }
@@ -144,7 +145,7 @@ class LiveScene {
   void put(const std::string& id, std::optional<Instance> instance);
   // Sets the instance at `at` to `instance`, under the same parent: put's
   // work without its searches (a transaction that moves a thousand).
-  void replace(std::map<std::string, Instance>::iterator at, Instance instance);
+  void replace(Instances::iterator at, Instance instance);
   // Notes an edit of `id`, playing or not after it: what put and replace share.
   void note_edit(const std::string& id, bool was_playing, const Instance* now);
 
@@ -153,7 +154,7 @@ class LiveScene {
   std::set<std::string> assets_;
   std::set<std::string> loading_;
   std::set<std::string> animated_;  // of assets_
-  std::map<std::string, Instance> instances_;
+  Instances instances_;
   std::map<std::string, std::set<std::string>> children_;  // parent → its children; "" → the world's
   std::size_t edits_this_frame_ = 0;
   std::set<std::string> edited_;
