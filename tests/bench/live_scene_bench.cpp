@@ -4,10 +4,11 @@
 // Throughput: the application moves 1, 100, 1,000 or 10,000 instances every
 // frame, each time a frame begins; right before each, the same cluster with
 // no application, so that each is held against a run a minute apart at most
-// (this machine's barrier round drifted by half between runs minutes apart). The barrier round, the achieved frame rate
-// and the bytes of the scene every node is sent a frame (its FrameBegin and the edits staged for it between rounds) and
-// of the FrameBegin alone, against a snapshot of the whole state (run.json: frame_state_bytes, frame_begin_bytes,
-// snapshot_bytes).
+// (this machine's barrier round drifted by half between runs minutes apart).
+// The barrier round, the achieved frame rate and the bytes of the scene every
+// node is sent a frame (its FrameBegin and the edits staged for it between
+// rounds) and of the FrameBegin alone, against a snapshot of the whole state
+// (run.json: frame_state_bytes, frame_begin_bytes, snapshot_bytes).
 //
 // Latency, edit to display: from the moment the application sends a
 // transaction to the display time of the frame its reply names (the first
@@ -293,11 +294,11 @@ int main(int argc, char** argv) {
         const Sample s = run_once(master_bin, work, nodes, frames, rate, c, static_cast<std::int64_t>(lead_us * 1e3));
         samples[run].push_back(s);
         if (run == 0) paired_none[i].push_back(s);
-        csv << i << ',' << name_of(c.send) << ',' << c.moved << ',' << r << ',' << nodes << ',' << frames << ',' << rate
-            << ',' << s.barrier_median << ',' << s.barrier_p99 << ',' << s.frame_rate << ',' << s.begin_bytes_median
-            << ',' << s.state_bytes_median << ',' << s.snapshot_bytes << ',' << s.latency_median_ms << ','
-            << s.latency_p99_ms << ',' << s.transactions << ',' << s.refused << ',' << s.missing << ',' << s.mismatches
-            << ',' << s.present_median_ms << ',' << s.present_p99_ms << '\n'
+        csv << run << ',' << name_of(c.send) << ',' << c.moved << ',' << r << ',' << nodes << ',' << frames << ','
+            << rate << ',' << s.barrier_median << ',' << s.barrier_p99 << ',' << s.frame_rate << ','
+            << s.begin_bytes_median << ',' << s.state_bytes_median << ',' << s.snapshot_bytes << ','
+            << s.latency_median_ms << ',' << s.latency_p99_ms << ',' << s.transactions << ',' << s.refused << ','
+            << s.missing << ',' << s.mismatches << ',' << s.present_median_ms << ',' << s.present_p99_ms << '\n'
             << std::flush;
         std::cerr << name_of(c.send) << " " << c.moved << " repeat " << r << ": barrier " << s.barrier_median << " µs, "
                   << s.frame_rate << " Hz, FrameBegin " << s.begin_bytes_median << " B (snapshot " << s.snapshot_bytes
