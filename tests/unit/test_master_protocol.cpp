@@ -81,9 +81,12 @@ class MasterTest : public ::testing::Test {
     return master_->message(peer, e, now_);
   }
 
-  Actions configured(PeerId peer) {
+  // `peer` set up, its warm-up frame drawn in `warm_up` and read back in `capture`.
+  Actions configured(PeerId peer, clock::Nanos warm_up = 0, clock::Nanos capture = 0) {
     wire::Envelope e = envelope();
     e.mutable_configured()->set_renderer("test");
+    e.mutable_configured()->set_warm_up_ns(warm_up);
+    e.mutable_configured()->set_capture_ns(capture);
     return master_->message(peer, e, now_);
   }
 
@@ -96,10 +99,12 @@ class MasterTest : public ::testing::Test {
     return last;
   }
 
-  Actions ready(PeerId peer, std::uint64_t frame, std::uint64_t hash) {
+  // `peer` is ready for `frame` with `hash`, drawn (it says) in `render`.
+  Actions ready(PeerId peer, std::uint64_t frame, std::uint64_t hash, clock::Nanos render = 0) {
     wire::Envelope e = envelope();
     e.mutable_frame_ready()->set_frame_id(frame);
     e.mutable_frame_ready()->set_state_hash(hash);
+    e.mutable_frame_ready()->set_render_ns(render);
     return master_->message(peer, e, now_);
   }
 
@@ -497,10 +502,7 @@ TEST_F(MasterTest, TheBarrierWaitsForASlowNodeAsLongAsItUsuallyTakes) {
   load("single-wall.json");
   const std::string id = run_.config.installation.projectors.front().id;
   (void)hello(1, id);
-  wire::Envelope e = envelope();
-  e.mutable_configured()->set_renderer("test");
-  e.mutable_configured()->set_warm_up_ns(400 * kMs);
-  Actions a = master_->message(1, e, now_);
+  Actions a = configured(1, 400 * kMs);
   EXPECT_TRUE(logged(a, "warm-up frame 400 ms"));
   const clock::Nanos* at = armed(a, Timer::barrier);
   ASSERT_NE(at, nullptr);
@@ -508,11 +510,7 @@ TEST_F(MasterTest, TheBarrierWaitsForASlowNodeAsLongAsItUsuallyTakes) {
   std::uint64_t hash = hash_of(a, 1);
   for (std::uint64_t frame = 0; frame < 9; ++frame) {
     now_ += 300 * kMs;
-    wire::Envelope r = envelope();
-    r.mutable_frame_ready()->set_frame_id(frame);
-    r.mutable_frame_ready()->set_state_hash(hash);
-    r.mutable_frame_ready()->set_render_ns(300 * kMs);
-    a = master_->message(1, r, now_);
+    a = ready(1, frame, hash, 300 * kMs);
     ASSERT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "frame " << frame;
     EXPECT_EQ(logged(a, "draws a frame in 300.0 ms, longer than the 16.7 ms frame period"), frame == 0)
         << "said once, at frame 0; frame " << frame;
@@ -550,20 +548,12 @@ TEST_F(MasterTest, ACapturedFrameIsWaitedForAsLongAsItsReadBackTakesBesides) {
   load("single-wall.json", {}, settings);
   const std::string id = run_.config.installation.projectors.front().id;
   (void)hello(1, id);
-  wire::Envelope e = envelope();
-  e.mutable_configured()->set_renderer("test");
-  e.mutable_configured()->set_warm_up_ns(100 * kMs);
-  e.mutable_configured()->set_capture_ns(250 * kMs);
-  Actions a = master_->message(1, e, now_);
+  Actions a = configured(1, 100 * kMs, 250 * kMs);
   const clock::Nanos* at = armed(a, Timer::barrier);
   ASSERT_NE(at, nullptr);
   EXPECT_EQ(*at - now_, 700 * kMs) << "frame 0 is captured: twice the warm-up's 100 ms drawing and 250 ms read-back";
-  wire::Envelope r = envelope();
-  r.mutable_frame_ready()->set_frame_id(0);
-  r.mutable_frame_ready()->set_state_hash(hash_of(a, 1));
-  r.mutable_frame_ready()->set_render_ns(350 * kMs);
   now_ += 350 * kMs;
-  (void)master_->message(1, r, now_);
+  (void)ready(1, 0, hash_of(a, 1), 350 * kMs);
   (void)shown(1, 0);
   a = master_->timer(Timer::next_frame, now_);
   at = armed(a, Timer::barrier);
@@ -587,18 +577,11 @@ TEST_F(MasterTest, TheBarrierWaitsAsLongAsTheRoundsTookAsTheMasterSawThem) {
   load("single-wall.json", [](config::Installation& i) { i.master.frame_timeout = std::chrono::milliseconds(20); });
   const std::string id = run_.config.installation.projectors.front().id;
   (void)hello(1, id);
-  wire::Envelope e = envelope();
-  e.mutable_configured()->set_renderer("test");
-  e.mutable_configured()->set_warm_up_ns(10 * kMs);
-  Actions a = master_->message(1, e, now_);
+  Actions a = configured(1, 10 * kMs);
   std::uint64_t hash = hash_of(a, 1);
   for (std::uint64_t frame = 0; frame < 8; ++frame) {
     now_ += 60 * kMs;  // drawn in 10 ms, read by the master 60 ms after it sent the FrameBegin
-    wire::Envelope r = envelope();
-    r.mutable_frame_ready()->set_frame_id(frame);
-    r.mutable_frame_ready()->set_state_hash(hash);
-    r.mutable_frame_ready()->set_render_ns(10 * kMs);
-    a = master_->message(1, r, now_);
+    a = ready(1, frame, hash, 10 * kMs);
     ASSERT_EQ(sent_to(a, 1, wire::Envelope::kSwap).size(), 1u) << "frame " << frame;
     (void)shown(1, frame);
     a = master_->timer(Timer::next_frame, now_);
