@@ -101,8 +101,12 @@ std::optional<scene::Placement> placement(const schema::Placement& p, Checker& c
       for (int i = 0; i < 4; ++i)
         finite = check.finite(path + ".rotation[" + std::to_string(i) + "]", p.rotation(i)) && finite;
       const glm::dquat q(p.rotation(0), p.rotation(1), p.rotation(2), p.rotation(3));
-      if (finite && !(glm::length(q) > 1e-9)) check.fail(path + ".rotation", "has length 0: it is no rotation");
-      if (finite && glm::length(q) > 1e-9) placed.rotation = q / glm::length(q);
+      const double length = glm::length(q);
+      if (finite && length > 1e-9) {
+        placed.rotation = q / length;
+      } else if (finite) {
+        check.fail(path + ".rotation", "has length 0: it is no rotation");
+      }
     }
   }
   if (p.has_fit()) {
